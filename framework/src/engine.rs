@@ -1,0 +1,228 @@
+//! One Moreau–Jean time step, one stage per function.
+//!
+//! Over [t_i, t_i+1] with step h and θ ∈ [½, 1] (DESIGN.md §2), for rigid bodies
+//! (M̂ = M):
+//!
+//! ```text
+//! V_free = V⁻ + M̂⁻¹ h F̂                 F̂: gravity + imposed forces at t_i + θh
+//! M̂ (V⁺ − V_free) = H r                  r: contact impulses (NLGS)
+//! q⁺ = q⁻ + h ((1 − θ) V⁻ + θ V⁺)
+//! ```
+//!
+//! Degrees of freedom driven by velocity take V⁺ = v(t_i+1) and have M̂⁻¹ = 0.
+//! Stages: [`free_velocity`], detection ([`crate::detect`]), [`build_contacts`]
+//! (frames, Delassus blocks W_αα, law targets ū and warm start), NLGS
+//! ([`crate::rigid2d::nlgs`]) and [`update_positions`].
+
+use crate::drive::Imposed;
+use crate::law::target_velocity;
+use crate::rigid2d::contacts::ContactKey;
+use crate::rigid2d::{nlgs, Contacts2};
+use crate::solver::SolveReport;
+use crate::world::World2;
+use std::time::Instant;
+
+/// Wall-clock seconds spent in each stage of a step.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct StageTimes {
+    pub detect: f64,
+    pub delassus: f64,
+    pub nlgs: f64,
+    pub update: f64,
+}
+
+/// What one step did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepReport {
+    pub solve: SolveReport,
+    pub contacts: usize,
+    pub times: StageTimes,
+}
+
+/// A step produced a non-finite state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Diverged {
+    pub step: u64,
+    pub body: u32,
+    pub message: String,
+}
+
+impl std::fmt::Display for Diverged {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "the run diverged at step {}: {}", self.step, self.message)
+    }
+}
+
+impl World2 {
+    /// Advances the scene by one step.
+    pub fn step(&mut self) -> Result<StepReport, Diverged> {
+        let mut rep = StepReport::default();
+        let t0 = Instant::now();
+        free_velocity(self);
+        self.scratch.detector.detect(&self.bodies, &self.shapes, &self.detectors, self.alert, &mut self.scratch.raw);
+        let t1 = Instant::now();
+        build_contacts(self);
+        let t2 = Instant::now();
+        let step = self.step;
+        nlgs::make_order(&mut self.scratch.order, self.contacts.len(), &self.solver, step);
+        rep.solve = nlgs::solve(&mut self.contacts, &mut self.bodies.vel, &self.bodies.inv_mass, &self.scratch.order, &self.solver);
+        let t3 = Instant::now();
+        update_positions(self)?;
+        let t4 = Instant::now();
+        rep.contacts = self.contacts.len();
+        rep.times = StageTimes {
+            detect: (t1 - t0).as_secs_f64(),
+            delassus: (t2 - t1).as_secs_f64(),
+            nlgs: (t3 - t2).as_secs_f64(),
+            update: (t4 - t3).as_secs_f64(),
+        };
+        Ok(rep)
+    }
+}
+
+/// V_free = V⁻ + h M̂⁻¹ F̂, with the drives applied; keeps V⁻ in the scratch.
+pub fn free_velocity(w: &mut World2) {
+    let h = w.time.h;
+    let (t_end, t_theta) = (w.t + h, w.t + w.time.theta * h);
+    let b = &mut w.bodies;
+    w.scratch.v_begin.clear();
+    w.scratch.v_begin.extend_from_slice(&b.vel);
+    for d in &w.drives {
+        let k = d.body as usize;
+        for dof in 0..3 {
+            if let Some(drv) = &d.dof[dof] {
+                b.inv_mass[k][dof] = if drv.is_velocity_at(t_end) { 0.0 } else { 1.0 / b.mass[k][dof] };
+            }
+        }
+    }
+    let g = w.gravity;
+    for k in 0..b.len() {
+        let im = b.inv_mass[k];
+        let v = &mut b.vel[k];
+        v[0] += h * im[0] * b.mass[k][0] * g[0];
+        v[1] += h * im[1] * b.mass[k][1] * g[1];
+    }
+    for d in &w.drives {
+        let k = d.body as usize;
+        for dof in 0..3 {
+            let Some(drv) = &d.dof[dof] else { continue };
+            match drv.at(t_end) {
+                Imposed::Velocity(v) => b.vel[k][dof] = v,
+                _ => {
+                    if let Imposed::Force(f) = drv.at(t_theta) {
+                        b.vel[k][dof] += h * f / b.mass[k][dof];
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Local velocity of a raw frame from explicit body velocities.
+#[inline]
+fn local(n: [f64; 2], ai: [f64; 2], aj: [f64; 2], vi: [f64; 3], vj: [f64; 3]) -> [f64; 2] {
+    let dv = [vi[0] - vj[0], vi[1] - vj[1]];
+    [n[0] * dv[0] + n[1] * dv[1] + ai[0] * vi[2] - aj[0] * vj[2], -n[1] * dv[0] + n[0] * dv[1] + ai[1] * vi[2] - aj[1] * vj[2]]
+}
+
+/// Builds this step's contact set from the raw contacts: lever arms, W_αα, ū, and
+/// the impulses of persisting contacts (warm start), which are applied at once to
+/// the free velocities.
+pub fn build_contacts(w: &mut World2) {
+    let (h, theta) = (w.time.h, w.time.theta);
+    let s = &mut w.scratch;
+    s.prev_keys.clear();
+    s.prev_keys.extend(w.contacts.key.iter().copied().zip(w.contacts.r.iter().copied()));
+    s.prev_keys.sort_unstable_by_key(|x| x.0);
+    let c = &mut s.next;
+    c.clear();
+    let b = &w.bodies;
+    for rc in &s.raw {
+        let (i, j) = (rc.i as usize, rc.j as usize);
+        let n = rc.normal;
+        let t = [-n[1], n[0]];
+        let arm = |x: [f64; 2]| {
+            let d = [rc.point[0] - x[0], rc.point[1] - x[1]];
+            [d[0] * n[1] - d[1] * n[0], d[0] * t[1] - d[1] * t[0]]
+        };
+        let (ai, aj) = (arm(b.pos[i]), arm(b.pos[j]));
+        let wb = Contacts2::delassus(n, ai, aj, b.inv_mass[i], b.inv_mass[j]);
+        if !(wb[0] > 0.0) {
+            continue;
+        }
+        let Some(law) = w.laws[b.material[i] as usize * w.materials.len() + b.material[j] as usize] else { continue };
+        let u_begin = local(n, ai, aj, s.v_begin[i], s.v_begin[j]);
+        let u_free = local(n, ai, aj, b.vel[i], b.vel[j]);
+        let key = ContactKey { i: rc.i, j: rc.j, feature: rc.feature };
+        let r = match s.prev_keys.binary_search_by_key(&key, |x| x.0) {
+            Ok(p) => s.prev_keys[p].1,
+            Err(_) => [0.0, 0.0],
+        };
+        c.i.push(rc.i);
+        c.j.push(rc.j);
+        c.n.push(n);
+        c.arm_i.push(ai);
+        c.arm_j.push(aj);
+        c.w.push(wb);
+        c.u_target.push(target_velocity(rc.gap, u_begin[0], u_free[0], h, theta, law.e));
+        c.mu.push(law.mu);
+        c.r.push(r);
+        c.u_free.push(u_free);
+        c.gap.push(rc.gap);
+        c.point.push(rc.point);
+        c.key.push(key);
+    }
+    std::mem::swap(&mut w.contacts, &mut s.next);
+    let c = &w.contacts;
+    for a in 0..c.len() {
+        if c.r[a] != [0.0, 0.0] {
+            c.apply(a, c.r[a], &mut w.bodies.vel, &w.bodies.inv_mass);
+        }
+    }
+}
+
+/// q⁺ = q⁻ + h((1 − θ)V⁻ + θV⁺); the per-body reactions; the divergence check.
+pub fn update_positions(w: &mut World2) -> Result<(), Diverged> {
+    let (h, theta) = (w.time.h, w.time.theta);
+    let b = &mut w.bodies;
+    for k in 0..b.len() {
+        let (v0, v1) = (w.scratch.v_begin[k], b.vel[k]);
+        let dq = [h * ((1.0 - theta) * v0[0] + theta * v1[0]), h * ((1.0 - theta) * v0[1] + theta * v1[1]), h * ((1.0 - theta) * v0[2] + theta * v1[2])];
+        b.pos[k][0] += dq[0];
+        b.pos[k][1] += dq[1];
+        b.rot[k] += dq[2];
+        if !(b.pos[k].iter().chain(&b.vel[k]).all(|x| x.is_finite()) && b.rot[k].is_finite()) {
+            let label = w.body_label(k);
+            return Err(Diverged {
+                step: w.step + 1,
+                body: k as u32,
+                message: format!("{label} has a non-finite state (position {:?}, velocity {:?})", w.bodies.pos[k], w.bodies.vel[k]),
+            });
+        }
+    }
+    let c = &w.contacts;
+    w.reaction.clear();
+    w.reaction.resize(w.bodies.len(), [0.0; 3]);
+    for a in 0..c.len() {
+        let (n, r) = (c.n[a], c.r[a]);
+        let p = [r[0] * n[0] - r[1] * n[1], r[0] * n[1] + r[1] * n[0]];
+        let (i, j) = (c.i[a] as usize, c.j[a] as usize);
+        let (ai, aj) = (c.arm_i[a], c.arm_j[a]);
+        let ri = &mut w.reaction[i];
+        ri[0] += p[0];
+        ri[1] += p[1];
+        ri[2] += ai[0] * r[0] + ai[1] * r[1];
+        let rj = &mut w.reaction[j];
+        rj[0] -= p[0];
+        rj[1] -= p[1];
+        rj[2] -= aj[0] * r[0] + aj[1] * r[1];
+    }
+    w.t += h;
+    w.step += 1;
+    if let (Some(bw), None) = (&w.box_walls, w.box_h0) {
+        if w.t >= bw.strain_from {
+            w.box_h0 = w.box_extent().map(|e| e[3] - e[2]);
+        }
+    }
+    Ok(())
+}

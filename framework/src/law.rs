@@ -1,0 +1,118 @@
+//! Contact laws: Signorini–Coulomb with Newton restitution and gap prediction.
+//!
+//! Over a step of length h, a contact with gap g (start of step), normal velocity
+//! u_n⁻ at the start of the step and free normal velocity u_n,free is **active** when
+//! its predicted gap closes:
+//!
+//! ```text
+//! g_pred = g + h ((1 − θ) u_n⁻ + θ u_n,free) ≤ 0.
+//! ```
+//!
+//! An active contact obeys Newton's impact law, `u_n⁺ + e min(u_n⁻, 0) ≥ 0 ⊥ r_n ≥ 0`
+//! (e = 0: plastic impact, e = 1: elastic; with θ = ½ and e = 1 energy is kept). An
+//! inactive contact may still be pushed closed by its neighbours during the solve; it
+//! then obeys the position-level condition of the θ-method, `g⁺ ≥ 0`, i.e.
+//! `u_n⁺ ≥ −(g + h (1 − θ) u_n⁻) / (h θ)`. Both are `u_n ≥ ū ⊥ r_n ≥ 0` with the
+//! target ū computed by [`target_velocity`]; the tangential part is Coulomb's law with
+//! the friction coefficient μ (see `rigid2d::coulomb`).
+//!
+//! Laws are chosen per pair of materials. Built-in law kinds: `coulomb` (keys
+//! `friction`, `restitution`) and `frictionless` (key `restitution`), which takes the
+//! cheaper μ = 0 path of the local solver.
+
+use crate::registry::{ParamError, Registry};
+
+/// Parameters of the law of one pair of materials.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ContactLaw {
+    /// Friction coefficient μ ≥ 0.
+    pub mu: f64,
+    /// Newton restitution coefficient e ∈ [0, 1].
+    pub e: f64,
+}
+
+/// A law kind: its name and its parameter parser.
+pub struct LawDef {
+    pub name: &'static str,
+    pub parse: fn(&toml::Table) -> Result<ContactLaw, ParamError>,
+}
+
+/// The target normal velocity ū of the law (see the module docs).
+#[inline]
+pub fn target_velocity(gap: f64, un_begin: f64, un_free: f64, h: f64, theta: f64, e: f64) -> f64 {
+    let g_pred = gap + h * ((1.0 - theta) * un_begin + theta * un_free);
+    if g_pred <= 0.0 {
+        if un_begin < 0.0 {
+            -e * un_begin
+        } else {
+            0.0
+        }
+    } else {
+        -(gap + h * (1.0 - theta) * un_begin) / (h * theta)
+    }
+}
+
+/// Reads an optional non-negative number key.
+pub fn number(t: &toml::Table, key: &str, default: Option<f64>) -> Result<f64, ParamError> {
+    match t.get(key) {
+        None => default.ok_or_else(|| ParamError::new(key, "missing key")),
+        Some(v) => {
+            let x = v.as_float().or_else(|| v.as_integer().map(|i| i as f64)).ok_or_else(|| ParamError::new(key, "must be a number"))?;
+            if !x.is_finite() {
+                return Err(ParamError::new(key, "must be finite"));
+            }
+            Ok(x)
+        }
+    }
+}
+
+/// Rejects keys of `t` outside `allowed`.
+pub fn only_keys(t: &toml::Table, allowed: &[&str]) -> Result<(), ParamError> {
+    for k in t.keys() {
+        if !allowed.contains(&k.as_str()) {
+            return Err(ParamError::new(k.clone(), format!("unknown key `{k}`; expected one of: {}", allowed.join(", "))));
+        }
+    }
+    Ok(())
+}
+
+fn restitution(t: &toml::Table) -> Result<f64, ParamError> {
+    let e = number(t, "restitution", Some(0.0))?;
+    if !(0.0..=1.0).contains(&e) {
+        return Err(ParamError::new("restitution", format!("must lie in [0, 1], got {e}")));
+    }
+    Ok(e)
+}
+
+fn parse_coulomb(t: &toml::Table) -> Result<ContactLaw, ParamError> {
+    only_keys(t, &["friction", "restitution"])?;
+    let mu = number(t, "friction", None)?;
+    if mu < 0.0 {
+        return Err(ParamError::new("friction", format!("μ must be ≥ 0, got {mu}")));
+    }
+    Ok(ContactLaw { mu, e: restitution(t)? })
+}
+
+fn parse_frictionless(t: &toml::Table) -> Result<ContactLaw, ParamError> {
+    only_keys(t, &["restitution"])?;
+    Ok(ContactLaw { mu: 0.0, e: restitution(t)? })
+}
+
+pub(crate) fn register_builtin(r: &mut Registry) {
+    r.add_law(LawDef { name: "coulomb", parse: parse_coulomb });
+    r.add_law(LawDef { name: "frictionless", parse: parse_frictionless });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    #[test]
+    fn targets() {
+        // approaching ball, predicted to close: Newton
+        assert_eq!(target_velocity(1e-4, -1.0, -1.0, 1e-3, 0.5, 0.5), 0.5);
+        // far away: position condition, very negative
+        assert!(target_velocity(1.0, -1.0, -1.0, 1e-3, 0.5, 0.5) < -100.0);
+        // resting
+        assert_eq!(target_velocity(0.0, 0.0, -1e-2, 1e-3, 0.5, 0.0), 0.0);
+    }
+}

@@ -1,0 +1,125 @@
+//! The exact one-contact 2D Signorini–Coulomb solver.
+//!
+//! For one contact α with diagonal Delassus block `W = [[W_nn, W_nt], [W_nt, W_tt]]`
+//! and the part of its local velocity that does not depend on its own impulse,
+//! `u0 = u − W r`, find `r = (r_n, r_t)` with `u = W r + u0` such that
+//!
+//! ```text
+//!   s = u_n − ū ≥ 0,   r_n ≥ 0,   s · r_n = 0        (Signorini, shifted by ū)
+//!   |r_t| ≤ μ r_n,     |r_t| < μ r_n ⇒ u_t = 0,
+//!   u_t ≠ 0 ⇒ r_t = −μ r_n sign(u_t)                  (Coulomb)
+//! ```
+//!
+//! `ū` is the law's target normal velocity (restitution and gap prediction, see
+//! `law`). In 2D the Coulomb cone has only four faces, so the solution is found by
+//! enumerating the cases: no contact, sticking, sliding forwards, sliding backwards;
+//! the first case that satisfies all its inequalities is returned. That is exact, not
+//! iterative. When W is singular or μ is so large that no case is consistent (a
+//! non-unique local problem), a projected fixed point on the local problem is used
+//! as a fallback.
+
+/// Relative tolerance used to accept a case of the enumeration.
+const ACCEPT: f64 = 1e-12;
+
+/// Solves the one-contact problem. `w = [W_nn, W_nt, W_tt]`, `u0 = [u0_n, u0_t]`.
+#[inline]
+pub fn solve(w: [f64; 3], u0: [f64; 2], u_target: f64, mu: f64) -> [f64; 2] {
+    let [wnn, wnt, wtt] = w;
+    let s0 = u0[0] - u_target;
+    // 1. no contact: the free part already separates.
+    if s0 >= 0.0 {
+        return [0.0, 0.0];
+    }
+    let scale = wnn.abs().max(wtt.abs());
+    // 2. stick: W r = -(s0, u0_t).
+    let det = wnn * wtt - wnt * wnt;
+    if det > ACCEPT * scale * scale {
+        let rn = (-s0 * wtt + u0[1] * wnt) / det;
+        let rt = (-u0[1] * wnn + s0 * wnt) / det;
+        if rn >= 0.0 && rt.abs() <= mu * rn * (1.0 + ACCEPT) {
+            return [rn, rt];
+        }
+    }
+    // 3. slide with u_t of sign σ, r_t = −σ μ r_n.
+    for sigma in [1.0_f64, -1.0] {
+        let d = wnn - sigma * mu * wnt;
+        if d > ACCEPT * scale {
+            let rn = -s0 / d;
+            let rt = -sigma * mu * rn;
+            let ut = wnt * rn + wtt * rt + u0[1];
+            if sigma * ut >= -ACCEPT * (u0[1].abs() + scale * rn) {
+                return [rn, rt];
+            }
+        }
+    }
+    fallback(w, u0, u_target, mu)
+}
+
+/// Projected fixed point `r ← P_K(r − ρ (u(r) − ū e_n))` for degenerate blocks.
+#[cold]
+fn fallback(w: [f64; 3], u0: [f64; 2], u_target: f64, mu: f64) -> [f64; 2] {
+    let [wnn, wnt, wtt] = w;
+    let rho = 1.0 / wnn.max(wtt).max(f64::MIN_POSITIVE);
+    let mut r = [0.0_f64, 0.0];
+    for _ in 0..200 {
+        let un = wnn * r[0] + wnt * r[1] + u0[0] - u_target;
+        let ut = wnt * r[0] + wtt * r[1] + u0[1];
+        let rn = (r[0] - rho * un).max(0.0);
+        let rt = (r[1] - rho * ut).clamp(-mu * rn, mu * rn);
+        let change = (rn - r[0]).abs() + (rt - r[1]).abs();
+        r = [rn, rt];
+        if change <= 1e-14 * (rn.abs() + rt.abs()) {
+            break;
+        }
+    }
+    r
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn check(w: [f64; 3], u0: [f64; 2], ut: f64, mu: f64) {
+        let r = solve(w, u0, ut, mu);
+        let un = w[0] * r[0] + w[1] * r[1] + u0[0] - ut;
+        let utan = w[1] * r[0] + w[2] * r[1] + u0[1];
+        let tol = 1e-9 * (1.0 + u0[0].abs() + u0[1].abs());
+        assert!(r[0] >= 0.0 && un >= -tol, "{r:?} {un}");
+        assert!((r[0] * un).abs() <= tol * (1.0 + r[0]));
+        assert!(r[1].abs() <= mu * r[0] + tol);
+        if r[1].abs() < mu * r[0] - tol {
+            assert!(utan.abs() <= tol, "stick but u_t = {utan}");
+        } else if r[0] > tol {
+            assert!(utan * r[1] <= tol, "slide against friction");
+        }
+    }
+
+    #[test]
+    fn cases() {
+        let w = [2.0, 0.3, 1.5];
+        check(w, [1.0, 0.2], 0.0, 0.5); // separating
+        check(w, [-1.0, 0.0], 0.0, 0.5); // stick
+        check(w, [-1.0, 3.0], 0.0, 0.5); // slide +
+        check(w, [-1.0, -3.0], 0.0, 0.5); // slide -
+        check(w, [-1.0, -3.0], 0.0, 0.0); // frictionless
+        check(w, [-1.0, -3.0], 0.5, 100.0); // huge mu
+        check([1.0, 0.99, 1.0], [-1.0, 2.0], 0.0, 10.0); // nearly singular
+        check([1.0, 1.0, 1.0], [-1.0, -1.0], 0.0, 10.0); // singular, many solutions
+    }
+
+    #[test]
+    fn random_blocks() {
+        let mut s = 12345u64;
+        let mut next = || {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((s >> 11) as f64) / ((1u64 << 53) as f64)
+        };
+        for _ in 0..20000 {
+            let a = next() * 3.0 + 0.01;
+            let c = next() * 3.0 + 0.01;
+            let b = (next() * 2.0 - 1.0) * (a * c).sqrt();
+            let mu = next() * 5.0;
+            check([a, b, c], [next() * 4.0 - 2.0, next() * 4.0 - 2.0], next() - 0.5, mu);
+        }
+    }
+}

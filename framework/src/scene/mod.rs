@@ -1,0 +1,302 @@
+//! Loading a scene file into a [`World2`]: parse, validate, build.
+//!
+//! Every problem is reported as one [`InputError`] naming the file, the line and the
+//! key, before anything runs: syntax errors, unknown keys, non-physical values
+//! (negative radius, density, step, μ), unknown materials, shapes, laws or
+//! generators, a pair of materials that can touch without a law, a pair of shape
+//! kinds without a detector, bodies overlapping beyond the tolerance, and drives of
+//! degrees of freedom that do not exist.
+
+pub mod builder;
+pub mod locate;
+pub mod schema;
+
+use crate::detect::{Detector, DetectorTable};
+use crate::error::{line_of, InputError};
+use crate::registry::{ParamError, Registry};
+use crate::world::{BodyDrive2, BoxWalls, Material, TimeSettings, World2};
+use builder::{Origin, SceneBuilder2};
+use locate::{locate, path_string, Seg};
+use schema::SceneFile;
+
+/// Output settings of a scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OutputSettings {
+    pub every: u64,
+    pub vtk: bool,
+    pub writers: Vec<String>,
+}
+
+/// A loaded scene: the world and how to write it.
+pub struct Scene {
+    pub world: World2,
+    pub output: OutputSettings,
+}
+
+/// Reads and loads a scene file.
+pub fn load(path: &std::path::Path, registry: &Registry) -> Result<Scene, InputError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| InputError { file: file.clone(), line: None, key: String::new(), message: format!("cannot read the file: {e}") })?;
+    load_str(&text, &file, registry)
+}
+
+struct Ctx<'a> {
+    text: &'a str,
+    file: &'a str,
+}
+
+impl Ctx<'_> {
+    fn err(&self, path: &[Seg], message: impl Into<String>) -> InputError {
+        InputError { file: self.file.to_string(), line: locate(self.text, path).map(|o| line_of(self.text, o)), key: path_string(path), message: message.into() }
+    }
+}
+
+fn k(s: &str) -> Seg {
+    Seg::Key(s.to_string())
+}
+fn at(base: &[Seg], more: &[Seg]) -> Vec<Seg> {
+    base.iter().chain(more).cloned().collect()
+}
+
+/// Loads a scene from its text; `file` names it in messages.
+pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, InputError> {
+    let cx = Ctx { text, file };
+    let sf: SceneFile = toml::from_str(text).map_err(|e| {
+        let span = e.span();
+        let key = span.clone().map(|s| text[s].trim().trim_matches('"').to_string()).filter(|s| s.len() < 40 && !s.contains('\n')).unwrap_or_default();
+        InputError { file: file.to_string(), line: span.map(|s| line_of(text, s.start)), key, message: e.message().trim().to_string() }
+    })?;
+    if sf.dimension != 2 {
+        return Err(cx.err(&[k("dimension")], format!("dimension {} is not supported by the installed plugins (2D only)", sf.dimension)));
+    }
+    if sf.gravity.len() != 2 || sf.gravity.iter().any(|g| !g.is_finite()) {
+        return Err(cx.err(&[k("gravity")], "gravity must be 2 finite numbers in 2D"));
+    }
+    let time = time_settings(&cx, &sf)?;
+    validate_solver(&cx, &sf.solver)?;
+    let materials = materials(&cx, &sf)?;
+    let mut b = SceneBuilder2::new(registry, materials);
+    let mut drives = vec![];
+    add_bodies(&cx, &sf, &mut b, &mut drives)?;
+    for (g, spec) in sf.generate.iter().enumerate() {
+        let base = [k("generate"), Seg::Index(g)];
+        let gen = registry.generators.get(spec.kind.as_str()).ok_or_else(|| cx.err(&at(&base, &[k("kind")]), format!("unknown generator `{}`; installed: {}", spec.kind, registry.generator_names().join(", "))))?;
+        b.origin = Origin::Generated(g);
+        gen.generate(&spec.params, &mut b).map_err(|e: ParamError| cx.err(&at(&base, &[k(&e.key)]), e.msg))?;
+    }
+    if b.bodies.is_empty() {
+        return Err(cx.err(&[], "the scene has no bodies"));
+    }
+    let nm = b.materials.len();
+    let laws = laws(&cx, &sf, registry, nm, &b)?;
+    let origin_path = |o: Origin, key: &str| match o {
+        Origin::Body(i) => vec![k("bodies"), Seg::Index(i), k(key)],
+        Origin::Generated(i) => vec![k("generate"), Seg::Index(i)],
+    };
+    // every pair of materials that can touch needs a law; every pair of kinds a detector
+    let nk = b.shapes.len();
+    let mut first_mat = vec![None; nm];
+    let mut mat_movable = vec![false; nm];
+    let mut first_kind = vec![None; nk];
+    let mut kind_movable = vec![false; nk];
+    for i in 0..b.bodies.len() {
+        let (m, kd, mv) = (b.bodies.material[i] as usize, b.bodies.shape[i].kind as usize, b.bodies.movable(i) || drives.iter().any(|d: &BodyDrive2| d.body as usize == i));
+        first_mat[m].get_or_insert(b.origins[i]);
+        first_kind[kd].get_or_insert(b.origins[i]);
+        mat_movable[m] |= mv;
+        kind_movable[kd] |= mv;
+    }
+    for ma in 0..nm {
+        for mb in ma..nm {
+            if let (Some(oa), Some(_)) = (first_mat[ma], first_mat[mb]) {
+                if (mat_movable[ma] || mat_movable[mb]) && laws[ma * nm + mb].is_none() {
+                    return Err(cx.err(&origin_path(oa, "material"), format!("no law for the material pair (`{}`, `{}`): add a [[laws]] entry with materials = [\"{}\", \"{}\"]", b.materials[ma].name, b.materials[mb].name, b.materials[ma].name, b.materials[mb].name)));
+                }
+            }
+        }
+    }
+    let mut table = DetectorTable { nk, table: vec![None; nk * nk] };
+    for ka in 0..nk {
+        for kb in 0..nk {
+            let (na, nb) = (b.shapes[ka].kind(), b.shapes[kb].kind());
+            match registry.detector(na, nb) {
+                Some((d, swapped)) => table.table[ka * nk + kb] = Some((d, swapped)),
+                None if kind_movable[ka] || kind_movable[kb] => {
+                    let o = first_kind[ka].or(first_kind[kb]).unwrap_or(Origin::Body(0));
+                    return Err(cx.err(&origin_path(o, "shape"), format!("no contact detector for the shape pair (`{na}`, `{nb}`) among the installed plugins")));
+                }
+                None => {}
+            }
+        }
+    }
+    let sizes: Vec<f64> = (0..b.bodies.len()).map(|i| b.shapes[b.bodies.shape[i].kind as usize].size(b.bodies.shape[i].index)).collect();
+    let alert = match sf.detection.alert {
+        Some(a) if !(a >= 0.0 && a.is_finite()) => return Err(cx.err(&[k("detection"), k("alert")], format!("must be ≥ 0, got {a}"))),
+        Some(a) => a,
+        None => {
+            let mut s: Vec<f64> = sizes.iter().copied().filter(|x| x.is_finite() && *x > 0.0).collect();
+            s.sort_by(|a, c| a.total_cmp(c));
+            0.1 * s.get(s.len() / 2).copied().unwrap_or(1.0)
+        }
+    };
+    let tol = sf.detection.overlap_tolerance;
+    if !(tol >= 0.0) {
+        return Err(cx.err(&[k("detection"), k("overlap_tolerance")], "must be ≥ 0"));
+    }
+    // initial interpenetrations beyond the tolerance
+    let mut raw = vec![];
+    Detector::default().detect(&b.bodies, &b.shapes, &table, 0.0, &mut raw);
+    for rc in &raw {
+        let (i, j) = (rc.i as usize, rc.j as usize);
+        let lim = tol * sizes[i].min(sizes[j]);
+        if rc.gap < -lim {
+            return Err(cx.err(&origin_path(b.origins[i], "position"), format!("bodies {i} and {j} overlap by {:.3e} m, more than the tolerance {:.3e} m (detection.overlap_tolerance × the smaller size)", -rc.gap, lim)));
+        }
+    }
+    let box_walls = match &sf.output.box_walls {
+        None => None,
+        Some(bs) => {
+            let find = |key: &str, name: &str| {
+                b.names.iter().position(|n| n.as_deref() == Some(name)).map(|p| p as u32).ok_or_else(|| cx.err(&[k("output"), k("box"), k(key)], format!("no body is named `{name}`")))
+            };
+            Some(BoxWalls { left: find("left", &bs.left)?, right: find("right", &bs.right)?, bottom: find("bottom", &bs.bottom)?, top: find("top", &bs.top)?, strain_from: bs.strain_from })
+        }
+    };
+    for (i, w) in sf.output.writers.iter().enumerate() {
+        if !registry.writers.contains_key(w.as_str()) {
+            return Err(cx.err(&[k("output"), k("writers"), Seg::Index(i)], format!("unknown writer `{w}`")));
+        }
+    }
+    let nb = b.bodies.len();
+    let world = World2 {
+        bodies: b.bodies,
+        names: b.names,
+        shapes: b.shapes,
+        materials: b.materials,
+        laws,
+        drives,
+        gravity: [sf.gravity[0], sf.gravity[1]],
+        time,
+        solver: sf.solver,
+        alert,
+        box_walls,
+        box_h0: None,
+        detectors: table,
+        t: 0.0,
+        step: 0,
+        contacts: Default::default(),
+        reaction: vec![[0.0; 3]; nb],
+        scratch: Default::default(),
+    };
+    Ok(Scene { world, output: OutputSettings { every: sf.output.every, vtk: sf.output.vtk, writers: sf.output.writers } })
+}
+
+fn time_settings(cx: &Ctx, sf: &SceneFile) -> Result<TimeSettings, InputError> {
+    let t = &sf.time;
+    if !(t.step > 0.0 && t.step.is_finite()) {
+        return Err(cx.err(&[k("time"), k("step")], format!("the step must be a positive number of seconds, got {}", t.step)));
+    }
+    if !(0.5..=1.0).contains(&t.theta) {
+        return Err(cx.err(&[k("time"), k("theta")], format!("θ must lie in [0.5, 1], got {}", t.theta)));
+    }
+    let steps = match (t.steps, t.duration) {
+        (Some(n), None) => n,
+        (None, Some(d)) if d >= 0.0 && d.is_finite() => (d / t.step).round() as u64,
+        (None, Some(d)) => return Err(cx.err(&[k("time"), k("duration")], format!("must be ≥ 0, got {d}"))),
+        _ => return Err(cx.err(&[k("time")], "give exactly one of `steps` or `duration`")),
+    };
+    Ok(TimeSettings { h: t.step, theta: t.theta, steps })
+}
+
+fn validate_solver(cx: &Ctx, s: &crate::solver::SolverSettings) -> Result<(), InputError> {
+    let p = |key: &str| vec![k("solver"), k(key)];
+    if !(s.tolerance > 0.0 && s.tolerance.is_finite()) {
+        return Err(cx.err(&p("tolerance"), format!("must be > 0, got {}", s.tolerance)));
+    }
+    if s.max_sweeps == 0 {
+        return Err(cx.err(&p("max_sweeps"), "must be ≥ 1"));
+    }
+    if s.check_every == 0 {
+        return Err(cx.err(&p("check_every"), "must be ≥ 1"));
+    }
+    if !(s.relaxation > 0.0 && s.relaxation <= 1.0) {
+        return Err(cx.err(&p("relaxation"), format!("ω must lie in (0, 1], got {}", s.relaxation)));
+    }
+    Ok(())
+}
+
+fn materials(cx: &Ctx, sf: &SceneFile) -> Result<Vec<Material>, InputError> {
+    let mut out: Vec<Material> = vec![];
+    for (i, m) in sf.materials.iter().enumerate() {
+        if !(m.density > 0.0 && m.density.is_finite()) {
+            return Err(cx.err(&[k("materials"), Seg::Index(i), k("density")], format!("density must be > 0, got {}", m.density)));
+        }
+        if out.iter().any(|o| o.name == m.name) {
+            return Err(cx.err(&[k("materials"), Seg::Index(i), k("name")], format!("material `{}` is declared twice", m.name)));
+        }
+        out.push(Material { name: m.name.clone(), density: m.density });
+    }
+    Ok(out)
+}
+
+fn laws(cx: &Ctx, sf: &SceneFile, registry: &Registry, nm: usize, b: &SceneBuilder2) -> Result<Vec<Option<crate::law::ContactLaw>>, InputError> {
+    let mut table = vec![None; nm * nm];
+    for (i, l) in sf.laws.iter().enumerate() {
+        let base = [k("laws"), Seg::Index(i)];
+        let def = registry.laws.get(l.law.as_str()).ok_or_else(|| cx.err(&at(&base, &[k("law")]), format!("unknown law `{}`; installed: {}", l.law, registry.law_names().join(", "))))?;
+        let mut ids = [0u16; 2];
+        for (s, name) in l.materials.iter().enumerate() {
+            ids[s] = b.material(name).ok_or_else(|| cx.err(&at(&base, &[k("materials"), Seg::Index(s)]), format!("unknown material `{name}`")))?;
+        }
+        let law = (def.parse)(&l.params).map_err(|e| cx.err(&at(&base, &[k(&e.key)]), e.msg))?;
+        let (a, c) = (ids[0] as usize, ids[1] as usize);
+        if table[a * nm + c].is_some() {
+            return Err(cx.err(&at(&base, &[k("materials")]), "a law for this pair of materials is already given"));
+        }
+        table[a * nm + c] = Some(law);
+        table[c * nm + a] = Some(law);
+    }
+    Ok(table)
+}
+
+fn add_bodies(cx: &Ctx, sf: &SceneFile, b: &mut SceneBuilder2, drives: &mut Vec<BodyDrive2>) -> Result<(), InputError> {
+    for (i, spec) in sf.bodies.iter().enumerate() {
+        let base = [k("bodies"), Seg::Index(i)];
+        let p = |key: &str| at(&base, &[k(key)]);
+        b.origin = Origin::Body(i);
+        let kind = b.kind(&spec.shape).ok_or_else(|| cx.err(&p("shape"), format!("unknown shape `{}`; installed: {}", spec.shape, b.registry.shape_kinds().join(", "))))?;
+        let material = b.material(&spec.material).ok_or_else(|| cx.err(&p("material"), format!("unknown material `{}`; declare it in [[materials]]", spec.material)))?;
+        let index = b.shapes[kind as usize].push_params(&spec.params).map_err(|e| cx.err(&p(&e.key), e.msg))?;
+        if spec.position.iter().chain(&spec.velocity).chain([&spec.rotation]).any(|x| !x.is_finite()) {
+            return Err(cx.err(&p("position"), "position, rotation and velocity must be finite"));
+        }
+        let id = b.add_body(crate::rigid2d::bodies::ShapeRef { kind, index }, material, spec.position, spec.rotation, spec.velocity);
+        let mp = b.bodies.mass[id as usize];
+        if !(mp[0] > 0.0 && mp[0].is_finite() && mp[2] > 0.0 && mp[2].is_finite()) {
+            return Err(cx.err(&p("shape"), format!("the body's mass ({}) and inertia ({}) must be positive and finite", mp[0], mp[2])));
+        }
+        if let Some(name) = &spec.name {
+            if b.names.iter().any(|n| n.as_deref() == Some(name.as_str())) {
+                return Err(cx.err(&p("name"), format!("two bodies are named `{name}`")));
+            }
+            b.names[id as usize] = Some(name.clone());
+        }
+        if spec.fixed {
+            if spec.drive.is_some() {
+                return Err(cx.err(&p("drive"), "a fixed body cannot also be driven"));
+            }
+            b.set_fixed(id);
+        }
+        if let Some(d) = &spec.drive {
+            let mut dof: [Option<crate::drive::DofDrive>; 3] = Default::default();
+            for (slot, (name, dd)) in [("x", &d.x), ("y", &d.y), ("rot", &d.rot)].into_iter().enumerate() {
+                if let Some(dd) = dd {
+                    dd.validate().map_err(|m| cx.err(&at(&base, &[k("drive"), k(name)]), m))?;
+                    dof[slot] = Some(dd.clone());
+                }
+            }
+            drives.push(BodyDrive2 { body: id, dof });
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,174 @@
+//! The scene file format (TOML, SI units). Unknown keys are rejected everywhere:
+//! shape- and generator-specific keys are checked by the plugin that owns them.
+//! See the README's "Scene files" section for a complete description.
+
+use crate::drive::DofDrive;
+use crate::solver::SolverSettings;
+use serde::Deserialize;
+
+fn two() -> u8 {
+    2
+}
+fn half() -> f64 {
+    0.5
+}
+fn gravity() -> Vec<f64> {
+    vec![0.0, -9.81]
+}
+fn yes() -> bool {
+    true
+}
+fn coulomb() -> String {
+    "coulomb".into()
+}
+fn overlap() -> f64 {
+    0.05
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// 2 (3D arrives with the spheres plugin).
+    #[serde(default = "two")]
+    pub dimension: u8,
+    /// Gravity vector (m/s²), default (0, −9.81).
+    #[serde(default = "gravity")]
+    pub gravity: Vec<f64>,
+    pub time: TimeSpec,
+    #[serde(default)]
+    pub solver: SolverSettings,
+    #[serde(default)]
+    pub detection: DetectionSpec,
+    #[serde(default)]
+    pub materials: Vec<MaterialSpec>,
+    #[serde(default)]
+    pub laws: Vec<LawSpec>,
+    #[serde(default)]
+    pub bodies: Vec<BodySpec>,
+    #[serde(default)]
+    pub generate: Vec<GenerateSpec>,
+    #[serde(default)]
+    pub output: OutputSpec,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct TimeSpec {
+    /// Step h (s).
+    pub step: f64,
+    /// θ ∈ [½, 1].
+    #[serde(default = "half")]
+    pub theta: f64,
+    /// Number of steps (or give `duration`).
+    pub steps: Option<u64>,
+    /// Duration (s); steps = round(duration / h).
+    pub duration: Option<f64>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct DetectionSpec {
+    /// Alert distance (m). Default: 0.1 × the median shape size.
+    pub alert: Option<f64>,
+    /// Initial interpenetration allowed, relative to the smaller shape size.
+    #[serde(default = "overlap")]
+    pub overlap_tolerance: f64,
+}
+
+impl Default for DetectionSpec {
+    fn default() -> Self {
+        DetectionSpec { alert: None, overlap_tolerance: overlap() }
+    }
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    pub name: String,
+    /// kg/m³ (per unit depth in 2D: mass = density × area).
+    pub density: f64,
+}
+
+#[derive(Deserialize, Debug)]
+pub struct LawSpec {
+    /// The two materials (order irrelevant).
+    pub materials: [String; 2],
+    /// Law kind: `coulomb` (default) or `frictionless`, or one a plugin registered.
+    #[serde(default = "coulomb")]
+    pub law: String,
+    /// Law parameters (`friction`, `restitution`).
+    #[serde(flatten)]
+    pub params: toml::Table,
+}
+
+#[derive(Deserialize, Debug)]
+pub struct BodySpec {
+    /// Shape kind (`disk`, `wall`, `halfplane`, ...).
+    pub shape: String,
+    pub material: String,
+    /// Optional unique name, used by outputs and `[output.box]`.
+    pub name: Option<String>,
+    pub position: [f64; 2],
+    #[serde(default)]
+    pub rotation: f64,
+    /// (v_x, v_y, ω).
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    #[serde(default)]
+    pub fixed: bool,
+    pub drive: Option<DriveSpec2>,
+    /// Shape-specific keys, checked by the shape's plugin.
+    #[serde(flatten)]
+    pub params: toml::Table,
+}
+
+/// Driven degrees of freedom of a 2D body.
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+pub struct DriveSpec2 {
+    pub x: Option<DofDrive>,
+    pub y: Option<DofDrive>,
+    pub rot: Option<DofDrive>,
+}
+
+#[derive(Deserialize, Debug)]
+pub struct GenerateSpec {
+    /// Generator name (`disk_deposit`, `square_lattice`, ...).
+    pub kind: String,
+    #[serde(flatten)]
+    pub params: toml::Table,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Write VTK (and extra writers) every `every` steps; 0: only the last step.
+    #[serde(default)]
+    pub every: u64,
+    #[serde(default = "yes")]
+    pub vtk: bool,
+    /// Extra writers registered by plugins.
+    #[serde(default)]
+    pub writers: Vec<String>,
+    /// The walls of a box sample, by body name.
+    #[serde(rename = "box")]
+    pub box_walls: Option<BoxSpec>,
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        OutputSpec { every: 0, vtk: true, writers: vec![], box_walls: None }
+    }
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct BoxSpec {
+    pub left: String,
+    pub right: String,
+    pub bottom: String,
+    pub top: String,
+    /// ε1 is measured from the height at this time (s).
+    #[serde(default)]
+    pub strain_from: f64,
+}

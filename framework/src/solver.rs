@@ -1,0 +1,58 @@
+//! Contact solver settings and the per-step report, shared by every dimension.
+
+use crate::norms::{Criterion, Norms};
+use serde::{Deserialize, Serialize};
+
+/// Order in which an NLGS sweep visits the contacts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Ordering {
+    /// As stored (detection order).
+    Stored,
+    /// Reversed storage order.
+    Reversed,
+    /// A random permutation drawn once per step from `seed` and the step number.
+    Shuffled,
+}
+
+/// NLGS settings (scene section `[solver]`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SolverSettings {
+    /// Tolerance `tol` of the LMGC90 norms.
+    pub tolerance: f64,
+    /// `"Quad"`, `"Maxm"` or `"QM/16"`.
+    pub norm: Criterion,
+    pub max_sweeps: u32,
+    /// A check pass every `check_every` sweeps.
+    pub check_every: u32,
+    /// Relaxation ω in (0, 1].
+    pub relaxation: f64,
+    pub ordering: Ordering,
+    pub seed: u64,
+}
+
+impl Default for SolverSettings {
+    fn default() -> Self {
+        SolverSettings {
+            tolerance: 1.666e-4,
+            norm: Criterion::QuadMax16,
+            max_sweeps: 1000,
+            check_every: 10,
+            relaxation: 1.0,
+            ordering: Ordering::Stored,
+            seed: 0,
+        }
+    }
+}
+
+/// What one contact solve did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SolveReport {
+    pub sweeps: u32,
+    pub converged: bool,
+    /// Norms of the last check pass.
+    pub norms: Norms,
+    /// Natural-map residual ‖F(r)‖/‖q‖ after the solve.
+    pub residual: f64,
+}
