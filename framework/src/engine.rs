@@ -217,8 +217,8 @@ pub fn update_positions(w: &mut World2) -> Result<(), Diverged> {
         rj[1] -= p[1];
         rj[2] -= aj[0] * r[0] + aj[1] * r[1];
     }
-    w.t += h;
     w.step += 1;
+    w.t = w.step as f64 * h;
     if let (Some(bw), None) = (&w.box_walls, w.box_h0) {
         if w.t >= bw.strain_from {
             w.box_h0 = w.box_extent().map(|e| e[3] - e[2]);

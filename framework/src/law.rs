@@ -20,6 +20,7 @@
 //! `friction`, `restitution`) and `frictionless` (key `restitution`), which takes the
 //! cheaper μ = 0 path of the local solver.
 
+use crate::params::{number, only_keys};
 use crate::registry::{ParamError, Registry};
 
 /// Parameters of the law of one pair of materials.
@@ -50,30 +51,6 @@ pub fn target_velocity(gap: f64, un_begin: f64, un_free: f64, h: f64, theta: f64
     } else {
         -(gap + h * (1.0 - theta) * un_begin) / (h * theta)
     }
-}
-
-/// Reads an optional non-negative number key.
-pub fn number(t: &toml::Table, key: &str, default: Option<f64>) -> Result<f64, ParamError> {
-    match t.get(key) {
-        None => default.ok_or_else(|| ParamError::new(key, "missing key")),
-        Some(v) => {
-            let x = v.as_float().or_else(|| v.as_integer().map(|i| i as f64)).ok_or_else(|| ParamError::new(key, "must be a number"))?;
-            if !x.is_finite() {
-                return Err(ParamError::new(key, "must be finite"));
-            }
-            Ok(x)
-        }
-    }
-}
-
-/// Rejects keys of `t` outside `allowed`.
-pub fn only_keys(t: &toml::Table, allowed: &[&str]) -> Result<(), ParamError> {
-    for k in t.keys() {
-        if !allowed.contains(&k.as_str()) {
-            return Err(ParamError::new(k.clone(), format!("unknown key `{k}`; expected one of: {}", allowed.join(", "))));
-        }
-    }
-    Ok(())
 }
 
 fn restitution(t: &toml::Table) -> Result<f64, ParamError> {

@@ -28,6 +28,7 @@ pub mod fc;
 pub mod law;
 pub mod norms;
 pub mod output;
+pub mod params;
 pub mod registry;
 pub mod rigid2d;
 pub mod run;

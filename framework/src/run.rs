@@ -1,0 +1,104 @@
+//! Running a loaded scene to its end and writing its outputs in a directory.
+
+use crate::engine::{Diverged, StepReport};
+use crate::output::{final_json, history::History};
+use crate::registry::{Registry, Writer2};
+use crate::scene::Scene;
+use crate::world::World2;
+use std::io::Write;
+use std::path::Path;
+use std::time::Instant;
+
+/// Why a run stopped early.
+#[derive(Debug)]
+pub enum RunError {
+    /// An output could not be written.
+    Io(String),
+    /// A non-finite state; what was written so far is kept.
+    Diverged(Diverged),
+}
+
+impl std::fmt::Display for RunError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            RunError::Io(m) => write!(f, "{m}"),
+            RunError::Diverged(d) => write!(f, "{d}"),
+        }
+    }
+}
+
+/// What a finished run did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RunSummary {
+    pub steps: u64,
+    /// Steps whose contact solve did not meet the criterion.
+    pub unconverged_steps: u64,
+    pub first_unconverged: Option<u64>,
+    pub total_sweeps: u64,
+    pub wall_seconds: f64,
+}
+
+fn io(dir: &Path, what: &str) -> impl Fn(std::io::Error) -> RunError {
+    let d = dir.display().to_string();
+    let what = what.to_string();
+    move |e| RunError::Io(format!("cannot write {what} in {d}: {e}"))
+}
+
+/// Runs `scene` for its number of steps, writing `history.csv`, the writers' frames
+/// every `output.every` steps (and at the first and last step) and `final.json` in
+/// `dir`. `on_step` is called after every step (progress display).
+pub fn run(scene: &mut Scene, registry: &Registry, dir: &Path, mut on_step: impl FnMut(&World2, &StepReport)) -> Result<RunSummary, RunError> {
+    let start = Instant::now();
+    std::fs::create_dir_all(dir).map_err(io(dir, "the output directory"))?;
+    let w = &mut scene.world;
+    let file = std::fs::File::create(dir.join("history.csv")).map_err(io(dir, "history.csv"))?;
+    let mut hist = History::new(std::io::BufWriter::new(file), w).map_err(io(dir, "history.csv"))?;
+    let mut writers: Vec<Box<dyn Writer2>> = vec![];
+    if scene.output.vtk {
+        writers.push((registry.writers["vtk"])());
+    }
+    for name in &scene.output.writers {
+        writers.push((registry.writers[name.as_str()])());
+    }
+    let mut frame = 0u32;
+    for wr in writers.iter_mut() {
+        wr.write(w, dir, frame).map_err(io(dir, "the first output frame"))?;
+    }
+    frame += 1;
+    let mut sum = RunSummary::default();
+    let steps = w.time.steps;
+    for s in 1..=steps {
+        let rep = match w.step() {
+            Ok(r) => r,
+            Err(d) => {
+                let _ = hist.flush();
+                return Err(RunError::Diverged(d));
+            }
+        };
+        let t0 = Instant::now();
+        if (scene.output.every > 0 && s % scene.output.every == 0) || s == steps {
+            for wr in writers.iter_mut() {
+                wr.write(w, dir, frame).map_err(io(dir, "an output frame"))?;
+            }
+            frame += 1;
+            hist.flush().map_err(io(dir, "history.csv"))?;
+        }
+        let t_out = t0.elapsed().as_secs_f64();
+        hist.row(w, &rep, t_out).map_err(io(dir, "history.csv"))?;
+        sum.steps += 1;
+        sum.total_sweeps += rep.solve.sweeps as u64;
+        if !rep.solve.converged {
+            sum.unconverged_steps += 1;
+            sum.first_unconverged.get_or_insert(w.step);
+        }
+        on_step(w, &rep);
+    }
+    hist.flush().map_err(io(dir, "history.csv"))?;
+    for wr in writers.iter_mut() {
+        wr.finish(dir).map_err(io(dir, "the output series"))?;
+    }
+    let mut f = std::fs::File::create(dir.join("final.json")).map_err(io(dir, "final.json"))?;
+    f.write_all(final_json(w).as_bytes()).map_err(io(dir, "final.json"))?;
+    sum.wall_seconds = start.elapsed().as_secs_f64();
+    Ok(sum)
+}
