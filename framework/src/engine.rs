@@ -164,6 +164,7 @@ pub fn build_contacts(w: &mut World2) {
         c.arm_i.push(ai);
         c.arm_j.push(aj);
         c.w.push(wb);
+        c.w_pre.push(crate::rigid2d::coulomb::precompute(wb, law.mu));
         c.u_target.push(target_velocity(rc.gap, u_begin[0], u_free[0], h, theta, law.e));
         c.mu.push(law.mu);
         c.r.push(r);

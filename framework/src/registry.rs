@@ -202,6 +202,10 @@ impl Registry {
     pub fn add_writer(&mut self, name: &'static str, make: fn() -> Box<dyn Writer2>) {
         self.writers.insert(name, make);
     }
+    /// A writer's constructor by name.
+    pub fn writer(&self, name: &str) -> Option<fn() -> Box<dyn Writer2>> {
+        self.writers.get(name).copied()
+    }
     pub fn shape_kinds(&self) -> Vec<&'static str> {
         self.shapes.keys().copied().collect()
     }

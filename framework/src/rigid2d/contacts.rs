@@ -26,6 +26,8 @@ pub struct Contacts2 {
     pub arm_j: Vec<[f64; 2]>,
     /// Diagonal Delassus block W_αα = [W_nn, W_nt, W_tt].
     pub w: Vec<[f64; 3]>,
+    /// [`super::coulomb::precompute`] of (W_αα, μ): inverses reused by every sweep.
+    pub w_pre: Vec<[f64; 5]>,
     /// Target normal velocity ū of the law: u_n ≥ ū ⊥ r_n ≥ 0.
     pub u_target: Vec<f64>,
     /// Friction coefficient μ.
@@ -55,6 +57,7 @@ impl Contacts2 {
         self.arm_i.clear();
         self.arm_j.clear();
         self.w.clear();
+        self.w_pre.clear();
         self.u_target.clear();
         self.mu.clear();
         self.r.clear();

@@ -55,6 +55,57 @@ pub fn solve(w: [f64; 3], u0: [f64; 2], u_target: f64, mu: f64) -> [f64; 2] {
     fallback(w, u0, u_target, mu)
 }
 
+/// Quantities of a block W that [`solve_pre`] reuses at every sweep: the inverse
+/// `W⁻¹ = [i_nn, i_nt, i_tt]` (zeros when W is singular) and `1 / (W_nn − σ μ W_nt)`
+/// for σ = +1, −1 (zero when that slide case has no positive pivot).
+pub fn precompute(w: [f64; 3], mu: f64) -> [f64; 5] {
+    let [wnn, wnt, wtt] = w;
+    let scale = wnn.abs().max(wtt.abs());
+    let det = wnn * wtt - wnt * wnt;
+    let mut p = [0.0; 5];
+    if det > ACCEPT * scale * scale {
+        p[0] = wtt / det;
+        p[1] = -wnt / det;
+        p[2] = wnn / det;
+    }
+    for (k, sigma) in [(3, 1.0), (4, -1.0)] {
+        let d = wnn - sigma * mu * wnt;
+        if d > ACCEPT * scale {
+            p[k] = 1.0 / d;
+        }
+    }
+    p
+}
+
+/// [`solve`] with the block's [`precompute`]d inverses: the same enumeration, without
+/// divisions. Used by the NLGS sweeps.
+#[inline(always)]
+pub fn solve_pre(w: [f64; 3], p: &[f64; 5], u0: [f64; 2], u_target: f64, mu: f64) -> [f64; 2] {
+    let s0 = u0[0] - u_target;
+    if s0 >= 0.0 {
+        return [0.0, 0.0];
+    }
+    if p[0] != 0.0 || p[2] != 0.0 {
+        let rn = -(p[0] * s0 + p[1] * u0[1]);
+        let rt = -(p[1] * s0 + p[2] * u0[1]);
+        if rn >= 0.0 && rt.abs() <= mu * rn * (1.0 + ACCEPT) {
+            return [rn, rt];
+        }
+    }
+    let scale = w[0].abs().max(w[2].abs());
+    for (k, sigma) in [(3, 1.0_f64), (4, -1.0)] {
+        if p[k] > 0.0 {
+            let rn = -s0 * p[k];
+            let rt = -sigma * mu * rn;
+            let ut = w[1] * rn + w[2] * rt + u0[1];
+            if sigma * ut >= -ACCEPT * (u0[1].abs() + scale * rn) {
+                return [rn, rt];
+            }
+        }
+    }
+    fallback(w, u0, u_target, mu)
+}
+
 /// Projected fixed point `r ← P_K(r − ρ (u(r) − ū e_n))` for degenerate blocks.
 #[cold]
 fn fallback(w: [f64; 3], u0: [f64; 2], u_target: f64, mu: f64) -> [f64; 2] {
@@ -105,6 +156,23 @@ mod tests {
         check(w, [-1.0, -3.0], 0.5, 100.0); // huge mu
         check([1.0, 0.99, 1.0], [-1.0, 2.0], 0.0, 10.0); // nearly singular
         check([1.0, 1.0, 1.0], [-1.0, -1.0], 0.0, 10.0); // singular, many solutions
+    }
+
+    #[test]
+    fn precomputed_agrees() {
+        let mut s = 99u64;
+        let mut next = || {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((s >> 11) as f64) / ((1u64 << 53) as f64)
+        };
+        for _ in 0..20000 {
+            let (a, c) = (next() * 3.0 + 0.01, next() * 3.0 + 0.01);
+            let w = [a, (next() * 2.0 - 1.0) * (a * c).sqrt(), c];
+            let mu = next() * 5.0;
+            let u0 = [next() * 4.0 - 2.0, next() * 4.0 - 2.0];
+            let (r1, r2) = (solve(w, u0, 0.1, mu), solve_pre(w, &precompute(w, mu), u0, 0.1, mu));
+            assert!((r1[0] - r2[0]).abs() + (r1[1] - r2[1]).abs() <= 1e-9 * (1.0 + r1[0].abs()), "{r1:?} {r2:?}");
+        }
     }
 
     #[test]

@@ -14,44 +14,103 @@ use crate::solver::{Ordering, SolveReport, SolverSettings};
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 
-/// Fills `order` with the visiting order of this step's contacts.
+/// Fills `order` with the visiting order of this step's contacts (left empty for
+/// storage order).
 pub fn make_order(order: &mut Vec<u32>, n: usize, s: &SolverSettings, step: u64) {
     order.clear();
-    order.extend(0..n as u32);
     match s.ordering {
+        // empty: storage order, visited without indirection
         Ordering::Stored => {}
-        Ordering::Reversed => order.reverse(),
+        Ordering::Reversed => order.extend((0..n as u32).rev()),
         Ordering::Shuffled => {
+            order.extend(0..n as u32);
             let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(s.seed ^ step.wrapping_mul(0x9E37_79B9_7F4A_7C15));
             order.shuffle(&mut rng);
         }
     }
 }
 
-/// One NLGS sweep; accumulates the check sums when `sums` is given.
+/// The contact fields a sweep reads, sliced to one length so that indexing them
+/// in storage order needs no bounds checks.
+struct Hot<'a> {
+    i: &'a [u32],
+    j: &'a [u32],
+    n: &'a [[f64; 2]],
+    arm_i: &'a [[f64; 2]],
+    arm_j: &'a [[f64; 2]],
+    w: &'a [[f64; 3]],
+    w_pre: &'a [[f64; 5]],
+    u_target: &'a [f64],
+    mu: &'a [f64],
+    r: &'a mut [[f64; 2]],
+}
+
+/// One NLGS sweep; accumulates the check sums when `sums` is given. An empty
+/// `order` means storage order.
 #[inline(never)]
 pub fn sweep(c: &mut Contacts2, vel: &mut [[f64; 3]], inv_mass: &[[f64; 3]], order: &[u32], omega: f64, mut sums: Option<&mut Sums>) {
-    for &a in order {
-        let a = a as usize;
-        let u = c.local_velocity(a, vel);
-        let r = c.r[a];
-        let w = c.w[a];
-        let wr_old = [w[0] * r[0] + w[1] * r[1], w[1] * r[0] + w[2] * r[1]];
-        let u0 = [u[0] - wr_old[0], u[1] - wr_old[1]];
-        let mut rn = coulomb::solve(w, u0, c.u_target[a], c.mu[a]);
-        if omega != 1.0 {
-            rn = [omega * rn[0] + (1.0 - omega) * r[0], omega * rn[1] + (1.0 - omega) * r[1]];
+    let m = c.len();
+    let mut h = Hot {
+        i: &c.i[..m],
+        j: &c.j[..m],
+        n: &c.n[..m],
+        arm_i: &c.arm_i[..m],
+        arm_j: &c.arm_j[..m],
+        w: &c.w[..m],
+        w_pre: &c.w_pre[..m],
+        u_target: &c.u_target[..m],
+        mu: &c.mu[..m],
+        r: &mut c.r[..m],
+    };
+    if order.is_empty() {
+        for a in 0..m {
+            visit(&mut h, a, vel, inv_mass, omega, sums.as_deref_mut());
         }
-        let dr = [rn[0] - r[0], rn[1] - r[1]];
-        if let Some(s) = sums.as_deref_mut() {
-            let wr = [w[0] * rn[0] + w[1] * rn[1], w[1] * rn[0] + w[2] * rn[1]];
-            let du = [wr[0] - wr_old[0], wr[1] - wr_old[1]];
-            s.add(&r, &rn, &du, &wr_old, &wr);
+    } else {
+        for &a in order {
+            visit(&mut h, a as usize, vel, inv_mass, omega, sums.as_deref_mut());
         }
-        if dr[0] != 0.0 || dr[1] != 0.0 {
-            c.r[a] = rn;
-            c.apply(a, dr, vel, inv_mass);
-        }
+    }
+}
+
+/// Solves contact α with the others' impulses fixed and updates its two bodies:
+/// u = H_αᵀ V, u0 = u − W_αα r_α, r_α ← local solution, V += M̂⁻¹ H_α Δr_α.
+#[inline(always)]
+fn visit(h: &mut Hot<'_>, a: usize, vel: &mut [[f64; 3]], inv_mass: &[[f64; 3]], omega: f64, sums: Option<&mut Sums>) {
+    let (bi, bj) = (h.i[a] as usize, h.j[a] as usize);
+    let n = h.n[a];
+    let (ai, aj) = (h.arm_i[a], h.arm_j[a]);
+    let (vi, vj) = (vel[bi], vel[bj]);
+    let dv = [vi[0] - vj[0], vi[1] - vj[1]];
+    let u = [n[0] * dv[0] + n[1] * dv[1] + ai[0] * vi[2] - aj[0] * vj[2], -n[1] * dv[0] + n[0] * dv[1] + ai[1] * vi[2] - aj[1] * vj[2]];
+    let r = h.r[a];
+    let w = h.w[a];
+    let wr_old = [w[0] * r[0] + w[1] * r[1], w[1] * r[0] + w[2] * r[1]];
+    let u0 = [u[0] - wr_old[0], u[1] - wr_old[1]];
+    let mut rn = coulomb::solve_pre(w, &h.w_pre[a], u0, h.u_target[a], h.mu[a]);
+    if omega != 1.0 {
+        rn = [omega * rn[0] + (1.0 - omega) * r[0], omega * rn[1] + (1.0 - omega) * r[1]];
+    }
+    let dr = [rn[0] - r[0], rn[1] - r[1]];
+    if let Some(s) = sums {
+        let wr = [w[0] * rn[0] + w[1] * rn[1], w[1] * rn[0] + w[2] * rn[1]];
+        let du = [wr[0] - wr_old[0], wr[1] - wr_old[1]];
+        s.add(&r, &rn, &du, &wr_old, &wr);
+    }
+    if dr[0] != 0.0 || dr[1] != 0.0 {
+        h.r[a] = rn;
+        let px = dr[0] * n[0] - dr[1] * n[1];
+        let py = dr[0] * n[1] + dr[1] * n[0];
+        let mi = inv_mass[bi];
+        let v = &mut vel[bi];
+        v[0] += mi[0] * px;
+        v[1] += mi[1] * py;
+        v[2] += mi[2] * (ai[0] * dr[0] + ai[1] * dr[1]);
+        let mj = inv_mass[bj];
+        let v = &mut vel[bj];
+        v[0] -= mj[0] * px;
+        v[1] -= mj[1] * py;
+        v[2] -= mj[2] * (aj[0] * dr[0] + aj[1] * dr[1]);
     }
 }
 
