@@ -63,8 +63,16 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
     let cx = Ctx { text, file };
     let sf: SceneFile = toml::from_str(text).map_err(|e| {
         let span = e.span();
-        let key = span.clone().map(|s| text[s].trim().trim_matches('"').to_string()).filter(|s| s.len() < 40 && !s.contains('\n')).unwrap_or_default();
-        InputError { file: file.to_string(), line: span.map(|s| line_of(text, s.start)), key, message: e.message().trim().to_string() }
+        let line = span.as_ref().map(|s| line_of(text, s.start));
+        // the full key path: from the parsed document (unknown keys, wrong types), or
+        // from the line's header and key (syntax errors)
+        let key = span
+            .as_ref()
+            .and_then(|s| locate::path_at(text, s.start))
+            .or_else(|| line.and_then(|l| locate::path_on_line(text, l)))
+            .or_else(|| span.clone().map(|s| text[s].trim().trim_matches('"').to_string()).filter(|s| s.len() < 40 && !s.contains('\n')))
+            .unwrap_or_default();
+        InputError { file: file.to_string(), line, key, message: e.message().trim().to_string() }
     })?;
     if sf.dimension != 2 {
         return Err(cx.err(&[k("dimension")], format!("dimension {} is not supported by the installed plugins (2D only)", sf.dimension)));
@@ -88,7 +96,7 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
         return Err(cx.err(&[], "the scene has no bodies"));
     }
     let nm = b.materials.len();
-    let laws = laws(&cx, &sf, registry, nm, &b)?;
+    let (laws, declared) = laws(&cx, &sf, registry, nm, &b)?;
     let origin_path = |o: Origin, key: &str| match o {
         Origin::Body(i) => vec![k("bodies"), Seg::Index(i), k(key)],
         Origin::Generated(i) => vec![k("generate"), Seg::Index(i)],
@@ -109,7 +117,7 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
     for ma in 0..nm {
         for mb in ma..nm {
             if let (Some(oa), Some(_)) = (first_mat[ma], first_mat[mb]) {
-                if (mat_movable[ma] || mat_movable[mb]) && laws[ma * nm + mb].is_none() {
+                if (mat_movable[ma] || mat_movable[mb]) && !declared[ma * nm + mb] {
                     return Err(cx.err(&origin_path(oa, "material"), format!("no law for the material pair (`{}`, `{}`): add a [[laws]] entry with materials = [\"{}\", \"{}\"]", b.materials[ma].name, b.materials[mb].name, b.materials[ma].name, b.materials[mb].name)));
                 }
             }
@@ -148,9 +156,16 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
     Detector::default().detect(&b.bodies, &b.shapes, &table, 0.0, &mut raw);
     for rc in &raw {
         let (i, j) = (rc.i as usize, rc.j as usize);
+        if laws[b.bodies.material[i] as usize * nm + b.bodies.material[j] as usize].is_none() {
+            continue; // materials declared never to interact
+        }
         let lim = tol * sizes[i].min(sizes[j]);
         if rc.gap < -lim {
-            return Err(cx.err(&origin_path(b.origins[i], "position"), format!("bodies {i} and {j} overlap by {:.3e} m, more than the tolerance {:.3e} m (detection.overlap_tolerance × the smaller size)", -rc.gap, lim)));
+            let label = |x: usize| match &b.names[x] {
+                Some(n) => format!("{x} (`{n}`)"),
+                None => format!("{x}"),
+            };
+            return Err(cx.err(&origin_path(b.origins[i], "position"), format!("bodies {} and {} overlap by {:.3e} m, more than the tolerance {:.3e} m (detection.overlap_tolerance × the smaller size)", label(i), label(j), -rc.gap, lim)));
         }
     }
     let box_walls = match &sf.output.box_walls {
@@ -239,24 +254,38 @@ fn materials(cx: &Ctx, sf: &SceneFile) -> Result<Vec<Material>, InputError> {
     Ok(out)
 }
 
-fn laws(cx: &Ctx, sf: &SceneFile, registry: &Registry, nm: usize, b: &SceneBuilder2) -> Result<Vec<Option<crate::law::ContactLaw>>, InputError> {
+/// The law table and, beside it, the pairs declared `law = "none"` (never interact).
+fn laws(cx: &Ctx, sf: &SceneFile, registry: &Registry, nm: usize, b: &SceneBuilder2) -> Result<(Vec<Option<crate::law::ContactLaw>>, Vec<bool>), InputError> {
     let mut table = vec![None; nm * nm];
+    let mut declared = vec![false; nm * nm];
     for (i, l) in sf.laws.iter().enumerate() {
         let base = [k("laws"), Seg::Index(i)];
-        let def = registry.laws.get(l.law.as_str()).ok_or_else(|| cx.err(&at(&base, &[k("law")]), format!("unknown law `{}`; installed: {}", l.law, registry.law_names().join(", "))))?;
+        let def = if l.law == "none" {
+            None
+        } else {
+            Some(registry.laws.get(l.law.as_str()).ok_or_else(|| cx.err(&at(&base, &[k("law")]), format!("unknown law `{}`; installed: none, {}", l.law, registry.law_names().join(", "))))?)
+        };
         let mut ids = [0u16; 2];
         for (s, name) in l.materials.iter().enumerate() {
             ids[s] = b.material(name).ok_or_else(|| cx.err(&at(&base, &[k("materials"), Seg::Index(s)]), format!("unknown material `{name}`")))?;
         }
-        let law = (def.parse)(&l.params).map_err(|e| cx.err(&at(&base, &[k(&e.key)]), e.msg))?;
+        let law = match def {
+            Some(def) => Some((def.parse)(&l.params).map_err(|e| cx.err(&at(&base, &[k(&e.key)]), e.msg))?),
+            None => {
+                crate::params::only_keys(&l.params, &[]).map_err(|e| cx.err(&at(&base, &[k(&e.key)]), e.msg))?;
+                None
+            }
+        };
         let (a, c) = (ids[0] as usize, ids[1] as usize);
-        if table[a * nm + c].is_some() {
+        if declared[a * nm + c] {
             return Err(cx.err(&at(&base, &[k("materials")]), "a law for this pair of materials is already given"));
         }
-        table[a * nm + c] = Some(law);
-        table[c * nm + a] = Some(law);
+        for (x, y) in [(a, c), (c, a)] {
+            table[x * nm + y] = law;
+            declared[x * nm + y] = true;
+        }
     }
-    Ok(table)
+    Ok((table, declared))
 }
 
 fn add_bodies(cx: &Ctx, sf: &SceneFile, b: &mut SceneBuilder2, drives: &mut Vec<BodyDrive2>) -> Result<(), InputError> {

@@ -93,7 +93,8 @@ pub struct MaterialSpec {
 pub struct LawSpec {
     /// The two materials (order irrelevant).
     pub materials: [String; 2],
-    /// Law kind: `coulomb` (default) or `frictionless`, or one a plugin registered.
+    /// Law kind: `coulomb` (default), `frictionless`, `none` (the two materials never
+    /// interact), or one a plugin registered.
     #[serde(default = "coulomb")]
     pub law: String,
     /// Law parameters (`friction`, `restitution`).
