@@ -1,0 +1,28 @@
+//! Physics validation: the engine's numbers against analytic answers.
+//!
+//! Each test states the analytic result, how it is measured, and why its tolerance
+//! is what it is. Run with
+//! `cargo test --release -p nscdd-tests --test physics -- --nocapture` to see every
+//! measured number beside its expected value.
+//!
+//! - [`incline`]: a block and a free disk on an incline (stick/slip thresholds
+//!   tan α = μ and μ = tan α / 3, accelerations, impulses);
+//! - [`stacks`]: a column of disks (force under the k-th disk = k m g) and a
+//!   three-disk pyramid (friction threshold 2 − √3, statics' forces);
+//! - [`impacts`]: Newton's cradle (Moreau's simultaneous impact law) and a
+//!   bouncing ball (rest time, energy conservation with θ = ½, e = 1);
+//! - [`determinism`]: bitwise-identical reruns.
+
+mod common;
+
+#[path = "physics/incline.rs"]
+mod incline;
+
+#[path = "physics/stacks.rs"]
+mod stacks;
+
+#[path = "physics/impacts.rs"]
+mod impacts;
+
+#[path = "physics/determinism.rs"]
+mod determinism;
