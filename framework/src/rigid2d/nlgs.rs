@@ -62,13 +62,25 @@ pub fn sweep(c: &mut Contacts2, vel: &mut [[f64; 3]], inv_mass: &[[f64; 3]], ord
         mu: &c.mu[..m],
         r: &mut c.r[..m],
     };
+    // one monomorphized loop per case, so that the plain sweep carries no check or
+    // relaxation code (fewer live values, no spills)
+    match (sums.as_deref_mut(), omega != 1.0) {
+        (None, false) => run::<false, false>(&mut h, order, vel, inv_mass, omega, &mut Sums::default()),
+        (None, true) => run::<false, true>(&mut h, order, vel, inv_mass, omega, &mut Sums::default()),
+        (Some(s), false) => run::<true, false>(&mut h, order, vel, inv_mass, omega, s),
+        (Some(s), true) => run::<true, true>(&mut h, order, vel, inv_mass, omega, s),
+    }
+}
+
+#[inline(always)]
+fn run<const CHECK: bool, const RELAX: bool>(h: &mut Hot<'_>, order: &[u32], vel: &mut [[f64; 3]], inv_mass: &[[f64; 3]], omega: f64, sums: &mut Sums) {
     if order.is_empty() {
-        for a in 0..m {
-            visit(&mut h, a, vel, inv_mass, omega, sums.as_deref_mut());
+        for a in 0..h.i.len() {
+            visit::<CHECK, RELAX>(h, a, vel, inv_mass, omega, sums);
         }
     } else {
         for &a in order {
-            visit(&mut h, a as usize, vel, inv_mass, omega, sums.as_deref_mut());
+            visit::<CHECK, RELAX>(h, a as usize, vel, inv_mass, omega, sums);
         }
     }
 }
@@ -76,7 +88,7 @@ pub fn sweep(c: &mut Contacts2, vel: &mut [[f64; 3]], inv_mass: &[[f64; 3]], ord
 /// Solves contact α with the others' impulses fixed and updates its two bodies:
 /// u = H_αᵀ V, u0 = u − W_αα r_α, r_α ← local solution, V += M̂⁻¹ H_α Δr_α.
 #[inline(always)]
-fn visit(h: &mut Hot<'_>, a: usize, vel: &mut [[f64; 3]], inv_mass: &[[f64; 3]], omega: f64, sums: Option<&mut Sums>) {
+fn visit<const CHECK: bool, const RELAX: bool>(h: &mut Hot<'_>, a: usize, vel: &mut [[f64; 3]], inv_mass: &[[f64; 3]], omega: f64, sums: &mut Sums) {
     let (bi, bj) = (h.i[a] as usize, h.j[a] as usize);
     let n = h.n[a];
     let (ai, aj) = (h.arm_i[a], h.arm_j[a]);
@@ -88,14 +100,14 @@ fn visit(h: &mut Hot<'_>, a: usize, vel: &mut [[f64; 3]], inv_mass: &[[f64; 3]],
     let wr_old = [w[0] * r[0] + w[1] * r[1], w[1] * r[0] + w[2] * r[1]];
     let u0 = [u[0] - wr_old[0], u[1] - wr_old[1]];
     let mut rn = coulomb::solve_pre(w, &h.w_pre[a], u0, h.u_target[a], h.mu[a]);
-    if omega != 1.0 {
+    if RELAX {
         rn = [omega * rn[0] + (1.0 - omega) * r[0], omega * rn[1] + (1.0 - omega) * r[1]];
     }
     let dr = [rn[0] - r[0], rn[1] - r[1]];
-    if let Some(s) = sums {
+    if CHECK {
         let wr = [w[0] * rn[0] + w[1] * rn[1], w[1] * rn[0] + w[2] * rn[1]];
         let du = [wr[0] - wr_old[0], wr[1] - wr_old[1]];
-        s.add(&r, &rn, &du, &wr_old, &wr);
+        sums.add(&r, &rn, &du, &wr_old, &wr);
     }
     if dr[0] != 0.0 || dr[1] != 0.0 {
         h.r[a] = rn;
