@@ -104,12 +104,14 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
     // every pair of materials that can touch needs a law; every pair of kinds a detector
     let nk = b.shapes.len();
     let mut first_mat = vec![None; nm];
+    let mut mat_count = vec![0usize; nm];
     let mut mat_movable = vec![false; nm];
     let mut first_kind = vec![None; nk];
     let mut kind_movable = vec![false; nk];
     for i in 0..b.bodies.len() {
         let (m, kd, mv) = (b.bodies.material[i] as usize, b.bodies.shape[i].kind as usize, b.bodies.movable(i) || drives.iter().any(|d: &BodyDrive2| d.body as usize == i));
         first_mat[m].get_or_insert(b.origins[i]);
+        mat_count[m] += 1;
         first_kind[kd].get_or_insert(b.origins[i]);
         mat_movable[m] |= mv;
         kind_movable[kd] |= mv;
@@ -117,7 +119,9 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
     for ma in 0..nm {
         for mb in ma..nm {
             if let (Some(oa), Some(_)) = (first_mat[ma], first_mat[mb]) {
-                if (mat_movable[ma] || mat_movable[mb]) && !declared[ma * nm + mb] {
+                // a material touches itself only if two bodies are made of it
+                let can_touch = ma != mb || mat_count[ma] >= 2;
+                if can_touch && (mat_movable[ma] || mat_movable[mb]) && !declared[ma * nm + mb] {
                     return Err(cx.err(&origin_path(oa, "material"), format!("no law for the material pair (`{}`, `{}`): add a [[laws]] entry with materials = [\"{}\", \"{}\"]", b.materials[ma].name, b.materials[mb].name, b.materials[ma].name, b.materials[mb].name)));
                 }
             }
