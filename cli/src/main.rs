@@ -115,6 +115,16 @@ fn main() -> ExitCode {
                             sum.first_unconverged.unwrap_or(0)
                         );
                     }
+                    if sum.suspect_steps > 0 {
+                        eprintln!(
+                            "warning: {} steps met the {} criterion with a natural-map residual above {} × tolerance (largest {:.2e} at step {}): the solve stalled; lower solver.tolerance (docs/EXTREMES.md)",
+                            sum.suspect_steps,
+                            s.world.solver.norm.name(),
+                            nscdd::run::SUSPECT_FACTOR,
+                            sum.max_residual,
+                            sum.max_residual_step
+                        );
+                    }
                     eprintln!("{} steps, {} sweeps, {:.2} s; outputs in {}", sum.steps, sum.total_sweeps, sum.wall_seconds, out.display());
                     ExitCode::SUCCESS
                 }

@@ -36,7 +36,18 @@ pub struct RunSummary {
     pub first_unconverged: Option<u64>,
     pub total_sweeps: u64,
     pub wall_seconds: f64,
+    /// Steps the criterion accepted although their natural-map residual exceeds
+    /// [`SUSPECT_FACTOR`] × tolerance: LMGC90's norms measure the change over a sweep,
+    /// so a stalled solve can pass them (see docs/EXTREMES.md).
+    pub suspect_steps: u64,
+    /// Largest natural-map residual of the run, and its step.
+    pub max_residual: f64,
+    pub max_residual_step: u64,
 }
+
+/// A converged step whose residual exceeds this factor × the solver tolerance is
+/// counted as suspect.
+pub const SUSPECT_FACTOR: f64 = 100.0;
 
 fn io(dir: &Path, what: &str) -> impl Fn(std::io::Error) -> RunError {
     let d = dir.display().to_string();
@@ -90,6 +101,12 @@ pub fn run(scene: &mut Scene, registry: &Registry, dir: &Path, mut on_step: impl
         if !rep.solve.converged {
             sum.unconverged_steps += 1;
             sum.first_unconverged.get_or_insert(w.step);
+        } else if rep.solve.residual > SUSPECT_FACTOR * w.solver.tolerance {
+            sum.suspect_steps += 1;
+        }
+        if rep.solve.residual > sum.max_residual {
+            sum.max_residual = rep.solve.residual;
+            sum.max_residual_step = w.step;
         }
         on_step(w, &rep);
     }
