@@ -16,7 +16,7 @@
 
 use crate::drive::Imposed;
 use crate::law::target_velocity;
-use crate::rigid2d::contacts::ContactKey;
+use crate::rigid2d::contacts::{Block2, ContactKey, Frame2, Target};
 use crate::rigid2d::{nlgs, Contacts2};
 use crate::solver::SolveReport;
 use crate::world::World2;
@@ -146,7 +146,8 @@ pub fn build_contacts(w: &mut World2) {
             [d[0] * n[1] - d[1] * n[0], d[0] * t[1] - d[1] * t[0]]
         };
         let (ai, aj) = (arm(b.pos[i]), arm(b.pos[j]));
-        let wb = Contacts2::delassus(n, ai, aj, b.inv_mass[i], b.inv_mass[j]);
+        let frame = Frame2 { n, arm_i: ai, arm_j: aj };
+        let wb = Contacts2::delassus(&frame, b.inv_mass[i], b.inv_mass[j]);
         if !(wb[0] > 0.0) {
             continue;
         }
@@ -158,15 +159,10 @@ pub fn build_contacts(w: &mut World2) {
             Ok(p) => s.prev_keys[p].1,
             Err(_) => [0.0, 0.0],
         };
-        c.i.push(rc.i);
-        c.j.push(rc.j);
-        c.n.push(n);
-        c.arm_i.push(ai);
-        c.arm_j.push(aj);
-        c.w.push(wb);
-        c.w_pre.push(crate::rigid2d::coulomb::precompute(wb, law.mu));
-        c.u_target.push(target_velocity(rc.gap, u_begin[0], u_free[0], h, theta, law.e));
-        c.mu.push(law.mu);
+        c.bodies.push([rc.i, rc.j]);
+        c.frame.push(frame);
+        c.block.push(Block2 { w: wb, pre: crate::rigid2d::coulomb::precompute(wb, law.mu) });
+        c.target.push(Target { u_target: target_velocity(rc.gap, u_begin[0], u_free[0], h, theta, law.e), mu: law.mu });
         c.r.push(r);
         c.u_free.push(u_free);
         c.gap.push(rc.gap);
@@ -205,10 +201,10 @@ pub fn update_positions(w: &mut World2) -> Result<(), Diverged> {
     w.reaction.clear();
     w.reaction.resize(w.bodies.len(), [0.0; 3]);
     for a in 0..c.len() {
-        let (n, r) = (c.n[a], c.r[a]);
+        let (Frame2 { n, arm_i: ai, arm_j: aj }, r) = (c.frame[a], c.r[a]);
         let p = [r[0] * n[0] - r[1] * n[1], r[0] * n[1] + r[1] * n[0]];
-        let (i, j) = (c.i[a] as usize, c.j[a] as usize);
-        let (ai, aj) = (c.arm_i[a], c.arm_j[a]);
+        let [i, j] = c.bodies[a];
+        let (i, j) = (i as usize, j as usize);
         let ri = &mut w.reaction[i];
         ri[0] += p[0];
         ri[1] += p[1];

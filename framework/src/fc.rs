@@ -469,18 +469,18 @@ pub fn problem_from_world(w: &World2) -> FcProblem {
     let nc = c.len();
     // H_bᵀ (2 × 3) of contact a seen from body b, with its sign.
     let h_of = |a: usize, arm: [f64; 2], s: f64| {
-        let n = c.n[a];
+        let n = c.frame[a].n;
         [[s * n[0], s * n[1], s * arm[0]], [-s * n[1], s * n[0], s * arm[1]]]
     };
     // (body, contact, H_bᵀ) for the bodies impulses can move, grouped by body.
     let mut inc: Vec<(u32, u32, [[f64; 3]; 2])> = Vec::with_capacity(2 * nc);
     for a in 0..nc {
-        let (i, j) = (c.i[a], c.j[a]);
+        let [i, j] = c.bodies[a];
         if b.movable(i as usize) {
-            inc.push((i, a as u32, h_of(a, c.arm_i[a], 1.0)));
+            inc.push((i, a as u32, h_of(a, c.frame[a].arm_i, 1.0)));
         }
         if b.movable(j as usize) {
-            inc.push((j, a as u32, h_of(a, c.arm_j[a], -1.0)));
+            inc.push((j, a as u32, h_of(a, c.frame[a].arm_j, -1.0)));
         }
     }
     inc.sort_by_key(|x| (x.0, x.1));
@@ -527,7 +527,7 @@ pub fn problem_from_world(w: &World2) -> FcProblem {
     trip.sort_by_key(|x| (x.0, x.1));
     let mut q = Vec::with_capacity(2 * nc);
     for a in 0..nc {
-        q.push(c.u_free[a][0] - c.u_target[a]);
+        q.push(c.u_free[a][0] - c.target[a].u_target);
         q.push(c.u_free[a][1]);
     }
     let meta = serde_json::json!({
@@ -543,7 +543,7 @@ pub fn problem_from_world(w: &World2) -> FcProblem {
             vals: trip.iter().map(|x| x.2).collect(),
         },
         q,
-        mu: c.mu.clone(),
+        mu: c.target.iter().map(|t| t.mu).collect(),
         meta: Some(meta),
     }
 }

@@ -45,7 +45,7 @@ fn detected(text: &str) -> BTreeSet<(u32, u32)> {
     let mut s = load_str(text, "detect.toml", &reg).unwrap_or_else(|e| panic!("{e}"));
     s.world.step().unwrap();
     let c = &s.world.contacts;
-    (0..c.len()).map(|a| (c.i[a].max(c.j[a]), c.i[a].min(c.j[a]))).map(|(i, j)| if j < 2 { (i, j) } else { (j, i) }).collect()
+    (0..c.len()).map(|a| (c.bodies[a][0].max(c.bodies[a][1]), c.bodies[a][0].min(c.bodies[a][1]))).map(|(i, j)| if j < 2 { (i, j) } else { (j, i) }).collect()
 }
 
 fn check(disks: Vec<([f64; 2], f64)>, alert: f64) {

@@ -229,7 +229,7 @@ fn generated(label: &str, toml: &str, steps: usize, at_rest: bool) -> (usize, u3
     }
     // Diagonal blocks agree with the world's W_αα.
     for a in 0..nc {
-        let wa = w.contacts.w[a];
+        let wa = w.contacts.block[a].w;
         for (ij, x) in [((2 * a, 2 * a), wa[0]), ((2 * a, 2 * a + 1), wa[1]), ((2 * a + 1, 2 * a + 1), wa[2])] {
             let y = entries.binary_search_by(|e| e.0.cmp(&ij)).map(|k| entries[k].1).unwrap_or(0.0);
             assert!((x - y).abs() <= 1e-12 * wa[0].abs().max(wa[2].abs()), "{label}: W_αα of contact {a}: {x} vs {y}");
@@ -243,7 +243,7 @@ fn generated(label: &str, toml: &str, steps: usize, at_rest: bool) -> (usize, u3
     let mut f2 = 0.0;
     for a in 0..nc {
         let mut uw = w.contacts.local_velocity(a, &w.bodies.vel);
-        uw[0] -= w.contacts.u_target[a];
+        uw[0] -= w.contacts.target[a].u_target;
         let tol = 1e4 * rho[a] + 1e-15;
         assert!((uw[0] - u[2 * a]).abs() <= tol && (uw[1] - u[2 * a + 1]).abs() <= tol, "{label}: contact {a}: world u = {uw:?}, W r + q = {:?}", &u[2 * a..2 * a + 2]);
         f2 += nscdd::norms::natural_map_sq(&r_world[2 * a..2 * a + 2], &u[2 * a..2 * a + 2], raw.mu[a]);
@@ -267,11 +267,11 @@ fn generated(label: &str, toml: &str, steps: usize, at_rest: bool) -> (usize, u3
     let floor = w.names.iter().position(|n| n.as_deref() == Some("floor")).unwrap() as u32;
     let mut on_floor = 0.0;
     for a in 0..nc {
-        let (n, r) = (w.contacts.n[a], [sol.r[2 * a], sol.r[2 * a + 1]]);
+        let (n, r) = (w.contacts.frame[a].n, [sol.r[2 * a], sol.r[2 * a + 1]]);
         let py = r[0] * n[1] + r[1] * n[0]; // impulse on body i along y
-        if w.contacts.j[a] == floor {
+        if w.contacts.bodies[a][1] == floor {
             on_floor -= py;
-        } else if w.contacts.i[a] == floor {
+        } else if w.contacts.bodies[a][0] == floor {
             on_floor += py;
         }
     }

@@ -61,7 +61,7 @@ pub fn final_json(w: &World2) -> String {
         })
         .collect();
     let c = &w.contacts;
-    let contacts = (0..c.len()).map(|a| ContactOut { bodies: [c.i[a], c.j[a]], point: c.point[a], normal: c.n[a], r_n: c.r[a][0], r_t: c.r[a][1], gap: c.gap[a] }).collect();
+    let contacts = (0..c.len()).map(|a| ContactOut { bodies: c.bodies[a], point: c.point[a], normal: c.frame[a].n, r_n: c.r[a][0], r_t: c.r[a][1], gap: c.gap[a] }).collect();
     let mut s = serde_json::to_string_pretty(&FinalOut { step: w.step, time: w.t, bodies, contacts }).expect("plain data serializes");
     s.push('\n');
     s

@@ -118,9 +118,10 @@ impl Writer2 for VtkWriter {
         let mut cpts = Vec::with_capacity(6 * m);
         let (mut rn, mut rt, mut fnn, mut gap) = (vec![], vec![], vec![], vec![]);
         for a in 0..m {
-            let (pi, pj) = (b.pos[c.i[a] as usize], b.pos[c.j[a] as usize]);
+            let [i, j] = c.bodies[a];
+            let (pi, pj) = (b.pos[i as usize], b.pos[j as usize]);
             // towards a wall, draw the line to the contact point
-            let pj = if b.movable(c.j[a] as usize) { pj } else { c.point[a] };
+            let pj = if b.movable(j as usize) { pj } else { c.point[a] };
             cpts.extend_from_slice(&[pi[0], pi[1], 0.0, pj[0], pj[1], 0.0]);
             rn.push(c.r[a][0]);
             rt.push(c.r[a][1]);

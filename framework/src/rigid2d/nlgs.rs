@@ -8,7 +8,8 @@
 //! check pass (see [`crate::norms`]). The loop holds only slices of plain data: no
 //! allocation and no dynamic dispatch per contact.
 
-use super::{contacts::Contacts2, coulomb};
+use super::contacts::{apply, local_velocity, Block2, Contacts2, Frame2, Target};
+use super::coulomb;
 use crate::norms::{natural_map_sq, Norms, Sums};
 use crate::solver::{Ordering, SolveReport, SolverSettings};
 use rand::seq::SliceRandom;
@@ -33,15 +34,10 @@ pub fn make_order(order: &mut Vec<u32>, n: usize, s: &SolverSettings, step: u64)
 /// The contact fields a sweep reads, sliced to one length so that indexing them
 /// in storage order needs no bounds checks.
 struct Hot<'a> {
-    i: &'a [u32],
-    j: &'a [u32],
-    n: &'a [[f64; 2]],
-    arm_i: &'a [[f64; 2]],
-    arm_j: &'a [[f64; 2]],
-    w: &'a [[f64; 3]],
-    w_pre: &'a [[f64; 5]],
-    u_target: &'a [f64],
-    mu: &'a [f64],
+    bodies: &'a [[u32; 2]],
+    frame: &'a [Frame2],
+    block: &'a [Block2],
+    target: &'a [Target],
     r: &'a mut [[f64; 2]],
 }
 
@@ -50,18 +46,7 @@ struct Hot<'a> {
 #[inline(never)]
 pub fn sweep(c: &mut Contacts2, vel: &mut [[f64; 3]], inv_mass: &[[f64; 3]], order: &[u32], omega: f64, mut sums: Option<&mut Sums>) {
     let m = c.len();
-    let mut h = Hot {
-        i: &c.i[..m],
-        j: &c.j[..m],
-        n: &c.n[..m],
-        arm_i: &c.arm_i[..m],
-        arm_j: &c.arm_j[..m],
-        w: &c.w[..m],
-        w_pre: &c.w_pre[..m],
-        u_target: &c.u_target[..m],
-        mu: &c.mu[..m],
-        r: &mut c.r[..m],
-    };
+    let mut h = Hot { bodies: &c.bodies[..m], frame: &c.frame[..m], block: &c.block[..m], target: &c.target[..m], r: &mut c.r[..m] };
     // one monomorphized loop per case, so that the plain sweep carries no check or
     // relaxation code (fewer live values, no spills)
     match (sums.as_deref_mut(), omega != 1.0) {
@@ -75,7 +60,7 @@ pub fn sweep(c: &mut Contacts2, vel: &mut [[f64; 3]], inv_mass: &[[f64; 3]], ord
 #[inline(always)]
 fn run<const CHECK: bool, const RELAX: bool>(h: &mut Hot<'_>, order: &[u32], vel: &mut [[f64; 3]], inv_mass: &[[f64; 3]], omega: f64, sums: &mut Sums) {
     if order.is_empty() {
-        for a in 0..h.i.len() {
+        for a in 0..h.bodies.len() {
             visit::<CHECK, RELAX>(h, a, vel, inv_mass, omega, sums);
         }
     } else {
@@ -89,17 +74,16 @@ fn run<const CHECK: bool, const RELAX: bool>(h: &mut Hot<'_>, order: &[u32], vel
 /// u = H_αᵀ V, u0 = u − W_αα r_α, r_α ← local solution, V += M̂⁻¹ H_α Δr_α.
 #[inline(always)]
 fn visit<const CHECK: bool, const RELAX: bool>(h: &mut Hot<'_>, a: usize, vel: &mut [[f64; 3]], inv_mass: &[[f64; 3]], omega: f64, sums: &mut Sums) {
-    let (bi, bj) = (h.i[a] as usize, h.j[a] as usize);
-    let n = h.n[a];
-    let (ai, aj) = (h.arm_i[a], h.arm_j[a]);
-    let (vi, vj) = (vel[bi], vel[bj]);
-    let dv = [vi[0] - vj[0], vi[1] - vj[1]];
-    let u = [n[0] * dv[0] + n[1] * dv[1] + ai[0] * vi[2] - aj[0] * vj[2], -n[1] * dv[0] + n[0] * dv[1] + ai[1] * vi[2] - aj[1] * vj[2]];
+    let [bi, bj] = h.bodies[a];
+    let (bi, bj) = (bi as usize, bj as usize);
+    let f = h.frame[a];
+    let u = local_velocity(&f, vel[bi], vel[bj]);
     let r = h.r[a];
-    let w = h.w[a];
+    let Block2 { w, pre } = h.block[a];
     let wr_old = [w[0] * r[0] + w[1] * r[1], w[1] * r[0] + w[2] * r[1]];
     let u0 = [u[0] - wr_old[0], u[1] - wr_old[1]];
-    let mut rn = coulomb::solve_pre(w, &h.w_pre[a], u0, h.u_target[a], h.mu[a]);
+    let t = h.target[a];
+    let mut rn = coulomb::solve_pre(w, &pre, u0, t.u_target, t.mu);
     if RELAX {
         rn = [omega * rn[0] + (1.0 - omega) * r[0], omega * rn[1] + (1.0 - omega) * r[1]];
     }
@@ -111,18 +95,7 @@ fn visit<const CHECK: bool, const RELAX: bool>(h: &mut Hot<'_>, a: usize, vel: &
     }
     if dr[0] != 0.0 || dr[1] != 0.0 {
         h.r[a] = rn;
-        let px = dr[0] * n[0] - dr[1] * n[1];
-        let py = dr[0] * n[1] + dr[1] * n[0];
-        let mi = inv_mass[bi];
-        let v = &mut vel[bi];
-        v[0] += mi[0] * px;
-        v[1] += mi[1] * py;
-        v[2] += mi[2] * (ai[0] * dr[0] + ai[1] * dr[1]);
-        let mj = inv_mass[bj];
-        let v = &mut vel[bj];
-        v[0] -= mj[0] * px;
-        v[1] -= mj[1] * py;
-        v[2] -= mj[2] * (aj[0] * dr[0] + aj[1] * dr[1]);
+        apply(&f, dr, bi, bj, vel, inv_mass);
     }
 }
 
@@ -159,10 +132,11 @@ pub fn residual(c: &Contacts2, vel: &[[f64; 3]]) -> f64 {
     let mut f2 = 0.0;
     let mut q2 = 0.0;
     for a in 0..c.len() {
+        let t = c.target[a];
         let mut u = c.local_velocity(a, vel);
-        u[0] -= c.u_target[a];
-        f2 += natural_map_sq(&c.r[a], &u, c.mu[a]);
-        let q = [c.u_free[a][0] - c.u_target[a], c.u_free[a][1]];
+        u[0] -= t.u_target;
+        f2 += natural_map_sq(&c.r[a], &u, t.mu);
+        let q = [c.u_free[a][0] - t.u_target, c.u_free[a][1]];
         q2 += q[0] * q[0] + q[1] * q[1];
     }
     if q2 == 0.0 {

@@ -64,14 +64,14 @@ pub fn disk_mass(density: f64, r: f64) -> f64 {
 /// World-frame impulse on the candidate body i of contact a: r_n n + r_t t.
 pub fn impulse_on_i(s: &Scene, a: usize) -> [f64; 2] {
     let c = &s.world.contacts;
-    let (n, r) = (c.n[a], c.r[a]);
+    let (n, r) = (c.frame[a].n, c.r[a]);
     [r[0] * n[0] - r[1] * n[1], r[0] * n[1] + r[1] * n[0]]
 }
 
 /// Index of the contact between bodies p and q (either order), if any.
 pub fn contact_between(s: &Scene, p: u32, q: u32) -> Option<usize> {
     let c = &s.world.contacts;
-    (0..c.len()).find(|&a| (c.i[a] == p && c.j[a] == q) || (c.i[a] == q && c.j[a] == p))
+    (0..c.len()).find(|&a| c.bodies[a] == [p, q] || c.bodies[a] == [q, p])
 }
 
 /// Solves A x = b by Gaussian elimination with partial pivoting (small dense).
