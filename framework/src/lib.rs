@@ -20,6 +20,7 @@
 //! }
 //! ```
 
+pub mod dd;
 pub mod detect;
 pub mod drive;
 pub mod engine;

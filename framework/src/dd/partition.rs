@@ -1,0 +1,299 @@
+//! Partition of one step's contact set into subdomains, and the interface bodies.
+//!
+//! Each contact belongs to exactly one subdomain: the cell of an nx × ny grid over
+//! the bounding box of the contact points that holds its point (points on the upper
+//! edges go to the last cell). A body belongs to every subdomain that owns one of
+//! its contacts; its multiplicity m is that count. Movable bodies with m ≥ 2 are the
+//! interface bodies, one copy per subdomain, glued; immovable bodies (M̂⁻¹ = 0) are
+//! copied into every subdomain that needs them without gluing.
+
+use super::subdomain::{Neighbor, Subdomain2, OWN};
+use crate::rigid2d::{Bodies2, Contacts2};
+
+/// The grid of subdomains over the contact points' bounding box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Grid {
+    pub nx: u32,
+    pub ny: u32,
+    pub origin: [f64; 2],
+    pub cell: [f64; 2],
+}
+
+impl Grid {
+    pub fn over(points: &[[f64; 2]], nx: u32, ny: u32) -> Grid {
+        let (nx, ny) = (nx.max(1), ny.max(1));
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in points.iter().filter(|p| p[0].is_finite() && p[1].is_finite()) {
+            for d in 0..2 {
+                lo[d] = lo[d].min(p[d]);
+                hi[d] = hi[d].max(p[d]);
+            }
+        }
+        if lo[0] > hi[0] {
+            (lo, hi) = ([0.0; 2], [0.0; 2]);
+        }
+        Grid {
+            nx,
+            ny,
+            origin: lo,
+            cell: [(hi[0] - lo[0]) / nx as f64, (hi[1] - lo[1]) / ny as f64],
+        }
+    }
+    pub fn len(&self) -> usize {
+        (self.nx * self.ny) as usize
+    }
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    /// Subdomain id `cx + nx cy` of a point.
+    pub fn cell_of(&self, p: [f64; 2]) -> u32 {
+        let c = |d: usize, n: u32| {
+            // a flat box (or NaN) puts every point in the first cell
+            if self.cell[d].is_nan() || self.cell[d] <= 0.0 {
+                return 0;
+            }
+            let k = ((p[d] - self.origin[d]) / self.cell[d]).floor();
+            if k >= 0.0 {
+                (k as u32).min(n - 1)
+            } else {
+                0
+            }
+        };
+        c(0, self.nx) + self.nx * c(1, self.ny)
+    }
+}
+
+/// The interface bodies and their copies, in ascending body id; copy lists in
+/// subdomain order (the chain order).
+#[derive(Clone, Debug, Default)]
+pub struct Interface {
+    /// Global body id.
+    pub body: Vec<u32>,
+    /// ρ² = I/m of the body (0 when undefined), for the gluing norm.
+    pub rho2: Vec<f64>,
+    /// Whether some copy had no F_Γ from the previous step (glued once before the
+    /// first sweep).
+    pub fresh: Vec<bool>,
+    /// Copies of body `ib`: `start[ib]..start[ib + 1]`.
+    pub start: Vec<u32>,
+    pub sub: Vec<u32>,
+    pub slot: Vec<u32>,
+}
+
+impl Interface {
+    pub fn len(&self) -> usize {
+        self.body.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.body.is_empty()
+    }
+    pub fn copies(&self, ib: usize) -> std::ops::Range<usize> {
+        self.start[ib] as usize..self.start[ib + 1] as usize
+    }
+    pub fn links(&self) -> usize {
+        self.sub.len() - self.body.len()
+    }
+}
+
+/// F_Γ of the interface copies, kept between steps: (body, subdomain) → impulse.
+#[derive(Clone, Debug, Default)]
+pub struct FGammaStore {
+    entries: Vec<(u32, u32, [f64; 3])>,
+}
+
+impl FGammaStore {
+    pub fn get(&self, body: u32, sub: u32) -> Option<[f64; 3]> {
+        self.entries
+            .binary_search_by_key(&(body, sub), |e| (e.0, e.1))
+            .ok()
+            .map(|p| self.entries[p].2)
+    }
+    /// Number of copies stored for `body`.
+    pub fn count(&self, body: u32) -> usize {
+        let lo = self.entries.partition_point(|e| e.0 < body);
+        let hi = self.entries.partition_point(|e| e.0 <= body);
+        hi - lo
+    }
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+    /// (body, subdomain, F_Γ), by body then subdomain.
+    pub fn iter(&self) -> impl Iterator<Item = (u32, u32, [f64; 3])> + '_ {
+        self.entries.iter().copied()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+    /// Replaces the store by the subdomains' current F_Γ.
+    pub fn keep(&mut self, subs: &[Subdomain2]) {
+        self.entries.clear();
+        for s in subs {
+            for (q, &l) in s.iface.iter().enumerate() {
+                self.entries.push((s.body_global[l as usize], s.id, s.f_gamma[q]));
+            }
+        }
+        self.entries.sort_unstable_by_key(|e| (e.0, e.1));
+    }
+}
+
+/// One step's decomposition.
+#[derive(Clone, Debug, Default)]
+pub struct Decomposition {
+    pub grid: Option<Grid>,
+    /// Subdomain of each global contact.
+    pub owner: Vec<u32>,
+    /// Number of subdomains holding a copy of each global body (0: none).
+    pub mult: Vec<u32>,
+    pub subs: Vec<Subdomain2>,
+    pub iface: Interface,
+}
+
+/// Splits the contact set `c` (built on `b`) over an nx × ny grid; copies start at
+/// V_free + M̂_E⁻¹(F_Γ + H_E r). `order` is the one-domain visiting order (empty:
+/// storage order).
+pub fn decompose(c: &Contacts2, b: &Bodies2, v_free: &[[f64; 3]], order: &[u32], nx: u32, ny: u32, store: &FGammaStore) -> Decomposition {
+    let grid = Grid::over(&c.point, nx, ny);
+    let ns = grid.len();
+    let nb = b.len();
+    let owner: Vec<u32> = c.point.iter().map(|&p| grid.cell_of(p)).collect();
+    let mut subs: Vec<Subdomain2> = (0..ns)
+        .map(|s| Subdomain2 {
+            id: s as u32,
+            ..Default::default()
+        })
+        .collect();
+    // contacts in storage order, copies on first sight
+    let (mut stamp, mut local) = (vec![u32::MAX; nb], vec![0u32; nb]);
+    let mut mult = vec![0u32; nb];
+    let mut by_sub: Vec<Vec<u32>> = vec![Vec::new(); ns];
+    for (a, &s) in owner.iter().enumerate() {
+        by_sub[s as usize].push(a as u32);
+    }
+    let mut copy_of: Vec<(u32, u32, u32)> = Vec::new(); // (body, sub, local)
+    for (s, sub) in subs.iter_mut().enumerate() {
+        for &a in &by_sub[s] {
+            let a = a as usize;
+            let mut id = |g: u32| {
+                let gi = g as usize;
+                if stamp[gi] != s as u32 {
+                    stamp[gi] = s as u32;
+                    local[gi] = sub.body_global.len() as u32;
+                    sub.body_global.push(g);
+                    mult[gi] += 1;
+                    copy_of.push((g, s as u32, local[gi]));
+                }
+                local[gi]
+            };
+            let (li, lj) = (id(c.bodies[a][0]), id(c.bodies[a][1]));
+            sub.push_contact(c, a, li, lj);
+        }
+    }
+    // copies' M̂_E⁻¹ and W_αα; the visiting order restricted to each subdomain
+    let mut local_of = vec![0u32; c.len()];
+    for sub in subs.iter_mut() {
+        sub.inv_mass = sub
+            .body_global
+            .iter()
+            .map(|&g| {
+                let (im, m) = (b.inv_mass[g as usize], mult[g as usize] as f64);
+                [im[0] * m, im[1] * m, im[2] * m]
+            })
+            .collect();
+        sub.copy_delassus();
+        for (la, &ga) in sub.contact_global.iter().enumerate() {
+            local_of[ga as usize] = la as u32;
+        }
+    }
+    for &a in order {
+        subs[owner[a as usize] as usize].order.push(local_of[a as usize]);
+    }
+    // interface bodies: copies grouped by body, in subdomain order
+    copy_of.sort_by_key(|e| e.0); // stable: subdomain order kept
+    let mut iface = Interface {
+        start: vec![0],
+        ..Default::default()
+    };
+    let mut p = 0;
+    while p < copy_of.len() {
+        let g = copy_of[p].0;
+        let m = mult[g as usize] as usize;
+        let copies = &copy_of[p..p + m];
+        p += m;
+        if m < 2 || !b.movable(g as usize) {
+            continue;
+        }
+        let ib = iface.body.len() as u32;
+        let ms = b.mass[g as usize];
+        iface.body.push(g);
+        iface.rho2.push(if ms[0] > 0.0 && ms[0].is_finite() && ms[2].is_finite() {
+            ms[2] / ms[0]
+        } else {
+            0.0
+        });
+        // F_Γ from the previous step where the same subdomain held a copy, made to sum to zero
+        let mut fresh = store.count(g) != m;
+        let mut f: Vec<[f64; 3]> = copies
+            .iter()
+            .map(|&(_, s, _)| {
+                store.get(g, s).unwrap_or_else(|| {
+                    fresh = true;
+                    [0.0; 3]
+                })
+            })
+            .collect();
+        if fresh {
+            let mean: Vec<f64> = (0..3).map(|d| f.iter().map(|x| x[d]).sum::<f64>() / m as f64).collect();
+            for x in f.iter_mut() {
+                for d in 0..3 {
+                    x[d] -= mean[d];
+                }
+            }
+        }
+        iface.fresh.push(fresh);
+        for (k, &(_, s, l)) in copies.iter().enumerate() {
+            let sub = &mut subs[s as usize];
+            iface.sub.push(s);
+            iface.slot.push(sub.iface.len() as u32);
+            sub.iface.push(l);
+            sub.iface_ib.push(ib);
+            sub.iface_k.push(k as u32);
+            sub.f_gamma.push(f[k]);
+        }
+        iface.start.push(iface.sub.len() as u32);
+    }
+    // neighbors and chains
+    for sub in subs.iter_mut() {
+        sub.chain_start.push(0);
+        for q in 0..sub.iface.len() {
+            let ib = sub.iface_ib[q] as usize;
+            for k in iface.copies(ib) {
+                let t = iface.sub[k];
+                if t == sub.id {
+                    sub.chain.push((OWN, q as u32));
+                    continue;
+                }
+                let ni = match sub.neighbors.iter().position(|n| n.sub == t) {
+                    Some(ni) => ni,
+                    None => {
+                        sub.neighbors.push(Neighbor { sub: t, slots: Vec::new() });
+                        sub.neighbors.len() - 1
+                    }
+                };
+                let nbr = &mut sub.neighbors[ni];
+                sub.chain.push((ni as u32, nbr.slots.len() as u32));
+                nbr.slots.push(q as u32);
+            }
+            sub.chain_start.push(sub.chain.len() as u32);
+        }
+    }
+    for sub in subs.iter_mut() {
+        sub.init_velocities(v_free);
+    }
+    Decomposition {
+        grid: Some(grid),
+        owner,
+        mult,
+        subs,
+        iface,
+    }
+}

@@ -1,0 +1,175 @@
+//! The two communication schemes of the gluing stage (DESIGN.md §3).
+//!
+//! - **Decentralized**: every subdomain sends, to each subdomain it shares interface
+//!   bodies with, its copies' velocities of those bodies; then each subdomain solves
+//!   the chain of each of its interface bodies ([`super::gluing::chain_increments`])
+//!   and applies its own copy's increment. A face body (m = 2) uses only the data of
+//!   the two subdomains its link joins; a corner body the data of its m subdomains,
+//!   all of which share it. The chain is solved redundantly, once per copy, with the
+//!   same inputs in the same order: every copy gets the same numbers.
+//! - **Centralized**: every subdomain sends all its interface velocities to the root
+//!   (subdomain 0), which solves every chain once and sends each subdomain its
+//!   copies' increments.
+//!
+//! Both call the same chain solve on the same velocities, so they give bitwise the
+//! same increments, and they accumulate the gluing residual per subdomain in the same
+//! order (slot order; the links of a body counted by the subdomain of its first
+//! copy), so the residuals agree bitwise as well.
+
+use super::gluing::{chain_increments, link_sum, norm2, ChainScratch, GluePartial};
+use super::partition::Interface;
+use super::subdomain::{Subdomain2, SubdomainSolver, OWN};
+use super::transport::Transport;
+
+/// The communication scheme of the gluing stage.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Scheme {
+    Decentralized,
+    Centralized,
+}
+
+/// Buffers reused between gluing stages.
+#[derive(Default)]
+pub struct GlueBuffers {
+    packets: Vec<Vec<[f64; 3]>>,
+    chain: Vec<[f64; 3]>,
+    dv: Vec<[f64; 3]>,
+    scratch: ChainScratch,
+    send: Vec<[f64; 3]>,
+}
+
+/// One gluing stage: exchange, chain solves, F_Γ and velocity updates. Returns each
+/// subdomain's share of the gluing residual, measured on the velocities before the
+/// update. With `only_fresh`, only the bodies marked fresh are updated (the start of
+/// a step).
+pub fn glue_stage(
+    subs: &mut [&mut Subdomain2],
+    iface: &Interface,
+    scheme: Scheme,
+    t: &mut dyn Transport,
+    only_fresh: bool,
+    b: &mut GlueBuffers,
+) -> Vec<GluePartial> {
+    match scheme {
+        Scheme::Decentralized => decentralized(subs, iface, t, only_fresh, b),
+        Scheme::Centralized => centralized(subs, iface, t, only_fresh, b),
+    }
+}
+
+fn decentralized(
+    subs: &mut [&mut Subdomain2],
+    iface: &Interface,
+    t: &mut dyn Transport,
+    only_fresh: bool,
+    b: &mut GlueBuffers,
+) -> Vec<GluePartial> {
+    for s in subs.iter() {
+        for nbr in &s.neighbors {
+            b.send.clear();
+            s.interface_velocities(&nbr.slots, &mut b.send);
+            t.send(s.id, nbr.sub, &b.send);
+        }
+    }
+    let mut parts = vec![GluePartial::default(); subs.len()];
+    for (s, part) in subs.iter_mut().zip(parts.iter_mut()) {
+        b.packets.resize_with(b.packets.len().max(s.neighbors.len()), Vec::new);
+        for (ni, nbr) in s.neighbors.iter().enumerate() {
+            t.recv(s.id, nbr.sub, &mut b.packets[ni]);
+        }
+        for q in 0..s.iface.len() {
+            let ib = s.iface_ib[q] as usize;
+            let k = s.iface_k[q] as usize;
+            b.chain.clear();
+            for &(ni, p) in &s.chain[s.chain_start[q] as usize..s.chain_start[q + 1] as usize] {
+                b.chain.push(if ni == OWN {
+                    s.interface_velocity(p as usize)
+                } else {
+                    b.packets[ni as usize][p as usize]
+                });
+            }
+            accumulate(part, &b.chain, k, iface.rho2[ib]);
+            if !only_fresh || iface.fresh[ib] {
+                b.dv.resize(b.chain.len(), [0.0; 3]);
+                chain_increments(&b.chain, &mut b.dv, &mut b.scratch);
+                s.glue(q, b.dv[k]);
+            }
+        }
+    }
+    parts
+}
+
+/// The residual share of one copy: its chain's links if it is the first copy.
+fn accumulate(part: &mut GluePartial, chain: &[[f64; 3]], k: usize, rho2: f64) {
+    if k == 0 {
+        part.jump2 += link_sum(chain, rho2);
+        part.links += chain.len() as u64 - 1;
+    }
+    part.v2 += norm2(chain[k], rho2);
+    part.copies += 1;
+}
+
+const ROOT: u32 = 0;
+
+fn centralized(
+    subs: &mut [&mut Subdomain2],
+    iface: &Interface,
+    t: &mut dyn Transport,
+    only_fresh: bool,
+    b: &mut GlueBuffers,
+) -> Vec<GluePartial> {
+    let ns = subs.len();
+    // gather
+    for s in subs.iter() {
+        b.send.clear();
+        for q in 0..s.iface.len() {
+            b.send.push(s.interface_velocity(q));
+        }
+        t.send(s.id, ROOT, &b.send);
+    }
+    b.packets.resize_with(b.packets.len().max(2 * ns), Vec::new);
+    let (all, out) = b.packets.split_at_mut(ns);
+    for s in 0..ns {
+        t.recv(ROOT, s as u32, &mut all[s]);
+        out[s].clear();
+        out[s].resize(all[s].len(), [0.0; 3]);
+    }
+    // solve every chain once, at the root
+    let mut parts = vec![GluePartial::default(); ns];
+    for ib in 0..iface.len() {
+        let r = iface.copies(ib);
+        b.chain.clear();
+        b.chain
+            .extend(r.clone().map(|c| all[iface.sub[c] as usize][iface.slot[c] as usize]));
+        if !only_fresh || iface.fresh[ib] {
+            b.dv.resize(b.chain.len(), [0.0; 3]);
+            chain_increments(&b.chain, &mut b.dv, &mut b.scratch);
+            for (k, c) in r.enumerate() {
+                out[iface.sub[c] as usize][iface.slot[c] as usize] = b.dv[k];
+            }
+        }
+    }
+    // residual shares, per subdomain in slot order (as the decentralized scheme)
+    for (s, part) in parts.iter_mut().enumerate() {
+        for q in 0..all[s].len() {
+            let ib = subs[s].iface_ib[q] as usize;
+            b.chain.clear();
+            b.chain
+                .extend(iface.copies(ib).map(|c| all[iface.sub[c] as usize][iface.slot[c] as usize]));
+            accumulate(part, &b.chain, subs[s].iface_k[q] as usize, iface.rho2[ib]);
+        }
+    }
+    // scatter
+    for (s, o) in out.iter().enumerate().take(ns) {
+        t.send(ROOT, s as u32, o);
+    }
+    for s in subs.iter_mut() {
+        t.recv(s.id, ROOT, &mut b.send);
+        for q in 0..b.send.len() {
+            if !only_fresh || iface.fresh[s.iface_ib[q] as usize] {
+                s.glue(q, b.send[q]);
+            }
+        }
+    }
+    parts
+}

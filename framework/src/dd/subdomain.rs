@@ -1,0 +1,139 @@
+//! One subdomain of 2D rigid bodies: its contacts and its copies of bodies.
+//!
+//! Local ids are dense `u32`s. Copy l of global body g = `body_global[l]` has the
+//! iteration matrix M̂_E = M̂/m_g (partition of unity), stored as its inverse
+//! `inv_mass[l] = m_g M̂⁻¹` (unchanged for immovable bodies, whose copies are not
+//! glued). Its loads are F̂/m_g, so its free velocity is the body's V_free:
+//! (F̂/m)/(M̂/m) = M̂⁻¹F̂. The contacts' Delassus blocks W_αα are those of the copies.
+
+use crate::norms::Sums;
+use crate::rigid2d::{nlgs, Contacts2};
+
+/// Marks, in a chain entry, the subdomain's own copy.
+pub const OWN: u32 = u32::MAX;
+
+/// A subdomain that shares interface bodies with this one.
+#[derive(Clone, Debug, Default)]
+pub struct Neighbor {
+    pub sub: u32,
+    /// Own interface slots of the bodies shared with `sub`, in ascending body id
+    /// (the same sequence on both sides: packet positions match).
+    pub slots: Vec<u32>,
+}
+
+/// Struct-of-arrays subdomain.
+#[derive(Clone, Debug, Default)]
+pub struct Subdomain2 {
+    pub id: u32,
+    /// The subdomain's contacts, `bodies` as local body ids; `block` with the
+    /// copies' M̂_E⁻¹.
+    pub contacts: Contacts2,
+    /// Global index of each local contact.
+    pub contact_global: Vec<u32>,
+    /// Visiting order (local ids; empty: storage order), the global order restricted.
+    pub order: Vec<u32>,
+    /// Global id of each local body copy.
+    pub body_global: Vec<u32>,
+    /// Copy velocities V_E.
+    pub vel: Vec<[f64; 3]>,
+    /// Copy M̂_E⁻¹ = m M̂⁻¹.
+    pub inv_mass: Vec<[f64; 3]>,
+    /// Local ids of the interface copies (ascending global id): the slots.
+    pub iface: Vec<u32>,
+    /// Per slot: index of the body in [`super::partition::Interface`].
+    pub iface_ib: Vec<u32>,
+    /// Per slot: position of this copy in the body's chain.
+    pub iface_k: Vec<u32>,
+    /// Per slot: F_Γ, the net interface impulse on the copy (N·s).
+    pub f_gamma: Vec<[f64; 3]>,
+    pub neighbors: Vec<Neighbor>,
+    /// Per slot, the body's chain: `chain[chain_start[q]..chain_start[q + 1]]` holds,
+    /// for each copy in chain order, (neighbor index, position in its packet), or
+    /// ([`OWN`], slot) for the own copy.
+    pub chain_start: Vec<u32>,
+    pub chain: Vec<(u32, u32)>,
+    /// Check-pass sums of the last check sweep.
+    pub sums: Sums,
+}
+
+/// What the NSCDD coordinator needs from a subdomain (DESIGN.md §3, §4).
+pub trait SubdomainSolver {
+    /// `n` NLGS sweeps with relaxation ω; the last one is a check pass when `check`
+    /// (its sums are then in [`Self::sums`], else those are zero).
+    fn sweeps(&mut self, n: u32, omega: f64, check: bool);
+    fn sums(&self) -> &Sums;
+    /// Velocities of the interface copies given by `slots`, appended to `out`.
+    fn interface_velocities(&self, slots: &[u32], out: &mut Vec<[f64; 3]>);
+    /// Velocity of the interface copy in `slot`.
+    fn interface_velocity(&self, slot: usize) -> [f64; 3];
+    /// Gluing increment of one interface copy: ΔF_Γ = M̂_E ΔV, applied through
+    /// M̂_E⁻¹ (so the copy moves by ΔV on its free degrees of freedom).
+    fn glue(&mut self, slot: usize, dv: [f64; 3]);
+}
+
+impl SubdomainSolver for Subdomain2 {
+    fn sweeps(&mut self, n: u32, omega: f64, check: bool) {
+        self.sums = Sums::default();
+        for k in 0..n {
+            let sums = if check && k + 1 == n { Some(&mut self.sums) } else { None };
+            nlgs::sweep(&mut self.contacts, &mut self.vel, &self.inv_mass, &self.order, omega, sums);
+        }
+    }
+    fn sums(&self) -> &Sums {
+        &self.sums
+    }
+    fn interface_velocities(&self, slots: &[u32], out: &mut Vec<[f64; 3]>) {
+        out.extend(slots.iter().map(|&q| self.vel[self.iface[q as usize] as usize]));
+    }
+    fn interface_velocity(&self, slot: usize) -> [f64; 3] {
+        self.vel[self.iface[slot] as usize]
+    }
+    fn glue(&mut self, slot: usize, dv: [f64; 3]) {
+        let l = self.iface[slot] as usize;
+        let im = self.inv_mass[l];
+        for d in 0..3 {
+            if im[d] != 0.0 {
+                self.vel[l][d] += dv[d];
+                self.f_gamma[slot][d] += dv[d] / im[d];
+            }
+        }
+    }
+}
+
+impl Subdomain2 {
+    /// Appends global contact `a` of `c`, with local body ids `li`, `lj`.
+    pub(crate) fn push_contact(&mut self, c: &Contacts2, a: usize, li: u32, lj: u32) {
+        self.contacts.push_from(c, a, li, lj);
+        self.contact_global.push(a as u32);
+    }
+
+    /// W_αα and its precomputed inverses from the copies' M̂_E⁻¹.
+    pub(crate) fn copy_delassus(&mut self) {
+        let c = &mut self.contacts;
+        for a in 0..c.len() {
+            let [i, j] = c.bodies[a];
+            let w = Contacts2::delassus(&c.frame[a], self.inv_mass[i as usize], self.inv_mass[j as usize]);
+            c.block[a] = crate::rigid2d::contacts::Block2 { w, pre: crate::rigid2d::coulomb::precompute(w, c.target[a].mu) };
+        }
+    }
+
+    /// V_E = V_free + M̂_E⁻¹ (F_Γ + H_E r) with the warm-start impulses, applied in
+    /// storage order (as the one-domain engine does).
+    pub(crate) fn init_velocities(&mut self, v_free: &[[f64; 3]]) {
+        self.vel.clear();
+        self.vel.extend(self.body_global.iter().map(|&g| v_free[g as usize]));
+        for (q, &l) in self.iface.iter().enumerate() {
+            let (l, g) = (l as usize, self.f_gamma[q]);
+            let (v, im) = (&mut self.vel[l], self.inv_mass[l]);
+            for d in 0..3 {
+                v[d] += im[d] * g[d];
+            }
+        }
+        let c = &self.contacts;
+        for a in 0..c.len() {
+            if c.r[a] != [0.0, 0.0] {
+                c.apply(a, c.r[a], &mut self.vel, &self.inv_mass);
+            }
+        }
+    }
+}
