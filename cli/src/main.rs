@@ -79,7 +79,13 @@ fn main() -> ExitCode {
         Cmd::Check { scene } => match nscdd::scene::load(&scene, &reg) {
             Ok(s) => {
                 let w = &s.world;
-                println!("{}: ok — {} bodies, {} steps of {} s", scene.display(), w.bodies.len(), w.time.steps, w.time.h);
+                println!(
+                    "{}: ok — {} bodies, {} steps of {} s",
+                    scene.display(),
+                    w.bodies.len(),
+                    w.time.steps,
+                    w.time.h
+                );
                 ExitCode::SUCCESS
             }
             Err(e) => input_error(e),
@@ -97,11 +103,19 @@ fn main() -> ExitCode {
             };
             let steps = s.world.time.steps;
             let bar = if quiet { ProgressBar::hidden() } else { ProgressBar::new(steps) };
-            bar.set_style(ProgressStyle::with_template("{bar:30} step {pos}/{len} | {msg} | {elapsed_precise} elapsed, {eta_precise} left").expect("valid template"));
+            bar.set_style(
+                ProgressStyle::with_template("{bar:30} step {pos}/{len} | {msg} | {elapsed_precise} elapsed, {eta_precise} left")
+                    .expect("valid template"),
+            );
             let res = nscdd::run::run(&mut s, &reg, &out, |w, rep| {
                 bar.set_position(w.step);
                 if w.step % 10 == 0 || w.step == steps {
-                    bar.set_message(format!("{} contacts, {} sweeps{}", rep.contacts, rep.solve.sweeps, if rep.solve.converged { "" } else { " (not converged)" }));
+                    bar.set_message(format!(
+                        "{} contacts, {} sweeps{}",
+                        rep.contacts,
+                        rep.solve.sweeps,
+                        if rep.solve.converged { "" } else { " (not converged)" }
+                    ));
                 }
             });
             bar.finish_and_clear();
@@ -125,7 +139,13 @@ fn main() -> ExitCode {
                             sum.max_residual_step
                         );
                     }
-                    eprintln!("{} steps, {} sweeps, {:.2} s; outputs in {}", sum.steps, sum.total_sweeps, sum.wall_seconds, out.display());
+                    eprintln!(
+                        "{} steps, {} sweeps, {:.2} s; outputs in {}",
+                        sum.steps,
+                        sum.total_sweeps,
+                        sum.wall_seconds,
+                        out.display()
+                    );
                     ExitCode::SUCCESS
                 }
                 Err(e) => {
@@ -134,7 +154,13 @@ fn main() -> ExitCode {
                 }
             }
         }
-        Cmd::SolveFc { problem, tol, max_sweeps, norm, check_every } => {
+        Cmd::SolveFc {
+            problem,
+            tol,
+            max_sweeps,
+            norm,
+            check_every,
+        } => {
             let norm = match norm.as_str() {
                 "natural" => FcNorm::Natural,
                 other => match Criterion::parse(other) {
@@ -145,7 +171,15 @@ fn main() -> ExitCode {
             if !(tol > 0.0) || max_sweeps == 0 || check_every == 0 {
                 return input_error("--tol must be > 0, --max-sweeps and --check-every ≥ 1");
             }
-            match nscdd::fc::solve_file(&problem, &FcOptions { tol, max_sweeps, check_every, norm }) {
+            match nscdd::fc::solve_file(
+                &problem,
+                &FcOptions {
+                    tol,
+                    max_sweeps,
+                    check_every,
+                    norm,
+                },
+            ) {
                 Ok(sol) => {
                     println!("{}", serde_json::to_string(&sol).expect("plain data"));
                     if !sol.converged {

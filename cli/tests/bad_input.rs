@@ -64,7 +64,11 @@ fn edit(base: &str, from: &str, to: &str) -> String {
 
 /// 1-based line of the first line of `scene` that contains `marker`.
 fn line_of(scene: &str, marker: &str) -> usize {
-    scene.lines().position(|l| l.contains(marker)).unwrap_or_else(|| panic!("`{marker}` is not in the scene")) + 1
+    scene
+        .lines()
+        .position(|l| l.contains(marker))
+        .unwrap_or_else(|| panic!("`{marker}` is not in the scene"))
+        + 1
 }
 
 struct Case {
@@ -85,20 +89,47 @@ fn check_bad(c: &Case) {
     let out = dir.join("out");
 
     let check = nscdd(&["check".as_ref(), path.as_os_str()]);
-    let run = nscdd(&["run".as_ref(), path.as_os_str(), "--out".as_ref(), out.as_os_str(), "--quiet".as_ref()]);
+    let run = nscdd(&[
+        "run".as_ref(),
+        path.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+        "--quiet".as_ref(),
+    ]);
     for (what, o) in [("check", &check), ("run", &run)] {
         let err = text(&o.stderr);
         println!("{} ({what}): {}", c.name, err.trim_end());
         assert_eq!(o.status.code(), Some(2), "{}: `{what}` must exit with 2; stderr: {err}", c.name);
         assert!(!err.contains("panicked"), "{}: `{what}` panicked: {err}", c.name);
-        assert_eq!(err.trim_end().lines().count(), 1, "{}: `{what}` must print one message: {err}", c.name);
-        assert!(err.contains(&expected), "{}: `{what}` stderr must contain `{expected}`, got: {err}", c.name);
-        assert!(text(&o.stdout).trim().is_empty(), "{}: `{what}` printed on stdout: {}", c.name, text(&o.stdout));
+        assert_eq!(
+            err.trim_end().lines().count(),
+            1,
+            "{}: `{what}` must print one message: {err}",
+            c.name
+        );
+        assert!(
+            err.contains(&expected),
+            "{}: `{what}` stderr must contain `{expected}`, got: {err}",
+            c.name
+        );
+        assert!(
+            text(&o.stdout).trim().is_empty(),
+            "{}: `{what}` printed on stdout: {}",
+            c.name,
+            text(&o.stdout)
+        );
     }
-    let entries: Vec<String> = std::fs::read_dir(&out).expect("DIR exists").map(|e| e.expect("entry").file_name().to_string_lossy().into_owned()).collect();
+    let entries: Vec<String> = std::fs::read_dir(&out)
+        .expect("DIR exists")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
     assert_eq!(entries, ["error.txt"], "{}: DIR must hold only error.txt", c.name);
     let saved = std::fs::read_to_string(out.join("error.txt")).expect("error.txt");
-    assert!(saved.contains(&expected), "{}: error.txt must hold the message, got: {saved}", c.name);
+    assert!(
+        saved.contains(&expected),
+        "{}: error.txt must hold the message, got: {saved}",
+        c.name
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -115,76 +146,142 @@ fn the_base_scene_is_valid() {
 #[test]
 fn syntax_error() {
     let scene = edit(BASE, "name = \"grain\"", "name = \"grain\" x");
-    check_bad(&Case { name: "syntax", scene, key: "materials[0].name", marker: "\"grain\" x" });
+    check_bad(&Case {
+        name: "syntax",
+        scene,
+        key: "materials[0].name",
+        marker: "\"grain\" x",
+    });
 }
 
 #[test]
 fn unknown_top_level_key() {
     let scene = format!("bogus = 1\n{BASE}");
-    check_bad(&Case { name: "unknown_top", scene, key: "bogus", marker: "bogus" });
+    check_bad(&Case {
+        name: "unknown_top",
+        scene,
+        key: "bogus",
+        marker: "bogus",
+    });
 }
 
 #[test]
 fn unknown_key_in_a_section() {
     let scene = edit(BASE, "steps = 10", "steps = 10\nsubsteps = 3");
-    check_bad(&Case { name: "unknown_time", scene, key: "time.substeps", marker: "substeps" });
+    check_bad(&Case {
+        name: "unknown_time",
+        scene,
+        key: "time.substeps",
+        marker: "substeps",
+    });
 }
 
 #[test]
 fn unknown_key_in_a_body() {
     let scene = edit(BASE, "radius = 0.1", "radius = 0.1\ncolour = \"red\"");
-    check_bad(&Case { name: "unknown_body", scene, key: "bodies[1].colour", marker: "colour" });
+    check_bad(&Case {
+        name: "unknown_body",
+        scene,
+        key: "bodies[1].colour",
+        marker: "colour",
+    });
 }
 
 #[test]
 fn negative_radius() {
     let scene = edit(BASE, "radius = 0.1", "radius = -0.1");
-    check_bad(&Case { name: "negative_radius", scene, key: "bodies[1].radius", marker: "radius" });
+    check_bad(&Case {
+        name: "negative_radius",
+        scene,
+        key: "bodies[1].radius",
+        marker: "radius",
+    });
 }
 
 #[test]
 fn negative_generated_radius() {
-    let scene = format!("{BASE}\n[[generate]]\nkind = \"square_lattice\"\nmaterial = \"grain\"\nnx = 2\nny = 2\nradius = -0.01\norigin = [1.0, 1.0]\n");
-    check_bad(&Case { name: "negative_generated_radius", scene, key: "generate[0].radius", marker: "radius = -0.01" });
+    let scene = format!(
+        "{BASE}\n[[generate]]\nkind = \"square_lattice\"\nmaterial = \"grain\"\nnx = 2\nny = 2\nradius = -0.01\norigin = [1.0, 1.0]\n"
+    );
+    check_bad(&Case {
+        name: "negative_generated_radius",
+        scene,
+        key: "generate[0].radius",
+        marker: "radius = -0.01",
+    });
 }
 
 #[test]
 fn negative_density() {
     let scene = edit(BASE, "density = 2600.0", "density = -2600.0");
-    check_bad(&Case { name: "negative_density", scene, key: "materials[0].density", marker: "density" });
+    check_bad(&Case {
+        name: "negative_density",
+        scene,
+        key: "materials[0].density",
+        marker: "density",
+    });
 }
 
 #[test]
 fn negative_time_step() {
     let scene = edit(BASE, "step = 1e-3", "step = -1e-3");
-    check_bad(&Case { name: "negative_step", scene, key: "time.step", marker: "step = -1e-3" });
+    check_bad(&Case {
+        name: "negative_step",
+        scene,
+        key: "time.step",
+        marker: "step = -1e-3",
+    });
 }
 
 #[test]
 fn zero_time_step() {
     let scene = edit(BASE, "step = 1e-3", "step = 0.0");
-    check_bad(&Case { name: "zero_step", scene, key: "time.step", marker: "step = 0.0" });
+    check_bad(&Case {
+        name: "zero_step",
+        scene,
+        key: "time.step",
+        marker: "step = 0.0",
+    });
 }
 
 #[test]
 fn negative_friction() {
     let scene = edit(BASE, "friction = 0.3", "friction = -0.3");
-    check_bad(&Case { name: "negative_friction", scene, key: "laws[0].friction", marker: "friction" });
+    check_bad(&Case {
+        name: "negative_friction",
+        scene,
+        key: "laws[0].friction",
+        marker: "friction",
+    });
 }
 
 #[test]
 fn overlapping_bodies() {
     // the ball sinks 0.05 m into the floor; the tolerance is 0.05 × 0.1 m
     let scene = edit(BASE, "position = [0.0, 0.1]", "position = [0.0, 0.05]");
-    check_bad(&Case { name: "overlap", scene, key: "bodies[1].position", marker: "position = [0.0, 0.05]" });
+    check_bad(&Case {
+        name: "overlap",
+        scene,
+        key: "bodies[1].position",
+        marker: "position = [0.0, 0.05]",
+    });
 }
 
 #[test]
 fn contacting_materials_without_a_law() {
-    let scene = edit(BASE, "[[bodies]]\nname = \"ball\"\nshape = \"disk\"\nmaterial = \"grain\"", "[[bodies]]\nname = \"ball\"\nshape = \"disk\"\nmaterial = \"steel\"");
+    let scene = edit(
+        BASE,
+        "[[bodies]]\nname = \"ball\"\nshape = \"disk\"\nmaterial = \"grain\"",
+        "[[bodies]]\nname = \"ball\"\nshape = \"disk\"\nmaterial = \"steel\"",
+    );
     let scene = edit(&scene, "[[laws]]", "[[materials]]\nname = \"steel\"\ndensity = 7800.0\n\n[[laws]]");
     // the message names the first body of the pair's first material (the floor)
-    check_bad(&Case { name: "no_law", scene: scene.clone(), key: "bodies[0].material", marker: "material = \"grain\"" });
+    check_bad(&Case {
+        name: "no_law",
+        scene: scene.clone(),
+        key: "bodies[0].material",
+        marker: "material = \"grain\"",
+    });
     let err = {
         let dir = scratch("no_law_msg");
         let p = dir.join("s.toml");
@@ -199,19 +296,34 @@ fn contacting_materials_without_a_law() {
 #[test]
 fn driven_dof_that_does_not_exist() {
     let scene = edit(BASE, "radius = 0.1", "radius = 0.1\ndrive.z = { velocity = 1.0 }");
-    check_bad(&Case { name: "drive_z", scene, key: "bodies[1].drive.z", marker: "drive.z" });
+    check_bad(&Case {
+        name: "drive_z",
+        scene,
+        key: "bodies[1].drive.z",
+        marker: "drive.z",
+    });
 }
 
 #[test]
 fn unknown_shape() {
     let scene = edit(BASE, "shape = \"disk\"", "shape = \"sphere\"");
-    check_bad(&Case { name: "unknown_shape", scene, key: "bodies[1].shape", marker: "sphere" });
+    check_bad(&Case {
+        name: "unknown_shape",
+        scene,
+        key: "bodies[1].shape",
+        marker: "sphere",
+    });
 }
 
 #[test]
 fn wrong_value_type() {
     let scene = edit(BASE, "position = [0.0, 0.1]", "position = [0.0, \"high\"]");
-    check_bad(&Case { name: "wrong_type", scene, key: "bodies[1].position[1]", marker: "\"high\"" });
+    check_bad(&Case {
+        name: "wrong_type",
+        scene,
+        key: "bodies[1].position[1]",
+        marker: "\"high\"",
+    });
 }
 
 #[test]
@@ -221,7 +333,10 @@ fn missing_file() {
     let o = nscdd(&["check".as_ref(), path.as_os_str()]);
     let err = text(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(err.contains(&path.display().to_string()) && err.contains("cannot read the file") && !err.contains("panicked"), "{err}");
+    assert!(
+        err.contains(&path.display().to_string()) && err.contains("cannot read the file") && !err.contains("panicked"),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -260,12 +375,21 @@ fn a_diverging_run_stops_and_keeps_its_history() {
     let path = dir.join("diverge.toml");
     std::fs::write(&path, DIVERGING).expect("write scene");
     let out = dir.join("out");
-    let o = nscdd(&["run".as_ref(), path.as_os_str(), "--out".as_ref(), out.as_os_str(), "--quiet".as_ref()]);
+    let o = nscdd(&[
+        "run".as_ref(),
+        path.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+        "--quiet".as_ref(),
+    ]);
     let err = text(&o.stderr);
     println!("diverge: {}", err.trim_end());
     assert_eq!(o.status.code(), Some(1), "a diverging run exits with 1: {err}");
     assert!(!err.contains("panicked"), "{err}");
-    assert!(err.contains("step 6") && err.contains("body 1") && err.contains("rocket"), "the message must name the step and the body: {err}");
+    assert!(
+        err.contains("step 6") && err.contains("body 1") && err.contains("rocket"),
+        "the message must name the step and the body: {err}"
+    );
     assert!(err.contains("non-finite"), "{err}");
     let hist = std::fs::read_to_string(out.join("history.csv")).expect("history.csv is kept");
     let rows: Vec<&str> = hist.lines().collect();

@@ -49,7 +49,12 @@ impl Detector {
             let s = bodies.shape[b];
             self.aabb.push(shapes[s.kind as usize].aabb(s.index, bodies.pos[b], bodies.rot[b]));
         }
-        let mut ext: Vec<f64> = self.aabb.iter().filter(|a| a.is_bounded()).map(|a| (a.max[0] - a.min[0]).max(a.max[1] - a.min[1])).collect();
+        let mut ext: Vec<f64> = self
+            .aabb
+            .iter()
+            .filter(|a| a.is_bounded())
+            .map(|a| (a.max[0] - a.min[0]).max(a.max[1] - a.min[1]))
+            .collect();
         let mut cell = 1.0;
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         if !ext.is_empty() {
@@ -145,7 +150,14 @@ impl Detector {
     }
 
     /// Runs the broad phase and the narrow phases; fills `out` (cleared first).
-    pub fn detect(&mut self, bodies: &Bodies2, shapes: &[Box<dyn ShapeStore2>], table: &DetectorTable, alert: f64, out: &mut Vec<RawContact2>) {
+    pub fn detect(
+        &mut self,
+        bodies: &Bodies2,
+        shapes: &[Box<dyn ShapeStore2>],
+        table: &DetectorTable,
+        alert: f64,
+        out: &mut Vec<RawContact2>,
+    ) {
         out.clear();
         let nk = table.nk;
         self.broad_phase(bodies, shapes, alert, nk);
@@ -165,7 +177,12 @@ impl Detector {
                     self.batch.extend(self.pairs[k..e].iter().map(|(_, p)| *p));
                 }
                 let (sa, sb) = if *swapped { (kb, ka) } else { (ka, kb) };
-                let ctx = crate::registry::DetectCtx { a: shapes[sa].as_ref(), b: shapes[sb].as_ref(), bodies, alert };
+                let ctx = crate::registry::DetectCtx {
+                    a: shapes[sa].as_ref(),
+                    b: shapes[sb].as_ref(),
+                    bodies,
+                    alert,
+                };
                 det.detect(&ctx, &self.batch, out);
             }
             k = e;

@@ -37,7 +37,11 @@ impl TimeFn {
             TimeFn::Constant(c) => *c,
             TimeFn::Shaped(Shape::Ramp([t0, v0, t1, v1])) => {
                 if t <= *t0 || t1 <= t0 {
-                    if t <= *t0 { *v0 } else { *v1 }
+                    if t <= *t0 {
+                        *v0
+                    } else {
+                        *v1
+                    }
                 } else if t >= *t1 {
                     *v1
                 } else {
@@ -183,8 +187,16 @@ mod tests {
         let t = TimeFn::Shaped(Shape::Table(vec![[0.0, 1.0], [1.0, 3.0]]));
         assert_eq!(t.eval(0.5), 2.0);
         let d = DofDrive::Phases(vec![
-            Phase { velocity: None, force: Some(TimeFn::Constant(5.0)), until: Some(1.0) },
-            Phase { velocity: Some(TimeFn::Constant(-1.0)), force: None, until: None },
+            Phase {
+                velocity: None,
+                force: Some(TimeFn::Constant(5.0)),
+                until: Some(1.0),
+            },
+            Phase {
+                velocity: Some(TimeFn::Constant(-1.0)),
+                force: None,
+                until: None,
+            },
         ]);
         assert!(d.validate().is_ok());
         assert_eq!(d.at(0.5), Imposed::Force(5.0));

@@ -59,13 +59,21 @@ impl World2 {
         let mut rep = StepReport::default();
         let t0 = Instant::now();
         free_velocity(self);
-        self.scratch.detector.detect(&self.bodies, &self.shapes, &self.detectors, self.alert, &mut self.scratch.raw);
+        self.scratch
+            .detector
+            .detect(&self.bodies, &self.shapes, &self.detectors, self.alert, &mut self.scratch.raw);
         let t1 = Instant::now();
         build_contacts(self);
         let t2 = Instant::now();
         let step = self.step;
         nlgs::make_order(&mut self.scratch.order, self.contacts.len(), &self.solver, step);
-        rep.solve = nlgs::solve(&mut self.contacts, &mut self.bodies.vel, &self.bodies.inv_mass, &self.scratch.order, &self.solver);
+        rep.solve = nlgs::solve(
+            &mut self.contacts,
+            &mut self.bodies.vel,
+            &self.bodies.inv_mass,
+            &self.scratch.order,
+            &self.solver,
+        );
         let t3 = Instant::now();
         update_positions(self)?;
         let t4 = Instant::now();
@@ -122,7 +130,10 @@ pub fn free_velocity(w: &mut World2) {
 #[inline]
 fn local(n: [f64; 2], ai: [f64; 2], aj: [f64; 2], vi: [f64; 3], vj: [f64; 3]) -> [f64; 2] {
     let dv = [vi[0] - vj[0], vi[1] - vj[1]];
-    [n[0] * dv[0] + n[1] * dv[1] + ai[0] * vi[2] - aj[0] * vj[2], -n[1] * dv[0] + n[0] * dv[1] + ai[1] * vi[2] - aj[1] * vj[2]]
+    [
+        n[0] * dv[0] + n[1] * dv[1] + ai[0] * vi[2] - aj[0] * vj[2],
+        -n[1] * dv[0] + n[0] * dv[1] + ai[1] * vi[2] - aj[1] * vj[2],
+    ]
 }
 
 /// Builds this step's contact set from the raw contacts: lever arms, W_αα, ū, and
@@ -151,18 +162,30 @@ pub fn build_contacts(w: &mut World2) {
         if !(wb[0] > 0.0) {
             continue;
         }
-        let Some(law) = w.laws[b.material[i] as usize * w.materials.len() + b.material[j] as usize] else { continue };
+        let Some(law) = w.laws[b.material[i] as usize * w.materials.len() + b.material[j] as usize] else {
+            continue;
+        };
         let u_begin = local(n, ai, aj, s.v_begin[i], s.v_begin[j]);
         let u_free = local(n, ai, aj, b.vel[i], b.vel[j]);
-        let key = ContactKey { i: rc.i, j: rc.j, feature: rc.feature };
+        let key = ContactKey {
+            i: rc.i,
+            j: rc.j,
+            feature: rc.feature,
+        };
         let r = match s.prev_keys.binary_search_by_key(&key, |x| x.0) {
             Ok(p) => s.prev_keys[p].1,
             Err(_) => [0.0, 0.0],
         };
         c.bodies.push([rc.i, rc.j]);
         c.frame.push(frame);
-        c.block.push(Block2 { w: wb, pre: crate::rigid2d::coulomb::precompute(wb, law.mu) });
-        c.target.push(Target { u_target: target_velocity(rc.gap, u_begin[0], u_free[0], h, theta, law.e), mu: law.mu });
+        c.block.push(Block2 {
+            w: wb,
+            pre: crate::rigid2d::coulomb::precompute(wb, law.mu),
+        });
+        c.target.push(Target {
+            u_target: target_velocity(rc.gap, u_begin[0], u_free[0], h, theta, law.e),
+            mu: law.mu,
+        });
         c.r.push(r);
         c.u_free.push(u_free);
         c.gap.push(rc.gap);
@@ -184,7 +207,11 @@ pub fn update_positions(w: &mut World2) -> Result<(), Diverged> {
     let b = &mut w.bodies;
     for k in 0..b.len() {
         let (v0, v1) = (w.scratch.v_begin[k], b.vel[k]);
-        let dq = [h * ((1.0 - theta) * v0[0] + theta * v1[0]), h * ((1.0 - theta) * v0[1] + theta * v1[1]), h * ((1.0 - theta) * v0[2] + theta * v1[2])];
+        let dq = [
+            h * ((1.0 - theta) * v0[0] + theta * v1[0]),
+            h * ((1.0 - theta) * v0[1] + theta * v1[1]),
+            h * ((1.0 - theta) * v0[2] + theta * v1[2]),
+        ];
         b.pos[k][0] += dq[0];
         b.pos[k][1] += dq[1];
         b.rot[k] += dq[2];
@@ -193,7 +220,10 @@ pub fn update_positions(w: &mut World2) -> Result<(), Diverged> {
             return Err(Diverged {
                 step: w.step + 1,
                 body: k as u32,
-                message: format!("{label} has a non-finite state (position {:?}, velocity {:?})", w.bodies.pos[k], w.bodies.vel[k]),
+                message: format!(
+                    "{label} has a non-finite state (position {:?}, velocity {:?})",
+                    w.bodies.pos[k], w.bodies.vel[k]
+                ),
             });
         }
     }

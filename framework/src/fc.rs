@@ -168,7 +168,12 @@ impl FcProblem {
     /// Reads a problem file (`.gz`: gzip-compressed) and validates it.
     pub fn read(path: &Path) -> Result<FcProblem, InputError> {
         let file = path.display().to_string();
-        let err = |message: String| InputError { file: file.clone(), line: None, key: String::new(), message };
+        let err = |message: String| InputError {
+            file: file.clone(),
+            line: None,
+            key: String::new(),
+            message,
+        };
         let mut text = String::new();
         let f = std::fs::File::open(path).map_err(|e| err(format!("cannot read the file: {e}")))?;
         let res = if file.ends_with(".gz") {
@@ -182,7 +187,12 @@ impl FcProblem {
 
     /// Parses and validates the JSON text of a problem; `file` names it in errors.
     pub fn parse(text: &str, file: &str) -> Result<FcProblem, InputError> {
-        let to_err = |(key, message): Bad| InputError { file: file.to_string(), line: None, key, message };
+        let to_err = |(key, message): Bad| InputError {
+            file: file.to_string(),
+            line: None,
+            key,
+            message,
+        };
         let v: Value = serde_json::from_str(text).map_err(|e| to_err(bad("", format!("invalid JSON: {e}"))))?;
         let p = Self::from_value(v).map_err(to_err)?;
         p.validate().map_err(to_err)?;
@@ -192,7 +202,10 @@ impl FcProblem {
     /// Reads the keys and their types; [`FcProblem::validate`] checks the rest.
     fn from_value(v: Value) -> Result<FcProblem, Bad> {
         let Value::Object(mut top) = v else {
-            return Err(bad("", "the problem must be a JSON object with keys dim, nc, W, q, mu (and optional meta)"));
+            return Err(bad(
+                "",
+                "the problem must be a JSON object with keys dim, nc, W, q, mu (and optional meta)",
+            ));
         };
         if let Some(k) = top.keys().find(|k| !TOP_KEYS.contains(&k.as_str())) {
             return Err(bad(k.clone(), "unknown key; expected dim, nc, W, q, mu or meta"));
@@ -224,7 +237,14 @@ impl FcProblem {
         let q = num_array(take(&mut top, "q", "q")?, "q")?;
         let mu = num_array(take(&mut top, "mu", "mu")?, "mu")?;
         let meta = top.remove("meta");
-        Ok(FcProblem { dim, nc, w: CooMatrix { n, rows, cols, vals }, q, mu, meta })
+        Ok(FcProblem {
+            dim,
+            nc,
+            w: CooMatrix { n, rows, cols, vals },
+            q,
+            mu,
+            meta,
+        })
     }
 
     /// Checks dimensions, lengths, indices, finiteness, μ ≥ 0 and W_nn > 0 per
@@ -235,7 +255,11 @@ impl FcProblem {
             3 => return Err(bad("dim", DIM3)),
             d => return Err(bad("dim", format!("{d} must be 2 or 3"))),
         }
-        let n = self.nc.checked_mul(self.dim).filter(|&n| n <= u32::MAX as usize).ok_or_else(|| bad("nc", "too many contacts"))?;
+        let n = self
+            .nc
+            .checked_mul(self.dim)
+            .filter(|&n| n <= u32::MAX as usize)
+            .ok_or_else(|| bad("nc", "too many contacts"))?;
         if self.q.len() != n {
             return Err(bad("q", format!("has {} values; expected dim·nc = {n}", self.q.len())));
         }
@@ -249,12 +273,18 @@ impl FcProblem {
         let nnz = w.rows.len();
         for (key, len) in [("W.cols", w.cols.len()), ("W.vals", w.vals.len())] {
             if len != nnz {
-                return Err(bad(key, format!("has {len} entries but W.rows has {nnz}: the coordinate arrays must have equal lengths")));
+                return Err(bad(
+                    key,
+                    format!("has {len} entries but W.rows has {nnz}: the coordinate arrays must have equal lengths"),
+                ));
             }
         }
         for (key, idx) in [("W.rows", &w.rows), ("W.cols", &w.cols)] {
             if let Some(k) = idx.iter().position(|&i| i >= n) {
-                return Err(bad(format!("{key}[{k}]"), format!("index {} out of range: W is {n} × {n} (dim·nc)", idx[k])));
+                return Err(bad(
+                    format!("{key}[{k}]"),
+                    format!("index {} out of range: W is {n} × {n} (dim·nc)", idx[k]),
+                ));
             }
         }
         if let Some(k) = w.vals.iter().position(|v| !v.is_finite()) {
@@ -264,16 +294,28 @@ impl FcProblem {
             return Err(bad(format!("q[{k}]"), format!("{} is not finite", self.q[k])));
         }
         if let Some(k) = self.mu.iter().position(|m| !(m.is_finite() && *m >= 0.0)) {
-            return Err(bad(format!("mu[{k}]"), format!("{}: a friction coefficient must be finite and ≥ 0", self.mu[k])));
+            return Err(bad(
+                format!("mu[{k}]"),
+                format!("{}: a friction coefficient must be finite and ≥ 0", self.mu[k]),
+            ));
         }
         let mut wnn = vec![0.0; self.nc];
         for k in 0..nnz {
-            if w.rows[k] == w.cols[k] && w.rows[k] % self.dim == 0 /* normal row */ {
+            if w.rows[k] == w.cols[k] && w.rows[k] % self.dim == 0
+            /* normal row */
+            {
                 wnn[w.rows[k] / self.dim] += w.vals[k];
             }
         }
         if let Some(a) = wnn.iter().position(|&x| !(x > 0.0)) {
-            return Err(bad("W", format!("contact {a}: the normal diagonal entry W[{0}][{0}] = {1} must be > 0", self.dim * a, wnn[a])));
+            return Err(bad(
+                "W",
+                format!(
+                    "contact {a}: the normal diagonal entry W[{0}][{0}] = {1} must be > 0",
+                    self.dim * a,
+                    wnn[a]
+                ),
+            ));
         }
         Ok(())
     }
@@ -297,7 +339,9 @@ impl FcProblem {
     pub fn natural_residual(&self, r: &[f64]) -> f64 {
         let u = self.velocity(r);
         let d = self.dim;
-        let f2: f64 = (0..self.nc).map(|a| natural_map_sq(&r[d * a..d * a + d], &u[d * a..d * a + d], self.mu[a])).sum();
+        let f2: f64 = (0..self.nc)
+            .map(|a| natural_map_sq(&r[d * a..d * a + d], &u[d * a..d * a + d], self.mu[a]))
+            .sum();
         f2.sqrt() / q_scale(&self.q)
     }
 
@@ -451,7 +495,14 @@ fn solve2(p: &FcProblem, opts: &FcOptions) -> FcSolution {
         converged |= residual < opts.tol;
     }
     let solve_seconds = t0.elapsed().as_secs_f64();
-    FcSolution { r: r.concat(), u: u.concat(), sweeps, converged, residual, solve_seconds }
+    FcSolution {
+        r: r.concat(),
+        u: u.concat(),
+        sweeps,
+        converged,
+        residual,
+        solve_seconds,
+    }
 }
 
 /// Reads and solves one problem file.
@@ -553,7 +604,12 @@ mod tests {
     use super::*;
 
     fn opts(norm: FcNorm, tol: f64) -> FcOptions {
-        FcOptions { tol, max_sweeps: 10_000, check_every: 1, norm }
+        FcOptions {
+            tol,
+            max_sweeps: 10_000,
+            check_every: 1,
+            norm,
+        }
     }
 
     fn problem(nc: usize, trip: &[(usize, usize, f64)], q: &[f64], mu: &[f64]) -> FcProblem {
@@ -576,7 +632,18 @@ mod tests {
     fn fc_assembly_sums_duplicates_and_symmetrises() {
         let p = problem(
             2,
-            &[(0, 0, 1.0), (0, 0, 0.5), (0, 1, 0.2), (1, 0, 0.4), (1, 1, 2.0), (0, 2, -0.1), (0, 2, -0.2), (3, 1, 0.7), (2, 2, 1.0), (3, 3, 1.0)],
+            &[
+                (0, 0, 1.0),
+                (0, 0, 0.5),
+                (0, 1, 0.2),
+                (1, 0, 0.4),
+                (1, 1, 2.0),
+                (0, 2, -0.1),
+                (0, 2, -0.2),
+                (3, 1, 0.7),
+                (2, 2, 1.0),
+                (3, 3, 1.0),
+            ],
             &[0.0; 4],
             &[0.1, 0.1],
         );
@@ -593,7 +660,11 @@ mod tests {
     fn fc_one_contact_cases() {
         // W = ½ I (a unit mass pair), μ = 0.5.
         let trip = [(0, 0, 0.5), (1, 1, 0.5)];
-        for (q, r) in [([-0.25, 0.0625], [0.5, -0.125]), ([-0.25, 1.0], [0.5, -0.25]), ([0.1, 1.0], [0.0, 0.0])] {
+        for (q, r) in [
+            ([-0.25, 0.0625], [0.5, -0.125]),
+            ([-0.25, 1.0], [0.5, -0.25]),
+            ([0.1, 1.0], [0.0, 0.0]),
+        ] {
             let s = problem(1, &trip, &q, &[0.5]).solve(&opts(FcNorm::Natural, 1e-12));
             assert_eq!(s.r, r.to_vec());
             assert!(s.converged && s.sweeps == 1 && s.residual == 0.0, "{s:?}");
@@ -602,7 +673,12 @@ mod tests {
 
     #[test]
     fn fc_lmgc_norm_and_empty_problem() {
-        let p = problem(2, &[(0, 0, 1.0), (1, 1, 1.0), (2, 2, 2.0), (3, 3, 2.0), (0, 2, -1.0), (2, 0, -1.0)], &[-1.0, 0.0, 0.0, 0.0], &[0.3, 0.3]);
+        let p = problem(
+            2,
+            &[(0, 0, 1.0), (1, 1, 1.0), (2, 2, 2.0), (3, 3, 2.0), (0, 2, -1.0), (2, 0, -1.0)],
+            &[-1.0, 0.0, 0.0, 0.0],
+            &[0.3, 0.3],
+        );
         let s = p.solve(&opts(FcNorm::Lmgc(Criterion::QuadMax16), 1e-10));
         assert!(s.converged && s.residual < 1e-8, "{s:?}");
         let e = problem(0, &[], &[], &[]).solve(&opts(FcNorm::Natural, 1e-8));
@@ -645,6 +721,9 @@ mod tests {
         assert_eq!(key(&ok.replace("[-1,0]", "[-1,null]")), "q[1]");
         assert_eq!(key(&ok.replace("[0.5]", "[-0.5]")), "mu[0]");
         assert_eq!(key(&ok.replace(",\"mu\":[0.5]", "")), "mu");
-        assert!(FcProblem::parse(&ok.replace("\"dim\":2", "\"dim\":3"), "p.json").unwrap_err().message.contains("spheres plugin"));
+        assert!(FcProblem::parse(&ok.replace("\"dim\":2", "\"dim\":3"), "p.json")
+            .unwrap_err()
+            .message
+            .contains("spheres plugin"));
     }
 }

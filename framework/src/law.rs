@@ -72,12 +72,21 @@ fn parse_coulomb(t: &toml::Table) -> Result<ContactLaw, ParamError> {
 
 fn parse_frictionless(t: &toml::Table) -> Result<ContactLaw, ParamError> {
     only_keys(t, &["restitution"])?;
-    Ok(ContactLaw { mu: 0.0, e: restitution(t)? })
+    Ok(ContactLaw {
+        mu: 0.0,
+        e: restitution(t)?,
+    })
 }
 
 pub(crate) fn register_builtin(r: &mut Registry) {
-    r.add_law(LawDef { name: "coulomb", parse: parse_coulomb });
-    r.add_law(LawDef { name: "frictionless", parse: parse_frictionless });
+    r.add_law(LawDef {
+        name: "coulomb",
+        parse: parse_coulomb,
+    });
+    r.add_law(LawDef {
+        name: "frictionless",
+        parse: parse_frictionless,
+    });
 }
 
 #[cfg(test)]

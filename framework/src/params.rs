@@ -8,7 +8,10 @@ pub fn number(t: &toml::Table, key: &str, default: Option<f64>) -> Result<f64, P
     match t.get(key) {
         None => default.ok_or_else(|| ParamError::new(key, "missing key")),
         Some(v) => {
-            let x = v.as_float().or_else(|| v.as_integer().map(|i| i as f64)).ok_or_else(|| ParamError::new(key, "must be a number"))?;
+            let x = v
+                .as_float()
+                .or_else(|| v.as_integer().map(|i| i as f64))
+                .ok_or_else(|| ParamError::new(key, "must be a number"))?;
             if !x.is_finite() {
                 return Err(ParamError::new(key, "must be finite"));
             }
@@ -50,10 +53,17 @@ pub fn array<const N: usize>(t: &toml::Table, key: &str, default: Option<[f64; N
     match t.get(key) {
         None => default.ok_or_else(|| ParamError::new(key, "missing key")),
         Some(v) => {
-            let a = v.as_array().filter(|a| a.len() == N).ok_or_else(|| ParamError::new(key, format!("must be an array of {N} numbers")))?;
+            let a = v
+                .as_array()
+                .filter(|a| a.len() == N)
+                .ok_or_else(|| ParamError::new(key, format!("must be an array of {N} numbers")))?;
             let mut out = [0.0; N];
             for (o, x) in out.iter_mut().zip(a) {
-                *o = x.as_float().or_else(|| x.as_integer().map(|i| i as f64)).filter(|f| f.is_finite()).ok_or_else(|| ParamError::new(key, format!("must be an array of {N} finite numbers")))?;
+                *o = x
+                    .as_float()
+                    .or_else(|| x.as_integer().map(|i| i as f64))
+                    .filter(|f| f.is_finite())
+                    .ok_or_else(|| ParamError::new(key, format!("must be an array of {N} finite numbers")))?;
             }
             Ok(out)
         }
@@ -64,7 +74,10 @@ pub fn array<const N: usize>(t: &toml::Table, key: &str, default: Option<[f64; N
 pub fn only_keys(t: &toml::Table, allowed: &[&str]) -> Result<(), ParamError> {
     for k in t.keys() {
         if !allowed.contains(&k.as_str()) {
-            return Err(ParamError::new(k.clone(), format!("unknown key `{k}`; expected one of: {}", allowed.join(", "))));
+            return Err(ParamError::new(
+                k.clone(),
+                format!("unknown key `{k}`; expected one of: {}", allowed.join(", ")),
+            ));
         }
     }
     Ok(())

@@ -36,7 +36,10 @@ pub struct Aabb2 {
 
 impl Aabb2 {
     pub fn overlaps(&self, o: &Aabb2, margin: f64) -> bool {
-        self.min[0] <= o.max[0] + margin && o.min[0] <= self.max[0] + margin && self.min[1] <= o.max[1] + margin && o.min[1] <= self.max[1] + margin
+        self.min[0] <= o.max[0] + margin
+            && o.min[0] <= self.max[0] + margin
+            && self.min[1] <= o.max[1] + margin
+            && o.min[1] <= self.max[1] + margin
     }
     pub fn is_bounded(&self) -> bool {
         self.min.iter().chain(&self.max).all(|x| x.is_finite())
@@ -73,7 +76,10 @@ pub struct ParamError {
 
 impl ParamError {
     pub fn new(key: impl Into<String>, msg: impl Into<String>) -> Self {
-        ParamError { key: key.into(), msg: msg.into() }
+        ParamError {
+            key: key.into(),
+            msg: msg.into(),
+        }
     }
 }
 
@@ -220,6 +226,9 @@ impl Registry {
         if let Some((_, d)) = self.detectors.iter().find(|((x, y), _)| *x == a && *y == b) {
             return Some((d.clone(), false));
         }
-        self.detectors.iter().find(|((x, y), _)| *x == b && *y == a).map(|(_, d)| (d.clone(), true))
+        self.detectors
+            .iter()
+            .find(|((x, y), _)| *x == b && *y == a)
+            .map(|(_, d)| (d.clone(), true))
     }
 }

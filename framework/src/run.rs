@@ -58,7 +58,12 @@ fn io(dir: &Path, what: &str) -> impl Fn(std::io::Error) -> RunError {
 /// Runs `scene` for its number of steps, writing `history.csv`, the writers' frames
 /// every `output.every` steps (and at the first and last step) and `final.json` in
 /// `dir`. `on_step` is called after every step (progress display).
-pub fn run(scene: &mut Scene, registry: &Registry, dir: &Path, mut on_step: impl FnMut(&World2, &StepReport)) -> Result<RunSummary, RunError> {
+pub fn run(
+    scene: &mut Scene,
+    registry: &Registry,
+    dir: &Path,
+    mut on_step: impl FnMut(&World2, &StepReport),
+) -> Result<RunSummary, RunError> {
     let start = Instant::now();
     std::fs::create_dir_all(dir).map_err(io(dir, "the output directory"))?;
     let w = &mut scene.world;

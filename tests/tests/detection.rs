@@ -13,7 +13,10 @@ fn scene(disks: &[([f64; 2], f64)], alert: f64) -> String {
          [[bodies]]\nshape = \"halfplane\"\nmaterial = \"m\"\nposition = [1.0, 0.0]\nrotation = 1.5707963267948966\nfixed = true\n"
     );
     for (x, r) in disks {
-        s.push_str(&format!("[[bodies]]\nshape = \"disk\"\nmaterial = \"m\"\nposition = [{}, {}]\nradius = {r}\n", x[0], x[1]));
+        s.push_str(&format!(
+            "[[bodies]]\nshape = \"disk\"\nmaterial = \"m\"\nposition = [{}, {}]\nradius = {r}\n",
+            x[0], x[1]
+        ));
     }
     s
 }
@@ -45,13 +48,28 @@ fn detected(text: &str) -> BTreeSet<(u32, u32)> {
     let mut s = load_str(text, "detect.toml", &reg).unwrap_or_else(|e| panic!("{e}"));
     s.world.step().unwrap();
     let c = &s.world.contacts;
-    (0..c.len()).map(|a| (c.bodies[a][0].max(c.bodies[a][1]), c.bodies[a][0].min(c.bodies[a][1]))).map(|(i, j)| if j < 2 { (i, j) } else { (j, i) }).collect()
+    (0..c.len())
+        .map(|a| (c.bodies[a][0].max(c.bodies[a][1]), c.bodies[a][0].min(c.bodies[a][1])))
+        .map(|(i, j)| if j < 2 { (i, j) } else { (j, i) })
+        .collect()
 }
 
 fn check(disks: Vec<([f64; 2], f64)>, alert: f64) {
-    let want: BTreeSet<(u32, u32)> = brute(&disks, alert).into_iter().map(|(i, j)| if j < 2 { (i, j) } else { (i.min(j), i.max(j)) }).collect();
-    let got: BTreeSet<(u32, u32)> = detected(&scene(&disks, alert)).into_iter().map(|(i, j)| if j < 2 { (i, j) } else { (i.min(j), i.max(j)) }).collect();
-    assert_eq!(got.len(), want.len(), "missing: {:?}\nextra: {:?}", want.difference(&got).take(5).collect::<Vec<_>>(), got.difference(&want).take(5).collect::<Vec<_>>());
+    let want: BTreeSet<(u32, u32)> = brute(&disks, alert)
+        .into_iter()
+        .map(|(i, j)| if j < 2 { (i, j) } else { (i.min(j), i.max(j)) })
+        .collect();
+    let got: BTreeSet<(u32, u32)> = detected(&scene(&disks, alert))
+        .into_iter()
+        .map(|(i, j)| if j < 2 { (i, j) } else { (i.min(j), i.max(j)) })
+        .collect();
+    assert_eq!(
+        got.len(),
+        want.len(),
+        "missing: {:?}\nextra: {:?}",
+        want.difference(&got).take(5).collect::<Vec<_>>(),
+        got.difference(&want).take(5).collect::<Vec<_>>()
+    );
     assert_eq!(got, want);
 }
 
@@ -70,7 +88,9 @@ fn grid_matches_brute_force_polydisperse() {
 #[test]
 fn grid_matches_brute_force_radii_spread_1_to_100() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4);
-    let mut disks: Vec<_> = (0..800).map(|_| ([rng.random_range(0.0..1.0), rng.random_range(0.0..1.0)], 0.002)).collect();
+    let mut disks: Vec<_> = (0..800)
+        .map(|_| ([rng.random_range(0.0..1.0), rng.random_range(0.0..1.0)], 0.002))
+        .collect();
     disks.extend((0..6).map(|_| ([rng.random_range(0.0..1.0), rng.random_range(0.0..1.0)], 0.2)));
     check(disks, 0.001);
 }

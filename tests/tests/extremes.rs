@@ -99,7 +99,12 @@ fn energy(w: &World2) -> f64 {
 fn simulate(case: &str, text: &str, mut each: impl FnMut(&World2, &StepReport)) -> (Scene, Figures) {
     let reg = nscdd_rigid_disks::registry();
     let mut s = load_str(text, &format!("{case}.toml"), &reg).unwrap_or_else(|e| panic!("{case}: {e}"));
-    let mut f = Figures { h: s.world.time.h, alert: s.world.alert, e0: energy(&s.world), ..Default::default() };
+    let mut f = Figures {
+        h: s.world.time.h,
+        alert: s.world.alert,
+        e0: energy(&s.world),
+        ..Default::default()
+    };
     let t0 = Instant::now();
     for _ in 0..s.world.time.steps {
         let rep = s.world.step().unwrap_or_else(|d| panic!("{case}: {d}"));
@@ -112,7 +117,11 @@ fn simulate(case: &str, text: &str, mut each: impl FnMut(&World2, &StepReport)) 
             f.first_unconverged.get_or_insert(w.step);
         }
         assert!(rep.solve.residual.is_finite(), "{case}: non-finite residual at step {}", w.step);
-        assert!(w.contacts.r.iter().flatten().all(|x| x.is_finite()), "{case}: non-finite impulse at step {}", w.step);
+        assert!(
+            w.contacts.r.iter().flatten().all(|x| x.is_finite()),
+            "{case}: non-finite impulse at step {}",
+            w.step
+        );
         f.max_residual = f.max_residual.max(rep.solve.residual);
         f.max_contacts = f.max_contacts.max(rep.contacts);
         for &g in &w.contacts.gap {
@@ -169,16 +178,28 @@ fn floor_halfplane() -> String {
 /// A box of walls (inner [0, width] × [0, height], thickness t): floor, left, right.
 fn open_box(width: f64, height: f64, t: f64) -> String {
     let v = std::f64::consts::FRAC_PI_2;
-    wall("floor", 0.5 * width, -0.5 * t, 0.0, width + 2.0 * t, t) + &wall("left", -0.5 * t, 0.5 * height, v, height + t, t) + &wall("right", width + 0.5 * t, 0.5 * height, v, height + t, t)
+    wall("floor", 0.5 * width, -0.5 * t, 0.0, width + 2.0 * t, t)
+        + &wall("left", -0.5 * t, 0.5 * height, v, height + t, t)
+        + &wall("right", width + 0.5 * t, 0.5 * height, v, height + t, t)
 }
 
 fn index_of(w: &World2, name: &str) -> usize {
-    w.names.iter().position(|n| n.as_deref() == Some(name)).unwrap_or_else(|| panic!("no body `{name}`"))
+    w.names
+        .iter()
+        .position(|n| n.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("no body `{name}`"))
 }
 
 /// Movable bodies whose centre left the box [0, width] × [0, ∞).
 fn escaped(w: &World2, width: f64) -> usize {
-    (0..w.bodies.len()).filter(|&b| w.bodies.movable(b) && { let p = w.bodies.pos[b]; p[1] < 0.0 || p[0] < 0.0 || p[0] > width }).count()
+    (0..w.bodies.len())
+        .filter(|&b| {
+            w.bodies.movable(b) && {
+                let p = w.bodies.pos[b];
+                p[1] < 0.0 || p[0] < 0.0 || p[0] > width
+            }
+        })
+        .count()
 }
 
 // ---------------------------------------------------------------------------------
@@ -190,9 +211,15 @@ fn heavy_scene(ratio: f64, steps: u64, tol: f64, max_sweeps: u32) -> String {
     let r = 0.01;
     let mut text = header(1e-3, steps, tol, max_sweeps, 0.3, 0.0);
     // one heavy body: no heavy–heavy law is needed
-    text += &format!("\n[[materials]]\nname = \"heavy\"\ndensity = {:e}\n\n[[laws]]\nmaterials = [\"heavy\", \"grain\"]\nfriction = 0.3\n", 1000.0 * ratio);
+    text += &format!(
+        "\n[[materials]]\nname = \"heavy\"\ndensity = {:e}\n\n[[laws]]\nmaterials = [\"heavy\", \"grain\"]\nfriction = 0.3\n",
+        1000.0 * ratio
+    );
     text += &floor_halfplane();
-    for (name, x, rot) in [("left", -2.0 * r, -std::f64::consts::FRAC_PI_2), ("right", 2.0 * r, std::f64::consts::FRAC_PI_2)] {
+    for (name, x, rot) in [
+        ("left", -2.0 * r, -std::f64::consts::FRAC_PI_2),
+        ("right", 2.0 * r, std::f64::consts::FRAC_PI_2),
+    ] {
         text += &format!("\n[[bodies]]\nname = \"{name}\"\nshape = \"halfplane\"\nmaterial = \"grain\"\nposition = [{x:e}, 0.0]\nrotation = {rot:e}\nfixed = true\n");
     }
     text += &disk("a", "grain", -r, r, r);
@@ -224,13 +251,22 @@ fn heavy_disk_on_light_ones() {
     // to |W r|, stall first and accept; the natural-map residual shows it
     let (f, sink, force) = heavy("heavy", 1e6, steps, 1.666e-4, 10_000);
     let free_fall = 0.5 * G * (steps as f64 * h).powi(2);
-    f.print("heavy disk, mass ratio 1e6, QM/16 tol 1.666e-4", &format!("heavy disk sank {sink:.3e} m (free fall: {free_fall:.3e} m), support force / total weight − 1 = {force:+.2e}"));
-    assert!(sink < free_fall * 1.01 && f.max_pen < free_fall * 1.01, "never worse than a free fall");
+    f.print(
+        "heavy disk, mass ratio 1e6, QM/16 tol 1.666e-4",
+        &format!("heavy disk sank {sink:.3e} m (free fall: {free_fall:.3e} m), support force / total weight − 1 = {force:+.2e}"),
+    );
+    assert!(
+        sink < free_fall * 1.01 && f.max_pen < free_fall * 1.01,
+        "never worse than a free fall"
+    );
     assert!(f.max_residual > 0.1, "the residual must show the unsupported heavy disk");
     // (b) a tight tolerance and enough sweeps hold it
     let (f, sink, force) = heavy("heavy-tight", 1e6, steps, 1e-8, 10_000_000);
     let bound = creep_bound(steps, h);
-    f.print("heavy disk, mass ratio 1e6, QM/16 tol 1e-8", &format!("heavy disk sank {sink:.3e} m, support force / total weight − 1 = {force:+.2e}, bound {bound:.2e} m"));
+    f.print(
+        "heavy disk, mass ratio 1e6, QM/16 tol 1e-8",
+        &format!("heavy disk sank {sink:.3e} m, support force / total weight − 1 = {force:+.2e}, bound {bound:.2e} m"),
+    );
     assert!(f.max_pen < bound, "interpenetration {} > {bound}", f.max_pen);
     assert!(sink.abs() < bound, "the heavy disk sank {sink} m");
     assert!(force.abs() < 1e-2, "support force off by {force}");
@@ -238,7 +274,10 @@ fn heavy_disk_on_light_ones() {
     // (c) sweeps of the first step against the mass ratio
     for ratio in [1.0, 1e2, 1e4] {
         let (f, sink, force) = heavy(&format!("heavy-{ratio}"), ratio, 1, 1e-8, 10_000_000);
-        f.print(&format!("heavy disk, mass ratio {ratio:e}, one step, tol 1e-8"), &format!("sank {sink:.3e} m, support force / total weight − 1 = {force:+.2e}"));
+        f.print(
+            &format!("heavy disk, mass ratio {ratio:e}, one step, tol 1e-8"),
+            &format!("sank {sink:.3e} m, support force / total weight − 1 = {force:+.2e}"),
+        );
         assert_eq!(f.unconverged, 0);
     }
 }
@@ -273,8 +312,15 @@ fn incline(mu: f64) -> (Figures, f64, f64, f64) {
 fn friction_zero_and_ten_on_an_incline() {
     for mu in [0.0, 10.0] {
         let (f, rel, spin, slip) = incline(mu);
-        let slip_txt = if mu == 0.0 { String::new() } else { format!(", v/(ω r) − 1 = {:+.2e}", slip - 1.0) };
-        f.print(&format!("incline 30°, mu={mu}"), &format!("distance/exact − 1 = {rel:+.2e}, ω = {spin:.4e} rad/s{slip_txt}"));
+        let slip_txt = if mu == 0.0 {
+            String::new()
+        } else {
+            format!(", v/(ω r) − 1 = {:+.2e}", slip - 1.0)
+        };
+        f.print(
+            &format!("incline 30°, mu={mu}"),
+            &format!("distance/exact − 1 = {rel:+.2e}, ω = {spin:.4e} rad/s{slip_txt}"),
+        );
         assert!(rel.abs() < 1e-6, "μ = {mu}: distance off the exact one by {rel}");
         if mu == 0.0 {
             assert!(spin.abs() < 1e-9, "no friction, no spin: ω = {spin}");
@@ -308,9 +354,20 @@ fn friction_zero_and_ten_in_a_pile() {
         // the deposit is not in equilibrium: a disk may fall off its support by up
         // to a diameter, v ≤ √(2 g 0.024) ≈ 0.7 m/s
         let bound = impact_bound(h, 0.7, f.alert) + creep_bound(steps, h);
-        f.print(&format!("pile of 100, mu={mu}"), &format!("final kinetic energy {ek:.3e} J, {} escaped, bound {bound:.2e} m", escaped(&s.world, 0.2)));
+        f.print(
+            &format!("pile of 100, mu={mu}"),
+            &format!(
+                "final kinetic energy {ek:.3e} J, {} escaped, bound {bound:.2e} m",
+                escaped(&s.world, 0.2)
+            ),
+        );
         assert!(f.max_pen < bound, "μ = {mu}: interpenetration {} > {bound}", f.max_pen);
-        assert!(f.e_end <= f.e0 + 1e-9, "μ = {mu}: a settling pile creates no energy ({} -> {})", f.e0, f.e_end);
+        assert!(
+            f.e_end <= f.e0 + 1e-9,
+            "μ = {mu}: a settling pile creates no energy ({} -> {})",
+            f.e0,
+            f.e_end
+        );
         assert_eq!(escaped(&s.world, 0.2), 0);
     }
 }
@@ -352,12 +409,18 @@ fn restitution_zero_and_one_drop() {
         for a in [None, Some(2e-3)] {
             let (f, top_late, dev) = drop(e, a);
             let bound = impact_bound(h, v, f.alert);
-            f.print(&format!("drop from 0.1 m, e={e}"), &format!("highest point after t = 0.5 s {top_late:.4e} m, max |E − E0| {dev:.3e} J, bound {bound:.2e} m"));
+            f.print(
+                &format!("drop from 0.1 m, e={e}"),
+                &format!("highest point after t = 0.5 s {top_late:.4e} m, max |E − E0| {dev:.3e} J, bound {bound:.2e} m"),
+            );
             assert!(f.max_pen <= bound, "e = {e}: interpenetration {} > {bound}", f.max_pen);
             if e == 0.0 {
                 assert!(top_late < 1e-6, "e = 0: the disk must stay on the floor, got {top_late}");
             } else {
-                assert!((top_late - height).abs() < 0.02 * height, "e = 1: it must bounce back to {height}, got {top_late}");
+                assert!(
+                    (top_late - height).abs() < 0.02 * height,
+                    "e = 1: it must bounce back to {height}, got {top_late}"
+                );
                 assert!(dev / f.e0 < 1e-9, "e = 1, θ = ½: energy kept, deviation {dev}");
             }
         }
@@ -390,14 +453,27 @@ fn restitution_one_cradle() {
         let (f, v) = cradle(gap);
         let p: f64 = v.iter().sum();
         let vs: Vec<String> = v.iter().map(|x| format!("{x:.4}")).collect();
-        f.print(&format!("row of 4, e=1, gap={gap:e}"), &format!("final velocities [{}], momentum {p:.9} (1 before), energy ratio {:.6}", vs.join(", "), f.e_end / f.e0));
+        f.print(
+            &format!("row of 4, e=1, gap={gap:e}"),
+            &format!(
+                "final velocities [{}], momentum {p:.9} (1 before), energy ratio {:.6}",
+                vs.join(", "),
+                f.e_end / f.e0
+            ),
+        );
         assert!((p - 1.0).abs() < 1e-9, "momentum kept");
         assert!(f.e_end <= f.e0 * (1.0 + 1e-9), "no energy created");
         if gap > 0.0 {
-            assert!((v[3] - 1.0).abs() < 1e-6 && v[..3].iter().all(|x| x.abs() < 1e-6), "sequential impacts: the last disk takes the velocity, {v:?}");
+            assert!(
+                (v[3] - 1.0).abs() < 1e-6 && v[..3].iter().all(|x| x.abs() < 1e-6),
+                "sequential impacts: the last disk takes the velocity, {v:?}"
+            );
             assert!((f.e_end / f.e0 - 1.0).abs() < 1e-9);
         } else {
-            assert!((v[0] + 0.5).abs() < 1e-4 && v[1..].iter().all(|x| (x - 0.5).abs() < 1e-4), "touching row: one body of 3 m, {v:?}");
+            assert!(
+                (v[0] + 0.5).abs() < 1e-4 && v[1..].iter().all(|x| (x - 0.5).abs() < 1e-4),
+                "touching row: one body of 3 m, {v:?}"
+            );
             assert!((f.e_end / f.e0 - 1.0).abs() < 1e-4);
         }
         assert!(f.max_pen < impact_bound(1e-4, 1.0, 1e-3), "interpenetration {}", f.max_pen);
@@ -437,7 +513,13 @@ fn time_steps_from_1e_6_to_1e_1() {
             let (ek, _) = s.world.energies();
             let out = escaped(&s.world, 0.11);
             let bound = impact_bound(h, v_max(h), f.alert) + creep_bound(steps, h);
-            f.print(&format!("falling pile of 20, h={h:e}"), &format!("simulated {:.3} s, final kinetic energy {ek:.3e} J, {out} escaped, bound {bound:.2e} m", steps as f64 * h));
+            f.print(
+                &format!("falling pile of 20, h={h:e}"),
+                &format!(
+                    "simulated {:.3} s, final kinetic energy {ek:.3e} J, {out} escaped, bound {bound:.2e} m",
+                    steps as f64 * h
+                ),
+            );
             assert!(f.e_end <= f.e0 + 1e-9, "h = {h}: energy created ({} -> {})", f.e0, f.e_end);
             if a.is_some() || h * v_max(h) <= f.alert {
                 assert!(f.max_pen < bound, "h = {h}: interpenetration {} > {bound}", f.max_pen);
@@ -454,7 +536,9 @@ fn column_scene(n: usize, steps: u64, tol: f64, max_sweeps: u32) -> String {
     let r = 0.01;
     header(1e-3, steps, tol, max_sweeps, 0.3, 0.0)
         + &floor_halfplane()
-        + &format!("\n[[generate]]\nkind = \"square_lattice\"\nmaterial = \"grain\"\nnx = 1\nny = {n}\nradius = {r:e}\norigin = [0.0, {r:e}]\n")
+        + &format!(
+            "\n[[generate]]\nkind = \"square_lattice\"\nmaterial = \"grain\"\nnx = 1\nny = {n}\nradius = {r:e}\norigin = [0.0, {r:e}]\n"
+        )
 }
 
 /// Bottom contact force / (n m g) after the last step.
@@ -476,12 +560,18 @@ fn column_of_1000_disks() {
             flagged_by_residual = false;
         }
         if [1, 2, 5, 10, 50, 100, 200, 400].contains(&w.step) {
-            samples.push(format!("step {}: {} sweeps, converged {}, bottom {:.3}, residual {:.2e}", w.step, rep.solve.sweeps, rep.solve.converged, ratio, rep.solve.residual));
+            samples.push(format!(
+                "step {}: {} sweeps, converged {}, bottom {:.3}, residual {:.2e}",
+                w.step, rep.solve.sweeps, rep.solve.converged, ratio, rep.solve.residual
+            ));
         }
     });
     let top_sink = (2 * n - 1) as f64 * r - s.world.bodies.pos[n][1];
     let bound = creep_bound(steps, h);
-    f.print("column of 1000, QM/16 tol 1.666e-4", &format!("top disk sank {top_sink:.3e} m, bound {bound:.2e} m; {}", samples.join("; ")));
+    f.print(
+        "column of 1000, QM/16 tol 1.666e-4",
+        &format!("top disk sank {top_sink:.3e} m, bound {bound:.2e} m; {}", samples.join("; ")),
+    );
     assert!(f.max_pen < bound, "interpenetration {} > {bound}", f.max_pen);
     // the LMGC norms stop on stagnation: the natural-map residual tells
     assert!(flagged_by_residual, "a bottom force off by > 10 % must show in the residual");
@@ -490,7 +580,10 @@ fn column_of_1000_disks() {
     let sweeps = 150_000;
     let (s, f) = simulate("column-one-step", &column_scene(n, 1, 1e-14, sweeps), |_, _| {});
     let ratio = bottom_ratio(&s.world, n);
-    f.print("column of 1000, one step, 150000 sweeps", &format!("bottom force / (1000 m g) = {ratio:.4}"));
+    f.print(
+        "column of 1000, one step, 150000 sweeps",
+        &format!("bottom force / (1000 m g) = {ratio:.4}"),
+    );
     assert_eq!(f.unconverged, 1, "the step must report that it did not converge");
     assert!(ratio > 0.2 && ratio < 1.0, "bottom ratio {ratio}");
 
@@ -532,7 +625,13 @@ fn large_disk_on_a_bed_of_small_ones() {
     let k = index_of(&s.world, "big");
     let sink = top + small + big - s.world.bodies.pos[k][1];
     let bound = creep_bound(steps, h);
-    f.print("radii 1:100, disk R = 0.5 m on 3 rows of r = 5 mm", &format!("{} bodies, the big disk sank {sink:.3e} m, bound {bound:.2e} m", s.world.bodies.len()));
+    f.print(
+        "radii 1:100, disk R = 0.5 m on 3 rows of r = 5 mm",
+        &format!(
+            "{} bodies, the big disk sank {sink:.3e} m, bound {bound:.2e} m",
+            s.world.bodies.len()
+        ),
+    );
     assert!(f.max_pen < bound, "interpenetration {} > {bound}", f.max_pen);
 }
 
@@ -546,7 +645,13 @@ fn polydisperse_deposit_1_to_100() {
     let (ek, _) = s.world.energies();
     // disks may roll off a support by up to the largest diameter: v ≤ √(2 g 0.2)
     let bound = impact_bound(h, (2.0 * G * 0.2).sqrt(), f.alert) + creep_bound(steps, h);
-    f.print("radii 1:100, deposit of 200 (r 1 mm–10 cm)", &format!("final kinetic energy {ek:.3e} J, {} escaped, bound {bound:.2e} m", escaped(&s.world, 1.0)));
+    f.print(
+        "radii 1:100, deposit of 200 (r 1 mm–10 cm)",
+        &format!(
+            "final kinetic energy {ek:.3e} J, {} escaped, bound {bound:.2e} m",
+            escaped(&s.world, 1.0)
+        ),
+    );
     assert!(f.max_pen < bound, "interpenetration {} > {bound}", f.max_pen);
     assert_eq!(escaped(&s.world, 1.0), 0);
     assert!(f.e_end <= f.e0 + 1e-9);

@@ -35,7 +35,9 @@ origin = [0.01, 0.01]
 
 fn points_and_cells(path: &std::path::Path) -> (usize, usize, usize) {
     let vtk = vtkio::Vtk::import(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let DataSet::PolyData { pieces, .. } = vtk.data else { panic!("not polydata") };
+    let DataSet::PolyData { pieces, .. } = vtk.data else {
+        panic!("not polydata")
+    };
     let Piece::Inline(p) = &pieces[0] else { panic!("not inline") };
     let n = |v: &Option<VertexNumbers>| v.as_ref().map(|v| v.num_cells()).unwrap_or(0);
     (p.num_points(), n(&p.verts), n(&p.lines))
@@ -54,7 +56,22 @@ fn run_writes_history_final_and_vtk() {
     let lines: Vec<&str> = hist.lines().collect();
     assert_eq!(lines.len(), 21, "a header and one row per step");
     let head: Vec<&str> = lines[0].split(',').collect();
-    for c in ["step", "time", "bodies", "contacts", "sweeps", "converged", "QuadDV", "MaxmDVR", "MeanDVoR", "residual", "kinetic_energy", "potential_energy", "floor_fy", "t_nlgs"] {
+    for c in [
+        "step",
+        "time",
+        "bodies",
+        "contacts",
+        "sweeps",
+        "converged",
+        "QuadDV",
+        "MaxmDVR",
+        "MeanDVoR",
+        "residual",
+        "kinetic_energy",
+        "potential_energy",
+        "floor_fy",
+        "t_nlgs",
+    ] {
         assert!(head.contains(&c), "column {c}");
     }
     for l in &lines[1..] {

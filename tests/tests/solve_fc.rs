@@ -41,7 +41,12 @@ impl Drop for TempFile {
 }
 
 fn natural(tol: f64) -> FcOptions {
-    FcOptions { tol, max_sweeps: 200_000, check_every: 1, norm: FcNorm::Natural }
+    FcOptions {
+        tol,
+        max_sweeps: 200_000,
+        check_every: 1,
+        norm: FcNorm::Natural,
+    }
 }
 
 /// The problem as read from its JSON text by the test itself (not by nscdd).
@@ -58,7 +63,13 @@ impl Raw {
     fn from_json(text: &str) -> Raw {
         let v: Value = serde_json::from_str(text).unwrap();
         let nums = |x: &Value| x.as_array().unwrap().iter().map(|y| y.as_f64().unwrap()).collect::<Vec<f64>>();
-        let ints = |x: &Value| x.as_array().unwrap().iter().map(|y| y.as_u64().unwrap() as usize).collect::<Vec<usize>>();
+        let ints = |x: &Value| {
+            x.as_array()
+                .unwrap()
+                .iter()
+                .map(|y| y.as_u64().unwrap() as usize)
+                .collect::<Vec<usize>>()
+        };
         assert_eq!(v["dim"], 2);
         Raw {
             nc: v["nc"].as_u64().unwrap() as usize,
@@ -119,8 +130,14 @@ fn check_signorini_coulomb(raw: &Raw, sol: &FcSolution, tol: f64) -> (usize, usi
         let (rn, rt, un, ut, mu) = (r[2 * a], r[2 * a + 1], u[2 * a], u[2 * a + 1], raw.mu[a]);
         let d = (eps + rho[a]) * 1.0001;
         // the solver's u agrees with the recomputed one
-        assert!((sol.u[2 * a] - un).abs() <= rho[a] && (sol.u[2 * a + 1] - ut).abs() <= rho[a], "contact {a}: u differs");
-        assert!(rn >= 0.0 && rt.abs() <= mu * rn * (1.0 + 1e-11), "contact {a}: r = ({rn}, {rt}) outside the cone μ = {mu}");
+        assert!(
+            (sol.u[2 * a] - un).abs() <= rho[a] && (sol.u[2 * a + 1] - ut).abs() <= rho[a],
+            "contact {a}: u differs"
+        );
+        assert!(
+            rn >= 0.0 && rt.abs() <= mu * rn * (1.0 + 1e-11),
+            "contact {a}: r = ({rn}, {rt}) outside the cone μ = {mu}"
+        );
         assert!(un >= -(1.0 + mu) * d, "contact {a}: u_n = {un} < −(1+μ)δ, δ = {d}");
         if rn > d {
             closed += 1;
@@ -130,7 +147,10 @@ fn check_signorini_coulomb(raw: &Raw, sol: &FcSolution, tol: f64) -> (usize, usi
             stick += 1;
             assert!(ut.abs() <= d, "contact {a}: sticking (r = ({rn}, {rt})) but u_t = {ut}");
         }
-        assert!(ut * rt <= d * (ut.abs() + rt.abs()), "contact {a}: friction r_t = {rt} drives the sliding u_t = {ut}");
+        assert!(
+            ut * rt <= d * (ut.abs() + rt.abs()),
+            "contact {a}: friction r_t = {rt} drives the sliding u_t = {ut}"
+        );
     }
     (closed, stick)
 }
@@ -230,9 +250,16 @@ fn generated(label: &str, toml: &str, steps: usize, at_rest: bool) -> (usize, u3
     // Diagonal blocks agree with the world's W_αα.
     for a in 0..nc {
         let wa = w.contacts.block[a].w;
-        for (ij, x) in [((2 * a, 2 * a), wa[0]), ((2 * a, 2 * a + 1), wa[1]), ((2 * a + 1, 2 * a + 1), wa[2])] {
+        for (ij, x) in [
+            ((2 * a, 2 * a), wa[0]),
+            ((2 * a, 2 * a + 1), wa[1]),
+            ((2 * a + 1, 2 * a + 1), wa[2]),
+        ] {
             let y = entries.binary_search_by(|e| e.0.cmp(&ij)).map(|k| entries[k].1).unwrap_or(0.0);
-            assert!((x - y).abs() <= 1e-12 * wa[0].abs().max(wa[2].abs()), "{label}: W_αα of contact {a}: {x} vs {y}");
+            assert!(
+                (x - y).abs() <= 1e-12 * wa[0].abs().max(wa[2].abs()),
+                "{label}: W_αα of contact {a}: {x} vs {y}"
+            );
         }
     }
     // The world's impulses give, through W r + q, the world's local velocities
@@ -245,20 +272,36 @@ fn generated(label: &str, toml: &str, steps: usize, at_rest: bool) -> (usize, u3
         let mut uw = w.contacts.local_velocity(a, &w.bodies.vel);
         uw[0] -= w.contacts.target[a].u_target;
         let tol = 1e4 * rho[a] + 1e-15;
-        assert!((uw[0] - u[2 * a]).abs() <= tol && (uw[1] - u[2 * a + 1]).abs() <= tol, "{label}: contact {a}: world u = {uw:?}, W r + q = {:?}", &u[2 * a..2 * a + 2]);
+        assert!(
+            (uw[0] - u[2 * a]).abs() <= tol && (uw[1] - u[2 * a + 1]).abs() <= tol,
+            "{label}: contact {a}: world u = {uw:?}, W r + q = {:?}",
+            &u[2 * a..2 * a + 2]
+        );
         f2 += nscdd::norms::natural_map_sq(&r_world[2 * a..2 * a + 2], &u[2 * a..2 * a + 2], raw.mu[a]);
     }
     let res_world = f2.sqrt() / raw.q_norm();
-    assert!((res_world - rep.solve.residual).abs() <= 1e-6 * rep.solve.residual + 1e-12, "{label}: residual {res_world} vs the world's {}", rep.solve.residual);
+    assert!(
+        (res_world - rep.solve.residual).abs() <= 1e-6 * rep.solve.residual + 1e-12,
+        "{label}: residual {res_world} vs the world's {}",
+        rep.solve.residual
+    );
 
     // Solve from the file.
     let file = TempFile::new(&format!("{label}.json"), &text);
     let tol = 1e-8;
     let sol = solve_file(file.path(), &natural(tol)).unwrap();
-    assert!(sol.converged && sol.residual <= tol, "{label}: {} sweeps, residual {}", sol.sweeps, sol.residual);
+    assert!(
+        sol.converged && sol.residual <= tol,
+        "{label}: {} sweeps, residual {}",
+        sol.sweeps,
+        sol.residual
+    );
     let (closed, stick) = check_signorini_coulomb(&raw, &sol, tol);
     let frictional = raw.mu.iter().any(|&m| m > 0.0);
-    assert!(closed > nc / 3 && (stick > 0 || !frictional), "{label}: {closed} closed, {stick} sticking contacts of {nc}");
+    assert!(
+        closed > nc / 3 && (stick > 0 || !frictional),
+        "{label}: {closed} closed, {stick} sticking contacts of {nc}"
+    );
 
     // A sample at rest: the floor carries the weight, Σ of the vertical impulses on
     // it ≈ −m g h.
@@ -275,11 +318,29 @@ fn generated(label: &str, toml: &str, steps: usize, at_rest: bool) -> (usize, u3
             on_floor += py;
         }
     }
-    assert!(on_floor < 0.0 && (!at_rest || (on_floor + weight_h).abs() <= 0.02 * weight_h), "{label}: impulse on the floor {on_floor} vs −m g h = {}", -weight_h);
+    assert!(
+        on_floor < 0.0 && (!at_rest || (on_floor + weight_h).abs() <= 0.02 * weight_h),
+        "{label}: impulse on the floor {on_floor} vs −m g h = {}",
+        -weight_h
+    );
 
     // LMGC90's norm also stops, with a small natural residual.
-    let lm = solve_file(file.path(), &FcOptions { tol: 1e-6, max_sweeps: 200_000, check_every: 10, norm: FcNorm::Lmgc(Criterion::QuadMax16) }).unwrap();
-    assert!(lm.converged && lm.residual < 1e-3, "{label}: QM/16: {} sweeps, residual {}", lm.sweeps, lm.residual);
+    let lm = solve_file(
+        file.path(),
+        &FcOptions {
+            tol: 1e-6,
+            max_sweeps: 200_000,
+            check_every: 10,
+            norm: FcNorm::Lmgc(Criterion::QuadMax16),
+        },
+    )
+    .unwrap();
+    assert!(
+        lm.converged && lm.residual < 1e-3,
+        "{label}: QM/16: {} sweeps, residual {}",
+        lm.sweeps,
+        lm.residual
+    );
 
     eprintln!(
         "{label}: {} bodies, {nc} contacts, {} W entries: natural 1e-8 in {} sweeps, {:.4} s (residual {:.2e}); QM/16 1e-6 in {} sweeps, {:.4} s (residual {:.2e}); {closed} closed, {stick} sticking",
@@ -312,7 +373,10 @@ fn triangular_lattice_pile_frictionless() {
 
 fn one_contact(q: [f64; 2], mu: f64) -> FcSolution {
     // A block of mass 2 on a fixed floor, contact at its centre line: W = ½ I.
-    let text = format!(r#"{{"dim":2,"nc":1,"W":{{"n":2,"rows":[0,1],"cols":[0,1],"vals":[0.5,0.5]}},"q":[{},{}],"mu":[{mu}]}}"#, q[0], q[1]);
+    let text = format!(
+        r#"{{"dim":2,"nc":1,"W":{{"n":2,"rows":[0,1],"cols":[0,1],"vals":[0.5,0.5]}},"q":[{},{}],"mu":[{mu}]}}"#,
+        q[0], q[1]
+    );
     let f = TempFile::new("one.json", &text);
     solve_file(f.path(), &natural(1e-12)).unwrap()
 }
@@ -321,7 +385,10 @@ fn one_contact(q: [f64; 2], mu: f64) -> FcSolution {
 fn one_contact_block_on_a_floor() {
     // Sticking: r = −W⁻¹ q = (0.5, −0.125), |r_t| < μ r_n; u = 0.
     let s = one_contact([-0.25, 0.0625], 0.5);
-    assert_eq!((s.r.as_slice(), s.u.as_slice(), s.sweeps, s.converged), (&[0.5, -0.125][..], &[0.0, 0.0][..], 1, true));
+    assert_eq!(
+        (s.r.as_slice(), s.u.as_slice(), s.sweeps, s.converged),
+        (&[0.5, -0.125][..], &[0.0, 0.0][..], 1, true)
+    );
     // Sliding forwards: r_n = 0.25/0.5, r_t = −μ r_n, u_t = ½ r_t + 1.
     let s = one_contact([-0.25, 1.0], 0.5);
     assert_eq!((s.r.as_slice(), s.u.as_slice()), (&[0.5, -0.25][..], &[0.0, 0.875][..]));
@@ -334,7 +401,10 @@ fn one_contact_block_on_a_floor() {
     assert_eq!((s.r.as_slice(), s.u.as_slice()), (&[0.5, 0.0][..], &[0.0, -1.0][..]));
     // Separating: no impulse.
     let s = one_contact([0.125, 3.0], 0.5);
-    assert_eq!((s.r.as_slice(), s.u.as_slice(), s.residual), (&[0.0, 0.0][..], &[0.125, 3.0][..], 0.0));
+    assert_eq!(
+        (s.r.as_slice(), s.u.as_slice(), s.residual),
+        (&[0.0, 0.0][..], &[0.125, 3.0][..], 0.0)
+    );
 }
 
 #[test]
@@ -367,40 +437,59 @@ fn two_stacked_blocks() {
     let (closed, stick) = check_signorini_coulomb(&Raw::from_json(text), &s, 1e-14);
     assert_eq!((closed, stick), (2, 1));
     // LMGC90's Quad norm, checked every 3 sweeps.
-    let q = solve_file(f.path(), &FcOptions { tol: 1e-10, max_sweeps: 1000, check_every: 3, norm: FcNorm::Lmgc(Criterion::Quad) }).unwrap();
+    let q = solve_file(
+        f.path(),
+        &FcOptions {
+            tol: 1e-10,
+            max_sweeps: 1000,
+            check_every: 3,
+            norm: FcNorm::Lmgc(Criterion::Quad),
+        },
+    )
+    .unwrap();
     assert!(q.converged && q.sweeps % 3 == 0);
     assert!(q.r.iter().zip(exact).all(|(a, b)| (a - b).abs() < 1e-8), "{:?}", q.r);
     // Not converged when the sweeps run out.
-    let n = solve_file(f.path(), &FcOptions { tol: 1e-14, max_sweeps: 3, check_every: 1, norm: FcNorm::Natural }).unwrap();
+    let n = solve_file(
+        f.path(),
+        &FcOptions {
+            tol: 1e-14,
+            max_sweeps: 3,
+            check_every: 1,
+            norm: FcNorm::Natural,
+        },
+    )
+    .unwrap();
     assert!(!n.converged && n.sweeps == 3 && n.residual > 1e-14);
 }
 
 #[test]
 fn bad_files_name_the_key() {
-    let ok = r#"{"dim":2,"nc":2,"W":{"n":4,"rows":[0,1,2,3],"cols":[0,1,2,3],"vals":[1.0,1.0,1.0,1.0]},"q":[-1.0,0.0,-1.0,0.0],"mu":[0.5,0.5]}"#;
+    let ok =
+        r#"{"dim":2,"nc":2,"W":{"n":4,"rows":[0,1,2,3],"cols":[0,1,2,3],"vals":[1.0,1.0,1.0,1.0]},"q":[-1.0,0.0,-1.0,0.0],"mu":[0.5,0.5]}"#;
     let f = TempFile::new("ok.json", ok);
     assert!(solve_file(f.path(), &natural(1e-10)).unwrap().converged);
     let cases: &[(&str, &str, &str)] = &[
-        (r#""nc":2,"#, "", "nc"),                                            // missing key
-        (r#","mu":[0.5,0.5]"#, "", "mu"),                                    // missing key
-        (r#""q":[-1.0,0.0,-1.0,0.0]"#, r#""q":[-1.0,0.0,-1.0]"#, "q"),         // wrong length
-        (r#""mu":[0.5,0.5]"#, r#""mu":[0.5]"#, "mu"),                          // wrong length
-        (r#""cols":[0,1,2,3]"#, r#""cols":[0,1,2]"#, "W.cols"),               // unequal coordinate arrays
-        (r#""vals":[1.0,1.0,1.0,1.0]"#, r#""vals":[1.0,1.0]"#, "W.vals"),     // unequal coordinate arrays
-        (r#""mu":[0.5,0.5]"#, r#""mu":[0.5,-0.1]"#, "mu[1]"),                  // negative μ
-        (r#""rows":[0,1,2,3]"#, r#""rows":[0,1,4,3]"#, "W.rows[2]"),          // index out of range
-        (r#""cols":[0,1,2,3]"#, r#""cols":[0,1,2,30]"#, "W.cols[3]"),         // index out of range
-        (r#""rows":[0,1,2,3]"#, r#""rows":[0,1,-2,3]"#, "W.rows[2]"),         // negative index
-        (r#""n":4"#, r#""n":6"#, "W.n"),                                       // W of the wrong order
-        (r#""dim":2"#, r#""dim":3"#, "dim"),                                  // 3D
+        (r#""nc":2,"#, "", "nc"),                                         // missing key
+        (r#","mu":[0.5,0.5]"#, "", "mu"),                                 // missing key
+        (r#""q":[-1.0,0.0,-1.0,0.0]"#, r#""q":[-1.0,0.0,-1.0]"#, "q"),    // wrong length
+        (r#""mu":[0.5,0.5]"#, r#""mu":[0.5]"#, "mu"),                     // wrong length
+        (r#""cols":[0,1,2,3]"#, r#""cols":[0,1,2]"#, "W.cols"),           // unequal coordinate arrays
+        (r#""vals":[1.0,1.0,1.0,1.0]"#, r#""vals":[1.0,1.0]"#, "W.vals"), // unequal coordinate arrays
+        (r#""mu":[0.5,0.5]"#, r#""mu":[0.5,-0.1]"#, "mu[1]"),             // negative μ
+        (r#""rows":[0,1,2,3]"#, r#""rows":[0,1,4,3]"#, "W.rows[2]"),      // index out of range
+        (r#""cols":[0,1,2,3]"#, r#""cols":[0,1,2,30]"#, "W.cols[3]"),     // index out of range
+        (r#""rows":[0,1,2,3]"#, r#""rows":[0,1,-2,3]"#, "W.rows[2]"),     // negative index
+        (r#""n":4"#, r#""n":6"#, "W.n"),                                  // W of the wrong order
+        (r#""dim":2"#, r#""dim":3"#, "dim"),                              // 3D
         (r#""dim":2"#, r#""dim":1"#, "dim"),
         (r#""nc":2"#, r#""nc":-2"#, "nc"),
-        (r#""q":[-1.0,0.0,"#, r#""q":[-1.0,"x","#, "q[1]"),                   // not a number
+        (r#""q":[-1.0,0.0,"#, r#""q":[-1.0,"x","#, "q[1]"), // not a number
         (r#""mu":[0.5,0.5]}"#, r#""mu":[0.5,0.5],"solution":[]}"#, "solution"), // unknown key
-        (r#""vals":[1.0,1.0,1.0,1.0]"#, r#""vals":[1.0,1.0,0.0,1.0]"#, "W"),  // W_nn = 0 at contact 1
+        (r#""vals":[1.0,1.0,1.0,1.0]"#, r#""vals":[1.0,1.0,0.0,1.0]"#, "W"), // W_nn = 0 at contact 1
         (r#""W":{"n":4,"rows""#, r#""W":{"n":4,"nnz":4,"rows""#, "W.nnz"),
-        (ok, "[1, 2]", ""),                                                  // not an object
-        (r#""mu":[0.5,0.5]}"#, r#""mu":[0.5,0.5]"#, ""),                       // JSON syntax
+        (ok, "[1, 2]", ""),                              // not an object
+        (r#""mu":[0.5,0.5]}"#, r#""mu":[0.5,0.5]"#, ""), // JSON syntax
     ];
     for &(from, to, key) in cases {
         assert!(ok.contains(from), "{from}");

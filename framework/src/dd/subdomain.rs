@@ -113,7 +113,10 @@ impl Subdomain2 {
         for a in 0..c.len() {
             let [i, j] = c.bodies[a];
             let w = Contacts2::delassus(&c.frame[a], self.inv_mass[i as usize], self.inv_mass[j as usize]);
-            c.block[a] = crate::rigid2d::contacts::Block2 { w, pre: crate::rigid2d::coulomb::precompute(w, c.target[a].mu) };
+            c.block[a] = crate::rigid2d::contacts::Block2 {
+                w,
+                pre: crate::rigid2d::coulomb::precompute(w, c.target[a].mu),
+            };
         }
     }
 

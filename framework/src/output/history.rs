@@ -63,14 +63,25 @@ impl<W: Write> History<W> {
         for (b, _) in &self.tracked {
             let b = *b as usize;
             let (p, f) = (w.bodies.pos[b], w.reaction[b]);
-            s.push_str(&format!(",{:e},{:e},{:e},{:e},{:e},{:e}", p[0], p[1], w.bodies.rot[b], f[0] / h, f[1] / h, f[2] / h));
+            s.push_str(&format!(
+                ",{:e},{:e},{:e},{:e},{:e},{:e}",
+                p[0],
+                p[1],
+                w.bodies.rot[b],
+                f[0] / h,
+                f[1] / h,
+                f[2] / h
+            ));
         }
         if self.has_box {
             let (nu, eps1, s1, s2, sphi) = box_measures(w);
             s.push_str(&format!(",{nu:e},{eps1:e},{s1:e},{s2:e},{sphi:e}"));
         }
         let tm = r.times;
-        s.push_str(&format!(",{:e},{:e},{:e},{:e},{:e}", tm.detect, tm.delassus, tm.nlgs, tm.update, t_output));
+        s.push_str(&format!(
+            ",{:e},{:e},{:e},{:e},{:e}",
+            tm.detect, tm.delassus, tm.nlgs, tm.update, t_output
+        ));
         writeln!(self.out, "{s}")
     }
 

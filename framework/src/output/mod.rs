@@ -61,8 +61,23 @@ pub fn final_json(w: &World2) -> String {
         })
         .collect();
     let c = &w.contacts;
-    let contacts = (0..c.len()).map(|a| ContactOut { bodies: c.bodies[a], point: c.point[a], normal: c.frame[a].n, r_n: c.r[a][0], r_t: c.r[a][1], gap: c.gap[a] }).collect();
-    let mut s = serde_json::to_string_pretty(&FinalOut { step: w.step, time: w.t, bodies, contacts }).expect("plain data serializes");
+    let contacts = (0..c.len())
+        .map(|a| ContactOut {
+            bodies: c.bodies[a],
+            point: c.point[a],
+            normal: c.frame[a].n,
+            r_n: c.r[a][0],
+            r_t: c.r[a][1],
+            gap: c.gap[a],
+        })
+        .collect();
+    let mut s = serde_json::to_string_pretty(&FinalOut {
+        step: w.step,
+        time: w.t,
+        bodies,
+        contacts,
+    })
+    .expect("plain data serializes");
     s.push('\n');
     s
 }

@@ -28,30 +28,54 @@ pub struct VtkWriter {
     frames: Vec<(f64, u32)>,
 }
 
-fn piece(points: Vec<f64>, verts: Option<VertexNumbers>, lines: Option<VertexNumbers>, polys: Option<VertexNumbers>, point: Vec<Attribute>, cell: Vec<Attribute>) -> Vtk {
+fn piece(
+    points: Vec<f64>,
+    verts: Option<VertexNumbers>,
+    lines: Option<VertexNumbers>,
+    polys: Option<VertexNumbers>,
+    point: Vec<Attribute>,
+    cell: Vec<Attribute>,
+) -> Vtk {
     Vtk {
         version: Version::new(),
         title: "nscdd".into(),
         byte_order: ByteOrder::LittleEndian,
         file_path: None,
-        data: DataSet::inline(PolyDataPiece { points: points.into(), verts, lines, polys, strips: None, data: Attributes { point, cell } }),
+        data: DataSet::inline(PolyDataPiece {
+            points: points.into(),
+            verts,
+            lines,
+            polys,
+            strips: None,
+            data: Attributes { point, cell },
+        }),
     }
 }
 
 fn cells(conn: Vec<u64>, offsets: Vec<u64>) -> Option<VertexNumbers> {
-    Some(VertexNumbers::XML { connectivity: conn, offsets })
+    Some(VertexNumbers::XML {
+        connectivity: conn,
+        offsets,
+    })
 }
 
 fn export(v: Vtk, path: &Path) -> std::io::Result<()> {
-    v.export(path).map_err(|e| std::io::Error::other(format!("writing {}: {e}", path.display())))
+    v.export(path)
+        .map_err(|e| std::io::Error::other(format!("writing {}: {e}", path.display())))
 }
 
 impl VtkWriter {
     fn write_pvd(&self, dir: &Path, name: &str) -> std::io::Result<()> {
         let mut f = std::io::BufWriter::new(std::fs::File::create(dir.join(format!("{name}.pvd")))?);
-        writeln!(f, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>")?;
+        writeln!(
+            f,
+            "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>"
+        )?;
         for (t, k) in &self.frames {
-            writeln!(f, "    <DataSet timestep=\"{t:e}\" group=\"\" part=\"0\" file=\"vtk/{name}_{k:06}.vtp\"/>")?;
+            writeln!(
+                f,
+                "    <DataSet timestep=\"{t:e}\" group=\"\" part=\"0\" file=\"vtk/{name}_{k:06}.vtp\"/>"
+            )?;
         }
         writeln!(f, "  </Collection>\n</VTKFile>")?;
         f.flush()
@@ -90,7 +114,12 @@ impl Writer2 for VtkWriter {
                     let d = [q[0] - p[0], q[1] - p[1]];
                     let l = (d[0] * d[0] + d[1] * d[1]).sqrt().max(f64::MIN_POSITIVE);
                     let o = [-d[1] / l * th / 2.0, d[0] / l * th / 2.0];
-                    vec![[p[0] - o[0], p[1] - o[1]], [q[0] - o[0], q[1] - o[1]], [q[0] + o[0], q[1] + o[1]], [p[0] + o[0], p[1] + o[1]]]
+                    vec![
+                        [p[0] - o[0], p[1] - o[1]],
+                        [q[0] - o[0], q[1] - o[1]],
+                        [q[0] + o[0], q[1] + o[1]],
+                        [p[0] + o[0], p[1] + o[1]],
+                    ]
                 }
             };
             for v in poly {
@@ -109,9 +138,15 @@ impl Writer2 for VtkWriter {
             Attribute::scalars("rotation", 1).with_data(rot),
             Attribute::scalars("material", 1).with_data(mat),
         ];
-        export(piece(pts, verts, None, None, point, vec![]), &vdir.join(format!("bodies_{frame:06}.vtp")))?;
+        export(
+            piece(pts, verts, None, None, point, vec![]),
+            &vdir.join(format!("bodies_{frame:06}.vtp")),
+        )?;
         let wcells = vec![Attribute::scalars("id", 1).with_data(wid)];
-        export(piece(wpts, None, None, cells(wconn, woff), vec![], wcells), &vdir.join(format!("walls_{frame:06}.vtp")))?;
+        export(
+            piece(wpts, None, None, cells(wconn, woff), vec![], wcells),
+            &vdir.join(format!("walls_{frame:06}.vtp")),
+        )?;
         // contact network
         let c = &w.contacts;
         let m = c.len();
@@ -135,7 +170,10 @@ impl Writer2 for VtkWriter {
             Attribute::scalars("f_n", 1).with_data(fnn),
             Attribute::scalars("gap", 1).with_data(gap),
         ];
-        export(piece(cpts, None, lines, None, vec![], cell), &vdir.join(format!("contacts_{frame:06}.vtp")))?;
+        export(
+            piece(cpts, None, lines, None, vec![], cell),
+            &vdir.join(format!("contacts_{frame:06}.vtp")),
+        )?;
         self.frames.push((w.t, frame));
         for name in ["bodies", "walls", "contacts"] {
             self.write_pvd(dir, name)?;

@@ -127,7 +127,10 @@ impl Contacts2 {
 pub fn local_velocity(f: &Frame2, vi: [f64; 3], vj: [f64; 3]) -> [f64; 2] {
     let (n, ai, aj) = (f.n, f.arm_i, f.arm_j);
     let dv = [vi[0] - vj[0], vi[1] - vj[1]];
-    [n[0] * dv[0] + n[1] * dv[1] + ai[0] * vi[2] - aj[0] * vj[2], -n[1] * dv[0] + n[0] * dv[1] + ai[1] * vi[2] - aj[1] * vj[2]]
+    [
+        n[0] * dv[0] + n[1] * dv[1] + ai[0] * vi[2] - aj[0] * vj[2],
+        -n[1] * dv[0] + n[0] * dv[1] + ai[1] * vi[2] - aj[1] * vj[2],
+    ]
 }
 
 /// V_i += M̂_i⁻¹ H_i Δr, V_j −= M̂_j⁻¹ H_j Δr for one frame.

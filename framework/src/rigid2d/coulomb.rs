@@ -171,7 +171,10 @@ mod tests {
             let mu = next() * 5.0;
             let u0 = [next() * 4.0 - 2.0, next() * 4.0 - 2.0];
             let (r1, r2) = (solve(w, u0, 0.1, mu), solve_pre(w, &precompute(w, mu), u0, 0.1, mu));
-            assert!((r1[0] - r2[0]).abs() + (r1[1] - r2[1]).abs() <= 1e-9 * (1.0 + r1[0].abs()), "{r1:?} {r2:?}");
+            assert!(
+                (r1[0] - r2[0]).abs() + (r1[1] - r2[1]).abs() <= 1e-9 * (1.0 + r1[0].abs()),
+                "{r1:?} {r2:?}"
+            );
         }
     }
 

@@ -46,7 +46,13 @@ struct Hot<'a> {
 #[inline(never)]
 pub fn sweep(c: &mut Contacts2, vel: &mut [[f64; 3]], inv_mass: &[[f64; 3]], order: &[u32], omega: f64, mut sums: Option<&mut Sums>) {
     let m = c.len();
-    let mut h = Hot { bodies: &c.bodies[..m], frame: &c.frame[..m], block: &c.block[..m], target: &c.target[..m], r: &mut c.r[..m] };
+    let mut h = Hot {
+        bodies: &c.bodies[..m],
+        frame: &c.frame[..m],
+        block: &c.block[..m],
+        target: &c.target[..m],
+        r: &mut c.r[..m],
+    };
     // one monomorphized loop per case, so that the plain sweep carries no check or
     // relaxation code (fewer live values, no spills)
     match (sums.as_deref_mut(), omega != 1.0) {
@@ -58,7 +64,14 @@ pub fn sweep(c: &mut Contacts2, vel: &mut [[f64; 3]], inv_mass: &[[f64; 3]], ord
 }
 
 #[inline(always)]
-fn run<const CHECK: bool, const RELAX: bool>(h: &mut Hot<'_>, order: &[u32], vel: &mut [[f64; 3]], inv_mass: &[[f64; 3]], omega: f64, sums: &mut Sums) {
+fn run<const CHECK: bool, const RELAX: bool>(
+    h: &mut Hot<'_>,
+    order: &[u32],
+    vel: &mut [[f64; 3]],
+    inv_mass: &[[f64; 3]],
+    omega: f64,
+    sums: &mut Sums,
+) {
     if order.is_empty() {
         for a in 0..h.bodies.len() {
             visit::<CHECK, RELAX>(h, a, vel, inv_mass, omega, sums);
@@ -73,7 +86,14 @@ fn run<const CHECK: bool, const RELAX: bool>(h: &mut Hot<'_>, order: &[u32], vel
 /// Solves contact α with the others' impulses fixed and updates its two bodies:
 /// u = H_αᵀ V, u0 = u − W_αα r_α, r_α ← local solution, V += M̂⁻¹ H_α Δr_α.
 #[inline(always)]
-fn visit<const CHECK: bool, const RELAX: bool>(h: &mut Hot<'_>, a: usize, vel: &mut [[f64; 3]], inv_mass: &[[f64; 3]], omega: f64, sums: &mut Sums) {
+fn visit<const CHECK: bool, const RELAX: bool>(
+    h: &mut Hot<'_>,
+    a: usize,
+    vel: &mut [[f64; 3]],
+    inv_mass: &[[f64; 3]],
+    omega: f64,
+    sums: &mut Sums,
+) {
     let [bi, bj] = h.bodies[a];
     let (bi, bj) = (bi as usize, bj as usize);
     let f = h.frame[a];

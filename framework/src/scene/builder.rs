@@ -49,8 +49,12 @@ impl<'r> SceneBuilder2<'r> {
 
     /// Material id of the key `key` of `params`, or a clear error.
     pub fn material_param(&self, params: &toml::Table, key: &str) -> Result<u16, ParamError> {
-        let name = params.get(key).and_then(|v| v.as_str()).ok_or_else(|| ParamError::new(key, "missing material name"))?;
-        self.material(name).ok_or_else(|| ParamError::new(key, format!("unknown material `{name}`; declare it in [[materials]]")))
+        let name = params
+            .get(key)
+            .and_then(|v| v.as_str())
+            .ok_or_else(|| ParamError::new(key, "missing material name"))?;
+        self.material(name)
+            .ok_or_else(|| ParamError::new(key, format!("unknown material `{name}`; declare it in [[materials]]")))
     }
 
     /// Kind id of a shape kind, creating its store on first use.

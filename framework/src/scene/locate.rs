@@ -40,7 +40,10 @@ pub fn locate(text: &str, path: &[Seg]) -> Option<usize> {
     for seg in path {
         let next = match (seg, &node) {
             (Seg::Key(k), Node::Table(t)) => t.get_key_value(k).map(|(key, it)| (key.span(), Node::Item(it))),
-            (Seg::Key(k), Node::Item(it)) => it.as_table_like().and_then(|t| t.get_key_value(k)).map(|(key, it)| (key.span(), Node::Item(it))),
+            (Seg::Key(k), Node::Item(it)) => it
+                .as_table_like()
+                .and_then(|t| t.get_key_value(k))
+                .map(|(key, it)| (key.span(), Node::Item(it))),
             (Seg::Key(k), Node::Value(Value::InlineTable(t))) => t.get_key_value(k).map(|(key, it)| (key.span(), Node::Item(it))),
             (Seg::Index(i), Node::Item(Item::ArrayOfTables(a))) => a.get(*i).map(|t| (t.span(), Node::Table(t))),
             (Seg::Index(i), Node::Item(Item::Value(Value::Array(a)))) | (Seg::Index(i), Node::Value(Value::Array(a))) => {
@@ -65,7 +68,11 @@ pub fn locate(text: &str, path: &[Seg]) -> Option<usize> {
 /// byte `offset`, in a text that parses as TOML (for the deserializer's messages).
 pub fn path_at(text: &str, offset: usize) -> Option<String> {
     let doc = toml_edit::Document::parse(text).ok()?;
-    let mut w = Walk { offset, path: vec![], best: None };
+    let mut w = Walk {
+        offset,
+        path: vec![],
+        best: None,
+    };
     w.table(doc.as_table());
     w.best.map(|p| path_string(&p))
 }
@@ -139,7 +146,11 @@ pub fn path_on_line(text: &str, line: usize) -> Option<String> {
             if key.is_empty() || !key.chars().all(|c| c.is_alphanumeric() || "_-.\"".contains(c)) {
                 return None;
             }
-            return Some(if table.is_empty() { key.to_string() } else { format!("{table}.{key}") });
+            return Some(if table.is_empty() {
+                key.to_string()
+            } else {
+                format!("{table}.{key}")
+            });
         }
         if let Some((h, _)) = s.strip_prefix("[[").and_then(|r| r.split_once("]]")) {
             let h = h.trim().to_string();
@@ -160,9 +171,15 @@ mod tests {
     fn finds_lines() {
         let text = "a = 1\n[[bodies]]\nx = 1\n\n[[bodies]]\nradius = -1\n[time]\nstep = 2\n";
         let line = |p: &[Seg]| locate(text, p).map(|o| crate::error::line_of(text, o));
-        assert_eq!(line(&[Seg::Key("bodies".into()), Seg::Index(1), Seg::Key("radius".into())]), Some(6));
+        assert_eq!(
+            line(&[Seg::Key("bodies".into()), Seg::Index(1), Seg::Key("radius".into())]),
+            Some(6)
+        );
         assert_eq!(line(&[Seg::Key("time".into()), Seg::Key("step".into())]), Some(8));
-        assert_eq!(line(&[Seg::Key("bodies".into()), Seg::Index(1), Seg::Key("nothing".into())]), Some(5));
+        assert_eq!(
+            line(&[Seg::Key("bodies".into()), Seg::Index(1), Seg::Key("nothing".into())]),
+            Some(5)
+        );
     }
 
     #[test]

@@ -36,7 +36,12 @@ pub struct Scene {
 /// Reads and loads a scene file.
 pub fn load(path: &std::path::Path, registry: &Registry) -> Result<Scene, InputError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| InputError { file: file.clone(), line: None, key: String::new(), message: format!("cannot read the file: {e}") })?;
+    let text = std::fs::read_to_string(path).map_err(|e| InputError {
+        file: file.clone(),
+        line: None,
+        key: String::new(),
+        message: format!("cannot read the file: {e}"),
+    })?;
     load_str(&text, &file, registry)
 }
 
@@ -47,7 +52,12 @@ struct Ctx<'a> {
 
 impl Ctx<'_> {
     fn err(&self, path: &[Seg], message: impl Into<String>) -> InputError {
-        InputError { file: self.file.to_string(), line: locate(self.text, path).map(|o| line_of(self.text, o)), key: path_string(path), message: message.into() }
+        InputError {
+            file: self.file.to_string(),
+            line: locate(self.text, path).map(|o| line_of(self.text, o)),
+            key: path_string(path),
+            message: message.into(),
+        }
     }
 }
 
@@ -70,12 +80,24 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
             .as_ref()
             .and_then(|s| locate::path_at(text, s.start))
             .or_else(|| line.and_then(|l| locate::path_on_line(text, l)))
-            .or_else(|| span.clone().map(|s| text[s].trim().trim_matches('"').to_string()).filter(|s| s.len() < 40 && !s.contains('\n')))
+            .or_else(|| {
+                span.clone()
+                    .map(|s| text[s].trim().trim_matches('"').to_string())
+                    .filter(|s| s.len() < 40 && !s.contains('\n'))
+            })
             .unwrap_or_default();
-        InputError { file: file.to_string(), line, key, message: e.message().trim().to_string() }
+        InputError {
+            file: file.to_string(),
+            line,
+            key,
+            message: e.message().trim().to_string(),
+        }
     })?;
     if sf.dimension != 2 {
-        return Err(cx.err(&[k("dimension")], format!("dimension {} is not supported by the installed plugins (2D only)", sf.dimension)));
+        return Err(cx.err(
+            &[k("dimension")],
+            format!("dimension {} is not supported by the installed plugins (2D only)", sf.dimension),
+        ));
     }
     if sf.gravity.len() != 2 || sf.gravity.iter().any(|g| !g.is_finite()) {
         return Err(cx.err(&[k("gravity")], "gravity must be 2 finite numbers in 2D"));
@@ -88,9 +110,19 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
     add_bodies(&cx, &sf, &mut b, &mut drives)?;
     for (g, spec) in sf.generate.iter().enumerate() {
         let base = [k("generate"), Seg::Index(g)];
-        let gen = registry.generators.get(spec.kind.as_str()).ok_or_else(|| cx.err(&at(&base, &[k("kind")]), format!("unknown generator `{}`; installed: {}", spec.kind, registry.generator_names().join(", "))))?;
+        let gen = registry.generators.get(spec.kind.as_str()).ok_or_else(|| {
+            cx.err(
+                &at(&base, &[k("kind")]),
+                format!(
+                    "unknown generator `{}`; installed: {}",
+                    spec.kind,
+                    registry.generator_names().join(", ")
+                ),
+            )
+        })?;
         b.origin = Origin::Generated(g);
-        gen.generate(&spec.params, &mut b).map_err(|e: ParamError| cx.err(&at(&base, &[k(&e.key)]), e.msg))?;
+        gen.generate(&spec.params, &mut b)
+            .map_err(|e: ParamError| cx.err(&at(&base, &[k(&e.key)]), e.msg))?;
     }
     if b.bodies.is_empty() {
         return Err(cx.err(&[], "the scene has no bodies"));
@@ -109,7 +141,11 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
     let mut first_kind = vec![None; nk];
     let mut kind_movable = vec![false; nk];
     for i in 0..b.bodies.len() {
-        let (m, kd, mv) = (b.bodies.material[i] as usize, b.bodies.shape[i].kind as usize, b.bodies.movable(i) || drives.iter().any(|d: &BodyDrive2| d.body as usize == i));
+        let (m, kd, mv) = (
+            b.bodies.material[i] as usize,
+            b.bodies.shape[i].kind as usize,
+            b.bodies.movable(i) || drives.iter().any(|d: &BodyDrive2| d.body as usize == i),
+        );
         first_mat[m].get_or_insert(b.origins[i]);
         mat_count[m] += 1;
         first_kind[kd].get_or_insert(b.origins[i]);
@@ -122,12 +158,21 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
                 // a material touches itself only if two bodies are made of it
                 let can_touch = ma != mb || mat_count[ma] >= 2;
                 if can_touch && (mat_movable[ma] || mat_movable[mb]) && !declared[ma * nm + mb] {
-                    return Err(cx.err(&origin_path(oa, "material"), format!("no law for the material pair (`{}`, `{}`): add a [[laws]] entry with materials = [\"{}\", \"{}\"]", b.materials[ma].name, b.materials[mb].name, b.materials[ma].name, b.materials[mb].name)));
+                    return Err(cx.err(
+                        &origin_path(oa, "material"),
+                        format!(
+                            "no law for the material pair (`{}`, `{}`): add a [[laws]] entry with materials = [\"{}\", \"{}\"]",
+                            b.materials[ma].name, b.materials[mb].name, b.materials[ma].name, b.materials[mb].name
+                        ),
+                    ));
                 }
             }
         }
     }
-    let mut table = DetectorTable { nk, table: vec![None; nk * nk] };
+    let mut table = DetectorTable {
+        nk,
+        table: vec![None; nk * nk],
+    };
     for ka in 0..nk {
         for kb in 0..nk {
             let (na, nb) = (b.shapes[ka].kind(), b.shapes[kb].kind());
@@ -135,13 +180,18 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
                 Some((d, swapped)) => table.table[ka * nk + kb] = Some((d, swapped)),
                 None if kind_movable[ka] || kind_movable[kb] => {
                     let o = first_kind[ka].or(first_kind[kb]).unwrap_or(Origin::Body(0));
-                    return Err(cx.err(&origin_path(o, "shape"), format!("no contact detector for the shape pair (`{na}`, `{nb}`) among the installed plugins")));
+                    return Err(cx.err(
+                        &origin_path(o, "shape"),
+                        format!("no contact detector for the shape pair (`{na}`, `{nb}`) among the installed plugins"),
+                    ));
                 }
                 None => {}
             }
         }
     }
-    let sizes: Vec<f64> = (0..b.bodies.len()).map(|i| b.shapes[b.bodies.shape[i].kind as usize].size(b.bodies.shape[i].index)).collect();
+    let sizes: Vec<f64> = (0..b.bodies.len())
+        .map(|i| b.shapes[b.bodies.shape[i].kind as usize].size(b.bodies.shape[i].index))
+        .collect();
     let alert = match sf.detection.alert {
         Some(a) if !(a >= 0.0 && a.is_finite()) => return Err(cx.err(&[k("detection"), k("alert")], format!("must be ≥ 0, got {a}"))),
         Some(a) => a,
@@ -176,9 +226,19 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
         None => None,
         Some(bs) => {
             let find = |key: &str, name: &str| {
-                b.names.iter().position(|n| n.as_deref() == Some(name)).map(|p| p as u32).ok_or_else(|| cx.err(&[k("output"), k("box"), k(key)], format!("no body is named `{name}`")))
+                b.names
+                    .iter()
+                    .position(|n| n.as_deref() == Some(name))
+                    .map(|p| p as u32)
+                    .ok_or_else(|| cx.err(&[k("output"), k("box"), k(key)], format!("no body is named `{name}`")))
             };
-            Some(BoxWalls { left: find("left", &bs.left)?, right: find("right", &bs.right)?, bottom: find("bottom", &bs.bottom)?, top: find("top", &bs.top)?, strain_from: bs.strain_from })
+            Some(BoxWalls {
+                left: find("left", &bs.left)?,
+                right: find("right", &bs.right)?,
+                bottom: find("bottom", &bs.bottom)?,
+                top: find("top", &bs.top)?,
+                strain_from: bs.strain_from,
+            })
         }
     };
     for (i, w) in sf.output.writers.iter().enumerate() {
@@ -207,13 +267,23 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
         reaction: vec![[0.0; 3]; nb],
         scratch: Default::default(),
     };
-    Ok(Scene { world, output: OutputSettings { every: sf.output.every, vtk: sf.output.vtk, writers: sf.output.writers } })
+    Ok(Scene {
+        world,
+        output: OutputSettings {
+            every: sf.output.every,
+            vtk: sf.output.vtk,
+            writers: sf.output.writers,
+        },
+    })
 }
 
 fn time_settings(cx: &Ctx, sf: &SceneFile) -> Result<TimeSettings, InputError> {
     let t = &sf.time;
     if !(t.step > 0.0 && t.step.is_finite()) {
-        return Err(cx.err(&[k("time"), k("step")], format!("the step must be a positive number of seconds, got {}", t.step)));
+        return Err(cx.err(
+            &[k("time"), k("step")],
+            format!("the step must be a positive number of seconds, got {}", t.step),
+        ));
     }
     if !(0.5..=1.0).contains(&t.theta) {
         return Err(cx.err(&[k("time"), k("theta")], format!("θ must lie in [0.5, 1], got {}", t.theta)));
@@ -224,7 +294,11 @@ fn time_settings(cx: &Ctx, sf: &SceneFile) -> Result<TimeSettings, InputError> {
         (None, Some(d)) => return Err(cx.err(&[k("time"), k("duration")], format!("must be ≥ 0, got {d}"))),
         _ => return Err(cx.err(&[k("time")], "give exactly one of `steps` or `duration`")),
     };
-    Ok(TimeSettings { h: t.step, theta: t.theta, steps })
+    Ok(TimeSettings {
+        h: t.step,
+        theta: t.theta,
+        steps,
+    })
 }
 
 fn validate_solver(cx: &Ctx, s: &crate::solver::SolverSettings) -> Result<(), InputError> {
@@ -248,18 +322,33 @@ fn materials(cx: &Ctx, sf: &SceneFile) -> Result<Vec<Material>, InputError> {
     let mut out: Vec<Material> = vec![];
     for (i, m) in sf.materials.iter().enumerate() {
         if !(m.density > 0.0 && m.density.is_finite()) {
-            return Err(cx.err(&[k("materials"), Seg::Index(i), k("density")], format!("density must be > 0, got {}", m.density)));
+            return Err(cx.err(
+                &[k("materials"), Seg::Index(i), k("density")],
+                format!("density must be > 0, got {}", m.density),
+            ));
         }
         if out.iter().any(|o| o.name == m.name) {
-            return Err(cx.err(&[k("materials"), Seg::Index(i), k("name")], format!("material `{}` is declared twice", m.name)));
+            return Err(cx.err(
+                &[k("materials"), Seg::Index(i), k("name")],
+                format!("material `{}` is declared twice", m.name),
+            ));
         }
-        out.push(Material { name: m.name.clone(), density: m.density });
+        out.push(Material {
+            name: m.name.clone(),
+            density: m.density,
+        });
     }
     Ok(out)
 }
 
 /// The law table and, beside it, the pairs declared `law = "none"` (never interact).
-fn laws(cx: &Ctx, sf: &SceneFile, registry: &Registry, nm: usize, b: &SceneBuilder2) -> Result<(Vec<Option<crate::law::ContactLaw>>, Vec<bool>), InputError> {
+fn laws(
+    cx: &Ctx,
+    sf: &SceneFile,
+    registry: &Registry,
+    nm: usize,
+    b: &SceneBuilder2,
+) -> Result<(Vec<Option<crate::law::ContactLaw>>, Vec<bool>), InputError> {
     let mut table = vec![None; nm * nm];
     let mut declared = vec![false; nm * nm];
     for (i, l) in sf.laws.iter().enumerate() {
@@ -267,11 +356,18 @@ fn laws(cx: &Ctx, sf: &SceneFile, registry: &Registry, nm: usize, b: &SceneBuild
         let def = if l.law == "none" {
             None
         } else {
-            Some(registry.laws.get(l.law.as_str()).ok_or_else(|| cx.err(&at(&base, &[k("law")]), format!("unknown law `{}`; installed: none, {}", l.law, registry.law_names().join(", "))))?)
+            Some(registry.laws.get(l.law.as_str()).ok_or_else(|| {
+                cx.err(
+                    &at(&base, &[k("law")]),
+                    format!("unknown law `{}`; installed: none, {}", l.law, registry.law_names().join(", ")),
+                )
+            })?)
         };
         let mut ids = [0u16; 2];
         for (s, name) in l.materials.iter().enumerate() {
-            ids[s] = b.material(name).ok_or_else(|| cx.err(&at(&base, &[k("materials"), Seg::Index(s)]), format!("unknown material `{name}`")))?;
+            ids[s] = b
+                .material(name)
+                .ok_or_else(|| cx.err(&at(&base, &[k("materials"), Seg::Index(s)]), format!("unknown material `{name}`")))?;
         }
         let law = match def {
             Some(def) => Some((def.parse)(&l.params).map_err(|e| cx.err(&at(&base, &[k(&e.key)]), e.msg))?),
@@ -297,16 +393,43 @@ fn add_bodies(cx: &Ctx, sf: &SceneFile, b: &mut SceneBuilder2, drives: &mut Vec<
         let base = [k("bodies"), Seg::Index(i)];
         let p = |key: &str| at(&base, &[k(key)]);
         b.origin = Origin::Body(i);
-        let kind = b.kind(&spec.shape).ok_or_else(|| cx.err(&p("shape"), format!("unknown shape `{}`; installed: {}", spec.shape, b.registry.shape_kinds().join(", "))))?;
-        let material = b.material(&spec.material).ok_or_else(|| cx.err(&p("material"), format!("unknown material `{}`; declare it in [[materials]]", spec.material)))?;
-        let index = b.shapes[kind as usize].push_params(&spec.params).map_err(|e| cx.err(&p(&e.key), e.msg))?;
-        if spec.position.iter().chain(&spec.velocity).chain([&spec.rotation]).any(|x| !x.is_finite()) {
+        let kind = b.kind(&spec.shape).ok_or_else(|| {
+            cx.err(
+                &p("shape"),
+                format!("unknown shape `{}`; installed: {}", spec.shape, b.registry.shape_kinds().join(", ")),
+            )
+        })?;
+        let material = b.material(&spec.material).ok_or_else(|| {
+            cx.err(
+                &p("material"),
+                format!("unknown material `{}`; declare it in [[materials]]", spec.material),
+            )
+        })?;
+        let index = b.shapes[kind as usize]
+            .push_params(&spec.params)
+            .map_err(|e| cx.err(&p(&e.key), e.msg))?;
+        if spec
+            .position
+            .iter()
+            .chain(&spec.velocity)
+            .chain([&spec.rotation])
+            .any(|x| !x.is_finite())
+        {
             return Err(cx.err(&p("position"), "position, rotation and velocity must be finite"));
         }
-        let id = b.add_body(crate::rigid2d::bodies::ShapeRef { kind, index }, material, spec.position, spec.rotation, spec.velocity);
+        let id = b.add_body(
+            crate::rigid2d::bodies::ShapeRef { kind, index },
+            material,
+            spec.position,
+            spec.rotation,
+            spec.velocity,
+        );
         let mp = b.bodies.mass[id as usize];
         if !(mp[0] > 0.0 && mp[0].is_finite() && mp[2] > 0.0 && mp[2].is_finite()) {
-            return Err(cx.err(&p("shape"), format!("the body's mass ({}) and inertia ({}) must be positive and finite", mp[0], mp[2])));
+            return Err(cx.err(
+                &p("shape"),
+                format!("the body's mass ({}) and inertia ({}) must be positive and finite", mp[0], mp[2]),
+            ));
         }
         if let Some(name) = &spec.name {
             if b.names.iter().any(|n| n.as_deref() == Some(name.as_str())) {

@@ -77,7 +77,10 @@ pub struct DetectionSpec {
 
 impl Default for DetectionSpec {
     fn default() -> Self {
-        DetectionSpec { alert: None, overlap_tolerance: overlap() }
+        DetectionSpec {
+            alert: None,
+            overlap_tolerance: overlap(),
+        }
     }
 }
 
@@ -158,7 +161,12 @@ pub struct OutputSpec {
 
 impl Default for OutputSpec {
     fn default() -> Self {
-        OutputSpec { every: 0, vtk: true, writers: vec![], box_walls: None }
+        OutputSpec {
+            every: 0,
+            vtk: true,
+            writers: vec![],
+            box_walls: None,
+        }
     }
 }
 

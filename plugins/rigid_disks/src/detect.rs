@@ -28,7 +28,14 @@ fn rounded(i: u32, j: u32, feature: u32, pi: V, pj: V, ri: f64, rj: f64, alert: 
     }
     let n = if dist > 0.0 { d / dist } else { V::new(0.0, 1.0) };
     let p = pj + n * (rj + 0.5 * gap);
-    Some(RawContact2 { i, j, feature, point: [p.x, p.y], normal: [n.x, n.y], gap })
+    Some(RawContact2 {
+        i,
+        j,
+        feature,
+        point: [p.x, p.y],
+        normal: [n.x, n.y],
+        gap,
+    })
 }
 
 /// Closest point of segment [a, b] to q.
@@ -46,7 +53,11 @@ fn closest_on_segment(a: V, b: V, q: V) -> V {
 fn closest_segments(a: V, b: V, c: V, d: V) -> (V, V) {
     let mut best = (a, closest_on_segment(c, d, a));
     let mut bd = (best.0 - best.1).norm_squared();
-    for (p, q) in [(b, closest_on_segment(c, d, b)), (closest_on_segment(a, b, c), c), (closest_on_segment(a, b, d), d)] {
+    for (p, q) in [
+        (b, closest_on_segment(c, d, b)),
+        (closest_on_segment(a, b, c), c),
+        (closest_on_segment(a, b, d), d),
+    ] {
         let dd = (p - q).norm_squared();
         if dd < bd {
             bd = dd;
@@ -75,7 +86,16 @@ impl PairDetector2 for DiskDisk {
         for &[p, q] in pairs {
             let (i, j) = (p.min(q), p.max(q));
             let (si, sj) = (b.shape[i as usize].index, b.shape[j as usize].index);
-            if let Some(c) = rounded(i, j, 0, v(b.pos[i as usize]), v(b.pos[j as usize]), disks.radius[si as usize], disks.radius[sj as usize], cx.alert) {
+            if let Some(c) = rounded(
+                i,
+                j,
+                0,
+                v(b.pos[i as usize]),
+                v(b.pos[j as usize]),
+                disks.radius[si as usize],
+                disks.radius[sj as usize],
+                cx.alert,
+            ) {
                 out.push(c);
             }
         }
@@ -93,7 +113,16 @@ impl PairDetector2 for DiskWall {
             let (e0, e1) = walls.ends(sw, b.pos[w as usize], b.rot[w as usize]);
             let x = v(b.pos[d as usize]);
             let q = closest_on_segment(v(e0), v(e1), x);
-            if let Some(c) = rounded(d, w, 0, x, q, disks.radius[sd as usize], 0.5 * walls.thickness[sw as usize], cx.alert) {
+            if let Some(c) = rounded(
+                d,
+                w,
+                0,
+                x,
+                q,
+                disks.radius[sd as usize],
+                0.5 * walls.thickness[sw as usize],
+                cx.alert,
+            ) {
                 out.push(c);
             }
         }
@@ -112,7 +141,14 @@ impl PairDetector2 for DiskHalfPlane {
             let gap = (x - v(b.pos[h as usize])).dot(&n) - r;
             if gap <= cx.alert {
                 let p = x - n * (r + 0.5 * gap);
-                out.push(RawContact2 { i: d, j: h, feature: 0, point: [p.x, p.y], normal: [n.x, n.y], gap });
+                out.push(RawContact2 {
+                    i: d,
+                    j: h,
+                    feature: 0,
+                    point: [p.x, p.y],
+                    normal: [n.x, n.y],
+                    gap,
+                });
             }
         }
     }
@@ -129,7 +165,16 @@ impl PairDetector2 for WallWall {
             let (a0, a1) = walls.ends(si, b.pos[i as usize], b.rot[i as usize]);
             let (c0, c1) = walls.ends(sj, b.pos[j as usize], b.rot[j as usize]);
             let (pi, pj) = closest_segments(v(a0), v(a1), v(c0), v(c1));
-            if let Some(c) = rounded(i, j, 0, pi, pj, 0.5 * walls.thickness[si as usize], 0.5 * walls.thickness[sj as usize], cx.alert) {
+            if let Some(c) = rounded(
+                i,
+                j,
+                0,
+                pi,
+                pj,
+                0.5 * walls.thickness[si as usize],
+                0.5 * walls.thickness[sj as usize],
+                cx.alert,
+            ) {
                 out.push(c);
             }
         }
@@ -152,7 +197,14 @@ impl PairDetector2 for WallHalfPlane {
                 let gap = (x - v(b.pos[h as usize])).dot(&n) - r;
                 if gap <= cx.alert {
                     let p = x - n * (r + 0.5 * gap);
-                    out.push(RawContact2 { i: w, j: h, feature: f as u32, point: [p.x, p.y], normal: [n.x, n.y], gap });
+                    out.push(RawContact2 {
+                        i: w,
+                        j: h,
+                        feature: f as u32,
+                        point: [p.x, p.y],
+                        normal: [n.x, n.y],
+                        gap,
+                    });
                 }
             }
         }

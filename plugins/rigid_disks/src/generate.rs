@@ -72,7 +72,13 @@ impl Deposit {
             if dy < 0.0 {
                 return c; // held from the side under an overhang
             }
-            let dir = if dx > 0.0 { 1.0 } else if dx < 0.0 { -1.0 } else { tie };
+            let dir = if dx > 0.0 {
+                1.0
+            } else if dx < 0.0 {
+                -1.0
+            } else {
+                tie
+            };
             let th0 = dx.atan2(dy) * dir; // angle from the vertical, positive downhill
             let pos = |th: f64| [pj[0] + dir * big_r * th.sin(), pj[1] + big_r * th.cos()];
             // first event along the arc th0 → π/2: a disk, a side, the floor
@@ -145,21 +151,35 @@ impl Generator2 for DiskDeposit {
         }
         let [x0, y0, x1, y1] = array::<4>(p, "box", None)?;
         if x1 - x0 < 2.0 * rmax || y1 <= y0 {
-            return Err(ParamError::new("box", "the box [x0, y0, x1, y1] must be wider than a disk and have y1 > y0"));
+            return Err(ParamError::new(
+                "box",
+                "the box [x0, y0, x1, y1] must be wider than a disk and have y1 > y0",
+            ));
         }
         let seed = count(p, "seed", Some(0))?;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         let kind = out.kind(Disks::KIND).expect("plugin shape");
         let cw = 2.0 * rmax;
         let ncol = ((x1 - x0) / cw).ceil() as usize + 1;
-        let mut dep = Deposit { x0, y0, x1, cw, rmax, cols: vec![vec![]; ncol], placed: Vec::with_capacity(n) };
+        let mut dep = Deposit {
+            x0,
+            y0,
+            x1,
+            cw,
+            rmax,
+            cols: vec![vec![]; ncol],
+            placed: Vec::with_capacity(n),
+        };
         for k in 0..n {
             let r = if rmax > rmin { rng.random_range(rmin..rmax) } else { rmin };
             let x = rng.random_range((x0 + r)..=(x1 - r));
             let tie = if rng.random::<bool>() { 1.0 } else { -1.0 };
             let c = dep.settle(x, r, tie);
             if c[1] + r > y1 {
-                return Err(ParamError::new("count", format!("the box holds only {k} of the {n} disks asked: make it taller")));
+                return Err(ParamError::new(
+                    "count",
+                    format!("the box holds only {k} of the {n} disks asked: make it taller"),
+                ));
             }
             let col = dep.col(c[0]);
             dep.cols[col].push(dep.placed.len());

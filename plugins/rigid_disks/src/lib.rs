@@ -32,9 +32,18 @@ impl Plugin for RigidDisks {
         "rigid_disks"
     }
     fn build(&self, reg: &mut Registry) {
-        reg.add_shape(ShapeKindDef { name: Disks::KIND, new_store: || Box::new(Disks::default()) });
-        reg.add_shape(ShapeKindDef { name: Walls::KIND, new_store: || Box::new(Walls::default()) });
-        reg.add_shape(ShapeKindDef { name: HalfPlanes::KIND, new_store: || Box::new(HalfPlanes::default()) });
+        reg.add_shape(ShapeKindDef {
+            name: Disks::KIND,
+            new_store: || Box::new(Disks::default()),
+        });
+        reg.add_shape(ShapeKindDef {
+            name: Walls::KIND,
+            new_store: || Box::new(Walls::default()),
+        });
+        reg.add_shape(ShapeKindDef {
+            name: HalfPlanes::KIND,
+            new_store: || Box::new(HalfPlanes::default()),
+        });
         reg.add_detector(Disks::KIND, Disks::KIND, Arc::new(detect::DiskDisk));
         reg.add_detector(Disks::KIND, Walls::KIND, Arc::new(detect::DiskWall));
         reg.add_detector(Disks::KIND, HalfPlanes::KIND, Arc::new(detect::DiskHalfPlane));

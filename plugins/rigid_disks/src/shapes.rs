@@ -36,14 +36,21 @@ impl ShapeStore2 for Disks {
     }
     fn aabb(&self, s: u32, x: [f64; 2], _rot: f64) -> Aabb2 {
         let r = self.radius[s as usize];
-        Aabb2 { min: [x[0] - r, x[1] - r], max: [x[0] + r, x[1] + r] }
+        Aabb2 {
+            min: [x[0] - r, x[1] - r],
+            max: [x[0] + r, x[1] + r],
+        }
     }
     /// Area π r², mass ρ π r², inertia m r²/2 (per unit depth).
     fn mass_properties(&self, s: u32, density: f64) -> MassProps2 {
         let r = self.radius[s as usize];
         let area = PI * r * r;
         let mass = density * area;
-        MassProps2 { area, mass, inertia: 0.5 * mass * r * r }
+        MassProps2 {
+            area,
+            mass,
+            inertia: 0.5 * mass * r * r,
+        }
     }
     fn size(&self, s: u32) -> f64 {
         self.radius[s as usize]
@@ -97,13 +104,20 @@ impl ShapeStore2 for Walls {
     fn aabb(&self, s: u32, x: [f64; 2], rot: f64) -> Aabb2 {
         let (a, b) = self.ends(s, x, rot);
         let t = 0.5 * self.thickness[s as usize];
-        Aabb2 { min: [a[0].min(b[0]) - t, a[1].min(b[1]) - t], max: [a[0].max(b[0]) + t, a[1].max(b[1]) + t] }
+        Aabb2 {
+            min: [a[0].min(b[0]) - t, a[1].min(b[1]) - t],
+            max: [a[0].max(b[0]) + t, a[1].max(b[1]) + t],
+        }
     }
     /// A rectangle length × thickness: m = ρ L T, I = m (L² + T²)/12.
     fn mass_properties(&self, s: u32, density: f64) -> MassProps2 {
         let (l, t) = (self.length[s as usize], self.thickness[s as usize]);
         let mass = density * l * t;
-        MassProps2 { area: l * t, mass, inertia: mass * (l * l + t * t) / 12.0 }
+        MassProps2 {
+            area: l * t,
+            mass,
+            inertia: mass * (l * l + t * t) / 12.0,
+        }
     }
     fn size(&self, s: u32) -> f64 {
         0.5 * self.thickness[s as usize]
@@ -159,16 +173,31 @@ impl ShapeStore2 for HalfPlanes {
         let n = Self::normal(rot);
         let inf = f64::INFINITY;
         // axis-aligned planes keep one finite face (used for box samples)
-        let mut b = Aabb2 { min: [-inf, -inf], max: [inf, inf] };
+        let mut b = Aabb2 {
+            min: [-inf, -inf],
+            max: [inf, inf],
+        };
         if n[0].abs() < 1e-12 {
-            if n[1] > 0.0 { b.max[1] = x[1] } else { b.min[1] = x[1] }
+            if n[1] > 0.0 {
+                b.max[1] = x[1]
+            } else {
+                b.min[1] = x[1]
+            }
         } else if n[1].abs() < 1e-12 {
-            if n[0] > 0.0 { b.max[0] = x[0] } else { b.min[0] = x[0] }
+            if n[0] > 0.0 {
+                b.max[0] = x[0]
+            } else {
+                b.min[0] = x[0]
+            }
         }
         b
     }
     fn mass_properties(&self, _s: u32, density: f64) -> MassProps2 {
-        MassProps2 { area: 1.0, mass: density, inertia: density / 6.0 }
+        MassProps2 {
+            area: 1.0,
+            mass: density,
+            inertia: density / 6.0,
+        }
     }
     fn size(&self, _s: u32) -> f64 {
         f64::INFINITY
@@ -178,7 +207,12 @@ impl ShapeStore2 for HalfPlanes {
         let hl = 0.5 * self.display_length[s as usize];
         let t = [n[1] * hl, -n[0] * hl];
         let d = 0.02 * hl;
-        Glyph2::Polygon(vec![[x[0] - t[0], x[1] - t[1]], [x[0] + t[0], x[1] + t[1]], [x[0] + t[0] - d * n[0], x[1] + t[1] - d * n[1]], [x[0] - t[0] - d * n[0], x[1] - t[1] - d * n[1]]])
+        Glyph2::Polygon(vec![
+            [x[0] - t[0], x[1] - t[1]],
+            [x[0] + t[0], x[1] + t[1]],
+            [x[0] + t[0] - d * n[0], x[1] + t[1] - d * n[1]],
+            [x[0] - t[0] - d * n[0], x[1] - t[1] - d * n[1]],
+        ])
     }
     fn describe(&self, _s: u32) -> serde_json::Value {
         serde_json::json!({})
