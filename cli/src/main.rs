@@ -29,6 +29,15 @@ enum Cmd {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+        /// NSCDD over NXxNY subdomains (e.g. 2x2); overrides [decomposition].
+        #[arg(long, value_name = "NXxNY", allow_hyphen_values = true)]
+        subdomains: Option<String>,
+        /// Gluing scheme: decentralized or centralized (needs a decomposition).
+        #[arg(long, allow_hyphen_values = true)]
+        scheme: Option<String>,
+        /// Threads sweeping the subdomains (needs a decomposition).
+        #[arg(long, value_name = "N", allow_hyphen_values = true)]
+        threads: Option<String>,
     },
     /// Validate a scene without running it.
     Check { scene: PathBuf },
@@ -65,6 +74,60 @@ fn input_error(e: impl std::fmt::Display) -> ExitCode {
     ExitCode::from(2)
 }
 
+/// `NXxNY` with NX, NY ≥ 1.
+fn parse_subdomains(v: &str) -> Result<(u32, u32), String> {
+    let bad = || format!("--subdomains: expected NXxNY with integers NX, NY ≥ 1 (e.g. 2x2), got `{v}`");
+    let (a, b) = v.split_once(['x', 'X']).ok_or_else(bad)?;
+    let n = |t: &str| t.trim().parse::<u32>().ok().filter(|&k| k >= 1);
+    match (n(a), n(b)) {
+        (Some(nx), Some(ny)) => Ok((nx, ny)),
+        _ => Err(bad()),
+    }
+}
+
+/// The command line's decomposition over the scene's: `--subdomains` sets (or makes)
+/// it, `--scheme` and `--threads` change it.
+fn apply_decomposition(
+    s: &mut nscdd::scene::Scene,
+    subdomains: Option<&str>,
+    scheme: Option<&str>,
+    threads: Option<&str>,
+) -> Result<(), String> {
+    if let Some(v) = subdomains {
+        let (nx, ny) = parse_subdomains(v)?;
+        let c = s.decomposition.get_or_insert_with(Default::default);
+        c.dd.nx = nx;
+        c.dd.ny = ny;
+    }
+    for (flag, given) in [("--scheme", scheme.is_some()), ("--threads", threads.is_some())] {
+        if given && s.decomposition.is_none() {
+            return Err(format!(
+                "{flag} needs a decomposition: give --subdomains NXxNY or a [decomposition] section"
+            ));
+        }
+    }
+    let Some(c) = s.decomposition.as_mut() else {
+        return Ok(());
+    };
+    if let Some(v) = scheme {
+        c.dd.scheme = nscdd::scene::parse_scheme(v).map_err(|m| format!("--scheme: {m}"))?;
+    }
+    if let Some(v) = threads {
+        c.dd.threads = v
+            .trim()
+            .parse::<usize>()
+            .ok()
+            .filter(|&t| t >= 1)
+            .ok_or_else(|| format!("--threads: expected an integer ≥ 1, got `{v}`"))?;
+    }
+    if subdomains.is_some() {
+        let w = &s.world;
+        let movable = (0..w.bodies.len()).filter(|&b| w.bodies.movable(b)).count();
+        c.check_capacity(movable).map_err(|(_, m)| format!("--subdomains: {m}"))?;
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(c) => c,
@@ -79,8 +142,15 @@ fn main() -> ExitCode {
         Cmd::Check { scene } => match nscdd::scene::load(&scene, &reg) {
             Ok(s) => {
                 let w = &s.world;
+                let dd = match &s.decomposition {
+                    Some(c) => format!(
+                        "; NSCDD {}x{} subdomains, {:?}, repartition every {} steps",
+                        c.dd.nx, c.dd.ny, c.dd.scheme, c.repartition_every
+                    ),
+                    None => String::new(),
+                };
                 println!(
-                    "{}: ok — {} bodies, {} steps of {} s",
+                    "{}: ok — {} bodies, {} steps of {} s{dd}",
                     scene.display(),
                     w.bodies.len(),
                     w.time.steps,
@@ -90,8 +160,19 @@ fn main() -> ExitCode {
             }
             Err(e) => input_error(e),
         },
-        Cmd::Run { scene, out, quiet } => {
-            let mut s = match nscdd::scene::load(&scene, &reg) {
+        Cmd::Run {
+            scene,
+            out,
+            quiet,
+            subdomains,
+            scheme,
+            threads,
+        } => {
+            let loaded = nscdd::scene::load(&scene, &reg).map_err(|e| e.to_string()).and_then(|mut s| {
+                apply_decomposition(&mut s, subdomains.as_deref(), scheme.as_deref(), threads.as_deref())?;
+                Ok(s)
+            });
+            let mut s = match loaded {
                 Ok(s) => s,
                 Err(e) => {
                     // nothing in DIR but the error
@@ -139,8 +220,15 @@ fn main() -> ExitCode {
                             sum.max_residual_step
                         );
                     }
+                    let dd = match &s.decomposition {
+                        Some(c) => format!(
+                            " ({}x{} subdomains, {:?}, {} migrations)",
+                            c.dd.nx, c.dd.ny, c.dd.scheme, sum.migrations
+                        ),
+                        None => String::new(),
+                    };
                     eprintln!(
-                        "{} steps, {} sweeps, {:.2} s; outputs in {}",
+                        "{} steps{dd}, {} sweeps, {:.2} s; outputs in {}",
                         sum.steps,
                         sum.total_sweeps,
                         sum.wall_seconds,

@@ -148,6 +148,17 @@ pub trait Generator2: Send + Sync {
 /// Writes extra outputs every `output.every` steps (`[output] writers = [...]`).
 pub trait Writer2: Send {
     fn write(&mut self, world: &crate::world::World2, dir: &std::path::Path, frame: u32) -> std::io::Result<()>;
+    /// A frame of a decomposed (NSCDD) run, with the subdomains of the bodies and
+    /// contacts; by default the plain frame.
+    fn write_dd(
+        &mut self,
+        world: &crate::world::World2,
+        _dd: &crate::dd::DdView,
+        dir: &std::path::Path,
+        frame: u32,
+    ) -> std::io::Result<()> {
+        self.write(world, dir, frame)
+    }
     /// Called once at the end of the run.
     fn finish(&mut self, _dir: &std::path::Path) -> std::io::Result<()> {
         Ok(())

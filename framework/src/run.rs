@@ -1,5 +1,6 @@
 //! Running a loaded scene to its end and writing its outputs in a directory.
 
+use crate::dd::Nscdd;
 use crate::engine::{Diverged, StepReport};
 use crate::output::{final_json, history::History};
 use crate::registry::{Registry, Writer2};
@@ -43,6 +44,8 @@ pub struct RunSummary {
     /// Largest natural-map residual of the run, and its step.
     pub max_residual: f64,
     pub max_residual_step: u64,
+    /// Decomposed runs: migrations summed over the repartitions.
+    pub migrations: u64,
 }
 
 /// A converged step whose residual exceeds this factor × the solver tolerance is
@@ -57,7 +60,9 @@ fn io(dir: &Path, what: &str) -> impl Fn(std::io::Error) -> RunError {
 
 /// Runs `scene` for its number of steps, writing `history.csv`, the writers' frames
 /// every `output.every` steps (and at the first and last step) and `final.json` in
-/// `dir`. `on_step` is called after every step (progress display).
+/// `dir`. `on_step` is called after every step (progress display). With
+/// `scene.decomposition` set, every step is an NSCDD step ([`Nscdd`]), history.csv
+/// gains the NSCDD columns and the VTK frames the subdomain arrays.
 pub fn run(
     scene: &mut Scene,
     registry: &Registry,
@@ -67,8 +72,10 @@ pub fn run(
     let start = Instant::now();
     std::fs::create_dir_all(dir).map_err(io(dir, "the output directory"))?;
     let w = &mut scene.world;
+    // a decomposed run steps with NSCDD; outputs take its report and view
+    let mut dd = scene.decomposition.as_ref().map(|c| c.solver());
     let file = std::fs::File::create(dir.join("history.csv")).map_err(io(dir, "history.csv"))?;
-    let mut hist = History::new(std::io::BufWriter::new(file), w).map_err(io(dir, "history.csv"))?;
+    let mut hist = History::with_columns(std::io::BufWriter::new(file), w, dd.is_some()).map_err(io(dir, "history.csv"))?;
     let mut writers: Vec<Box<dyn Writer2>> = vec![];
     if scene.output.vtk {
         writers.push((registry.writers["vtk"])());
@@ -77,14 +84,33 @@ pub fn run(
         writers.push((registry.writers[name.as_str()])());
     }
     let mut frame = 0u32;
-    for wr in writers.iter_mut() {
-        wr.write(w, dir, frame).map_err(io(dir, "the first output frame"))?;
-    }
+    let write_frame = |writers: &mut Vec<Box<dyn Writer2>>, w: &World2, dd: &Option<Nscdd>, frame: u32| -> std::io::Result<()> {
+        let view = dd.as_ref().map(|n| n.view(w));
+        for wr in writers.iter_mut() {
+            match &view {
+                Some(v) => wr.write_dd(w, v, dir, frame)?,
+                None => wr.write(w, dir, frame)?,
+            }
+        }
+        Ok(())
+    };
+    write_frame(&mut writers, w, &dd, frame).map_err(io(dir, "the first output frame"))?;
     frame += 1;
     let mut sum = RunSummary::default();
     let steps = w.time.steps;
     for s in 1..=steps {
-        let rep = match w.step() {
+        let stepped = match &mut dd {
+            Some(n) => n.step(w).map(|r| {
+                let plain = StepReport {
+                    solve: r.solve,
+                    contacts: r.contacts,
+                    times: r.times,
+                };
+                (plain, Some(r))
+            }),
+            None => w.step().map(|r| (r, None)),
+        };
+        let (rep, dd_rep) = match stepped {
             Ok(r) => r,
             Err(d) => {
                 let _ = hist.flush();
@@ -93,14 +119,15 @@ pub fn run(
         };
         let t0 = Instant::now();
         if (scene.output.every > 0 && s % scene.output.every == 0) || s == steps {
-            for wr in writers.iter_mut() {
-                wr.write(w, dir, frame).map_err(io(dir, "an output frame"))?;
-            }
+            write_frame(&mut writers, w, &dd, frame).map_err(io(dir, "an output frame"))?;
             frame += 1;
             hist.flush().map_err(io(dir, "history.csv"))?;
         }
         let t_out = t0.elapsed().as_secs_f64();
-        hist.row(w, &rep, t_out).map_err(io(dir, "history.csv"))?;
+        hist.row_dd(w, &rep, dd_rep.as_ref(), t_out).map_err(io(dir, "history.csv"))?;
+        if let Some(r) = &dd_rep {
+            sum.migrations += r.migrations as u64;
+        }
         sum.steps += 1;
         sum.total_sweeps += rep.solve.sweeps as u64;
         if !rep.solve.converged {

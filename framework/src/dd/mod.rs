@@ -24,6 +24,11 @@
 //! would: V_free + M̂⁻¹ Σ_E H_E r_E with the warm-start impulses.) Gluing and residual: [`gluing`]; schemes:
 //! [`schemes`]; exchange: [`transport`].
 //!
+//! Repartition: a new grid over the contact points every `repartition_every` steps;
+//! in between, a contact found in the previous step, by key, keeps its subdomain and
+//! a new one goes to the cell of the last grid holding its point. Migrations are
+//! counted at repartitions. A scene's `[decomposition]` is a [`DdConfig`].
+//!
 //! Counting: a *stage* is `sweeps_per_gluing` sweeps and one gluing; the check
 //! period `check_every` and the limit `max_sweeps / sweeps_per_gluing` (rounded up)
 //! count stages. With one subdomain and one sweep per stage this is the one-domain
@@ -41,6 +46,7 @@ pub mod subdomain;
 pub mod team;
 pub mod transport;
 
+use crate::rigid2d::contacts::ContactKey;
 pub use partition::{Decomposition, FGammaStore, Grid, Interface};
 pub use schemes::Scheme;
 pub use subdomain::{Subdomain2, SubdomainSolver};
@@ -81,6 +87,49 @@ impl Default for DdSettings {
     }
 }
 
+/// A scene's decomposition: the NSCDD settings and the repartition period (the
+/// scene's `[decomposition]` section, or the command line's `--subdomains`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DdConfig {
+    pub dd: DdSettings,
+    /// Re-partition every this many steps (≥ 1).
+    pub repartition_every: u32,
+}
+
+impl Default for DdConfig {
+    fn default() -> Self {
+        DdConfig {
+            dd: DdSettings::default(),
+            repartition_every: 1,
+        }
+    }
+}
+
+impl DdConfig {
+    /// The solver state for a run.
+    pub fn solver(&self) -> Nscdd {
+        Nscdd::new(self.dd.clone()).with_repartition_every(self.repartition_every)
+    }
+
+    /// Whether the sample can hold the grid: `nx × ny` may not exceed the number of
+    /// movable bodies (a subdomain is a set of contacts, each touching a movable
+    /// body, and a body's contacts can split over several subdomains only if there
+    /// are more bodies than subdomains). Err: (the key at fault, the message).
+    pub fn check_capacity(&self, movable: usize) -> Result<(), (&'static str, String)> {
+        let n = self.dd.nx as u64 * self.dd.ny as u64;
+        if n > movable as u64 {
+            return Err((
+                "nx",
+                format!(
+                    "{} × {} = {n} subdomains is more than the sample can hold: at most one subdomain per movable body ({movable})",
+                    self.dd.nx, self.dd.ny
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// What one NSCDD step did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct DdStepReport {
@@ -98,9 +147,62 @@ pub struct DdStepReport {
     /// egluing of the last check (before its gluing) and egluing / QuadWR.
     pub egluing: f64,
     pub egluing_rel: f64,
+    /// Which criterion was met last (the one that held the iteration longest).
+    pub prevailing: Prevailing,
+    /// Whether the contact set was re-partitioned over a new grid at this step.
+    pub repartitioned: bool,
+    /// At a repartition: bodies with contacts before and after it whose set of
+    /// subdomains changed (0 between repartitions).
+    pub migrations: usize,
     /// Messages and values exchanged during the step.
     pub exchange: TransportStats,
     pub times: StageTimes,
+}
+
+/// Which stopping criterion was met last in a step: `Nlgs` when the gluing residual
+/// was already below tol at the check before the converged one and the NLGS norms
+/// were not (the contact solve held the iteration), `Gluing` the other way round,
+/// `Both` when both became true at the same check (or at the first check). For a
+/// step that did not converge: the criteria still unmet. `None`: no contacts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Prevailing {
+    #[default]
+    None,
+    Nlgs,
+    Gluing,
+    Both,
+}
+
+impl Prevailing {
+    pub fn name(self) -> &'static str {
+        match self {
+            Prevailing::None => "none",
+            Prevailing::Nlgs => "nlgs",
+            Prevailing::Gluing => "gluing",
+            Prevailing::Both => "both",
+        }
+    }
+    fn of(now: (bool, bool), before: Option<(bool, bool)>) -> Self {
+        match (now, before) {
+            ((true, true), Some((true, false))) => Prevailing::Gluing,
+            ((true, true), Some((false, true))) => Prevailing::Nlgs,
+            ((true, true), _) | ((false, false), _) => Prevailing::Both,
+            ((false, true), _) => Prevailing::Nlgs,
+            ((true, false), _) => Prevailing::Gluing,
+        }
+    }
+}
+
+/// Per body and per contact fields of the last step's decomposition, for outputs.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct DdView {
+    /// The subdomain owning most of the body's contacts (ties: the smaller id); −1
+    /// for a body without contacts.
+    pub body_subdomain: Vec<i32>,
+    /// Number of subdomains holding a copy of the body (0: no contacts).
+    pub multiplicity: Vec<u32>,
+    /// Subdomain of each contact of `World2::contacts`.
+    pub contact_subdomain: Vec<u32>,
 }
 
 /// The NSCDD solver state kept between steps.
@@ -112,6 +214,19 @@ pub struct Nscdd {
     /// The last step's decomposition (copies as after the last gluing, before the
     /// averaging).
     pub last: Decomposition,
+    /// Re-partition over a new grid every this many steps (0 counts as 1); between
+    /// repartitions persisting contacts keep their subdomain and new ones go to the
+    /// cell of the last grid that holds their point.
+    pub repartition_every: u32,
+    /// Steps done by this solver.
+    pub steps: u64,
+    /// The grid of the last repartition.
+    pub grid: Option<Grid>,
+    /// Owner of each contact of the last step, by key (sorted).
+    kept: Vec<(ContactKey, u32)>,
+    /// Whether the last grid was made over no contact (then the next step
+    /// re-partitions).
+    grid_empty: bool,
     transport: InProcess,
     bufs: GlueBuffers,
     v_free: Vec<[f64; 3]>,
@@ -121,8 +236,87 @@ impl Nscdd {
     pub fn new(settings: DdSettings) -> Self {
         Nscdd {
             settings,
+            repartition_every: 1,
             ..Default::default()
         }
+    }
+
+    /// Re-partitions every `k` steps (see [`Nscdd::repartition_every`]).
+    pub fn with_repartition_every(mut self, k: u32) -> Self {
+        self.repartition_every = k;
+        self
+    }
+
+    /// The last step's subdomain of each body and contact of `w` and the bodies'
+    /// multiplicities (all −1 / 0 before the first step).
+    pub fn view(&self, w: &World2) -> DdView {
+        let nb = w.bodies.len();
+        let d = &self.last;
+        let mut v = DdView {
+            body_subdomain: vec![-1; nb],
+            multiplicity: (0..nb).map(|b| d.mult.get(b).copied().unwrap_or(0)).collect(),
+            contact_subdomain: Vec::new(),
+        };
+        if d.owner.len() != w.contacts.len() {
+            return v;
+        }
+        v.contact_subdomain.clone_from(&d.owner);
+        let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(2 * d.owner.len());
+        for (a, &s) in d.owner.iter().enumerate() {
+            for g in w.contacts.bodies[a] {
+                pairs.push((g, s));
+            }
+        }
+        pairs.sort_unstable();
+        let mut best = vec![0usize; nb];
+        let mut p = 0;
+        while p < pairs.len() {
+            let q = p + pairs[p..].iter().take_while(|e| **e == pairs[p]).count();
+            let (g, s) = (pairs[p].0 as usize, pairs[p].1);
+            // ascending subdomain ids: a strictly larger count wins, ties keep the smaller id
+            if g < nb && q - p > best[g] {
+                best[g] = q - p;
+                v.body_subdomain[g] = s as i32;
+            }
+            p = q;
+        }
+        v
+    }
+
+    /// This step's decomposition of `w.contacts`: a new grid every
+    /// `repartition_every` steps, else the kept owners.
+    fn partition(&mut self, w: &World2, rep: &mut DdStepReport) {
+        let s = &self.settings;
+        let k = self.repartition_every.max(1) as u64;
+        let c = &w.contacts;
+        let repart = self.grid.is_none() || self.grid_empty || self.steps.is_multiple_of(k);
+        let (grid, owner) = match self.grid {
+            Some(g) if !repart => (g, partition::kept_owners(c, &g, &self.kept)),
+            _ => {
+                let g = Grid::over(&c.point, s.nx, s.ny);
+                (g, c.point.iter().map(|&p| g.cell_of(p)).collect())
+            }
+        };
+        let nb = w.bodies.len();
+        let before = (repart && self.steps > 0).then(|| partition::body_sets(&self.last, nb));
+        if repart {
+            self.grid = Some(grid);
+            self.grid_empty = c.is_empty();
+        }
+        self.last = partition::decompose_owned(c, &w.bodies, &self.v_free, &w.scratch.order, grid, owner, &self.store);
+        rep.repartitioned = repart;
+        if let Some(before) = before {
+            let after = partition::body_sets(&self.last, nb);
+            rep.migrations = before
+                .iter()
+                .zip(&after)
+                .filter(|(x, y)| !x.is_empty() && !y.is_empty() && x != y)
+                .count();
+        }
+        self.kept.clear();
+        self.kept.extend(c.key.iter().copied().zip(self.last.owner.iter().copied()));
+        self.kept.sort_unstable_by_key(|e| e.0);
+        self.steps += 1;
     }
 
     /// Advances `w` by one step, the contact problem solved by NSCDD.
@@ -137,8 +331,7 @@ impl Nscdd {
         self.v_free.clone_from(&w.bodies.vel);
         build_contacts(w);
         nlgs::make_order(&mut w.scratch.order, w.contacts.len(), &w.solver, w.step);
-        let s = &self.settings;
-        self.last = partition::decompose(&w.contacts, &w.bodies, &self.v_free, &w.scratch.order, s.nx, s.ny, &self.store);
+        self.partition(w, &mut rep);
         let t2 = Instant::now();
         self.solve(w, &mut rep);
         let t3 = Instant::now();
@@ -174,6 +367,7 @@ impl Nscdd {
         let max_stages = sv.max_sweeps.div_ceil(per).max(1);
         let k = sv.check_every.max(1);
         let (iface, transport, bufs) = (&d.iface, &mut self.transport, &mut self.bufs);
+        let mut before: Option<(bool, bool)> = None;
         let stages = team::with_team(&mut d.subs, set.threads, |team| {
             if iface.fresh.iter().any(|&f| f) {
                 team.with_all(|subs| glue_stage(subs, iface, set.scheme, transport, true, bufs));
@@ -211,7 +405,10 @@ impl Nscdd {
                     };
                     rep.egluing = g.egluing();
                     rep.egluing_rel = g.relative(quad_wr);
-                    if rep.solve.norms.converged(sv.norm) && rep.egluing_rel < sv.tolerance {
+                    let now = (rep.solve.norms.converged(sv.norm), rep.egluing_rel < sv.tolerance);
+                    rep.prevailing = Prevailing::of(now, before);
+                    before = Some(now);
+                    if now == (true, true) {
                         rep.solve.converged = true;
                         break;
                     }

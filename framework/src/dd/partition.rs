@@ -5,9 +5,11 @@
 //! edges go to the last cell). A body belongs to every subdomain that owns one of
 //! its contacts; its multiplicity m is that count. Movable bodies with m ≥ 2 are the
 //! interface bodies, one copy per subdomain, glued; immovable bodies (M̂⁻¹ = 0) are
-//! copied into every subdomain that needs them without gluing.
+//! copied into every subdomain that needs them without gluing. Between repartitions
+//! ([`kept_owners`]) persisting contacts keep their subdomain.
 
 use super::subdomain::{Neighbor, Subdomain2, OWN};
+use crate::rigid2d::contacts::ContactKey;
 use crate::rigid2d::{Bodies2, Contacts2};
 
 /// The grid of subdomains over the contact points' bounding box.
@@ -153,9 +155,48 @@ pub struct Decomposition {
 /// storage order).
 pub fn decompose(c: &Contacts2, b: &Bodies2, v_free: &[[f64; 3]], order: &[u32], nx: u32, ny: u32, store: &FGammaStore) -> Decomposition {
     let grid = Grid::over(&c.point, nx, ny);
+    let owner: Vec<u32> = c.point.iter().map(|&p| grid.cell_of(p)).collect();
+    decompose_owned(c, b, v_free, order, grid, owner, store)
+}
+
+/// The owners between repartitions: a contact whose key is in `kept` (sorted by key)
+/// stays in its subdomain; a new contact goes to the cell of `grid` (the grid of the
+/// last repartition) that holds its point.
+pub fn kept_owners(c: &Contacts2, grid: &Grid, kept: &[(ContactKey, u32)]) -> Vec<u32> {
+    (0..c.len())
+        .map(|a| match kept.binary_search_by_key(&c.key[a], |e| e.0) {
+            Ok(p) => kept[p].1,
+            Err(_) => grid.cell_of(c.point[a]),
+        })
+        .collect()
+}
+
+/// The subdomains of each body (ascending), `out[b]`, from a decomposition.
+pub fn body_sets(d: &Decomposition, nb: usize) -> Vec<Vec<u32>> {
+    let mut out = vec![Vec::new(); nb];
+    for s in &d.subs {
+        for &g in &s.body_global {
+            if let Some(v) = out.get_mut(g as usize) {
+                v.push(s.id);
+            }
+        }
+    }
+    out
+}
+
+/// Splits the contact set `c` over the subdomains given by `owner` (one per contact,
+/// each below `grid.len()`); see [`decompose`].
+pub fn decompose_owned(
+    c: &Contacts2,
+    b: &Bodies2,
+    v_free: &[[f64; 3]],
+    order: &[u32],
+    grid: Grid,
+    owner: Vec<u32>,
+    store: &FGammaStore,
+) -> Decomposition {
     let ns = grid.len();
     let nb = b.len();
-    let owner: Vec<u32> = c.point.iter().map(|&p| grid.cell_of(p)).collect();
     let mut subs: Vec<Subdomain2> = (0..ns)
         .map(|s| Subdomain2 {
             id: s as u32,

@@ -1,5 +1,6 @@
 //! `history.csv`: one row per step.
 
+use crate::dd::DdStepReport;
 use crate::engine::StepReport;
 use crate::world::World2;
 use std::io::Write;
@@ -10,10 +11,29 @@ pub struct History<W: Write> {
     /// Bodies with their own columns: named or driven ones.
     tracked: Vec<(u32, String)>,
     has_box: bool,
+    /// NSCDD columns (a decomposed run).
+    dd: bool,
 }
 
+/// The NSCDD columns, after the timings.
+pub const DD_COLUMNS: [&str; 8] = [
+    "nscdd_iterations",
+    "egluing",
+    "egluing_rel",
+    "interface_bodies",
+    "links",
+    "migrations",
+    "prevailing",
+    "subdomains",
+];
+
 impl<W: Write> History<W> {
-    pub fn new(mut out: W, w: &World2) -> std::io::Result<Self> {
+    pub fn new(out: W, w: &World2) -> std::io::Result<Self> {
+        Self::with_columns(out, w, false)
+    }
+
+    /// With `dd`, the NSCDD columns [`DD_COLUMNS`] follow the timings.
+    pub fn with_columns(mut out: W, w: &World2, dd: bool) -> std::io::Result<Self> {
         let mut tracked: Vec<(u32, String)> = vec![];
         for b in 0..w.bodies.len() {
             let driven = w.drives.iter().any(|d| d.body as usize == b);
@@ -34,11 +54,23 @@ impl<W: Write> History<W> {
             head.push_str(",solid_fraction,eps1,sigma1,sigma2,sin_phi");
         }
         head.push_str(",t_detect,t_delassus,t_nlgs,t_update,t_output");
+        if dd {
+            for c in DD_COLUMNS {
+                head.push(',');
+                head.push_str(c);
+            }
+        }
         writeln!(out, "{head}")?;
-        Ok(History { out, tracked, has_box })
+        Ok(History { out, tracked, has_box, dd })
     }
 
     pub fn row(&mut self, w: &World2, r: &StepReport, t_output: f64) -> std::io::Result<()> {
+        self.row_dd(w, r, None, t_output)
+    }
+
+    /// A row; `dd` fills the NSCDD columns (empty when the history has them and
+    /// `dd` is `None`).
+    pub fn row_dd(&mut self, w: &World2, r: &StepReport, dd: Option<&DdStepReport>, t_output: f64) -> std::io::Result<()> {
         let n = &r.solve.norms;
         let (ek, ep) = w.energies();
         let mut s = format!(
@@ -82,6 +114,22 @@ impl<W: Write> History<W> {
             ",{:e},{:e},{:e},{:e},{:e}",
             tm.detect, tm.delassus, tm.nlgs, tm.update, t_output
         ));
+        if self.dd {
+            match dd {
+                Some(d) => s.push_str(&format!(
+                    ",{},{:e},{:e},{},{},{},{},{}",
+                    d.stages,
+                    d.egluing,
+                    d.egluing_rel,
+                    d.interface_bodies,
+                    d.links,
+                    d.migrations,
+                    d.prevailing.name(),
+                    d.subdomains
+                )),
+                None => s.push_str(&",".repeat(DD_COLUMNS.len())),
+            }
+        }
         writeln!(self.out, "{s}")
     }
 

@@ -2,16 +2,19 @@
 //!
 //! - `vtk/bodies_NNNNNN.vtp`: one point per body, with point data `id`, `radius`
 //!   (of disk glyphs; the shape size otherwise), `velocity` (v_x, v_y, 0),
-//!   `angular_velocity`, `rotation`, `material`; use ParaView's Glyph filter
+//!   `angular_velocity`, `rotation`, `material` (and, in a decomposed run,
+//!   `subdomain`: the subdomain owning most of the body's contacts, ties to the
+//!   smaller id, −1 without contacts; `multiplicity`: subdomains holding a copy); use ParaView's Glyph filter
 //!   (sphere, scale by `radius`, factor 2) to draw the disks;
 //! - `vtk/walls_NNNNNN.vtp`: the non-disk shapes (walls, half-plane pieces) as polygons;
 //! - `vtk/contacts_NNNNNN.vtp`: the contact network, a line between the two bodies'
 //!   centres per contact, with cell data `r_n`, `r_t` (N·s), `f_n` = r_n/h (N),
-//!   `gap` (m);
+//!   `gap` (m) (and `subdomain` in a decomposed run);
 //!
 //! and the series `bodies.pvd`, `walls.pvd`, `contacts.pvd` (rewritten at every frame,
 //! so that a stopped run leaves valid series). Files are written with `vtkio`.
 
+use crate::dd::DdView;
 use crate::registry::{Glyph2, Registry, Writer2};
 use crate::world::World2;
 use std::io::Write;
@@ -84,6 +87,17 @@ impl VtkWriter {
 
 impl Writer2 for VtkWriter {
     fn write(&mut self, w: &World2, dir: &Path, frame: u32) -> std::io::Result<()> {
+        self.frame(w, None, dir, frame)
+    }
+    fn write_dd(&mut self, w: &World2, dd: &DdView, dir: &Path, frame: u32) -> std::io::Result<()> {
+        self.frame(w, Some(dd), dir, frame)
+    }
+}
+
+impl VtkWriter {
+    /// One frame; a decomposed run adds `subdomain` and `multiplicity` to the bodies
+    /// and `subdomain` to the contacts.
+    fn frame(&mut self, w: &World2, dd: Option<&DdView>, dir: &Path, frame: u32) -> std::io::Result<()> {
         let vdir = dir.join("vtk");
         std::fs::create_dir_all(&vdir)?;
         let b = &w.bodies;
@@ -130,7 +144,7 @@ impl Writer2 for VtkWriter {
             wid.push(k as f64);
         }
         let verts = cells((0..n as u64).collect(), (1..=n as u64).collect());
-        let point = vec![
+        let mut point = vec![
             Attribute::scalars("id", 1).with_data(id),
             Attribute::scalars("radius", 1).with_data(radius),
             Attribute::vectors("velocity").with_data(vel),
@@ -138,6 +152,12 @@ impl Writer2 for VtkWriter {
             Attribute::scalars("rotation", 1).with_data(rot),
             Attribute::scalars("material", 1).with_data(mat),
         ];
+        if let Some(d) = dd {
+            let sub: Vec<f64> = (0..n).map(|k| d.body_subdomain.get(k).copied().unwrap_or(-1) as f64).collect();
+            let mult: Vec<f64> = (0..n).map(|k| d.multiplicity.get(k).copied().unwrap_or(0) as f64).collect();
+            point.push(Attribute::scalars("subdomain", 1).with_data(sub));
+            point.push(Attribute::scalars("multiplicity", 1).with_data(mult));
+        }
         export(
             piece(pts, verts, None, None, point, vec![]),
             &vdir.join(format!("bodies_{frame:06}.vtp")),
@@ -164,12 +184,16 @@ impl Writer2 for VtkWriter {
             gap.push(c.gap[a]);
         }
         let lines = cells((0..2 * m as u64).collect(), (1..=m as u64).map(|x| 2 * x).collect());
-        let cell = vec![
+        let mut cell = vec![
             Attribute::scalars("r_n", 1).with_data(rn),
             Attribute::scalars("r_t", 1).with_data(rt),
             Attribute::scalars("f_n", 1).with_data(fnn),
             Attribute::scalars("gap", 1).with_data(gap),
         ];
+        if let Some(d) = dd {
+            let sub: Vec<f64> = (0..m).map(|a| d.contact_subdomain.get(a).map_or(-1.0, |&s| s as f64)).collect();
+            cell.push(Attribute::scalars("subdomain", 1).with_data(sub));
+        }
         export(
             piece(cpts, None, lines, None, vec![], cell),
             &vdir.join(format!("contacts_{frame:06}.vtp")),

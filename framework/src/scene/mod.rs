@@ -31,6 +31,9 @@ pub struct OutputSettings {
 pub struct Scene {
     pub world: World2,
     pub output: OutputSettings,
+    /// NSCDD settings (`[decomposition]`); `None`: the one-domain engine.
+    /// [`crate::run::run`] steps with [`crate::dd::Nscdd`] when set.
+    pub decomposition: Option<crate::dd::DdConfig>,
 }
 
 /// Reads and loads a scene file.
@@ -247,6 +250,11 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
         }
     }
     let nb = b.bodies.len();
+    let movable = (0..nb).filter(|&i| b.bodies.movable(i)).count();
+    let decomposition = match &sf.decomposition {
+        None => None,
+        Some(d) => Some(decomposition(&cx, d, movable)?),
+    };
     let world = World2 {
         bodies: b.bodies,
         names: b.names,
@@ -274,7 +282,47 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
             vtk: sf.output.vtk,
             writers: sf.output.writers,
         },
+        decomposition,
     })
+}
+
+/// A scheme name (`decentralized` or `centralized`).
+pub fn parse_scheme(name: &str) -> Result<crate::dd::Scheme, String> {
+    match name {
+        "decentralized" => Ok(crate::dd::Scheme::Decentralized),
+        "centralized" => Ok(crate::dd::Scheme::Centralized),
+        other => Err(format!("unknown scheme `{other}`; expected `decentralized` or `centralized`")),
+    }
+}
+
+fn decomposition(cx: &Ctx, d: &schema::DecompositionSpec, movable: usize) -> Result<crate::dd::DdConfig, InputError> {
+    let p = |key: &str| vec![k("decomposition"), k(key)];
+    let int = |key: &str, v: Option<i64>, min: i64, def: i64| -> Result<i64, InputError> {
+        let v = v.unwrap_or(def);
+        if v < min || v > u32::MAX as i64 {
+            return Err(cx.err(&p(key), format!("must be an integer ≥ {min}, got {v}")));
+        }
+        Ok(v)
+    };
+    let def = crate::dd::DdSettings::default();
+    let mut c = crate::dd::DdConfig::default();
+    c.dd.nx = int("nx", d.nx, 1, def.nx as i64)? as u32;
+    c.dd.ny = int("ny", d.ny, 1, def.ny as i64)? as u32;
+    c.dd.sweeps_per_gluing = int("sweeps_per_gluing", d.sweeps_per_gluing, 1, 1)? as u32;
+    c.dd.threads = int("threads", d.threads, 1, 1)? as usize;
+    c.repartition_every = int("repartition_every", d.repartition_every, 1, 1)? as u32;
+    if let Some(s) = &d.scheme {
+        c.dd.scheme = parse_scheme(s).map_err(|m| cx.err(&p("scheme"), m))?;
+    }
+    c.check_capacity(movable).map_err(|(key, m)| {
+        // name a key the section has
+        let key = match (d.nx.is_some(), d.ny.is_some()) {
+            (true, _) | (false, false) => key,
+            (false, true) => "ny",
+        };
+        cx.err(&p(key), m)
+    })?;
+    Ok(c)
 }
 
 fn time_settings(cx: &Ctx, sf: &SceneFile) -> Result<TimeSettings, InputError> {

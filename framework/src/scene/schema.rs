@@ -49,6 +49,21 @@ pub struct SceneFile {
     pub generate: Vec<GenerateSpec>,
     #[serde(default)]
     pub output: OutputSpec,
+    /// NSCDD: split the contact set over nx × ny subdomains.
+    pub decomposition: Option<DecompositionSpec>,
+}
+
+/// `[decomposition]`: signed integers so that a negative value gets its own message.
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+pub struct DecompositionSpec {
+    pub nx: Option<i64>,
+    pub ny: Option<i64>,
+    /// `decentralized` (default) or `centralized`.
+    pub scheme: Option<String>,
+    pub sweeps_per_gluing: Option<i64>,
+    pub threads: Option<i64>,
+    pub repartition_every: Option<i64>,
 }
 
 #[derive(Deserialize, Debug)]
