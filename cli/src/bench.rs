@@ -144,3 +144,137 @@ pub fn deposit(reg: &Registry, n: usize, steps: usize) {
         ms(total)
     );
 }
+
+/// The biaxial example for `n` disks: `examples/scenes/biaxial.toml` with its box,
+/// walls and wall forces scaled by √(n / 2000) (the file unchanged for 2000).
+fn biaxial_text(n: usize) -> String {
+    let path = std::path::Path::new("examples/scenes/biaxial.toml");
+    let text = std::fs::read_to_string(path).expect("run from the repository root: examples/scenes/biaxial.toml");
+    let f = (n as f64 / 2000.0).sqrt();
+    let subst = |t: String, from: &str, to: String| {
+        assert!(t.contains(from), "examples/scenes/biaxial.toml changed: `{from}` not found");
+        t.replace(from, &to)
+    };
+    let mut t = subst(text, "count = 2000", format!("count = {n}"));
+    if n != 2000 {
+        let (w, h) = (0.4 * f, 0.535 * f);
+        t = subst(t, "box = [0.0, 0.0, 0.4, 0.535]", format!("box = [0.0, 0.0, {w}, {h}]"));
+        t = subst(t, "position = [0.2, -0.01]", format!("position = [{}, -0.01]", w / 2.0));
+        t = subst(t, "position = [0.2, 0.55]", format!("position = [{}, {}]", w / 2.0, h + 0.015));
+        t = subst(t, "position = [-0.01, 0.28]", format!("position = [-0.01, {}]", 0.28 * f));
+        t = subst(t, "position = [0.41, 0.28]", format!("position = [{}, {}]", w + 0.01, 0.28 * f));
+        t = subst(t, "length = 0.5", format!("length = {}", 0.5 * f));
+        t = subst(t, "length = 0.6", format!("length = {}", 0.6 * f));
+        t = subst(t, "-4000.0", format!("{:.3}", -4000.0 * f));
+        t = subst(t, "-5200.0", format!("{:.3}", -5200.0 * f));
+    }
+    t
+}
+
+/// The end of the biaxial example's compaction phase (s).
+const COMPACTED: f64 = 0.3;
+
+/// What `steps` NSCDD steps from the compacted biaxial sample did.
+struct DdRun {
+    stages: u64,
+    sweeps: u64,
+    unconverged: u64,
+    interface_bodies: u64,
+    contacts: u64,
+    seconds: f64,
+    solve_seconds: f64,
+    vel_bits: Vec<[u64; 3]>,
+}
+
+/// Loads the biaxial scene, compacts it with the one-domain engine (t < 0.3 s, the
+/// same steps for every call), then times `steps` NSCDD steps of the loading phase.
+fn dd_run(reg: &Registry, text: &str, steps: usize, settings: nscdd::dd::DdSettings) -> (DdRun, u64) {
+    let mut s = nscdd::scene::load_str(text, "biaxial.toml", reg).expect("biaxial scene");
+    let w = &mut s.world;
+    while w.t < COMPACTED - 0.5 * w.time.h {
+        w.step().expect("compaction step");
+    }
+    let start = w.step;
+    let mut n = nscdd::dd::Nscdd::new(settings);
+    let mut r = DdRun {
+        stages: 0,
+        sweeps: 0,
+        unconverged: 0,
+        interface_bodies: 0,
+        contacts: 0,
+        seconds: 0.0,
+        solve_seconds: 0.0,
+        vel_bits: Vec::new(),
+    };
+    for _ in 0..steps {
+        let t = Instant::now();
+        let rep = n.step(w).expect("NSCDD step");
+        r.seconds += t.elapsed().as_secs_f64();
+        r.solve_seconds += rep.times.nlgs;
+        r.stages += rep.stages as u64;
+        r.sweeps += rep.solve.sweeps as u64;
+        r.unconverged += !rep.solve.converged as u64;
+        r.interface_bodies += rep.interface_bodies as u64;
+        r.contacts += rep.contacts as u64;
+    }
+    r.vel_bits = w.bodies.vel.iter().map(|v| v.map(f64::to_bits)).collect();
+    (r, start)
+}
+
+/// NSCDD on the compacted biaxial sample: per decomposition, the stages (NSCDD
+/// iterations) over `steps` loading steps relative to one subdomain, and with two
+/// subdomains or more the wall time per step with 1 and 2 threads.
+pub fn nscdd(reg: &Registry, n: usize, steps: usize, subdomains: &[(u32, u32)]) {
+    let text = biaxial_text(n);
+    let mut rows = Vec::new();
+    let (mut s0, mut start, mut tol) = (None, 0, String::new());
+    if let Ok(s) = nscdd::scene::load_str(&text, "biaxial.toml", reg) {
+        let sv = &s.world.solver;
+        tol = format!("{} {:e}, check every {}", sv.norm.name(), sv.tolerance, sv.check_every);
+    }
+    for &(nx, ny) in subdomains {
+        let set = |threads| nscdd::dd::DdSettings {
+            nx,
+            ny,
+            threads,
+            ..Default::default()
+        };
+        let (one, st) = dd_run(reg, &text, steps, set(1));
+        start = st;
+        let stages0 = *s0.get_or_insert(one.stages);
+        let per = |x: f64| 1e3 * x / steps as f64;
+        let mut row = serde_json::json!({
+            "nx": nx,
+            "ny": ny,
+            "subdomains": nx * ny,
+            "stages": one.stages,
+            "stages_rel": one.stages as f64 / stages0 as f64,
+            "sweeps": one.sweeps,
+            "unconverged_steps": one.unconverged,
+            "mean_contacts": one.contacts as f64 / steps as f64,
+            "mean_interface_bodies": one.interface_bodies as f64 / steps as f64,
+            "ms_per_step_1": per(one.seconds),
+            "solve_ms_per_step_1": per(one.solve_seconds),
+        });
+        if nx * ny >= 2 {
+            let (two, _) = dd_run(reg, &text, steps, set(2));
+            row["ms_per_step_2"] = per(two.seconds).into();
+            row["solve_ms_per_step_2"] = per(two.solve_seconds).into();
+            row["efficiency"] = (one.seconds / (2.0 * two.seconds)).into();
+            row["solve_efficiency"] = (one.solve_seconds / (2.0 * two.solve_seconds)).into();
+            row["identical"] = (one.vel_bits == two.vel_bits && one.stages == two.stages).into();
+        }
+        eprintln!("{row}");
+        rows.push(row);
+    }
+    let out = serde_json::json!({
+        "bench": "nscdd",
+        "scene": "examples/scenes/biaxial.toml",
+        "disks": n,
+        "compacted_at_step": start,
+        "steps": steps,
+        "criterion": tol,
+        "decompositions": rows,
+    });
+    println!("{out}");
+}

@@ -56,16 +56,20 @@ enum Cmd {
         #[arg(long, default_value_t = 1)]
         check_every: u32,
     },
-    /// Benchmarks: `nlgs` (contact updates per second) or `deposit` (time per stage).
+    /// Benchmarks: `nlgs` (contact updates per second), `deposit` (time per stage) or
+    /// `nscdd` (NSCDD iterations and thread efficiency on the compacted biaxial sample).
     Bench {
-        #[arg(value_parser = ["nlgs", "deposit"])]
+        #[arg(value_parser = ["nlgs", "deposit", "nscdd"])]
         which: String,
-        /// Number of disks.
-        #[arg(long, default_value_t = 10000)]
-        disks: usize,
-        /// Sweeps (nlgs) or steps (deposit) to time.
-        #[arg(long, default_value_t = 200)]
-        repeat: usize,
+        /// Number of disks (default 10000; nscdd: 2000).
+        #[arg(long)]
+        disks: Option<usize>,
+        /// Sweeps (nlgs) or steps (deposit, nscdd) to time (default 200; nscdd: 20).
+        #[arg(long)]
+        repeat: Option<usize>,
+        /// nscdd: decompositions, comma-separated NXxNY.
+        #[arg(long, value_name = "LIST", default_value = "1x1,2x1,2x2,3x3,4x4")]
+        subdomains: String,
     },
 }
 
@@ -278,10 +282,22 @@ fn main() -> ExitCode {
                 Err(e) => input_error(e),
             }
         }
-        Cmd::Bench { which, disks, repeat } => {
+        Cmd::Bench {
+            which,
+            disks,
+            repeat,
+            subdomains,
+        } => {
             match which.as_str() {
-                "nlgs" => bench::nlgs(&reg, disks, repeat),
-                _ => bench::deposit(&reg, disks, repeat),
+                "nlgs" => bench::nlgs(&reg, disks.unwrap_or(10000), repeat.unwrap_or(200)),
+                "deposit" => bench::deposit(&reg, disks.unwrap_or(10000), repeat.unwrap_or(200)),
+                _ => {
+                    let list: Result<Vec<_>, _> = subdomains.split(',').map(parse_subdomains).collect();
+                    match list {
+                        Ok(list) => bench::nscdd(&reg, disks.unwrap_or(2000), repeat.unwrap_or(20), &list),
+                        Err(e) => return input_error(e),
+                    }
+                }
             }
             ExitCode::SUCCESS
         }

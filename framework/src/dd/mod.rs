@@ -34,8 +34,8 @@
 //! count stages. With one subdomain and one sweep per stage this is the one-domain
 //! NLGS, bitwise: the same sweep on the same data in the same order.
 //!
-//! Threads ([`team`]): subdomains are split into `threads` contiguous groups swept in
-//! parallel by threads kept for the whole step; a subdomain's sweep reads and writes
+//! Threads ([`team`]): subdomains are split into `threads` groups swept (and, with
+//! the decentralized scheme, glued) in parallel by threads kept for the whole step; a subdomain's sweep reads and writes
 //! only its own data and every reduction runs in subdomain order, so the result does
 //! not depend on the number of threads.
 
@@ -53,7 +53,7 @@ pub use subdomain::{Subdomain2, SubdomainSolver};
 pub use transport::{InProcess, Transport, TransportStats};
 
 use crate::engine::{build_contacts, free_velocity, update_positions, Diverged, StageTimes};
-use crate::norms::{Norms, Sums, VANISHING};
+use crate::norms::{Norms, VANISHING};
 use crate::rigid2d::nlgs;
 use crate::solver::SolveReport;
 use crate::world::World2;
@@ -368,7 +368,7 @@ impl Nscdd {
         let k = sv.check_every.max(1);
         let (iface, transport, bufs) = (&d.iface, &mut self.transport, &mut self.bufs);
         let mut before: Option<(bool, bool)> = None;
-        let stages = team::with_team(&mut d.subs, set.threads, |team| {
+        let stages = team::with_team(&mut d.subs, set.threads, iface, |team| {
             if iface.fresh.iter().any(|&f| f) {
                 team.with_all(|subs| glue_stage(subs, iface, set.scheme, transport, true, bufs));
             }
@@ -376,22 +376,8 @@ impl Nscdd {
             while stages < max_stages {
                 stages += 1;
                 let check = stages % k == 0 || stages == max_stages;
-                team.sweep(per, sv.relaxation, check);
-                let (sums, parts) = team.with_all(|subs| {
-                    let parts = if iface.is_empty() {
-                        Vec::new()
-                    } else {
-                        glue_stage(subs, iface, set.scheme, transport, false, bufs)
-                    };
-                    // reduced in subdomain order
-                    let mut sums = Sums::default();
-                    if check {
-                        for s in subs.iter() {
-                            sums.merge(s.sums());
-                        }
-                    }
-                    (sums, parts)
-                });
+                // sweeps and gluing; with `check`, the sums reduced in subdomain order
+                let (sums, parts) = team.stage(per, sv.relaxation, check, set.scheme, transport, bufs);
                 if check {
                     let mut g = GluePartial::default();
                     for p in &parts {

@@ -212,6 +212,9 @@ pub fn decompose_owned(
     }
     let mut copy_of: Vec<(u32, u32, u32)> = Vec::new(); // (body, sub, local)
     for (s, sub) in subs.iter_mut().enumerate() {
+        // one allocation per field (growing them by push cost 0.4 ms of 4000 contacts)
+        sub.contacts.reserve(by_sub[s].len());
+        sub.contact_global.reserve(by_sub[s].len());
         for &a in &by_sub[s] {
             let a = a as usize;
             let mut id = |g: u32| {

@@ -33,10 +33,16 @@ pub enum Scheme {
 #[derive(Default)]
 pub struct GlueBuffers {
     packets: Vec<Vec<[f64; 3]>>,
+    c: ChainBuffers,
+    send: Vec<[f64; 3]>,
+}
+
+/// Buffers of the chain solves of one subdomain's gluing ([`glue_sub`]).
+#[derive(Default)]
+pub struct ChainBuffers {
     chain: Vec<[f64; 3]>,
     dv: Vec<[f64; 3]>,
     scratch: ChainScratch,
-    send: Vec<[f64; 3]>,
 }
 
 /// One gluing stage: exchange, chain solves, F_Γ and velocity updates. Returns each
@@ -77,26 +83,46 @@ fn decentralized(
         for (ni, nbr) in s.neighbors.iter().enumerate() {
             t.recv(s.id, nbr.sub, &mut b.packets[ni]);
         }
-        for q in 0..s.iface.len() {
-            let ib = s.iface_ib[q] as usize;
-            let k = s.iface_k[q] as usize;
-            b.chain.clear();
-            for &(ni, p) in &s.chain[s.chain_start[q] as usize..s.chain_start[q + 1] as usize] {
-                b.chain.push(if ni == OWN {
-                    s.interface_velocity(p as usize)
-                } else {
-                    b.packets[ni as usize][p as usize]
-                });
-            }
-            accumulate(part, &b.chain, k, iface.rho2[ib]);
-            if !only_fresh || iface.fresh[ib] {
-                b.dv.resize(b.chain.len(), [0.0; 3]);
-                chain_increments(&b.chain, &mut b.dv, &mut b.scratch);
-                s.glue(q, b.dv[k]);
-            }
-        }
+        *part = glue_sub(s, &b.packets, iface, only_fresh, &mut b.c);
     }
     parts
+}
+
+/// The decentralized scheme's packets of subdomain `s`: `out[ni]` its copies'
+/// velocities of the bodies shared with neighbor `ni` (what [`decentralized`] sends).
+pub fn post(s: &Subdomain2, out: &mut Vec<Vec<[f64; 3]>>) {
+    out.resize_with(s.neighbors.len(), Vec::new);
+    for (o, nbr) in out.iter_mut().zip(&s.neighbors) {
+        o.clear();
+        s.interface_velocities(&nbr.slots, o);
+    }
+}
+
+/// The decentralized gluing of one subdomain once its neighbors' packets are in
+/// (`packets[ni]`: what neighbor `ni` posted to `s`): each interface body's chain
+/// solved, the own copy's increment applied. Returns the subdomain's residual share,
+/// measured on the velocities before the update.
+pub fn glue_sub(s: &mut Subdomain2, packets: &[Vec<[f64; 3]>], iface: &Interface, only_fresh: bool, b: &mut ChainBuffers) -> GluePartial {
+    let mut part = GluePartial::default();
+    for q in 0..s.iface.len() {
+        let ib = s.iface_ib[q] as usize;
+        let k = s.iface_k[q] as usize;
+        b.chain.clear();
+        for &(ni, p) in &s.chain[s.chain_start[q] as usize..s.chain_start[q + 1] as usize] {
+            b.chain.push(if ni == OWN {
+                s.interface_velocity(p as usize)
+            } else {
+                packets[ni as usize][p as usize]
+            });
+        }
+        accumulate(&mut part, &b.chain, k, iface.rho2[ib]);
+        if !only_fresh || iface.fresh[ib] {
+            b.dv.resize(b.chain.len(), [0.0; 3]);
+            chain_increments(&b.chain, &mut b.dv, &mut b.scratch);
+            s.glue(q, b.dv[k]);
+        }
+    }
+    part
 }
 
 /// The residual share of one copy: its chain's links if it is the first copy.
@@ -138,14 +164,14 @@ fn centralized(
     let mut parts = vec![GluePartial::default(); ns];
     for ib in 0..iface.len() {
         let r = iface.copies(ib);
-        b.chain.clear();
-        b.chain
+        b.c.chain.clear();
+        b.c.chain
             .extend(r.clone().map(|c| all[iface.sub[c] as usize][iface.slot[c] as usize]));
         if !only_fresh || iface.fresh[ib] {
-            b.dv.resize(b.chain.len(), [0.0; 3]);
-            chain_increments(&b.chain, &mut b.dv, &mut b.scratch);
+            b.c.dv.resize(b.c.chain.len(), [0.0; 3]);
+            chain_increments(&b.c.chain, &mut b.c.dv, &mut b.c.scratch);
             for (k, c) in r.enumerate() {
-                out[iface.sub[c] as usize][iface.slot[c] as usize] = b.dv[k];
+                out[iface.sub[c] as usize][iface.slot[c] as usize] = b.c.dv[k];
             }
         }
     }
@@ -153,10 +179,10 @@ fn centralized(
     for (s, part) in parts.iter_mut().enumerate() {
         for q in 0..all[s].len() {
             let ib = subs[s].iface_ib[q] as usize;
-            b.chain.clear();
-            b.chain
+            b.c.chain.clear();
+            b.c.chain
                 .extend(iface.copies(ib).map(|c| all[iface.sub[c] as usize][iface.slot[c] as usize]));
-            accumulate(part, &b.chain, subs[s].iface_k[q] as usize, iface.rho2[ib]);
+            accumulate(part, &b.c.chain, subs[s].iface_k[q] as usize, iface.rho2[ib]);
         }
     }
     // scatter

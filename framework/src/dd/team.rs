@@ -1,119 +1,393 @@
-//! Threads sweeping the subdomains, kept for a whole step.
+//! Threads sweeping and gluing the subdomains, kept for a whole step.
 //!
-//! The subdomains are split into contiguous groups, one per thread; the calling
-//! thread (the coordinator) sweeps group 0. Each stage: the coordinator posts the
-//! command, every thread sweeps its group, all meet at a barrier; the gluing stage
-//! then runs on the coordinator with every subdomain locked (uncontended). A
-//! subdomain is only ever swept by its group's thread, on its own data, so the
+//! The subdomains are split into groups, one per thread, balanced by contact count
+//! (the sweep's cost); the calling thread (the coordinator) runs group 0. The
+//! coordinator posts a *phase* (a command), every thread runs it on its group, and
+//! the coordinator waits until all are done; a phase costs two one-way signals, each
+//! waited for by spinning ([`Parker`]: `spin_loop` for a bounded time, then a
+//! condition variable), so that a wake-up costs well under a microsecond where a
+//! parked thread's costs tens (std's `Barrier` parks at once: with it, two threads
+//! were slower than one).
+//!
+//! With the decentralized scheme the gluing runs in the groups too: after its sweeps
+//! a subdomain *posts* its packets (its copies' velocities of the bodies shared with
+//! each neighbor, [`schemes::post`]) into its outbox; once every subdomain has
+//! posted, each one reads its neighbors' packets addressed to it and glues its own
+//! copies ([`schemes::glue_sub`]). That gluing is put off to the start of the next
+//! stage's phase, so that a stage is one phase: `glue(n − 1), sweep(n), post(n)`.
+//! Outboxes alternate between two buffers by stage parity: a phase reads the parity
+//! posted by the previous one and writes the other. A check stage adds a gluing
+//! phase, whose residual shares the convergence test needs. The centralized scheme
+//! glues on the coordinator with every subdomain locked (uncontended).
+//!
+//! A subdomain is only ever swept and glued by its group's thread, on its own data
+//! and the packets, which are copies; each subdomain's arithmetic is the serial one
+//! ([`schemes::glue_stage`]) and every reduction runs in subdomain order, so the
 //! result does not depend on the number of threads.
 
+use super::gluing::GluePartial;
+use super::partition::Interface;
+use super::schemes::{self, glue_stage, ChainBuffers, GlueBuffers, Scheme};
 use super::subdomain::{Subdomain2, SubdomainSolver};
-use std::ops::Range;
-use std::sync::{Barrier, Mutex, MutexGuard};
+use super::transport::Transport;
+use crate::norms::Sums;
+use std::sync::atomic::{AtomicBool, AtomicU32, AtomicUsize, Ordering::SeqCst};
+use std::sync::{Condvar, Mutex, MutexGuard};
+use std::time::{Duration, Instant};
 
-#[derive(Clone, Copy, Default)]
-struct Cmd {
-    n: u32,
-    omega: f64,
-    check: bool,
-    stop: bool,
-}
-
-/// The subdomains of a step, shared between the coordinator and the workers.
-pub struct Team<'a, 'b> {
-    cells: &'a [Mutex<&'b mut Subdomain2>],
-    groups: Vec<Range<usize>>,
-    start: Barrier,
-    done: Barrier,
-    cmd: Mutex<Cmd>,
-}
+/// How long a thread spins before it parks: longer than the coordinator's serial
+/// work between two phases and a phase's imbalance, far shorter than a step.
+const SPIN: Duration = Duration::from_micros(200);
 
 fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-impl<'a, 'b> Team<'a, 'b> {
-    fn sweep_group(&self, g: usize, c: Cmd) {
-        for k in self.groups[g].clone() {
-            lock(&self.cells[k]).sweeps(c.n, c.omega, c.check);
+/// Waiting for a condition set by another thread: spin, then park. No
+/// `yield_now`: on a loaded machine it hands the core to another process for a
+/// whole time slice.
+#[derive(Default)]
+struct Parker {
+    sleepers: AtomicU32,
+    m: Mutex<()>,
+    cv: Condvar,
+}
+
+impl Parker {
+    /// Returns once `ready()` (which must load with `SeqCst`) holds.
+    fn wait(&self, ready: impl Fn() -> bool) {
+        let t0 = Instant::now();
+        let mut i = 0u32;
+        while !ready() {
+            std::hint::spin_loop();
+            i = i.wrapping_add(1);
+            if i.is_multiple_of(64) && t0.elapsed() > SPIN {
+                let mut g = lock(&self.m);
+                // sleepers before ready(), against wake()'s store then load: one of
+                // the two sees the other (SeqCst)
+                self.sleepers.fetch_add(1, SeqCst);
+                while !ready() {
+                    g = self.cv.wait(g).unwrap_or_else(|e| e.into_inner());
+                }
+                self.sleepers.fetch_sub(1, SeqCst);
+                return;
+            }
         }
     }
 
-    /// `n` sweeps in every subdomain (the last a check pass when `check`).
-    pub fn sweep(&self, n: u32, omega: f64, check: bool) {
-        let c = Cmd {
-            n,
-            omega,
-            check,
-            stop: false,
-        };
-        if self.groups.len() == 1 {
-            return self.sweep_group(0, c);
+    /// To call after the store that makes a waiter's condition true (`SeqCst`).
+    fn wake(&self) {
+        if self.sleepers.load(SeqCst) > 0 {
+            drop(lock(&self.m));
+            self.cv.notify_all();
         }
-        *lock(&self.cmd) = c;
-        self.start.wait();
-        self.sweep_group(0, c);
-        self.done.wait();
     }
+}
 
-    /// Runs `f` on all the subdomains, in subdomain order, on the coordinator.
-    pub fn with_all<R>(&self, f: impl FnOnce(&mut [&mut Subdomain2]) -> R) -> R {
-        let mut guards: Vec<_> = self.cells.iter().map(lock).collect();
-        let mut subs: Vec<&mut Subdomain2> = guards.iter_mut().map(|g| &mut ***g).collect();
-        f(&mut subs)
+#[derive(Clone, Copy, Default)]
+struct Cmd {
+    /// Glue from the packets of this parity first.
+    glue_from: Option<usize>,
+    /// Then `n` sweeps (the last a check pass when `check`) and post to `post_to`.
+    sweep: bool,
+    n: u32,
+    omega: f64,
+    check: bool,
+    post_to: Option<usize>,
+    stop: bool,
+}
+
+/// A subdomain's packets of one stage parity, one per neighbor (neighbor order).
+type Outbox = Mutex<Vec<Vec<[f64; 3]>>>;
+
+/// What the threads share.
+struct Shared<'a, 'b> {
+    cells: &'a [Mutex<&'b mut Subdomain2>],
+    /// Per subdomain and parity: one packet per neighbor, neighbor order.
+    outbox: &'a [[Outbox; 2]],
+    /// Per subdomain, per neighbor: (neighbor, index of the subdomain among its neighbors).
+    back: &'a [Vec<(usize, usize)>],
+    /// Per subdomain: residual share of its last gluing.
+    partials: &'a [Mutex<GluePartial>],
+    iface: &'a Interface,
+    groups: Vec<Vec<usize>>,
+    cmd: Mutex<Cmd>,
+    /// Phases posted / finished by the workers (cumulative).
+    epoch: AtomicUsize,
+    done: AtomicUsize,
+    failed: AtomicBool,
+    go: Parker,
+    finished: Parker,
+}
+
+/// Per-thread buffers.
+#[derive(Default)]
+struct Scratch {
+    packets: Vec<Vec<[f64; 3]>>,
+    chain: ChainBuffers,
+}
+
+impl Shared<'_, '_> {
+    fn run_group(&self, g: usize, c: Cmd, buf: &mut Scratch) {
+        for &k in &self.groups[g] {
+            let mut s = lock(&self.cells[k]);
+            if let Some(q) = c.glue_from {
+                let back = &self.back[k];
+                buf.packets.resize_with(buf.packets.len().max(back.len()), Vec::new);
+                for (p, &(t, j)) in buf.packets.iter_mut().zip(back) {
+                    p.clear();
+                    p.extend_from_slice(&lock(&self.outbox[t][q])[j]);
+                }
+                *lock(&self.partials[k]) = schemes::glue_sub(&mut s, &buf.packets, self.iface, false, &mut buf.chain);
+            }
+            if c.sweep {
+                s.sweeps(c.n, c.omega, c.check);
+            }
+            if let Some(p) = c.post_to {
+                schemes::post(&s, &mut lock(&self.outbox[k][p]));
+            }
+        }
     }
 
     fn work(&self, g: usize) {
+        struct Fail<'s, 'a, 'b>(&'s Shared<'a, 'b>);
+        impl Drop for Fail<'_, '_, '_> {
+            fn drop(&mut self) {
+                if std::thread::panicking() {
+                    self.0.failed.store(true, SeqCst);
+                    self.0.finished.wake();
+                }
+            }
+        }
+        let _fail = Fail(self);
+        let mut buf = Scratch::default();
+        let mut seen = 0;
         loop {
-            self.start.wait();
+            self.go.wait(|| self.epoch.load(SeqCst) > seen);
+            seen += 1;
             let c = *lock(&self.cmd);
             if c.stop {
                 return;
             }
-            self.sweep_group(g, c);
-            self.done.wait();
+            self.run_group(g, c, &mut buf);
+            self.done.fetch_add(1, SeqCst);
+            self.finished.wake();
+        }
+    }
+}
+
+/// The coordinator's handle on the subdomains of a step.
+pub struct Team<'s, 'a, 'b> {
+    sh: &'s Shared<'a, 'b>,
+    buf: Scratch,
+    phases: usize,
+    /// Stage parity of the next post.
+    parity: usize,
+    /// Packets posted and not glued yet (their parity).
+    pending: Option<usize>,
+    /// (from, to, copies) of the decentralized exchange, counted once per gluing.
+    links: Vec<(u32, u32, usize)>,
+}
+
+impl Team<'_, '_, '_> {
+    /// Runs `c` on every group, group 0 here; returns when all are done.
+    fn phase(&mut self, c: Cmd) {
+        let sh = self.sh;
+        if sh.groups.len() == 1 {
+            return sh.run_group(0, c, &mut self.buf);
+        }
+        *lock(&sh.cmd) = c;
+        self.phases += 1;
+        sh.epoch.store(self.phases, SeqCst);
+        sh.go.wake();
+        sh.run_group(0, c, &mut self.buf);
+        let target = self.phases * (sh.groups.len() - 1);
+        sh.finished.wait(|| sh.done.load(SeqCst) >= target || sh.failed.load(SeqCst));
+        assert!(!sh.failed.load(SeqCst), "a subdomain thread panicked");
+    }
+
+    /// Applies the pending gluing, if any.
+    fn flush(&mut self) {
+        if let Some(q) = self.pending.take() {
+            self.phase(Cmd {
+                glue_from: Some(q),
+                ..Cmd::default()
+            });
         }
     }
 
-    fn stop(&self) {
-        if self.groups.len() > 1 {
-            lock(&self.cmd).stop = true;
-            self.start.wait();
+    /// `n` sweeps in every subdomain (the last a check pass when `check`).
+    pub fn sweep(&mut self, n: u32, omega: f64, check: bool) {
+        self.flush();
+        self.phase(Cmd {
+            sweep: true,
+            n,
+            omega,
+            check,
+            ..Cmd::default()
+        });
+    }
+
+    /// One stage: `n` sweeps in every subdomain (the last a check pass when `check`),
+    /// then one gluing stage (as [`glue_stage`] on all the subdomains). With `check`,
+    /// returns the check pass's sums merged in subdomain order and each subdomain's
+    /// residual share (else default sums and no shares). The decentralized gluing
+    /// runs in parallel, and outside check stages at the start of the next phase
+    /// (any call but `stage` applies it first).
+    pub fn stage(
+        &mut self,
+        n: u32,
+        omega: f64,
+        check: bool,
+        scheme: Scheme,
+        t: &mut dyn Transport,
+        bufs: &mut GlueBuffers,
+    ) -> (Sums, Vec<GluePartial>) {
+        let iface = self.sh.iface;
+        let parts = if scheme == Scheme::Decentralized && !iface.is_empty() {
+            let p = self.parity;
+            self.parity ^= 1;
+            let glue_from = self.pending.take();
+            self.phase(Cmd {
+                glue_from,
+                sweep: true,
+                n,
+                omega,
+                check,
+                post_to: Some(p),
+                stop: false,
+            });
+            for &(from, to, len) in &self.links {
+                t.record(from, to, len);
+            }
+            self.pending = Some(p);
+            if check {
+                self.flush();
+                self.sh.partials.iter().map(|m| *lock(m)).collect()
+            } else {
+                Vec::new()
+            }
+        } else {
+            self.sweep(n, omega, check);
+            if iface.is_empty() {
+                Vec::new()
+            } else {
+                self.with_all(|subs| glue_stage(subs, iface, scheme, t, false, bufs))
+            }
+        };
+        let mut sums = Sums::default();
+        if check {
+            // reduced in subdomain order
+            for c in self.sh.cells {
+                sums.merge(lock(c).sums());
+            }
         }
+        (sums, parts)
+    }
+
+    /// Runs `f` on all the subdomains, in subdomain order, on the coordinator.
+    pub fn with_all<R>(&mut self, f: impl FnOnce(&mut [&mut Subdomain2]) -> R) -> R {
+        self.flush();
+        let mut guards: Vec<_> = self.sh.cells.iter().map(lock).collect();
+        let mut subs: Vec<&mut Subdomain2> = guards.iter_mut().map(|g| &mut ***g).collect();
+        f(&mut subs)
     }
 }
 
 /// Releases the workers when the coordinator leaves (also on a panic).
-struct StopOnDrop<'t, 'a, 'b>(&'t Team<'a, 'b>);
+struct StopOnDrop<'s, 'a, 'b>(&'s Shared<'a, 'b>);
 impl Drop for StopOnDrop<'_, '_, '_> {
     fn drop(&mut self) {
-        self.0.stop();
+        let sh = self.0;
+        if sh.groups.len() > 1 {
+            lock(&sh.cmd).stop = true;
+            sh.epoch.fetch_add(1, SeqCst);
+            sh.go.wake();
+        }
     }
 }
 
-/// Runs `driver` with a [`Team`] of `threads` threads over `subs`.
-pub fn with_team<R>(subs: &mut [Subdomain2], threads: usize, driver: impl FnOnce(&Team<'_, '_>) -> R) -> R {
-    let n = subs.len();
-    let groups_n = threads.clamp(1, n.max(1));
-    let chunk = n.div_ceil(groups_n).max(1);
-    let groups: Vec<Range<usize>> = (0..n.div_ceil(chunk).max(1)).map(|g| g * chunk..((g + 1) * chunk).min(n)).collect();
+/// Groups of subdomains, one per thread, balanced by contact count (largest first to
+/// the least loaded group; ties to the smaller id); each group in subdomain order.
+fn groups(subs: &[Subdomain2], threads: usize) -> Vec<Vec<usize>> {
+    let n = threads.clamp(1, subs.len().max(1));
+    let mut by_load: Vec<usize> = (0..subs.len()).collect();
+    by_load.sort_by_key(|&k| (std::cmp::Reverse(subs[k].contacts.len()), k));
+    let mut g = vec![Vec::new(); n];
+    let mut load = vec![0usize; n];
+    for k in by_load {
+        let i = (0..n).min_by_key(|&i| (load[i], i)).unwrap_or(0);
+        load[i] += subs[k].contacts.len();
+        g[i].push(k);
+    }
+    for x in g.iter_mut() {
+        x.sort_unstable();
+    }
+    g.retain(|x| !x.is_empty());
+    if g.is_empty() {
+        g.push(Vec::new());
+    }
+    g
+}
+
+/// Runs `driver` with a [`Team`] of `threads` threads over `subs`, glued across
+/// `iface`; a gluing left pending is applied before returning.
+pub fn with_team<R>(subs: &mut [Subdomain2], threads: usize, iface: &Interface, driver: impl FnOnce(&mut Team<'_, '_, '_>) -> R) -> R {
+    let groups = groups(subs, threads);
+    let mut links = Vec::new();
+    let back: Vec<Vec<(usize, usize)>> = subs
+        .iter()
+        .map(|s| {
+            s.neighbors
+                .iter()
+                .map(|nbr| {
+                    links.push((s.id, nbr.sub, nbr.slots.len()));
+                    let t = nbr.sub as usize;
+                    let j = subs[t].neighbors.iter().position(|m| m.sub == s.id);
+                    (t, j.expect("neighbors are mutual"))
+                })
+                .collect()
+        })
+        .collect();
+    let outbox: Vec<[Outbox; 2]> = subs.iter().map(|_| Default::default()).collect();
+    let partials: Vec<Mutex<GluePartial>> = subs.iter().map(|_| Default::default()).collect();
     let cells: Vec<Mutex<&mut Subdomain2>> = subs.iter_mut().map(Mutex::new).collect();
-    let team = Team {
+    let sh = Shared {
         cells: &cells,
-        start: Barrier::new(groups.len()),
-        done: Barrier::new(groups.len()),
-        cmd: Mutex::new(Cmd::default()),
+        outbox: &outbox,
+        back: &back,
+        partials: &partials,
+        iface,
         groups,
+        cmd: Mutex::new(Cmd::default()),
+        epoch: AtomicUsize::new(0),
+        done: AtomicUsize::new(0),
+        failed: AtomicBool::new(false),
+        go: Parker::default(),
+        finished: Parker::default(),
     };
-    if team.groups.len() == 1 {
-        return driver(&team);
+    let mut team = Team {
+        sh: &sh,
+        buf: Scratch::default(),
+        phases: 0,
+        parity: 0,
+        pending: None,
+        links,
+    };
+    let drive = move || {
+        let r = driver(&mut team);
+        team.flush();
+        r
+    };
+    if sh.groups.len() == 1 {
+        return drive();
     }
     std::thread::scope(|sc| {
-        for g in 1..team.groups.len() {
-            let t = &team;
-            sc.spawn(move || t.work(g));
+        for g in 1..sh.groups.len() {
+            let s = &sh;
+            sc.spawn(move || s.work(g));
         }
-        let _stop = StopOnDrop(&team);
-        driver(&team)
+        let _stop = StopOnDrop(&sh);
+        drive()
     })
 }

@@ -27,6 +27,9 @@ pub trait Transport {
     /// (cleared first; left empty when none was posted).
     fn recv(&mut self, to: u32, from: u32, out: &mut Vec<[f64; 3]>);
     fn stats(&self) -> TransportStats;
+    /// Counts a packet of `len` copies from `from` to `to` that went through shared
+    /// memory instead (the threads of [`super::team`]), as `send` would.
+    fn record(&mut self, from: u32, to: u32, len: usize);
 }
 
 /// In-process transport: one mailbox per (receiver, sender) pair, buffers reused.
@@ -56,10 +59,7 @@ impl Transport for InProcess {
         let b = &mut self.boxes[to as usize * self.n + from as usize];
         b.clear();
         b.extend_from_slice(data);
-        if from != to {
-            self.stats.messages += 1;
-            self.stats.values += 3 * data.len() as u64;
-        }
+        self.record(from, to, data.len());
     }
     fn recv(&mut self, to: u32, from: u32, out: &mut Vec<[f64; 3]>) {
         out.clear();
@@ -67,5 +67,11 @@ impl Transport for InProcess {
     }
     fn stats(&self) -> TransportStats {
         self.stats
+    }
+    fn record(&mut self, from: u32, to: u32, len: usize) {
+        if from != to {
+            self.stats.messages += 1;
+            self.stats.values += 3 * len as u64;
+        }
     }
 }

@@ -82,6 +82,19 @@ impl Contacts2 {
         self.key.clear();
     }
 
+    /// Room for `n` more contacts in every field.
+    pub fn reserve(&mut self, n: usize) {
+        self.bodies.reserve(n);
+        self.frame.reserve(n);
+        self.block.reserve(n);
+        self.target.reserve(n);
+        self.r.reserve(n);
+        self.u_free.reserve(n);
+        self.gap.reserve(n);
+        self.point.reserve(n);
+        self.key.reserve(n);
+    }
+
     /// Appends contact `a` of `other` with its bodies renamed (i, j).
     pub fn push_from(&mut self, other: &Contacts2, a: usize, i: u32, j: u32) {
         self.bodies.push([i, j]);
