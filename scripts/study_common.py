@@ -122,17 +122,33 @@ seed = 7
 """
 
 
+def _num(v):
+    try:
+        return float(v)
+    except ValueError:
+        return v  # text columns (e.g. `prevailing`)
+
+
 def run(nscdd, scene_text, out_dir, extra_args=()):
-    """Runs a scene; returns (wall seconds, rows of history.csv as dicts of floats)."""
+    """Runs a scene (or reuses the run already in out_dir for the same scene and
+    arguments); returns (wall seconds, rows of history.csv as dicts)."""
     os.makedirs(out_dir, exist_ok=True)
     path = os.path.join(out_dir, "scene.toml")
-    with open(path, "w") as f:
-        f.write(scene_text)
-    t0 = time.time()
-    subprocess.run([nscdd, "run", path, "--out", out_dir, "--quiet", *extra_args], check=True)
-    elapsed = time.time() - t0
+    stamp = os.path.join(out_dir, "elapsed.txt")
+    key = scene_text + "\n# args: " + " ".join(extra_args)
+    cached = os.path.exists(stamp) and os.path.exists(path + ".key") and open(path + ".key").read() == key
+    if not cached:
+        with open(path, "w") as f:
+            f.write(scene_text)
+        t0 = time.time()
+        subprocess.run([nscdd, "run", path, "--out", out_dir, "--quiet", *extra_args], check=True)
+        with open(stamp, "w") as f:
+            f.write(f"{time.time() - t0}\n")
+        with open(path + ".key", "w") as f:
+            f.write(key)
+    elapsed = float(open(stamp).read())
     with open(os.path.join(out_dir, "history.csv")) as f:
-        rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
+        rows = [{k: _num(v) for k, v in r.items()} for r in csv.DictReader(f)]
     return elapsed, rows
 
 
