@@ -53,9 +53,38 @@ impl std::fmt::Display for Diverged {
     }
 }
 
+/// The contact-solve stage of a step, between the construction of the contact set
+/// and the position update: the one-domain NLGS ([`Nlgs`]) or NSCDD
+/// (`crate::dd::Nscdd`). The rest of the step is the same for both
+/// ([`World2::step_with`]).
+pub trait ContactStage {
+    /// After the free velocity (the bodies hold V_free), before the contact set is
+    /// built and the warm-start impulses are applied.
+    fn after_free_velocity(&mut self, _w: &World2) {}
+    /// After the contact set and the visiting order are built (timed with the
+    /// Delassus stage).
+    fn prepare(&mut self, _w: &mut World2) {}
+    /// Solves the contact problem: V⁺ in `w.bodies.vel`, r in `w.contacts.r`.
+    fn solve(&mut self, w: &mut World2) -> SolveReport;
+}
+
+/// The one-domain NLGS stage.
+pub struct Nlgs;
+
+impl ContactStage for Nlgs {
+    fn solve(&mut self, w: &mut World2) -> SolveReport {
+        nlgs::solve(&mut w.contacts, &mut w.bodies.vel, &w.bodies.inv_mass, &w.scratch.order, &w.solver)
+    }
+}
+
 impl World2 {
-    /// Advances the scene by one step.
+    /// Advances the scene by one step, contacts solved by NLGS.
     pub fn step(&mut self) -> Result<StepReport, Diverged> {
+        self.step_with(&mut Nlgs)
+    }
+
+    /// Advances the scene by one step with the given contact-solve stage.
+    pub fn step_with(&mut self, stage: &mut impl ContactStage) -> Result<StepReport, Diverged> {
         let mut rep = StepReport::default();
         let t0 = Instant::now();
         free_velocity(self);
@@ -63,17 +92,12 @@ impl World2 {
             .detector
             .detect(&self.bodies, &self.shapes, &self.detectors, self.alert, &mut self.scratch.raw);
         let t1 = Instant::now();
+        stage.after_free_velocity(self);
         build_contacts(self);
+        nlgs::make_order(&mut self.scratch.order, self.contacts.len(), &self.solver, self.step);
+        stage.prepare(self);
         let t2 = Instant::now();
-        let step = self.step;
-        nlgs::make_order(&mut self.scratch.order, self.contacts.len(), &self.solver, step);
-        rep.solve = nlgs::solve(
-            &mut self.contacts,
-            &mut self.bodies.vel,
-            &self.bodies.inv_mass,
-            &self.scratch.order,
-            &self.solver,
-        );
+        rep.solve = stage.solve(self);
         let t3 = Instant::now();
         update_positions(self)?;
         let t4 = Instant::now();

@@ -52,14 +52,13 @@ pub use schemes::Scheme;
 pub use subdomain::{Subdomain2, SubdomainSolver};
 pub use transport::{InProcess, Transport, TransportStats};
 
-use crate::engine::{build_contacts, free_velocity, update_positions, Diverged, StageTimes};
+use crate::engine::{ContactStage, Diverged, StageTimes};
 use crate::norms::{Norms, VANISHING};
 use crate::rigid2d::nlgs;
 use crate::solver::SolveReport;
 use crate::world::World2;
 use gluing::GluePartial;
 use schemes::{glue_stage, GlueBuffers};
-use std::time::Instant;
 
 /// NSCDD settings.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -222,6 +221,8 @@ pub struct Nscdd {
     pub steps: u64,
     /// The grid of the last repartition.
     pub grid: Option<Grid>,
+    /// The report of the step in progress.
+    pending: DdStepReport,
     /// Owner of each contact of the last step, by key (sorted).
     kept: Vec<(ContactKey, u32)>,
     /// Whether the last grid was made over no contact (then the next step
@@ -321,29 +322,12 @@ impl Nscdd {
 
     /// Advances `w` by one step, the contact problem solved by NSCDD.
     pub fn step(&mut self, w: &mut World2) -> Result<DdStepReport, Diverged> {
-        let mut rep = DdStepReport::default();
-        let t0 = Instant::now();
-        free_velocity(w);
-        w.scratch
-            .detector
-            .detect(&w.bodies, &w.shapes, &w.detectors, w.alert, &mut w.scratch.raw);
-        let t1 = Instant::now();
-        self.v_free.clone_from(&w.bodies.vel);
-        build_contacts(w);
-        nlgs::make_order(&mut w.scratch.order, w.contacts.len(), &w.solver, w.step);
-        self.partition(w, &mut rep);
-        let t2 = Instant::now();
-        self.solve(w, &mut rep);
-        let t3 = Instant::now();
-        update_positions(w)?;
-        let t4 = Instant::now();
-        rep.contacts = w.contacts.len();
-        rep.times = StageTimes {
-            detect: (t1 - t0).as_secs_f64(),
-            delassus: (t2 - t1).as_secs_f64(),
-            nlgs: (t3 - t2).as_secs_f64(),
-            update: (t4 - t3).as_secs_f64(),
-        };
+        self.pending = DdStepReport::default();
+        let base = w.step_with(self)?;
+        let mut rep = std::mem::take(&mut self.pending);
+        rep.solve = base.solve;
+        rep.contacts = base.contacts;
+        rep.times = base.times;
         Ok(rep)
     }
 
@@ -446,4 +430,24 @@ pub fn write_back(d: &Decomposition, w: &mut World2) {
 /// One NSCDD step of `w` with a solver state (F_Γ kept in `state` between steps).
 pub fn step(w: &mut World2, state: &mut Nscdd) -> Result<DdStepReport, Diverged> {
     state.step(w)
+}
+
+/// NSCDD as the contact-solve stage of [`World2::step_with`]: it keeps V_free, splits
+/// the contact set (timed with the Delassus stage), and runs the NSCDD iteration.
+impl ContactStage for Nscdd {
+    fn after_free_velocity(&mut self, w: &World2) {
+        self.v_free.clone_from(&w.bodies.vel);
+    }
+    fn prepare(&mut self, w: &mut World2) {
+        let mut rep = std::mem::take(&mut self.pending);
+        self.partition(w, &mut rep);
+        self.pending = rep;
+    }
+    fn solve(&mut self, w: &mut World2) -> SolveReport {
+        let mut rep = std::mem::take(&mut self.pending);
+        Nscdd::solve(self, w, &mut rep);
+        let s = rep.solve;
+        self.pending = rep;
+        s
+    }
 }

@@ -71,28 +71,4 @@ impl Bodies2 {
     pub fn movable(&self, b: usize) -> bool {
         self.inv_mass[b].iter().any(|&x| x != 0.0)
     }
-
-    /// Kinetic energy ½ Vᵀ M V, over the bodies with finite mass.
-    pub fn kinetic_energy(&self) -> f64 {
-        let mut e = 0.0;
-        for (v, m) in self.vel.iter().zip(&self.mass) {
-            for k in 0..3 {
-                if m[k].is_finite() {
-                    e += 0.5 * m[k] * v[k] * v[k];
-                }
-            }
-        }
-        e
-    }
-
-    /// Potential energy of gravity −Σ m g·x (bodies with finite mass).
-    pub fn potential_energy(&self, gravity: [f64; 2]) -> f64 {
-        let mut e = 0.0;
-        for (x, m) in self.pos.iter().zip(&self.mass) {
-            if m[0].is_finite() {
-                e -= m[0] * (gravity[0] * x[0] + gravity[1] * x[1]);
-            }
-        }
-        e
-    }
 }
