@@ -83,6 +83,18 @@ pub struct CooMatrix {
     pub vals: Vec<f64>,
 }
 
+impl CooMatrix {
+    /// An n × n matrix from (row, column, value) triplets.
+    pub fn from_triplets(n: usize, trip: &[(usize, usize, f64)]) -> Self {
+        CooMatrix {
+            n,
+            rows: trip.iter().map(|x| x.0).collect(),
+            cols: trip.iter().map(|x| x.1).collect(),
+            vals: trip.iter().map(|x| x.2).collect(),
+        }
+    }
+}
+
 /// One frictional contact problem `u = W r + q`, as in the JSON exchange format.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FcProblem {
@@ -587,12 +599,7 @@ pub fn problem_from_world(w: &World2) -> FcProblem {
     FcProblem {
         dim: 2,
         nc,
-        w: CooMatrix {
-            n: 2 * nc,
-            rows: trip.iter().map(|x| x.0).collect(),
-            cols: trip.iter().map(|x| x.1).collect(),
-            vals: trip.iter().map(|x| x.2).collect(),
-        },
+        w: CooMatrix::from_triplets(2 * nc, &trip),
         q,
         mu: c.target.iter().map(|t| t.mu).collect(),
         meta: Some(meta),
@@ -616,12 +623,7 @@ mod tests {
         FcProblem {
             dim: 2,
             nc,
-            w: CooMatrix {
-                n: 2 * nc,
-                rows: trip.iter().map(|x| x.0).collect(),
-                cols: trip.iter().map(|x| x.1).collect(),
-                vals: trip.iter().map(|x| x.2).collect(),
-            },
+            w: CooMatrix::from_triplets(2 * nc, trip),
             q: q.to_vec(),
             mu: mu.to_vec(),
             meta: None,
