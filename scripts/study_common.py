@@ -8,6 +8,7 @@ The geometry scales with N from examples/scenes/biaxial.toml (2000 disks, 0.4 m 
 import csv
 import math
 import os
+import resource
 import subprocess
 import time
 
@@ -17,13 +18,14 @@ PRESSURE = 1.0e4
 H_STEP = 5e-4
 
 
-def biaxial_scene(n, eps1_max, tol=1e-3, norm="Quad", max_sweeps=1000, decomposition=None):
-    """TOML text of the biaxial test of n disks loaded to eps1_max."""
+def biaxial_scene(n, eps1_max, tol=1e-3, norm="Quad", max_sweeps=1000, decomposition=None, compact_only=False):
+    """TOML text of the biaxial test of n disks loaded to eps1_max (compact_only: the
+    compaction phase alone, T_COMPACT seconds, whose final.json restarts the loading)."""
     scale = math.sqrt(n / 2000.0)
     width = 0.4 * scale
     height = 0.535 * scale  # deposit height for the same aspect ratio
     h0 = 0.52 * scale  # compacted height, for the lateral force
-    duration = T_COMPACT + eps1_max * h0 / V_TOP + 0.01
+    duration = T_COMPACT if compact_only else T_COMPACT + eps1_max * h0 / V_TOP + 0.01
     t = 0.02
     dec = ""
     if decomposition:
@@ -129,9 +131,11 @@ def _num(v):
         return v  # text columns (e.g. `prevailing`)
 
 
-def run(nscdd, scene_text, out_dir, extra_args=()):
+def run(nscdd, scene_text, out_dir, extra_args=(), cpu=False):
     """Runs a scene (or reuses the run already in out_dir for the same scene and
-    arguments); returns (wall seconds, rows of history.csv as dicts)."""
+    arguments); returns (seconds, rows of history.csv as dicts): wall-clock seconds,
+    or with cpu=True the CPU seconds of the run (user + system; for one-thread runs,
+    unaffected by other work on the machine)."""
     os.makedirs(out_dir, exist_ok=True)
     path = os.path.join(out_dir, "scene.toml")
     stamp = os.path.join(out_dir, "elapsed.txt")
@@ -141,12 +145,15 @@ def run(nscdd, scene_text, out_dir, extra_args=()):
         with open(path, "w") as f:
             f.write(scene_text)
         t0 = time.time()
+        r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
         subprocess.run([nscdd, "run", path, "--out", out_dir, "--quiet", *extra_args], check=True)
+        r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
         with open(stamp, "w") as f:
-            f.write(f"{time.time() - t0}\n")
+            f.write(f"{time.time() - t0}\n{(r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)}\n")
         with open(path + ".key", "w") as f:
             f.write(key)
-    elapsed = float(open(stamp).read())
+    times = open(stamp).read().split()
+    elapsed = float(times[1] if cpu and len(times) > 1 else times[0])
     with open(os.path.join(out_dir, "history.csv")) as f:
         rows = [{k: _num(v) for k, v in r.items()} for r in csv.DictReader(f)]
     return elapsed, rows

@@ -38,6 +38,10 @@ enum Cmd {
         /// Threads sweeping the subdomains (needs a decomposition).
         #[arg(long, value_name = "N", allow_hyphen_values = true)]
         threads: Option<String>,
+        /// Continue from a saved state (a run's final.json or checkpoint.json) of the
+        /// same scene, to the scene's end time.
+        #[arg(long, value_name = "STATE")]
+        restart: Option<PathBuf>,
     },
     /// Validate a scene without running it.
     Check { scene: PathBuf },
@@ -171,9 +175,24 @@ fn main() -> ExitCode {
             subdomains,
             scheme,
             threads,
+            restart,
         } => {
             let loaded = nscdd::scene::load(&scene, &reg).map_err(|e| e.to_string()).and_then(|mut s| {
                 apply_decomposition(&mut s, subdomains.as_deref(), scheme.as_deref(), threads.as_deref())?;
+                if let Some(state) = &restart {
+                    let dir_of = |p: &std::path::Path| std::fs::canonicalize(p).ok();
+                    let parent = state
+                        .parent()
+                        .map(|p| if p.as_os_str().is_empty() { std::path::Path::new(".") } else { p });
+                    if dir_of(&out).is_some() && dir_of(&out) == parent.and_then(dir_of) {
+                        return Err(format!(
+                            "--out: {} holds the restart file {}; write the continued run elsewhere (its history.csv would be overwritten)",
+                            out.display(),
+                            state.display()
+                        ));
+                    }
+                    nscdd::scene::restart(&mut s.world, state).map_err(|e| e.to_string())?;
+                }
                 Ok(s)
             });
             let mut s = match loaded {
@@ -188,6 +207,7 @@ fn main() -> ExitCode {
             };
             let steps = s.world.time.steps;
             let bar = if quiet { ProgressBar::hidden() } else { ProgressBar::new(steps) };
+            bar.set_position(s.world.step);
             bar.set_style(
                 ProgressStyle::with_template("{bar:30} step {pos}/{len} | {msg} | {elapsed_precise} elapsed, {eta_precise} left")
                     .expect("valid template"),

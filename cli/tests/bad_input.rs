@@ -573,3 +573,49 @@ fn subdomains_flag_runs_nscdd() {
     assert_eq!(hist.lines().count(), 11);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn missing_restart_file() {
+    check_bad_flags(
+        "flag_restart_missing",
+        BASE,
+        &["--restart", "/nonexistent/final.json"],
+        "/nonexistent/final.json",
+    );
+}
+
+#[test]
+fn restart_continues_and_never_overwrites_its_own_run() {
+    let dir = scratch("restart");
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, BASE).expect("write scene");
+    let first = dir.join("first");
+    let run = |out: &PathBuf, extra: &[&std::ffi::OsStr]| {
+        let mut a: Vec<&std::ffi::OsStr> = vec![
+            "run".as_ref(),
+            path.as_os_str(),
+            "--out".as_ref(),
+            out.as_os_str(),
+            "--quiet".as_ref(),
+        ];
+        a.extend_from_slice(extra);
+        nscdd(&a)
+    };
+    // a first run of 10 steps; the scene then asks for 20
+    assert_eq!(run(&first, &[]).status.code(), Some(0));
+    std::fs::write(&path, edit(BASE, "steps = 10", "steps = 20")).expect("write scene");
+    let state = first.join("final.json");
+    let before = std::fs::read_to_string(first.join("history.csv")).unwrap();
+    let o = run(&first, &["--restart".as_ref(), state.as_os_str()]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.starts_with("error: --out:") && err.contains("restart file"), "{err}");
+    assert_eq!(std::fs::read_to_string(first.join("history.csv")).unwrap(), before, "nothing lost");
+    let second = dir.join("second");
+    let o = run(&second, &["--restart".as_ref(), state.as_os_str()]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let hist = std::fs::read_to_string(second.join("history.csv")).unwrap();
+    assert_eq!(hist.lines().count(), 11, "steps 11 to 20");
+    assert!(hist.lines().nth(1).unwrap().starts_with("11,"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -58,6 +58,16 @@ fn io(dir: &Path, what: &str) -> impl Fn(std::io::Error) -> RunError {
     move |e| RunError::Io(format!("cannot write {what} in {d}: {e}"))
 }
 
+/// Writes the state (a restart file) as `name` in `dir`, through a temporary file
+/// renamed into place, so that a run killed while writing keeps the previous one.
+fn save_state(dir: &Path, name: &str, w: &World2) -> Result<(), RunError> {
+    let tmp = dir.join(format!(".{name}.tmp"));
+    let mut f = std::fs::File::create(&tmp).map_err(io(dir, name))?;
+    f.write_all(final_json(w).as_bytes()).map_err(io(dir, name))?;
+    drop(f);
+    std::fs::rename(&tmp, dir.join(name)).map_err(io(dir, name))
+}
+
 /// Runs `scene` for its number of steps, writing `history.csv`, the writers' frames
 /// every `output.every` steps (and at the first and last step) and `final.json` in
 /// `dir`. `on_step` is called after every step (progress display). With
@@ -98,7 +108,8 @@ pub fn run(
     frame += 1;
     let mut sum = RunSummary::default();
     let steps = w.time.steps;
-    for s in 1..=steps {
+    // a restarted world continues from its saved step
+    for s in (w.step + 1)..=steps {
         let stepped = match &mut dd {
             Some(n) => n.step(w).map(|r| {
                 let plain = StepReport {
@@ -125,6 +136,10 @@ pub fn run(
         }
         let t_out = t0.elapsed().as_secs_f64();
         hist.row_dd(w, &rep, dd_rep.as_ref(), t_out).map_err(io(dir, "history.csv"))?;
+        if scene.output.checkpoint_every > 0 && s % scene.output.checkpoint_every == 0 && s != steps {
+            hist.flush().map_err(io(dir, "history.csv"))?;
+            save_state(dir, "checkpoint.json", w)?;
+        }
         if let Some(r) = &dd_rep {
             sum.migrations += r.migrations as u64;
         }
@@ -146,8 +161,7 @@ pub fn run(
     for wr in writers.iter_mut() {
         wr.finish(dir).map_err(io(dir, "the output series"))?;
     }
-    let mut f = std::fs::File::create(dir.join("final.json")).map_err(io(dir, "final.json"))?;
-    f.write_all(final_json(w).as_bytes()).map_err(io(dir, "final.json"))?;
+    save_state(dir, "final.json", w)?;
     sum.wall_seconds = start.elapsed().as_secs_f64();
     Ok(sum)
 }

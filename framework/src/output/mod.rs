@@ -24,6 +24,7 @@ struct BodyOut<'a> {
 #[derive(Serialize)]
 struct ContactOut {
     bodies: [u32; 2],
+    feature: u32,
     point: [f64; 2],
     normal: [f64; 2],
     r_n: f64,
@@ -35,13 +36,17 @@ struct ContactOut {
 struct FinalOut<'a> {
     step: u64,
     time: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    box_h0: Option<f64>,
     bodies: Vec<BodyOut<'a>>,
     contacts: Vec<ContactOut>,
 }
 
-/// The state as `final.json`: bodies (id, name, kind, material, position, rotation,
-/// velocity, fixed, shape) and contacts (bodies [candidate, antagonist], point,
-/// normal from antagonist to candidate, impulses r_n, r_t in N·s, gap in m).
+/// The state as `final.json`: step, time, `box_h0` (the box height ε1 is measured
+/// from, once set), bodies (id, name, kind, material, position, rotation, velocity,
+/// fixed, shape) and contacts (bodies [candidate, antagonist], feature, point, normal
+/// from antagonist to candidate, impulses r_n, r_t in N·s, gap in m). It is also a
+/// restart file ([`crate::scene::restart`]).
 pub fn final_json(w: &World2) -> String {
     let b = &w.bodies;
     let bodies = (0..b.len())
@@ -64,6 +69,7 @@ pub fn final_json(w: &World2) -> String {
     let contacts = (0..c.len())
         .map(|a| ContactOut {
             bodies: c.bodies[a],
+            feature: c.key[a].feature,
             point: c.point[a],
             normal: c.frame[a].n,
             r_n: c.r[a][0],
@@ -74,6 +80,7 @@ pub fn final_json(w: &World2) -> String {
     let mut s = serde_json::to_string_pretty(&FinalOut {
         step: w.step,
         time: w.t,
+        box_h0: w.box_h0,
         bodies,
         contacts,
     })

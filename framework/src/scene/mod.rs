@@ -9,6 +9,7 @@
 
 pub mod builder;
 pub mod locate;
+pub mod restart;
 pub mod schema;
 
 use crate::detect::{Detector, DetectorTable};
@@ -17,6 +18,7 @@ use crate::registry::{ParamError, Registry};
 use crate::world::{BodyDrive2, BoxWalls, Material, TimeSettings, World2};
 use builder::{Origin, SceneBuilder2};
 use locate::{locate, path_string, Seg};
+pub use restart::restart;
 use schema::SceneFile;
 
 /// Output settings of a scene.
@@ -25,6 +27,8 @@ pub struct OutputSettings {
     pub every: u64,
     pub vtk: bool,
     pub writers: Vec<String>,
+    /// Steps between saved states (`checkpoint.json`); 0: none.
+    pub checkpoint_every: u64,
 }
 
 /// A loaded scene: the world and how to write it.
@@ -281,6 +285,7 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
             every: sf.output.every,
             vtk: sf.output.vtk,
             writers: sf.output.writers,
+            checkpoint_every: sf.output.checkpoint_every,
         },
         decomposition,
     })

@@ -169,6 +169,10 @@ pub struct OutputSpec {
     /// Extra writers registered by plugins.
     #[serde(default)]
     pub writers: Vec<String>,
+    /// Save the state to `checkpoint.json` every this many steps (0: never; the
+    /// final state is always in `final.json`). Both are restart files.
+    #[serde(default)]
+    pub checkpoint_every: u64,
     /// The walls of a box sample, by body name.
     #[serde(rename = "box")]
     pub box_walls: Option<BoxSpec>,
@@ -180,6 +184,7 @@ impl Default for OutputSpec {
             every: 0,
             vtk: true,
             writers: vec![],
+            checkpoint_every: 0,
             box_walls: None,
         }
     }

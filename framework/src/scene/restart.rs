@@ -1,0 +1,170 @@
+//! Restart from a saved state: a run's `final.json` (or a `checkpoint_NNNNNN.json`
+//! written every `output.checkpoint_every` steps) holds the step, the time, every
+//! body's position, rotation and velocity, the contacts' keys and impulses (the warm
+//! start of the next step) and the box height ε1 is measured from. [`restart`] puts
+//! that state into a world loaded from the same scene, so that the run continues to
+//! the scene's end time. Continuing is bitwise the uninterrupted one-domain run (the
+//! saved numbers round-trip exactly through JSON); a decomposed run starts its gluing
+//! multipliers F_Γ from zero and repartitions at the first step.
+//!
+//! The scene may change anything that is not state: solver settings, the
+//! decomposition, outputs, the end time, drives. It may not change the bodies (their
+//! number and kinds are checked) nor the step h (the saved time must be step × h).
+
+use crate::error::InputError;
+use crate::rigid2d::contacts::{ContactKey, Frame2};
+use crate::rigid2d::Contacts2;
+use crate::world::World2;
+use serde::Deserialize;
+use std::path::Path;
+
+#[derive(Deserialize)]
+struct SavedBody {
+    id: u32,
+    kind: String,
+    position: [f64; 2],
+    rotation: f64,
+    velocity: [f64; 3],
+}
+
+#[derive(Deserialize)]
+struct SavedContact {
+    bodies: [u32; 2],
+    #[serde(default)]
+    feature: Option<u32>,
+    point: [f64; 2],
+    normal: [f64; 2],
+    r_n: f64,
+    r_t: f64,
+    gap: f64,
+}
+
+#[derive(Deserialize)]
+struct Saved {
+    step: u64,
+    time: f64,
+    #[serde(default)]
+    box_h0: Option<f64>,
+    bodies: Vec<SavedBody>,
+    contacts: Vec<SavedContact>,
+}
+
+/// Loads the saved state in `path` into `w` (a world loaded from the scene that
+/// wrote it). Errors name the file, the line and the key.
+pub fn restart(w: &mut World2, path: &Path) -> Result<(), InputError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| InputError {
+        file: file.clone(),
+        line: None,
+        key: String::new(),
+        message: format!("cannot read the restart file: {e}"),
+    })?;
+    restart_str(w, &text, &file)
+}
+
+/// [`restart`] from the text of a saved state; `file` names it in messages.
+pub fn restart_str(w: &mut World2, text: &str, file: &str) -> Result<(), InputError> {
+    let err = |line: Option<usize>, key: String, message: String| InputError {
+        file: file.to_string(),
+        line,
+        key,
+        message,
+    };
+    let saved: Saved =
+        serde_json::from_str(text).map_err(|e| err(Some(e.line()), String::new(), format!("not a saved state (final.json): {e}")))?;
+    // the line of the k-th occurrence of `"key":` (the file is written one field per line)
+    let line_of = |key: &str, k: usize| -> Option<usize> {
+        let pat = format!("\"{key}\":");
+        text.match_indices(&pat).nth(k).map(|(o, _)| crate::error::line_of(text, o))
+    };
+    let nb = w.bodies.len();
+    if saved.bodies.len() != nb {
+        return Err(err(
+            line_of("bodies", 0),
+            "bodies".into(),
+            format!(
+                "the saved state has {} bodies, the scene {nb}: a restart needs the scene that wrote it",
+                saved.bodies.len()
+            ),
+        ));
+    }
+    for (k, sb) in saved.bodies.iter().enumerate() {
+        if sb.id as usize != k {
+            return Err(err(
+                line_of("id", k),
+                format!("bodies[{k}].id"),
+                format!("expected id {k}, found {}", sb.id),
+            ));
+        }
+        if sb.kind != w.kind_name(k) {
+            return Err(err(
+                line_of("kind", k),
+                format!("bodies[{k}].kind"),
+                format!("the saved body is a `{}`, the scene's body {k} a `{}`", sb.kind, w.kind_name(k)),
+            ));
+        }
+        let finite = sb.position.iter().chain(&sb.velocity).all(|x| x.is_finite()) && sb.rotation.is_finite();
+        if !finite {
+            return Err(err(line_of("position", k), format!("bodies[{k}]"), "non-finite state".into()));
+        }
+    }
+    let expected = saved.step as f64 * w.time.h;
+    if !(saved.time.is_finite() && (saved.time - expected).abs() <= 1e-9 * expected.abs().max(w.time.h)) {
+        return Err(err(
+            line_of("time", 0),
+            "time".into(),
+            format!(
+                "the saved time {} s is not step {} × h = {expected} s: a restart keeps the scene's step h",
+                saved.time, saved.step
+            ),
+        ));
+    }
+    if saved.step >= w.time.steps {
+        return Err(err(
+            line_of("step", 0),
+            "step".into(),
+            format!(
+                "the saved state is at step {}, the scene ends at step {}: nothing left to run (raise time.steps or time.duration)",
+                saved.step, w.time.steps
+            ),
+        ));
+    }
+    let mut c = Contacts2::default();
+    for (a, sc) in saved.contacts.iter().enumerate() {
+        let [i, j] = sc.bodies;
+        if i as usize >= nb || j as usize >= nb {
+            return Err(err(
+                line_of("bodies", a + 1),
+                format!("contacts[{a}].bodies"),
+                format!("body ids must be below {nb}"),
+            ));
+        }
+        c.bodies.push([i, j]);
+        c.frame.push(Frame2 {
+            n: sc.normal,
+            ..Default::default()
+        });
+        c.block.push(Default::default());
+        c.target.push(Default::default());
+        c.r.push([sc.r_n, sc.r_t]);
+        c.u_free.push([0.0; 2]);
+        c.gap.push(sc.gap);
+        c.point.push(sc.point);
+        c.key.push(ContactKey {
+            i,
+            j,
+            feature: sc.feature.unwrap_or(0),
+        });
+    }
+    let b = &mut w.bodies;
+    for (k, sb) in saved.bodies.iter().enumerate() {
+        b.pos[k] = sb.position;
+        b.rot[k] = sb.rotation;
+        b.vel[k] = sb.velocity;
+    }
+    w.contacts = c;
+    w.step = saved.step;
+    w.t = expected;
+    w.box_h0 = saved.box_h0;
+    Ok(())
+}
