@@ -18,7 +18,7 @@ PRESSURE = 1.0e4
 H_STEP = 5e-4
 
 
-def biaxial_scene(n, eps1_max, tol=1e-3, norm="Quad", max_sweeps=1000, decomposition=None, compact_only=False):
+def biaxial_scene(n, eps1_max, tol=1e-3, norm="Quad", max_sweeps=1000, decomposition=None, compact_only=False, ordering="stored"):
     """TOML text of the biaxial test of n disks loaded to eps1_max (compact_only: the
     compaction phase alone, T_COMPACT seconds, whose final.json restarts the loading)."""
     scale = math.sqrt(n / 2000.0)
@@ -41,6 +41,7 @@ tolerance = {tol}
 norm = "{norm}"
 max_sweeps = {max_sweeps}
 check_every = 10
+ordering = "{ordering}"
 [detection]
 alert = 5e-4
 [output]

@@ -32,6 +32,7 @@ pub mod output;
 pub mod params;
 pub mod registry;
 pub mod rigid2d;
+pub mod rigid3d;
 pub mod run;
 pub mod scene;
 pub mod solver;
