@@ -55,6 +55,102 @@ pub fn mul(w: &Sym3, v: [f64; 3]) -> [f64; 3] {
     ]
 }
 
+/// A 3 × 3 block as the slip and fallback cases use it: symmetric ([`Sym3`]) or
+/// full ([`Full3`], for problems whose diagonal blocks are not symmetric, as some
+/// FCLIB files).
+pub trait Block3 {
+    fn mul(&self, v: [f64; 3]) -> [f64; 3];
+    /// The normal row (W_nn, W_nt1, W_nt2).
+    fn row0(&self) -> [f64; 3];
+    /// |W_nn| + |W_t1t1| + |W_t2t2|, a scale for acceptance tests.
+    fn trace_abs(&self) -> f64;
+    /// A bound of the largest eigenvalue (Gershgorin).
+    fn lmax(&self) -> f64;
+}
+
+impl Block3 for Sym3 {
+    #[inline(always)]
+    fn mul(&self, v: [f64; 3]) -> [f64; 3] {
+        mul(self, v)
+    }
+    #[inline(always)]
+    fn row0(&self) -> [f64; 3] {
+        [self[0], self[1], self[2]]
+    }
+    fn trace_abs(&self) -> f64 {
+        self[0].abs() + self[3].abs() + self[5].abs()
+    }
+    fn lmax(&self) -> f64 {
+        let w = self;
+        (w[0].abs() + w[1].abs() + w[2].abs())
+            .max(w[1].abs() + w[3].abs() + w[4].abs())
+            .max(w[2].abs() + w[4].abs() + w[5].abs())
+    }
+}
+
+/// A full 3 × 3 block, row-major.
+pub type Full3 = [[f64; 3]; 3];
+
+impl Block3 for Full3 {
+    #[inline(always)]
+    fn mul(&self, v: [f64; 3]) -> [f64; 3] {
+        let m = self;
+        [
+            m[0][0] * v[0] + m[0][1] * v[1] + m[0][2] * v[2],
+            m[1][0] * v[0] + m[1][1] * v[1] + m[1][2] * v[2],
+            m[2][0] * v[0] + m[2][1] * v[1] + m[2][2] * v[2],
+        ]
+    }
+    fn row0(&self) -> [f64; 3] {
+        self[0]
+    }
+    fn trace_abs(&self) -> f64 {
+        self[0][0].abs() + self[1][1].abs() + self[2][2].abs()
+    }
+    fn lmax(&self) -> f64 {
+        self.iter().map(|r| r.iter().map(|x| x.abs()).sum::<f64>()).fold(0.0, f64::max)
+    }
+}
+
+/// Solves the one-contact problem for a full, possibly non-symmetric block: the
+/// cases of the module docs without the symmetric shortcuts (no contact, stick by
+/// the inverse, slip angle, projected fallback).
+pub fn solve_full(w: &Full3, u0: [f64; 3], u_target: f64, mu: f64) -> [f64; 3] {
+    let s0 = u0[0] - u_target;
+    if s0 >= 0.0 {
+        return [0.0; 3];
+    }
+    if mu == 0.0 && w[0][0] > 0.0 {
+        // the normal impulse alone, r_t = 0
+        return [-s0 / w[0][0], 0.0, 0.0];
+    }
+    let m = w;
+    let c = [
+        [m[1][1] * m[2][2] - m[1][2] * m[2][1], m[0][2] * m[2][1] - m[0][1] * m[2][2], m[0][1] * m[1][2] - m[0][2] * m[1][1]],
+        [m[1][2] * m[2][0] - m[1][0] * m[2][2], m[0][0] * m[2][2] - m[0][2] * m[2][0], m[0][2] * m[1][0] - m[0][0] * m[1][2]],
+        [m[1][0] * m[2][1] - m[1][1] * m[2][0], m[0][1] * m[2][0] - m[0][0] * m[2][1], m[0][0] * m[1][1] - m[0][1] * m[1][0]],
+    ];
+    let det = m[0][0] * c[0][0] + m[0][1] * c[1][0] + m[0][2] * c[2][0];
+    let scale = w.lmax();
+    let b = [-s0, -u0[1], -u0[2]];
+    let mut guess = (-u0[2]).atan2(-u0[1]);
+    if det.abs() > ACCEPT * scale * scale * scale {
+        let r = c.mul(b).map(|x| x / det);
+        if r[0] >= 0.0 && (r[1] * r[1] + r[2] * r[2]).sqrt() <= mu * r[0] * (1.0 + ACCEPT) {
+            return r;
+        }
+        guess = r[2].atan2(r[1]);
+    }
+    let u0t = [u0[1], u0[2]];
+    if let Some(r) = slide_secant(w, s0, u0t, mu, guess) {
+        return r;
+    }
+    if let Some(r) = slide_general(w, s0, u0t, mu) {
+        return r;
+    }
+    fallback(w, u0, u_target, mu)
+}
+
 /// Inverse of a symmetric block, or `None` when it is singular (relative to its
 /// largest entry).
 pub fn inverse(w: &Sym3) -> Option<Sym3> {
@@ -158,7 +254,17 @@ pub fn solve_pre(w: &Sym3, pre: &Pre3, u0: [f64; 3], u_target: f64, mu: f64) -> 
             return [rn, rt[0], rt[1]];
         }
     }
-    // 4. slide, general block
+    // 4. slide, general block: a few secant steps on the slip angle from the
+    // direction of the sticking impulse, then the bracketing scan
+    let guess = if pre.singular == 0 {
+        let r = mul(&pre.inv, [-s0, -u0[1], -u0[2]]);
+        r[2].atan2(r[1])
+    } else {
+        (-u0[2]).atan2(-u0[1])
+    };
+    if let Some(r) = slide_secant(w, s0, [u0[1], u0[2]], mu, guess) {
+        return r;
+    }
     if let Some(r) = slide_general(w, s0, [u0[1], u0[2]], mu) {
         return r;
     }
@@ -215,11 +321,52 @@ fn disk_min(a: f64, c: f64, d: f64, b: [f64; 2], rad: f64) -> Option<[f64; 2]> {
     Some([x[0] * rad / n, x[1] * rad / n])
 }
 
+/// r(φ), g(φ) = u_t · d⊥ and h(φ) = u_t · d of case 4 (`None` where the pivot
+/// W_nn + μ W_nt·d(φ) is not positive).
+#[inline(always)]
+fn slip_eval<B: Block3>(w: &B, s0: f64, u0t: [f64; 2], mu: f64, phi: f64) -> Option<([f64; 3], f64, f64)> {
+    let (s, c) = phi.sin_cos();
+    let w0 = w.row0();
+    let d = w0[0] + mu * (w0[1] * c + w0[2] * s);
+    if !(d > 0.0) {
+        return None;
+    }
+    let rn = -s0 / d;
+    let r = [rn, mu * rn * c, mu * rn * s];
+    let u = w.mul(r);
+    let (ut1, ut2) = (u[1] + u0t[0], u[2] + u0t[1]);
+    Some((r, -ut1 * s + ut2 * c, ut1 * c + ut2 * s))
+}
+
+/// Case 4 by secant steps on g(φ) from `phi0`; `None` unless it lands on a valid
+/// root (g = 0 to round-off, h ≤ 0).
+fn slide_secant<B: Block3>(w: &B, s0: f64, u0t: [f64; 2], mu: f64, phi0: f64) -> Option<[f64; 3]> {
+    let (mut a, mut b) = (phi0, phi0 + 1e-3);
+    let mut ga = slip_eval(w, s0, u0t, mu, a)?.1;
+    for _ in 0..30 {
+        let (r, gb, h) = slip_eval(w, s0, u0t, mu, b)?;
+        let scale = w.trace_abs() * r[0] + u0t[0].abs() + u0t[1].abs();
+        if gb.abs() <= 1e-14 * scale || (b - a).abs() <= 1e-15 {
+            return if h <= ACCEPT * scale && gb.abs() <= 1e-10 * scale { Some(r) } else { None };
+        }
+        if gb == ga {
+            return None;
+        }
+        let next = b - gb * (b - a) / (gb - ga);
+        if !next.is_finite() || (next - b).abs() > 1.0 {
+            return None;
+        }
+        (a, ga, b) = (b, gb, next);
+    }
+    None
+}
+
 /// Case 4 of the module docs: a sliding solution of a coupled block.
-fn slide_general(w: &Sym3, s0: f64, u0t: [f64; 2], mu: f64) -> Option<[f64; 3]> {
+fn slide_general<B: Block3>(w: &B, s0: f64, u0t: [f64; 2], mu: f64) -> Option<[f64; 3]> {
+    let w0 = w.row0();
     let den = |phi: f64| {
         let (s, c) = phi.sin_cos();
-        w[0] + mu * (w[1] * c + w[2] * s)
+        w0[0] + mu * (w0[1] * c + w0[2] * s)
     };
     // r(φ), g(φ) = u_t · d⊥ and h(φ) = u_t · d, where W_nn + μ W_nt·d > 0
     let eval = |phi: f64| -> Option<([f64; 3], f64, f64)> {
@@ -230,7 +377,7 @@ fn slide_general(w: &Sym3, s0: f64, u0t: [f64; 2], mu: f64) -> Option<[f64; 3]> 
         }
         let rn = -s0 / d;
         let r = [rn, mu * rn * c, mu * rn * s];
-        let u = mul(w, r);
+        let u = w.mul(r);
         let (ut1, ut2) = (u[1] + u0t[0], u[2] + u0t[1]);
         Some((r, -ut1 * s + ut2 * c, ut1 * c + ut2 * s))
     };
@@ -291,7 +438,7 @@ fn slide_general(w: &Sym3, s0: f64, u0t: [f64; 2], mu: f64) -> Option<[f64; 3]> 
         }
         if let Some((r, _, h)) = eval(lo) {
             // u_t opposite to the slip direction of r_t
-            let scale = (w[0].abs() + w[3].abs() + w[5].abs()) * r[0] + u0t[0].abs() + u0t[1].abs();
+            let scale = w.trace_abs() * r[0] + u0t[0].abs() + u0t[1].abs();
             if h <= ACCEPT * scale && best.is_none_or(|(_, hb)| h < hb) {
                 best = Some((r, h));
             }
@@ -301,18 +448,16 @@ fn slide_general(w: &Sym3, s0: f64, u0t: [f64; 2], mu: f64) -> Option<[f64; 3]> 
 }
 
 /// Projected fixed point on the local problem, for degenerate blocks.
-fn fallback(w: &Sym3, u0: [f64; 3], u_target: f64, mu: f64) -> [f64; 3] {
+fn fallback<B: Block3>(w: &B, u0: [f64; 3], u_target: f64, mu: f64) -> [f64; 3] {
     // ρ = 1 / (Gershgorin bound of λ_max)
-    let lmax = (w[0].abs() + w[1].abs() + w[2].abs())
-        .max(w[1].abs() + w[3].abs() + w[4].abs())
-        .max(w[2].abs() + w[4].abs() + w[5].abs());
+    let lmax = w.lmax();
     if !(lmax > 0.0) {
         return [0.0; 3];
     }
     let rho = 1.0 / lmax;
     let mut r = [0.0; 3];
     for _ in 0..2000 {
-        let wr = mul(w, r);
+        let wr = w.mul(r);
         let u = [wr[0] + u0[0] - u_target, wr[1] + u0[1], wr[2] + u0[2]];
         let ut = (u[1] * u[1] + u[2] * u[2]).sqrt();
         let z = [r[0] - rho * (u[0] + mu * ut), r[1] - rho * u[1], r[2] - rho * u[2]];
@@ -388,5 +533,42 @@ mod tests {
         // isotropic: projection of −b/a on the circle
         let x = disk_min(2.0, 0.0, 2.0, [4.0, 0.0], 1.0).unwrap();
         assert!((x[0] + 1.0).abs() < 1e-15 && x[1].abs() < 1e-15);
+    }
+}
+
+#[cfg(test)]
+mod full_tests {
+    use super::*;
+    use crate::norms::natural_map_sq;
+
+    /// Non-symmetric blocks (SPD plus a 1 % skew part), μ from 0 to 10.
+    #[test]
+    fn non_symmetric_blocks() {
+        let mut seed = 777u64;
+        let mut rnd = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        };
+        for k in 0..5000 {
+            let a: Vec<f64> = (0..9).map(|_| rnd()).collect();
+            let mut w = [[0.0; 3]; 3];
+            for i in 0..3 {
+                for j in 0..3 {
+                    w[i][j] = (0..3).map(|l| a[3 * l + i] * a[3 * l + j]).sum::<f64>() + if i == j { 0.1 } else { 0.0 };
+                }
+            }
+            for (i, j) in [(0, 1), (0, 2), (1, 2)] {
+                let s = 0.01 * rnd();
+                w[i][j] += s;
+                w[j][i] -= s;
+            }
+            let u0 = [rnd(), rnd(), rnd()];
+            let mu = [0.0, 0.2, 0.5, 1.0, 10.0][k % 5];
+            let r = solve_full(&w, u0, 0.0, mu);
+            let wr = w.mul(r);
+            let u = [wr[0] + u0[0], wr[1] + u0[1], wr[2] + u0[2]];
+            let e = natural_map_sq(&r, &u, mu).sqrt() / u0.iter().map(|x| x * x).sum::<f64>().sqrt();
+            assert!(e < 1e-8, "block {w:?}, u0 {u0:?}, μ {mu}: r {r:?}, residual {e}");
+        }
     }
 }

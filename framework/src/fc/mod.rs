@@ -2,24 +2,26 @@
 //! format (keys `dim`, `nc`, `W` = {`n`, `rows`, `cols`, `vals`}, `q`, `mu`, optional
 //! `meta`; `.gz` files are gzip) and solved by NLGS: the `solve-fc` command.
 //!
-//! A problem with `nc` contacts in dimension `dim` (2 here; 3D arrives with the
-//! spheres plugin) is: find `r, u ∈ ℝ^{dim·nc}` with
+//! A problem with `nc` contacts in dimension `dim` (2 or 3) is: find
+//! `r, u ∈ ℝ^{dim·nc}` with
 //!
 //! ```text
 //! u = W r + q,     for each contact α:  (u_α, r_α) satisfies Signorini–Coulomb with μ_α
 //!   u_n ≥ 0,  r_n ≥ 0,  u_n r_n = 0,   |r_t| ≤ μ r_n,
-//!   |r_t| < μ r_n ⇒ u_t = 0,           u_t ≠ 0 ⇒ r_t = −μ r_n sign(u_t)
+//!   |r_t| < μ r_n ⇒ u_t = 0,           u_t ≠ 0 ⇒ r_t = −μ r_n u_t/|u_t|
 //! ```
 //!
 //! `W` (symmetric, given as coordinate triplets, duplicates summed) is stored per
-//! contact as its diagonal block `W_αα = [W_nn, W_nt, W_tt]` (the symmetric average
-//! ½(W_nt + W_tn) is used) and the off-diagonal 2 × 2 blocks `W_αβ` in compressed
-//! rows. One NLGS sweep visits the contacts in storage order and, for α, forms
+//! contact as its diagonal block `W_αα` (symmetrised) and the off-diagonal dim × dim
+//! blocks `W_αβ` in compressed rows ([`nlgs`]). One NLGS sweep visits the contacts in
+//! storage order and, for α, forms
 //!
 //! ```text
 //! u0_α = q_α + Σ_{β≠α} W_αβ r_β   (= u_α − W_αα r_α),
-//! r_α  ← the exact one-contact solution for (W_αα, u0_α, μ_α)   (rigid2d::coulomb)
+//! r_α  ← the one-contact solution for (W_αα, u0_α, μ_α)   (rigid2d::coulomb, rigid3d::coulomb)
 //! ```
+//!
+//! FCLIB's HDF5 files are read by [`fclib`] (cargo feature `hdf5`).
 //!
 //! Stopping tests: [`FcNorm::Natural`], the natural-map residual
 //! `‖F(r)‖ / ‖q‖ < tol` with `F(r) = r − P_K(r − (u + Φ(u)))`, `Φ(u)_α = (μ_α |u_t,α|, 0)`
@@ -34,14 +36,18 @@
 //! and `q_α = (u_free,n − ū, u_free,t)`, ū being the law's target normal velocity.
 
 use crate::error::InputError;
-use crate::norms::{natural_map_sq, Criterion, Norms, Sums};
-use crate::rigid2d::coulomb;
-use crate::world::World2;
+pub mod nlgs;
+mod world;
+
+#[cfg(feature = "hdf5")]
+pub mod fclib;
+
+use crate::norms::{natural_map_sq, Criterion};
+pub use world::problem_from_world;
 use serde::Serialize;
 use serde_json::{Map, Value};
 use std::io::Read;
 use std::path::Path;
-use std::time::Instant;
 
 /// Stopping test of `solve-fc`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -118,7 +124,6 @@ fn bad(key: impl Into<String>, msg: impl Into<String>) -> Bad {
 
 const TOP_KEYS: [&str; 6] = ["dim", "nc", "W", "q", "mu", "meta"];
 const W_KEYS: [&str; 4] = ["n", "rows", "cols", "vals"];
-const DIM3: &str = "3D problems arrive with the spheres plugin; this build solves 2D problems (dim = 2) only";
 
 fn type_name(v: &Value) -> &'static str {
     match v {
@@ -224,8 +229,7 @@ impl FcProblem {
         }
         let dim = uint(&take(&mut top, "dim", "dim")?, "dim")?;
         match dim {
-            2 => {}
-            3 => return Err(bad("dim", DIM3)),
+            2 | 3 => {}
             d => return Err(bad("dim", format!("{d} must be 2 or 3"))),
         }
         let nc = uint(&take(&mut top, "nc", "nc")?, "nc")?;
@@ -263,8 +267,7 @@ impl FcProblem {
     /// contact. Errors are (key, message).
     pub fn validate(&self) -> Result<(), (String, String)> {
         match self.dim {
-            2 => {}
-            3 => return Err(bad("dim", DIM3)),
+            2 | 3 => {}
             d => return Err(bad("dim", format!("{d} must be 2 or 3"))),
         }
         let n = self
@@ -366,11 +369,14 @@ impl FcProblem {
         if let Err((k, m)) = self.validate() {
             panic!("FcProblem::solve on an invalid problem: `{k}`: {m}");
         }
-        solve2(self, opts)
+        match self.dim {
+            2 => nlgs::solve::<2>(self, opts),
+            _ => nlgs::solve::<3>(self, opts),
+        }
     }
 }
 
-fn q_scale(q: &[f64]) -> f64 {
+pub(crate) fn q_scale(q: &[f64]) -> f64 {
     let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
     if n == 0.0 {
         1.0
@@ -379,231 +385,28 @@ fn q_scale(q: &[f64]) -> f64 {
     }
 }
 
-/// W of a 2D problem in block form: diagonal blocks and a CSR of off-diagonal ones.
-struct Blocks2 {
-    /// W_αα = [W_nn, ½(W_nt + W_tn), W_tt].
-    diag: Vec<[f64; 3]>,
-    /// Off-diagonal blocks of row α: `ptr[α]..ptr[α + 1]`.
-    ptr: Vec<usize>,
-    col: Vec<u32>,
-    /// Row-major [nn, nt, tn, tt].
-    blk: Vec<[f64; 4]>,
-}
-
-impl Blocks2 {
-    fn assemble(p: &FcProblem) -> Blocks2 {
-        let nc = p.nc;
-        let w = &p.w;
-        let mut dfull = vec![[0.0; 4]; nc];
-        let mut off: Vec<(u32, u32, u8, f64)> = Vec::new();
-        for k in 0..w.rows.len() {
-            let (i, j, v) = (w.rows[k], w.cols[k], w.vals[k]);
-            let (a, b, s) = (i / 2, j / 2, 2 * (i % 2) + j % 2);
-            if a == b {
-                dfull[a][s] += v;
-            } else {
-                off.push((a as u32, b as u32, s as u8, v));
-            }
-        }
-        off.sort_by_key(|x| (x.0, x.1)); // stable: duplicates summed in file order
-        let mut ptr = vec![0usize; nc + 1];
-        let mut col = Vec::new();
-        let mut blk: Vec<[f64; 4]> = Vec::new();
-        let mut last = None;
-        for &(a, b, s, v) in &off {
-            if last != Some((a, b)) {
-                last = Some((a, b));
-                col.push(b);
-                blk.push([0.0; 4]);
-                ptr[a as usize + 1] += 1;
-            }
-            blk.last_mut().expect("pushed")[s as usize] += v;
-        }
-        for a in 0..nc {
-            ptr[a + 1] += ptr[a];
-        }
-        let diag = dfull.iter().map(|d| [d[0], 0.5 * (d[1] + d[2]), d[3]]).collect();
-        Blocks2 { diag, ptr, col, blk }
-    }
-
-    /// `q_α + Σ_{β≠α} W_αβ r_β`.
-    #[inline(always)]
-    fn off_sum(&self, a: usize, q: [f64; 2], r: &[[f64; 2]]) -> [f64; 2] {
-        let mut u = q;
-        for k in self.ptr[a]..self.ptr[a + 1] {
-            let (m, rb) = (self.blk[k], r[self.col[k] as usize]);
-            u[0] += m[0] * rb[0] + m[1] * rb[1];
-            u[1] += m[2] * rb[0] + m[3] * rb[1];
-        }
-        u
-    }
-
-    /// u = W r + q.
-    fn velocity(&self, q: &[[f64; 2]], r: &[[f64; 2]], u: &mut [[f64; 2]]) {
-        for a in 0..q.len() {
-            let (w, ra) = (self.diag[a], r[a]);
-            let v = self.off_sum(a, q[a], r);
-            u[a] = [v[0] + w[0] * ra[0] + w[1] * ra[1], v[1] + w[1] * ra[0] + w[2] * ra[1]];
-        }
-    }
-
-    /// One NLGS sweep in storage order; accumulates LMGC90's sums when asked.
-    #[inline(never)]
-    fn sweep(&self, q: &[[f64; 2]], mu: &[f64], r: &mut [[f64; 2]], mut sums: Option<&mut Sums>) {
-        for a in 0..q.len() {
-            let u0 = self.off_sum(a, q[a], r);
-            let (w, ro) = (self.diag[a], r[a]);
-            let rn = coulomb::solve(w, u0, 0.0, mu[a]);
-            if let Some(s) = sums.as_deref_mut() {
-                let wr_old = [w[0] * ro[0] + w[1] * ro[1], w[1] * ro[0] + w[2] * ro[1]];
-                let wr = [w[0] * rn[0] + w[1] * rn[1], w[1] * rn[0] + w[2] * rn[1]];
-                let du = [wr[0] - wr_old[0], wr[1] - wr_old[1]];
-                s.add(&ro, &rn, &du, &wr_old, &wr);
-            }
-            r[a] = rn;
-        }
-    }
-}
-
-fn residual2(u: &[[f64; 2]], r: &[[f64; 2]], mu: &[f64], qs: f64) -> f64 {
-    let f2: f64 = (0..r.len()).map(|a| natural_map_sq(&r[a], &u[a], mu[a])).sum();
-    f2.sqrt() / qs
-}
-
-/// NLGS on a validated 2D problem.
-fn solve2(p: &FcProblem, opts: &FcOptions) -> FcSolution {
-    let t0 = Instant::now();
-    let nc = p.nc;
-    let b = Blocks2::assemble(p);
-    let q: Vec<[f64; 2]> = p.q.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
-    let qs = q_scale(&p.q);
-    let mut r = vec![[0.0; 2]; nc];
-    let mut u = vec![[0.0; 2]; nc];
-    let k = opts.check_every.max(1);
-    let mut sweeps = 0;
-    let mut converged = nc == 0;
-    while !converged && sweeps < opts.max_sweeps {
-        sweeps += 1;
-        let check = sweeps % k == 0 || sweeps == opts.max_sweeps;
-        match opts.norm {
-            FcNorm::Natural => {
-                b.sweep(&q, &p.mu, &mut r, None);
-                if check {
-                    b.velocity(&q, &r, &mut u);
-                    converged = residual2(&u, &r, &p.mu, qs) < opts.tol;
-                }
-            }
-            FcNorm::Lmgc(c) if check => {
-                let mut sums = Sums::default();
-                b.sweep(&q, &p.mu, &mut r, Some(&mut sums));
-                converged = Norms::from_sums(&sums, opts.tol).converged(c);
-            }
-            FcNorm::Lmgc(_) => b.sweep(&q, &p.mu, &mut r, None),
-        }
-    }
-    b.velocity(&q, &r, &mut u);
-    let residual = residual2(&u, &r, &p.mu, qs);
-    if opts.max_sweeps == 0 && opts.norm == FcNorm::Natural {
-        converged |= residual < opts.tol;
-    }
-    let solve_seconds = t0.elapsed().as_secs_f64();
-    FcSolution {
-        r: r.concat(),
-        u: u.concat(),
-        sweeps,
-        converged,
-        residual,
-        solve_seconds,
-    }
-}
-
 /// Reads and solves one problem file.
 pub fn solve_file(path: &Path, opts: &FcOptions) -> Result<FcSolution, InputError> {
-    let p = FcProblem::read(path)?;
-    Ok(solve2(&p, opts))
+    let p = read_any(path)?;
+    Ok(p.solve(opts))
 }
 
-/// The local problem of the last step of a 2D world (call it right after
-/// [`World2::step`]): W = Hᵀ M̂⁻¹ H over `w.contacts` and q = u_free − ū e_n. The
-/// impulses the world found, `w.contacts.r`, are an (approximate) solution of it.
-pub fn problem_from_world(w: &World2) -> FcProblem {
-    let c = &w.contacts;
-    let b = &w.bodies;
-    let nc = c.len();
-    // H_bᵀ (2 × 3) of contact a seen from body b, with its sign.
-    let h_of = |a: usize, arm: [f64; 2], s: f64| {
-        let n = c.frame[a].n;
-        [[s * n[0], s * n[1], s * arm[0]], [-s * n[1], s * n[0], s * arm[1]]]
-    };
-    // (body, contact, H_bᵀ) for the bodies impulses can move, grouped by body.
-    let mut inc: Vec<(u32, u32, [[f64; 3]; 2])> = Vec::with_capacity(2 * nc);
-    for a in 0..nc {
-        let [i, j] = c.bodies[a];
-        if b.movable(i as usize) {
-            inc.push((i, a as u32, h_of(a, c.frame[a].arm_i, 1.0)));
-        }
-        if b.movable(j as usize) {
-            inc.push((j, a as u32, h_of(a, c.frame[a].arm_j, -1.0)));
-        }
+/// Reads a problem file: FCLIB's HDF5 (`.hdf5`, `.h5`; cargo feature `hdf5`) or the
+/// JSON exchange format (plain or `.gz`).
+pub fn read_any(path: &Path) -> Result<FcProblem, InputError> {
+    let name = path.to_string_lossy();
+    if name.ends_with(".hdf5") || name.ends_with(".h5") {
+        #[cfg(feature = "hdf5")]
+        return fclib::read(path);
+        #[cfg(not(feature = "hdf5"))]
+        return Err(InputError {
+            file: name.into_owned(),
+            line: None,
+            key: String::new(),
+            message: "FCLIB HDF5 files need the `hdf5` feature: install Debian's libhdf5-dev and build with `cargo build --release --features hdf5`".into(),
+        });
     }
-    inc.sort_by_key(|x| (x.0, x.1));
-    // Contributions to the blocks (α ≤ β) from each shared body.
-    let mut contrib: Vec<(u32, u32, [f64; 4])> = Vec::new();
-    let mut g0 = 0;
-    while g0 < inc.len() {
-        let body = inc[g0].0;
-        let g1 = g0 + inc[g0..].iter().take_while(|x| x.0 == body).count();
-        let m = b.inv_mass[body as usize];
-        for x in g0..g1 {
-            for y in x..g1 {
-                let ((_, ca, ha), (_, cb, hb)) = (inc[x], inc[y]);
-                let e = |p: usize, q: usize| (0..3).map(|k| ha[p][k] * m[k] * hb[q][k]).sum::<f64>();
-                let mut blk = [e(0, 0), e(0, 1), e(1, 0), e(1, 1)];
-                if ca == cb {
-                    blk[2] = blk[1];
-                }
-                contrib.push((ca, cb, blk));
-            }
-        }
-        g0 = g1;
-    }
-    contrib.sort_by_key(|x| (x.0, x.1));
-    let mut trip: Vec<(usize, usize, f64)> = Vec::with_capacity(4 * contrib.len());
-    let mut k = 0;
-    while k < contrib.len() {
-        let (ca, cb, mut blk) = contrib[k];
-        k += 1;
-        while k < contrib.len() && (contrib[k].0, contrib[k].1) == (ca, cb) {
-            for (x, y) in blk.iter_mut().zip(contrib[k].2) {
-                *x += y;
-            }
-            k += 1;
-        }
-        let (ra, rb) = (2 * ca as usize, 2 * cb as usize);
-        for (s, v) in blk.iter().enumerate() {
-            trip.push((ra + s / 2, rb + s % 2, *v));
-            if ca != cb {
-                trip.push((rb + s % 2, ra + s / 2, *v));
-            }
-        }
-    }
-    trip.sort_by_key(|x| (x.0, x.1));
-    let mut q = Vec::with_capacity(2 * nc);
-    for a in 0..nc {
-        q.push(c.u_free[a][0] - c.target[a].u_target);
-        q.push(c.u_free[a][1]);
-    }
-    let meta = serde_json::json!({
-        "source": format!("nscdd: 2D world after step {} (t = {} s), {} bodies", w.step, w.t, b.len()),
-    });
-    FcProblem {
-        dim: 2,
-        nc,
-        w: CooMatrix::from_triplets(2 * nc, &trip),
-        q,
-        mu: c.target.iter().map(|t| t.mu).collect(),
-        meta: Some(meta),
-    }
+    FcProblem::read(path)
 }
 
 #[cfg(test)]
@@ -649,13 +452,13 @@ mod tests {
             &[0.0; 4],
             &[0.1, 0.1],
         );
-        let b = Blocks2::assemble(&p);
-        assert_eq!(b.diag[0], [1.5, 0.30000000000000004, 2.0]);
-        assert_eq!(b.diag[1], [1.0, 0.0, 1.0]);
+        let b = nlgs::Blocks::<2>::assemble(&p);
+        assert_eq!(b.diag[0], [[1.5, 0.30000000000000004], [0.30000000000000004, 2.0]]);
+        assert_eq!(b.diag[1], [[1.0, 0.0], [0.0, 1.0]]);
         assert_eq!(b.ptr, vec![0, 1, 2]);
         assert_eq!(b.col, vec![1, 0]);
-        assert_eq!(b.blk[0], [-0.30000000000000004, 0.0, 0.0, 0.0]);
-        assert_eq!(b.blk[1], [0.0, 0.0, 0.0, 0.7]);
+        assert_eq!(b.blk[0], [[-0.30000000000000004, 0.0], [0.0, 0.0]]);
+        assert_eq!(b.blk[1], [[0.0, 0.0], [0.0, 0.7]]);
     }
 
     #[test]
@@ -710,7 +513,7 @@ mod tests {
         assert_eq!(key("[1]"), "");
         assert_eq!(key("{"), "");
         assert_eq!(key(&ok.replace("\"meta\"", "\"extra\"")), "extra");
-        assert_eq!(key(&ok.replace("\"dim\":2", "\"dim\":3")), "dim");
+        assert_eq!(key(&ok.replace("\"dim\":2", "\"dim\":4")), "dim");
         assert_eq!(key(&ok.replace("\"nc\":1", "\"nc\":-1")), "nc");
         assert_eq!(key(&ok.replace("\"nc\":1", "\"nc\":1.5")), "nc");
         assert_eq!(key(&ok.replace("\"n\":2", "\"n\":3")), "W.n");
@@ -723,9 +526,7 @@ mod tests {
         assert_eq!(key(&ok.replace("[-1,0]", "[-1,null]")), "q[1]");
         assert_eq!(key(&ok.replace("[0.5]", "[-0.5]")), "mu[0]");
         assert_eq!(key(&ok.replace(",\"mu\":[0.5]", "")), "mu");
-        assert!(FcProblem::parse(&ok.replace("\"dim\":2", "\"dim\":3"), "p.json")
-            .unwrap_err()
-            .message
-            .contains("spheres plugin"));
+        // 3D: three values per contact
+        assert_eq!(key(&ok.replace("\"dim\":2", "\"dim\":3")), "q");
     }
 }
