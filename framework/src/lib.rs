@@ -22,8 +22,10 @@
 
 pub mod dd;
 pub mod detect;
+pub mod detect3;
 pub mod drive;
 pub mod engine;
+pub mod engine3;
 pub mod error;
 pub mod fc;
 pub mod law;
@@ -31,9 +33,11 @@ pub mod norms;
 pub mod output;
 pub mod params;
 pub mod registry;
+pub mod registry3;
 pub mod rigid2d;
 pub mod rigid3d;
 pub mod run;
 pub mod scene;
 pub mod solver;
 pub mod world;
+pub mod world3;

@@ -186,6 +186,9 @@ pub struct Registry {
     pub(crate) generators: BTreeMap<&'static str, Box<dyn Generator2>>,
     pub(crate) laws: BTreeMap<&'static str, LawDef>,
     pub(crate) writers: BTreeMap<&'static str, fn() -> Box<dyn Writer2>>,
+    pub(crate) shapes3: BTreeMap<&'static str, crate::registry3::ShapeKindDef3>,
+    pub(crate) detectors3: BTreeMap<(&'static str, &'static str), Arc<dyn crate::registry3::PairDetector3>>,
+    pub(crate) generators3: BTreeMap<&'static str, Box<dyn crate::registry3::Generator3>>,
 }
 
 impl Registry {

@@ -8,6 +8,8 @@
 //! degrees of freedom that do not exist.
 
 pub mod builder;
+pub mod builder3;
+pub mod load3;
 pub mod locate;
 pub mod restart;
 pub mod schema;
@@ -52,13 +54,13 @@ pub fn load(path: &std::path::Path, registry: &Registry) -> Result<Scene, InputE
     load_str(&text, &file, registry)
 }
 
-struct Ctx<'a> {
+pub(crate) struct Ctx<'a> {
     text: &'a str,
     file: &'a str,
 }
 
 impl Ctx<'_> {
-    fn err(&self, path: &[Seg], message: impl Into<String>) -> InputError {
+    pub(crate) fn err(&self, path: &[Seg], message: impl Into<String>) -> InputError {
         InputError {
             file: self.file.to_string(),
             line: locate(self.text, path).map(|o| line_of(self.text, o)),
@@ -68,17 +70,17 @@ impl Ctx<'_> {
     }
 }
 
-fn k(s: &str) -> Seg {
+pub(crate) fn k(s: &str) -> Seg {
     Seg::Key(s.to_string())
 }
-fn at(base: &[Seg], more: &[Seg]) -> Vec<Seg> {
+pub(crate) fn at(base: &[Seg], more: &[Seg]) -> Vec<Seg> {
     base.iter().chain(more).cloned().collect()
 }
 
-/// Loads a scene from its text; `file` names it in messages.
-pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, InputError> {
-    let cx = Ctx { text, file };
-    let sf: SceneFile = toml::from_str(text).map_err(|e| {
+/// Parses a scene file's TOML into its schema; errors name the line and the full
+/// key path.
+pub(crate) fn parse<T: serde::de::DeserializeOwned>(text: &str, file: &str) -> Result<T, InputError> {
+    toml::from_str(text).map_err(|e| {
         let span = e.span();
         let line = span.as_ref().map(|s| line_of(text, s.start));
         // the full key path: from the parsed document (unknown keys, wrong types), or
@@ -99,11 +101,46 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
             key,
             message: e.message().trim().to_string(),
         }
+    })
+}
+
+/// A loaded scene of either dimension.
+pub enum AnyScene {
+    D2(Scene),
+    D3(load3::Scene3),
+}
+
+/// Reads and loads a scene file of either dimension (its `dimension` key).
+pub fn load_any(path: &std::path::Path, registry: &Registry) -> Result<AnyScene, InputError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| InputError {
+        file: file.clone(),
+        line: None,
+        key: String::new(),
+        message: format!("cannot read the file: {e}"),
     })?;
+    load_any_str(&text, &file, registry)
+}
+
+/// [`load_any`] from the text of a scene.
+pub fn load_any_str(text: &str, file: &str, registry: &Registry) -> Result<AnyScene, InputError> {
+    let dim = toml::from_str::<toml::Table>(text)
+        .ok()
+        .and_then(|t| t.get("dimension").and_then(|d| d.as_integer()));
+    match dim {
+        Some(3) => load3::load_str(text, file, registry).map(AnyScene::D3),
+        _ => load_str(text, file, registry).map(AnyScene::D2),
+    }
+}
+
+/// Loads a scene from its text; `file` names it in messages.
+pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, InputError> {
+    let cx = Ctx { text, file };
+    let sf: SceneFile = parse(text, file)?;
     if sf.dimension != 2 {
         return Err(cx.err(
             &[k("dimension")],
-            format!("dimension {} is not supported by the installed plugins (2D only)", sf.dimension),
+            format!("dimension {} is not supported: 2 or 3", sf.dimension),
         ));
     }
     if sf.gravity.len() != 2 || sf.gravity.iter().any(|g| !g.is_finite()) {
@@ -135,7 +172,7 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
         return Err(cx.err(&[], "the scene has no bodies"));
     }
     let nm = b.materials.len();
-    let (laws, declared) = laws(&cx, &sf, registry, nm, &b)?;
+    let (laws, declared) = laws(&cx, &sf, registry, nm, &b.materials)?;
     let origin_path = |o: Origin, key: &str| match o {
         Origin::Body(i) => vec![k("bodies"), Seg::Index(i), k(key)],
         Origin::Generated(i) => vec![k("generate"), Seg::Index(i)],
@@ -300,7 +337,7 @@ pub fn parse_scheme(name: &str) -> Result<crate::dd::Scheme, String> {
     }
 }
 
-fn decomposition(cx: &Ctx, d: &schema::DecompositionSpec, movable: usize) -> Result<crate::dd::DdConfig, InputError> {
+pub(crate) fn decomposition(cx: &Ctx, d: &schema::DecompositionSpec, movable: usize) -> Result<crate::dd::DdConfig, InputError> {
     let p = |key: &str| vec![k("decomposition"), k(key)];
     let int = |key: &str, v: Option<i64>, min: i64, def: i64| -> Result<i64, InputError> {
         let v = v.unwrap_or(def);
@@ -330,7 +367,7 @@ fn decomposition(cx: &Ctx, d: &schema::DecompositionSpec, movable: usize) -> Res
     Ok(c)
 }
 
-fn time_settings(cx: &Ctx, sf: &SceneFile) -> Result<TimeSettings, InputError> {
+pub(crate) fn time_settings<B>(cx: &Ctx, sf: &SceneFile<B>) -> Result<TimeSettings, InputError> {
     let t = &sf.time;
     if !(t.step > 0.0 && t.step.is_finite()) {
         return Err(cx.err(
@@ -354,7 +391,7 @@ fn time_settings(cx: &Ctx, sf: &SceneFile) -> Result<TimeSettings, InputError> {
     })
 }
 
-fn validate_solver(cx: &Ctx, s: &crate::solver::SolverSettings) -> Result<(), InputError> {
+pub(crate) fn validate_solver(cx: &Ctx, s: &crate::solver::SolverSettings) -> Result<(), InputError> {
     let p = |key: &str| vec![k("solver"), k(key)];
     if !(s.tolerance > 0.0 && s.tolerance.is_finite()) {
         return Err(cx.err(&p("tolerance"), format!("must be > 0, got {}", s.tolerance)));
@@ -371,7 +408,7 @@ fn validate_solver(cx: &Ctx, s: &crate::solver::SolverSettings) -> Result<(), In
     Ok(())
 }
 
-fn materials(cx: &Ctx, sf: &SceneFile) -> Result<Vec<Material>, InputError> {
+pub(crate) fn materials<B>(cx: &Ctx, sf: &SceneFile<B>) -> Result<Vec<Material>, InputError> {
     let mut out: Vec<Material> = vec![];
     for (i, m) in sf.materials.iter().enumerate() {
         if !(m.density > 0.0 && m.density.is_finite()) {
@@ -395,12 +432,12 @@ fn materials(cx: &Ctx, sf: &SceneFile) -> Result<Vec<Material>, InputError> {
 }
 
 /// The law table and, beside it, the pairs declared `law = "none"` (never interact).
-fn laws(
+pub(crate) fn laws<B>(
     cx: &Ctx,
-    sf: &SceneFile,
+    sf: &SceneFile<B>,
     registry: &Registry,
     nm: usize,
-    b: &SceneBuilder2,
+    materials: &[Material],
 ) -> Result<(Vec<Option<crate::law::ContactLaw>>, Vec<bool>), InputError> {
     let mut table = vec![None; nm * nm];
     let mut declared = vec![false; nm * nm];
@@ -418,8 +455,10 @@ fn laws(
         };
         let mut ids = [0u16; 2];
         for (s, name) in l.materials.iter().enumerate() {
-            ids[s] = b
-                .material(name)
+            ids[s] = materials
+                .iter()
+                .position(|m| m.name == *name)
+                .map(|i| i as u16)
                 .ok_or_else(|| cx.err(&at(&base, &[k("materials"), Seg::Index(s)]), format!("unknown material `{name}`")))?;
         }
         let law = match def {

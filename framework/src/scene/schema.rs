@@ -25,13 +25,15 @@ fn overlap() -> f64 {
     0.05
 }
 
+/// A scene file; `B` is the body entry of its dimension ([`BodySpec`] in 2D,
+/// [`BodySpec3`] in 3D).
 #[derive(Deserialize, Debug)]
-#[serde(deny_unknown_fields)]
-pub struct SceneFile {
-    /// 2 (3D arrives with the spheres plugin).
+#[serde(deny_unknown_fields, bound(deserialize = "B: Deserialize<'de>"))]
+pub struct SceneFile<B = BodySpec> {
+    /// 2 or 3.
     #[serde(default = "two")]
     pub dimension: u8,
-    /// Gravity vector (m/s²), default (0, −9.81).
+    /// Gravity vector (m/s²), default (0, −9.81) in 2D, (0, 0, −9.81) in 3D.
     #[serde(default = "gravity")]
     pub gravity: Vec<f64>,
     pub time: TimeSpec,
@@ -43,8 +45,8 @@ pub struct SceneFile {
     pub materials: Vec<MaterialSpec>,
     #[serde(default)]
     pub laws: Vec<LawSpec>,
-    #[serde(default)]
-    pub bodies: Vec<BodySpec>,
+    #[serde(default = "Vec::new")]
+    pub bodies: Vec<B>,
     #[serde(default)]
     pub generate: Vec<GenerateSpec>,
     #[serde(default)]
@@ -59,6 +61,8 @@ pub struct SceneFile {
 pub struct DecompositionSpec {
     pub nx: Option<i64>,
     pub ny: Option<i64>,
+    /// 3D only.
+    pub nz: Option<i64>,
     /// `decentralized` (default) or `centralized`.
     pub scheme: Option<String>,
     pub sweeps_per_gluing: Option<i64>,
@@ -150,6 +154,40 @@ pub struct DriveSpec2 {
     pub rot: Option<DofDrive>,
 }
 
+/// A body of a 3D scene.
+#[derive(Deserialize, Debug)]
+pub struct BodySpec3 {
+    /// Shape kind (`sphere`, `plane`, `box`, ...).
+    pub shape: String,
+    pub material: String,
+    pub name: Option<String>,
+    pub position: [f64; 3],
+    /// Orientation as a rotation vector (axis × angle, rad).
+    #[serde(default)]
+    pub rotation: [f64; 3],
+    /// (v_x, v_y, v_z, ω_x, ω_y, ω_z), ω in the world frame.
+    #[serde(default)]
+    pub velocity: [f64; 6],
+    #[serde(default)]
+    pub fixed: bool,
+    pub drive: Option<DriveSpec3>,
+    /// Shape-specific keys, checked by the shape's plugin.
+    #[serde(flatten)]
+    pub params: toml::Table,
+}
+
+/// Driven degrees of freedom of a 3D body (rotations about the world axes).
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+pub struct DriveSpec3 {
+    pub x: Option<DofDrive>,
+    pub y: Option<DofDrive>,
+    pub z: Option<DofDrive>,
+    pub rx: Option<DofDrive>,
+    pub ry: Option<DofDrive>,
+    pub rz: Option<DofDrive>,
+}
+
 #[derive(Deserialize, Debug)]
 pub struct GenerateSpec {
     /// Generator name (`disk_deposit`, `square_lattice`, ...).
@@ -173,9 +211,11 @@ pub struct OutputSpec {
     /// final state is always in `final.json`). Both are restart files.
     #[serde(default)]
     pub checkpoint_every: u64,
-    /// The walls of a box sample, by body name.
+    /// The walls of a box sample, by body name (2D).
     #[serde(rename = "box")]
     pub box_walls: Option<BoxSpec>,
+    /// The six walls of a box sample, by body name (3D).
+    pub box3: Option<BoxSpec3>,
 }
 
 impl Default for OutputSpec {
@@ -186,6 +226,7 @@ impl Default for OutputSpec {
             writers: vec![],
             checkpoint_every: 0,
             box_walls: None,
+            box3: None,
         }
     }
 }
@@ -198,6 +239,21 @@ pub struct BoxSpec {
     pub bottom: String,
     pub top: String,
     /// ε1 is measured from the height at this time (s).
+    #[serde(default)]
+    pub strain_from: f64,
+}
+
+/// `[output] box3 = { xmin = .., xmax = .., ymin = .., ymax = .., zmin = .., zmax = .. }`.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct BoxSpec3 {
+    pub xmin: String,
+    pub xmax: String,
+    pub ymin: String,
+    pub ymax: String,
+    pub zmin: String,
+    pub zmax: String,
+    /// ε1 (along z) is measured from the height at this time (s).
     #[serde(default)]
     pub strain_from: f64,
 }

@@ -1,0 +1,252 @@
+//! One Moreau–Jean time step of a 3D world, one stage per function, as in 2D
+//! ([`crate::engine`]):
+//!
+//! ```text
+//! V_free = V⁻ + h M̂⁻¹ F̂        F̂: gravity, imposed forces at t_i + θh, and the
+//!                               gyroscopic torque −ω⁻ × (I_w ω⁻) (zero for spheres)
+//! M̂ (V⁺ − V_free) = H r          r: contact impulses (NLGS, rigid3d::nlgs)
+//! x⁺ = x⁻ + h ((1 − θ) v⁻ + θ v⁺)
+//! q⁺ = exp(½ h ω_θ) ⊗ q⁻,       ω_θ = (1 − θ) ω⁻ + θ ω⁺   (world-frame ω)
+//! ```
+//!
+//! The orientation update is the θ-method's increment h ω_θ applied as an exact
+//! rotation (unit quaternion, renormalised), so orientations stay orthonormal
+//! whatever the step. Degrees of freedom driven by velocity take V⁺ = v(t_i+1) and
+//! are removed from M̂⁻¹ (rotations: the world inertia restricted to the free axes).
+
+use crate::drive::Imposed;
+use crate::engine::{Diverged, StageTimes, StepReport};
+use crate::law::target_velocity;
+use crate::rigid2d::contacts::{ContactKey, Target};
+use crate::rigid2d::nlgs::make_order;
+use crate::rigid3d::bodies::{cross, from_rotation_vector, normalize, quat_mul, ALL_FREE};
+use crate::rigid3d::contacts::{local_velocity, tangents, Block3, Frame3};
+use crate::rigid3d::{coulomb, nlgs, Contacts3};
+use crate::world3::World3;
+use std::time::Instant;
+
+impl World3 {
+    /// Advances the scene by one step.
+    pub fn step(&mut self) -> Result<StepReport, Diverged> {
+        let mut rep = StepReport::default();
+        let t0 = Instant::now();
+        free_velocity(self);
+        self.scratch
+            .detector
+            .detect(&self.bodies, &self.shapes, &self.detectors, self.alert, &mut self.scratch.raw);
+        let t1 = Instant::now();
+        build_contacts(self);
+        make_order(&mut self.scratch.order, self.contacts.len(), &self.solver, self.step);
+        let t2 = Instant::now();
+        let b = &mut self.bodies;
+        rep.solve = nlgs::solve(&mut self.contacts, &mut b.vel, &b.inv_m, &b.inv_i, &self.scratch.order, &self.solver);
+        let t3 = Instant::now();
+        update_positions(self)?;
+        let t4 = Instant::now();
+        rep.contacts = self.contacts.len();
+        rep.times = StageTimes {
+            detect: (t1 - t0).as_secs_f64(),
+            delassus: (t2 - t1).as_secs_f64(),
+            nlgs: (t3 - t2).as_secs_f64(),
+            update: (t4 - t3).as_secs_f64(),
+        };
+        Ok(rep)
+    }
+}
+
+/// Whether body b's inertia is isotropic (then I_w does not depend on orientation).
+fn isotropic(i: [f64; 3]) -> bool {
+    i[0] == i[1] && i[1] == i[2]
+}
+
+/// V_free = V⁻ + h M̂⁻¹ F̂ with the drives applied; keeps V⁻.
+pub fn free_velocity(w: &mut World3) {
+    let h = w.time.h;
+    let (t_end, t_theta) = (w.t + h, w.t + w.time.theta * h);
+    let b = &mut w.bodies;
+    w.scratch.v_begin.clear();
+    w.scratch.v_begin.extend_from_slice(&b.vel);
+    // free degrees of freedom at the end of the step; M̂⁻¹ where it can change
+    for d in &w.drives {
+        let k = d.body as usize;
+        let mut free = ALL_FREE;
+        for (dof, drv) in d.dof.iter().enumerate() {
+            if drv.as_ref().is_some_and(|x| x.is_velocity_at(t_end)) {
+                free &= !(1 << dof);
+            }
+        }
+        if b.free[k] != free {
+            b.free[k] = free;
+            b.refresh_inverse(k);
+        }
+    }
+    for k in 0..b.len() {
+        if b.free[k] != 0 && !isotropic(b.inertia[k]) {
+            b.refresh_inverse(k);
+        }
+    }
+    let g = w.gravity;
+    for k in 0..b.len() {
+        if b.free[k] == 0 {
+            continue;
+        }
+        let (im, ii) = (b.inv_m[k], b.inv_i[k]);
+        let m = b.mass[k];
+        let iw = if isotropic(b.inertia[k]) { [0.0; 6] } else { b.world_inertia(k) };
+        let v = &mut b.vel[k];
+        for a in 0..3 {
+            v[a] += h * im[a] * m * g[a];
+        }
+        if !isotropic(b.inertia[k]) {
+            // gyroscopic torque −ω × (I_w ω), explicit
+            let om = [v[3], v[4], v[5]];
+            let l = coulomb::mul(&iw, om);
+            let tq = cross(om, l);
+            let dw = coulomb::mul(&ii, [-h * tq[0], -h * tq[1], -h * tq[2]]);
+            for a in 0..3 {
+                v[3 + a] += dw[a];
+            }
+        }
+    }
+    for d in &w.drives {
+        let k = d.body as usize;
+        for dof in 0..6 {
+            let Some(drv) = &d.dof[dof] else { continue };
+            match drv.at(t_end) {
+                Imposed::Velocity(v) => b.vel[k][dof] = v,
+                _ => {
+                    if let Imposed::Force(f) = drv.at(t_theta) {
+                        if dof < 3 {
+                            b.vel[k][dof] += h * f / b.mass[k];
+                        } else {
+                            // an imposed moment about a world axis, through I_w⁻¹
+                            let mut tq = [0.0; 3];
+                            tq[dof - 3] = h * f;
+                            let dw = coulomb::mul(&b.inv_i[k], tq);
+                            for a in 0..3 {
+                                b.vel[k][3 + a] += dw[a];
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// This step's contact set: frames, W_αα, ū and the warm start, applied at once.
+pub fn build_contacts(w: &mut World3) {
+    let (h, theta) = (w.time.h, w.time.theta);
+    let s = &mut w.scratch;
+    s.prev_keys.clear();
+    s.prev_keys.extend(w.contacts.key.iter().copied().zip(w.contacts.r.iter().copied()));
+    s.prev_keys.sort_unstable_by_key(|x| x.0);
+    let c = &mut s.next;
+    c.clear();
+    let b = &w.bodies;
+    let nm = w.materials.len();
+    for rc in &s.raw {
+        let (i, j) = (rc.i as usize, rc.j as usize);
+        let n = rc.normal;
+        let (t1, t2) = tangents(n);
+        let arm = |x: [f64; 3]| [rc.point[0] - x[0], rc.point[1] - x[1], rc.point[2] - x[2]];
+        let frame = Frame3 {
+            basis: [n, t1, t2],
+            d_i: arm(b.pos[i]),
+            d_j: arm(b.pos[j]),
+        };
+        let wb = Contacts3::delassus(&frame, b.inv_m[i], &b.inv_i[i], b.inv_m[j], &b.inv_i[j]);
+        if !(wb[0] > 0.0) {
+            continue;
+        }
+        let Some(law) = w.laws[b.material[i] as usize * nm + b.material[j] as usize] else {
+            continue;
+        };
+        let u_begin = local_velocity(&frame, &s.v_begin[i], &s.v_begin[j]);
+        let u_free = local_velocity(&frame, &b.vel[i], &b.vel[j]);
+        let key = ContactKey {
+            i: rc.i,
+            j: rc.j,
+            feature: rc.feature,
+        };
+        let r = match s.prev_keys.binary_search_by_key(&key, |x| x.0) {
+            Ok(p) => s.prev_keys[p].1,
+            Err(_) => [0.0; 3],
+        };
+        c.bodies.push([rc.i, rc.j]);
+        c.frame.push(frame);
+        c.block.push(Block3 {
+            w: wb,
+            pre: coulomb::precompute(&wb),
+        });
+        c.target.push(Target {
+            u_target: target_velocity(rc.gap, u_begin[0], u_free[0], h, theta, law.e),
+            mu: law.mu,
+        });
+        c.r.push(r);
+        c.u_free.push(u_free);
+        c.gap.push(rc.gap);
+        c.point.push(rc.point);
+        c.key.push(key);
+    }
+    std::mem::swap(&mut w.contacts, &mut s.next);
+    let c = &w.contacts;
+    for a in 0..c.len() {
+        if c.r[a] != [0.0; 3] {
+            let [i, j] = c.bodies[a];
+            crate::rigid3d::contacts::apply(&c.frame[a], c.r[a], i as usize, j as usize, &mut w.bodies.vel, &w.bodies.inv_m, &w.bodies.inv_i);
+        }
+    }
+}
+
+/// Positions and orientations, the reactions, and the divergence check.
+pub fn update_positions(w: &mut World3) -> Result<(), Diverged> {
+    let (h, theta) = (w.time.h, w.time.theta);
+    let b = &mut w.bodies;
+    for k in 0..b.len() {
+        let (v0, v1) = (w.scratch.v_begin[k], b.vel[k]);
+        let vm: [f64; 6] = std::array::from_fn(|a| (1.0 - theta) * v0[a] + theta * v1[a]);
+        for a in 0..3 {
+            b.pos[k][a] += h * vm[a];
+        }
+        let rot = [h * vm[3], h * vm[4], h * vm[5]];
+        if rot != [0.0; 3] {
+            b.quat[k] = normalize(quat_mul(from_rotation_vector(rot), b.quat[k]));
+        }
+        let finite = b.pos[k].iter().chain(&b.vel[k]).chain(&b.quat[k]).all(|x| x.is_finite());
+        if !finite {
+            let label = w.body_label(k);
+            return Err(Diverged {
+                step: w.step + 1,
+                body: k as u32,
+                message: format!(
+                    "{label} has a non-finite state (position {:?}, velocity {:?})",
+                    w.bodies.pos[k], w.bodies.vel[k]
+                ),
+            });
+        }
+    }
+    let c = &w.contacts;
+    w.reaction.clear();
+    w.reaction.resize(w.bodies.len(), [0.0; 6]);
+    for a in 0..c.len() {
+        let p = c.world_impulse(a);
+        let [i, j] = c.bodies[a];
+        let f = c.frame[a];
+        let (mi, mj) = (cross(f.d_i, p), cross(f.d_j, p));
+        for k in 0..3 {
+            w.reaction[i as usize][k] += p[k];
+            w.reaction[i as usize][3 + k] += mi[k];
+            w.reaction[j as usize][k] -= p[k];
+            w.reaction[j as usize][3 + k] -= mj[k];
+        }
+    }
+    w.step += 1;
+    w.t = w.step as f64 * h;
+    if let (Some(bw), None) = (&w.box_walls, w.box_h0) {
+        if w.t >= bw.strain_from {
+            w.box_h0 = w.box_extent().map(|e| e[5] - e[4]);
+        }
+    }
+    Ok(())
+}

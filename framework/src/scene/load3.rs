@@ -1,0 +1,280 @@
+//! Loading a 3D scene (`dimension = 3`): the same file format as in 2D with 3D
+//! bodies (position (x, y, z), `rotation` as a rotation vector, velocity
+//! (v, ω), drives of x, y, z, rx, ry, rz), 3D shapes and generators from the
+//! registry, and `[output] box3` for box samples. Errors name the file, the line
+//! and the key, as in 2D.
+
+use super::builder::Origin;
+use super::builder3::SceneBuilder3;
+use super::locate::Seg;
+use super::schema::{BodySpec3, SceneFile};
+use super::{at, k, laws, materials, parse, time_settings, validate_solver, Ctx, OutputSettings};
+use crate::detect3::{Detector3, DetectorTable3};
+use crate::error::InputError;
+use crate::registry::{ParamError, Registry};
+use crate::rigid2d::bodies::ShapeRef;
+use crate::world3::{BodyDrive3, BoxWalls3, World3};
+
+/// A loaded 3D scene: the world and how to write it.
+pub struct Scene3 {
+    pub world: World3,
+    pub output: OutputSettings,
+}
+
+/// Loads a 3D scene from its text; `file` names it in messages.
+pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene3, InputError> {
+    let cx = Ctx { text, file };
+    let sf: SceneFile<BodySpec3> = parse(text, file)?;
+    let gravity = match sf.gravity.len() {
+        // the 2D default when the key is absent
+        2 if sf.gravity == [0.0, -9.81] && !text.contains("gravity") => [0.0, 0.0, -9.81],
+        3 if sf.gravity.iter().all(|g| g.is_finite()) => [sf.gravity[0], sf.gravity[1], sf.gravity[2]],
+        _ => return Err(cx.err(&[k("gravity")], "gravity must be 3 finite numbers in 3D")),
+    };
+    if sf.decomposition.is_some() {
+        return Err(cx.err(
+            &[k("decomposition")],
+            "NSCDD subdomains are not available for 3D scenes yet: remove [decomposition]",
+        ));
+    }
+    if sf.output.box_walls.is_some() {
+        return Err(cx.err(&[k("output"), k("box")], "`box` names the 4 walls of a 2D sample; in 3D use `box3`"));
+    }
+    let time = time_settings(&cx, &sf)?;
+    validate_solver(&cx, &sf.solver)?;
+    let mats = materials(&cx, &sf)?;
+    let nm = mats.len();
+    let (laws, declared) = laws(&cx, &sf, registry, nm, &mats)?;
+    let mut b = SceneBuilder3::new(registry, mats);
+    let mut drives = vec![];
+    add_bodies(&cx, &sf, &mut b, &mut drives)?;
+    for (g, spec) in sf.generate.iter().enumerate() {
+        let base = [k("generate"), Seg::Index(g)];
+        let gen = registry.generators3.get(spec.kind.as_str()).ok_or_else(|| {
+            cx.err(
+                &at(&base, &[k("kind")]),
+                format!(
+                    "unknown 3D generator `{}`; installed: {}",
+                    spec.kind,
+                    registry.generator_names3().join(", ")
+                ),
+            )
+        })?;
+        b.origin = Origin::Generated(g);
+        gen.generate(&spec.params, &mut b)
+            .map_err(|e: ParamError| cx.err(&at(&base, &[k(&e.key)]), e.msg))?;
+    }
+    if b.bodies.is_empty() {
+        return Err(cx.err(&[], "the scene has no bodies"));
+    }
+    let origin_path = |o: Origin, key: &str| match o {
+        Origin::Body(i) => vec![k("bodies"), Seg::Index(i), k(key)],
+        Origin::Generated(i) => vec![k("generate"), Seg::Index(i)],
+    };
+    let n = b.bodies.len();
+    let driven: Vec<bool> = (0..n).map(|i| drives.iter().any(|d: &BodyDrive3| d.body as usize == i)).collect();
+    let nk = b.shapes.len();
+    let mut first_mat = vec![None; nm];
+    let mut mat_count = vec![0usize; nm];
+    let mut mat_movable = vec![false; nm];
+    let mut first_kind = vec![None; nk];
+    let mut kind_movable = vec![false; nk];
+    for i in 0..n {
+        let (m, kd) = (b.bodies.material[i] as usize, b.bodies.shape[i].kind as usize);
+        let mv = b.bodies.movable(i) || driven[i];
+        first_mat[m].get_or_insert(b.origins[i]);
+        mat_count[m] += 1;
+        first_kind[kd].get_or_insert(b.origins[i]);
+        mat_movable[m] |= mv;
+        kind_movable[kd] |= mv;
+    }
+    for ma in 0..nm {
+        for mb in ma..nm {
+            if let (Some(oa), Some(_)) = (first_mat[ma], first_mat[mb]) {
+                let can_touch = ma != mb || mat_count[ma] >= 2;
+                if can_touch && (mat_movable[ma] || mat_movable[mb]) && !declared[ma * nm + mb] {
+                    let (x, y) = (&b.materials[ma].name, &b.materials[mb].name);
+                    return Err(cx.err(
+                        &origin_path(oa, "material"),
+                        format!("no law for the material pair (`{x}`, `{y}`): add a [[laws]] entry with materials = [\"{x}\", \"{y}\"]"),
+                    ));
+                }
+            }
+        }
+    }
+    let mut table = DetectorTable3 {
+        nk,
+        table: vec![None; nk * nk],
+    };
+    for ka in 0..nk {
+        for kb in 0..nk {
+            let (na, nb) = (b.shapes[ka].kind(), b.shapes[kb].kind());
+            match registry.detector3(na, nb) {
+                Some(d) => table.table[ka * nk + kb] = Some(d),
+                None if kind_movable[ka] || kind_movable[kb] => {
+                    let o = first_kind[ka].or(first_kind[kb]).unwrap_or(Origin::Body(0));
+                    return Err(cx.err(
+                        &origin_path(o, "shape"),
+                        format!("no contact detector for the shape pair (`{na}`, `{nb}`) among the installed plugins"),
+                    ));
+                }
+                None => {}
+            }
+        }
+    }
+    let sizes: Vec<f64> = (0..n)
+        .map(|i| b.shapes[b.bodies.shape[i].kind as usize].size(b.bodies.shape[i].index))
+        .collect();
+    let alert = match sf.detection.alert {
+        Some(a) if !(a >= 0.0 && a.is_finite()) => return Err(cx.err(&[k("detection"), k("alert")], format!("must be ≥ 0, got {a}"))),
+        Some(a) => a,
+        None => {
+            let mut s: Vec<f64> = sizes.iter().copied().filter(|x| x.is_finite() && *x > 0.0).collect();
+            s.sort_by(|a, c| a.total_cmp(c));
+            0.1 * s.get(s.len() / 2).copied().unwrap_or(1.0)
+        }
+    };
+    let tol = sf.detection.overlap_tolerance;
+    if !(tol >= 0.0) {
+        return Err(cx.err(&[k("detection"), k("overlap_tolerance")], "must be ≥ 0"));
+    }
+    let mut raw = vec![];
+    Detector3::default().detect(&b.bodies, &b.shapes, &table, 0.0, &mut raw);
+    for rc in &raw {
+        let (i, j) = (rc.i as usize, rc.j as usize);
+        if laws[b.bodies.material[i] as usize * nm + b.bodies.material[j] as usize].is_none() {
+            continue;
+        }
+        let lim = tol * sizes[i].min(sizes[j]);
+        if rc.gap < -lim {
+            let label = |x: usize| match &b.names[x] {
+                Some(nm) => format!("{x} (`{nm}`)"),
+                None => format!("{x}"),
+            };
+            return Err(cx.err(
+                &origin_path(b.origins[i], "position"),
+                format!(
+                    "bodies {} and {} overlap by {:.3e} m, more than the tolerance {:.3e} m (detection.overlap_tolerance × the smaller size)",
+                    label(i),
+                    label(j),
+                    -rc.gap,
+                    lim
+                ),
+            ));
+        }
+    }
+    let box_walls = match &sf.output.box3 {
+        None => None,
+        Some(bs) => {
+            let find = |key: &str, name: &str| {
+                b.names
+                    .iter()
+                    .position(|x| x.as_deref() == Some(name))
+                    .map(|p| p as u32)
+                    .ok_or_else(|| cx.err(&[k("output"), k("box3"), k(key)], format!("no body is named `{name}`")))
+            };
+            Some(BoxWalls3 {
+                walls: [
+                    find("xmin", &bs.xmin)?,
+                    find("xmax", &bs.xmax)?,
+                    find("ymin", &bs.ymin)?,
+                    find("ymax", &bs.ymax)?,
+                    find("zmin", &bs.zmin)?,
+                    find("zmax", &bs.zmax)?,
+                ],
+                strain_from: bs.strain_from,
+            })
+        }
+    };
+    for (i, w) in sf.output.writers.iter().enumerate() {
+        return Err(cx.err(
+            &[k("output"), k("writers"), Seg::Index(i)],
+            format!("unknown writer `{w}` for a 3D scene"),
+        ));
+    }
+    let world = World3 {
+        bodies: b.bodies,
+        names: b.names,
+        shapes: b.shapes,
+        materials: b.materials,
+        laws,
+        drives,
+        fixed: b.fixed,
+        gravity,
+        time,
+        solver: sf.solver,
+        alert,
+        box_walls,
+        box_h0: None,
+        detectors: table,
+        t: 0.0,
+        step: 0,
+        contacts: Default::default(),
+        reaction: vec![[0.0; 6]; n],
+        scratch: Default::default(),
+    };
+    Ok(Scene3 {
+        world,
+        output: OutputSettings {
+            every: sf.output.every,
+            vtk: sf.output.vtk,
+            writers: vec![],
+            checkpoint_every: sf.output.checkpoint_every,
+        },
+    })
+}
+
+fn add_bodies(cx: &Ctx, sf: &SceneFile<BodySpec3>, b: &mut SceneBuilder3, drives: &mut Vec<BodyDrive3>) -> Result<(), InputError> {
+    for (i, spec) in sf.bodies.iter().enumerate() {
+        let base = [k("bodies"), Seg::Index(i)];
+        let p = |key: &str| at(&base, &[k(key)]);
+        b.origin = Origin::Body(i);
+        let kind = b.kind(&spec.shape).ok_or_else(|| {
+            cx.err(
+                &p("shape"),
+                format!("unknown 3D shape `{}`; installed: {}", spec.shape, b.registry.shape_kinds3().join(", ")),
+            )
+        })?;
+        let material = b.material(&spec.material).ok_or_else(|| {
+            cx.err(&p("material"), format!("unknown material `{}`; declare it in [[materials]]", spec.material))
+        })?;
+        let index = b.shapes[kind as usize]
+            .push_params(&spec.params)
+            .map_err(|e| cx.err(&p(&e.key), e.msg))?;
+        if spec.position.iter().chain(&spec.velocity).chain(&spec.rotation).any(|x| !x.is_finite()) {
+            return Err(cx.err(&p("position"), "position, rotation and velocity must be finite"));
+        }
+        let id = b.add_body(ShapeRef { kind, index }, material, spec.position, spec.rotation, spec.velocity);
+        let (m, inertia) = (b.bodies.mass[id as usize], b.bodies.inertia[id as usize]);
+        if !(m > 0.0 && m.is_finite() && inertia.iter().all(|x| *x > 0.0 && x.is_finite())) {
+            return Err(cx.err(
+                &p("shape"),
+                format!("the body's mass ({m}) and inertia ({inertia:?}) must be positive and finite"),
+            ));
+        }
+        if let Some(name) = &spec.name {
+            if b.names.iter().any(|x| x.as_deref() == Some(name.as_str())) {
+                return Err(cx.err(&p("name"), format!("two bodies are named `{name}`")));
+            }
+            b.set_name(id, name);
+        }
+        if spec.fixed {
+            if spec.drive.is_some() {
+                return Err(cx.err(&p("drive"), "a fixed body cannot also be driven"));
+            }
+            b.set_fixed(id);
+        }
+        if let Some(d) = &spec.drive {
+            let mut dof: [Option<crate::drive::DofDrive>; 6] = Default::default();
+            let named = [("x", &d.x), ("y", &d.y), ("z", &d.z), ("rx", &d.rx), ("ry", &d.ry), ("rz", &d.rz)];
+            for (slot, (name, dd)) in named.into_iter().enumerate() {
+                if let Some(dd) = dd {
+                    dd.validate().map_err(|m| cx.err(&at(&base, &[k("drive"), k(name)]), m))?;
+                    dof[slot] = Some(dd.clone());
+                }
+            }
+            drives.push(BodyDrive3 { body: id, dof });
+        }
+    }
+    Ok(())
+}
