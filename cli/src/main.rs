@@ -4,6 +4,7 @@
 //! 2 bad input (the message names the file, the line and the key).
 
 mod bench;
+mod run3;
 
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -145,10 +146,22 @@ fn main() -> ExitCode {
             return ExitCode::from(code);
         }
     };
-    let reg = nscdd_rigid_disks::registry();
+    let mut reg = nscdd_rigid_disks::registry();
+    reg.add_plugin(&nscdd_spheres::SpheresPlugin);
     match cli.cmd {
-        Cmd::Check { scene } => match nscdd::scene::load(&scene, &reg) {
-            Ok(s) => {
+        Cmd::Check { scene } => match nscdd::scene::load_any(&scene, &reg) {
+            Ok(nscdd::scene::AnyScene::D3(s)) => {
+                let w = &s.world;
+                println!(
+                    "{}: ok — 3D, {} bodies, {} steps of {} s",
+                    scene.display(),
+                    w.bodies.len(),
+                    w.time.steps,
+                    w.time.h
+                );
+                ExitCode::SUCCESS
+            }
+            Ok(nscdd::scene::AnyScene::D2(s)) => {
                 let w = &s.world;
                 let dd = match &s.decomposition {
                     Some(c) => format!(
@@ -177,7 +190,20 @@ fn main() -> ExitCode {
             threads,
             restart,
         } => {
-            let loaded = nscdd::scene::load(&scene, &reg).map_err(|e| e.to_string()).and_then(|mut s| {
+            let loaded = match nscdd::scene::load_any(&scene, &reg) {
+                Ok(nscdd::scene::AnyScene::D3(s3)) => {
+                    let flags = [
+                        ("--subdomains", subdomains.is_some()),
+                        ("--scheme", scheme.is_some()),
+                        ("--threads", threads.is_some()),
+                        ("--restart", restart.is_some()),
+                    ];
+                    return run3::run(s3, &out, quiet, &flags);
+                }
+                Ok(nscdd::scene::AnyScene::D2(s)) => Ok(s),
+                Err(e) => Err(e.to_string()),
+            }
+            .and_then(|mut s| {
                 apply_decomposition(&mut s, subdomains.as_deref(), scheme.as_deref(), threads.as_deref())?;
                 if let Some(state) = &restart {
                     let dir_of = |p: &std::path::Path| std::fs::canonicalize(p).ok();

@@ -61,7 +61,8 @@ impl Detector3 {
             let (ka, kb) = (key as usize / nk, key as usize % nk);
             if let Some((det, swapped)) = &table.table[ka * nk + kb] {
                 self.batch.clear();
-                self.batch.extend(self.pairs[p..q].iter().map(|x| if *swapped { [x.1[1], x.1[0]] } else { x.1 }));
+                self.batch
+                    .extend(self.pairs[p..q].iter().map(|x| if *swapped { [x.1[1], x.1[0]] } else { x.1 }));
                 let (sa, sb) = if *swapped { (kb, ka) } else { (ka, kb) };
                 let ctx = DetectCtx3 {
                     a: shapes[sa].as_ref(),

@@ -39,7 +39,14 @@ impl World3 {
         make_order(&mut self.scratch.order, self.contacts.len(), &self.solver, self.step);
         let t2 = Instant::now();
         let b = &mut self.bodies;
-        rep.solve = nlgs::solve(&mut self.contacts, &mut b.vel, &b.inv_m, &b.inv_i, &self.scratch.order, &self.solver);
+        rep.solve = nlgs::solve(
+            &mut self.contacts,
+            &mut b.vel,
+            &b.inv_m,
+            &b.inv_i,
+            &self.scratch.order,
+            &self.solver,
+        );
         let t3 = Instant::now();
         update_positions(self)?;
         let t4 = Instant::now();
@@ -194,7 +201,15 @@ pub fn build_contacts(w: &mut World3) {
     for a in 0..c.len() {
         if c.r[a] != [0.0; 3] {
             let [i, j] = c.bodies[a];
-            crate::rigid3d::contacts::apply(&c.frame[a], c.r[a], i as usize, j as usize, &mut w.bodies.vel, &w.bodies.inv_m, &w.bodies.inv_i);
+            crate::rigid3d::contacts::apply(
+                &c.frame[a],
+                c.r[a],
+                i as usize,
+                j as usize,
+                &mut w.bodies.vel,
+                &w.bodies.inv_m,
+                &w.bodies.inv_i,
+            );
         }
     }
 }

@@ -37,6 +37,7 @@ pub mod registry3;
 pub mod rigid2d;
 pub mod rigid3d;
 pub mod run;
+pub mod run3;
 pub mod scene;
 pub mod solver;
 pub mod world;

@@ -98,7 +98,10 @@ impl World3 {
     /// Σ grain volumes / box volume.
     pub fn solid_fraction(&self) -> Option<f64> {
         let e = self.box_extent()?;
-        let v: f64 = (0..self.bodies.len()).filter(|&b| self.is_grain(b)).map(|b| self.bodies.volume[b]).sum();
+        let v: f64 = (0..self.bodies.len())
+            .filter(|&b| self.is_grain(b))
+            .map(|b| self.bodies.volume[b])
+            .sum();
         Some(v / ((e[1] - e[0]) * (e[3] - e[2]) * (e[5] - e[4])))
     }
     /// Mean stresses on the box walls (σ_xx, σ_yy, σ_zz), compression positive, from

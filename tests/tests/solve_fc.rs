@@ -535,12 +535,26 @@ fn fclib_files_reach_the_requested_residual() {
             norm: FcNorm::Natural,
         };
         let s = p.solve(&opts);
-        println!("{}: {} contacts, {} sweeps, residual {:.2e}", f.display(), p.nc, s.sweeps, s.residual);
+        println!(
+            "{}: {} contacts, {} sweeps, residual {:.2e}",
+            f.display(),
+            p.nc,
+            s.sweeps,
+            s.residual
+        );
         assert!(s.converged && s.residual < 1e-6, "{}: {s:?}", f.display());
         let again = p.natural_residual(&s.r);
-        assert!((again - s.residual).abs() <= 1e-9 * s.residual.max(1e-12) + 1e-15, "{again} vs {}", s.residual);
+        assert!(
+            (again - s.residual).abs() <= 1e-9 * s.residual.max(1e-12) + 1e-15,
+            "{again} vs {}",
+            s.residual
+        );
         // a tolerance NLGS cannot reach in 5 sweeps is reported as not converged
-        let short = p.solve(&FcOptions { max_sweeps: 5, tol: 1e-12, ..opts });
+        let short = p.solve(&FcOptions {
+            max_sweeps: 5,
+            tol: 1e-12,
+            ..opts
+        });
         assert!(!short.converged && short.residual > 1e-12);
     }
 }

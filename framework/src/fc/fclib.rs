@@ -127,7 +127,10 @@ pub fn read(path: &Path) -> Result<FcProblem, InputError> {
     } else if f.link_exists("fclib_global") {
         global(&f).map_err(err)?
     } else {
-        return Err(err((String::new(), "neither /fclib_local nor /fclib_global: not an FCLIB problem".into())));
+        return Err(err((
+            String::new(),
+            "neither /fclib_local nor /fclib_global: not an FCLIB problem".into(),
+        )));
     };
     p.validate().map_err(err)?;
     Ok(p)
@@ -193,7 +196,9 @@ fn global(f: &hdf5::File) -> R<FcProblem> {
 fn condense(m: &Coo, h: &Coo, f: &[f64], w: &[f64]) -> Result<(CooMatrix, Vec<f64>), String> {
     let nd = m.n;
     // the lower triangle of M, whether the file stores it whole or one triangle
-    let (lo, up) = m.t.iter().fold((0, 0), |(l, u), e| (l + (e.0 > e.1) as usize, u + (e.0 < e.1) as usize));
+    let (lo, up) =
+        m.t.iter()
+            .fold((0, 0), |(l, u), e| (l + (e.0 > e.1) as usize, u + (e.0 < e.1) as usize));
     let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(m.t.len());
     for &(r, c, v) in &m.t {
         if r >= c {

@@ -43,11 +43,11 @@ mod world;
 pub mod fclib;
 
 use crate::norms::{natural_map_sq, Criterion};
-pub use world::problem_from_world;
 use serde::Serialize;
 use serde_json::{Map, Value};
 use std::io::Read;
 use std::path::Path;
+pub use world::problem_from_world;
 
 /// Stopping test of `solve-fc`.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -69,7 +69,11 @@ impl<const D: usize> Blocks<D> {
             diag.iter()
                 .map(|d| {
                     let s = [d[0][0], d[0][1], d[0][2], d[1][1], d[1][2], d[2][2]];
-                    let full = [[d[0][0], d[0][1], d[0][2]], [d[1][0], d[1][1], d[1][2]], [d[2][0], d[2][1], d[2][2]]];
+                    let full = [
+                        [d[0][0], d[0][1], d[0][2]],
+                        [d[1][0], d[1][1], d[1][2]],
+                        [d[2][0], d[2][1], d[2][2]],
+                    ];
                     (s, c3::precompute(&s), if sym3(d) { None } else { Some(full) })
                 })
                 .collect()
@@ -172,15 +176,14 @@ pub fn solve<const D: usize>(p: &FcProblem, opts: &FcOptions) -> FcSolution {
     let t0 = Instant::now();
     let nc = p.nc;
     let b = Blocks::<D>::assemble(p);
-    let q: Vec<[f64; D]> = p
-        .q
-        .chunks_exact(D)
-        .map(|c| {
-            let mut v = [0.0; D];
-            v.copy_from_slice(c);
-            v
-        })
-        .collect();
+    let q: Vec<[f64; D]> =
+        p.q.chunks_exact(D)
+            .map(|c| {
+                let mut v = [0.0; D];
+                v.copy_from_slice(c);
+                v
+            })
+            .collect();
     let qs = q_scale(&p.q);
     let mut r = vec![[0.0; D]; nc];
     let mut u = vec![[0.0; D]; nc];

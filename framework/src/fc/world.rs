@@ -85,4 +85,3 @@ pub fn problem_from_world(w: &World2) -> FcProblem {
         meta: Some(meta),
     }
 }
-

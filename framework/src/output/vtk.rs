@@ -28,10 +28,10 @@ pub(crate) fn register_builtin(r: &mut Registry) {
 /// Writes the VTK frames and `.pvd` series.
 #[derive(Default)]
 pub struct VtkWriter {
-    frames: Vec<(f64, u32)>,
+    pub(crate) frames: Vec<(f64, u32)>,
 }
 
-fn piece(
+pub(crate) fn piece(
     points: Vec<f64>,
     verts: Option<VertexNumbers>,
     lines: Option<VertexNumbers>,
@@ -55,20 +55,20 @@ fn piece(
     }
 }
 
-fn cells(conn: Vec<u64>, offsets: Vec<u64>) -> Option<VertexNumbers> {
+pub(crate) fn cells(conn: Vec<u64>, offsets: Vec<u64>) -> Option<VertexNumbers> {
     Some(VertexNumbers::XML {
         connectivity: conn,
         offsets,
     })
 }
 
-fn export(v: Vtk, path: &Path) -> std::io::Result<()> {
+pub(crate) fn export(v: Vtk, path: &Path) -> std::io::Result<()> {
     v.export(path)
         .map_err(|e| std::io::Error::other(format!("writing {}: {e}", path.display())))
 }
 
 impl VtkWriter {
-    fn write_pvd(&self, dir: &Path, name: &str) -> std::io::Result<()> {
+    pub(crate) fn write_pvd(&self, dir: &Path, name: &str) -> std::io::Result<()> {
         let mut f = std::io::BufWriter::new(std::fs::File::create(dir.join(format!("{name}.pvd")))?);
         writeln!(
             f,

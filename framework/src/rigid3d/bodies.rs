@@ -229,7 +229,16 @@ mod tests {
     fn restricted_inverse_inertia() {
         let mut b = Bodies3::default();
         let s = ShapeRef { kind: 0, index: 0 };
-        b.push([0.0; 3], from_rotation_vector([0.3, -0.2, 0.5]), [0.0; 6], 2.0, [1.0, 2.0, 3.0], 1.0, s, 0);
+        b.push(
+            [0.0; 3],
+            from_rotation_vector([0.3, -0.2, 0.5]),
+            [0.0; 6],
+            2.0,
+            [1.0, 2.0, 3.0],
+            1.0,
+            s,
+            0,
+        );
         let iw = b.world_inertia(0);
         let inv = crate::rigid3d::coulomb::inverse(&iw).unwrap();
         for k in 0..6 {

@@ -3,8 +3,8 @@
 //! one-contact solver ([`super::coulomb`]). The check pass, the stopping test and the
 //! natural-map residual are the dimension-free ones of [`crate::norms`].
 
-use super::coulomb::{self, Sym3};
 use super::contacts::{apply, local_velocity, Contacts3};
+use super::coulomb::{self, Sym3};
 use crate::norms::{natural_map_sq, Norms, Sums};
 use crate::solver::{SolveReport, SolverSettings};
 

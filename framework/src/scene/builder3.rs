@@ -81,8 +81,16 @@ impl<'r> SceneBuilder3<'r> {
         self.names.push(None);
         self.fixed.push(false);
         self.origins.push(self.origin);
-        self.bodies
-            .push(pos, from_rotation_vector(rotation), vel, mp.mass, mp.inertia, mp.volume, shape, material)
+        self.bodies.push(
+            pos,
+            from_rotation_vector(rotation),
+            vel,
+            mp.mass,
+            mp.inertia,
+            mp.volume,
+            shape,
+            material,
+        )
     }
 
     /// Makes a body immovable.

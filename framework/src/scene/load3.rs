@@ -79,12 +79,14 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene3, I
     let mut mat_movable = vec![false; nm];
     let mut first_kind = vec![None; nk];
     let mut kind_movable = vec![false; nk];
+    let mut kind_mats = vec![false; nk * nm];
     for i in 0..n {
         let (m, kd) = (b.bodies.material[i] as usize, b.bodies.shape[i].kind as usize);
         let mv = b.bodies.movable(i) || driven[i];
         first_mat[m].get_or_insert(b.origins[i]);
         mat_count[m] += 1;
         first_kind[kd].get_or_insert(b.origins[i]);
+        kind_mats[kd * nm + m] = true;
         mat_movable[m] |= mv;
         kind_movable[kd] |= mv;
     }
@@ -109,9 +111,12 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene3, I
     for ka in 0..nk {
         for kb in 0..nk {
             let (na, nb) = (b.shapes[ka].kind(), b.shapes[kb].kind());
+            // a detector is needed where a law can act between the two kinds' materials
+            let interact =
+                (0..nm).any(|ma| (0..nm).any(|mb| kind_mats[ka * nm + ma] && kind_mats[kb * nm + mb] && laws[ma * nm + mb].is_some()));
             match registry.detector3(na, nb) {
                 Some(d) => table.table[ka * nk + kb] = Some(d),
-                None if kind_movable[ka] || kind_movable[kb] => {
+                None if interact && (kind_movable[ka] || kind_movable[kb]) => {
                     let o = first_kind[ka].or(first_kind[kb]).unwrap_or(Origin::Body(0));
                     return Err(cx.err(
                         &origin_path(o, "shape"),
@@ -232,16 +237,29 @@ fn add_bodies(cx: &Ctx, sf: &SceneFile<BodySpec3>, b: &mut SceneBuilder3, drives
         let kind = b.kind(&spec.shape).ok_or_else(|| {
             cx.err(
                 &p("shape"),
-                format!("unknown 3D shape `{}`; installed: {}", spec.shape, b.registry.shape_kinds3().join(", ")),
+                format!(
+                    "unknown 3D shape `{}`; installed: {}",
+                    spec.shape,
+                    b.registry.shape_kinds3().join(", ")
+                ),
             )
         })?;
         let material = b.material(&spec.material).ok_or_else(|| {
-            cx.err(&p("material"), format!("unknown material `{}`; declare it in [[materials]]", spec.material))
+            cx.err(
+                &p("material"),
+                format!("unknown material `{}`; declare it in [[materials]]", spec.material),
+            )
         })?;
         let index = b.shapes[kind as usize]
             .push_params(&spec.params)
             .map_err(|e| cx.err(&p(&e.key), e.msg))?;
-        if spec.position.iter().chain(&spec.velocity).chain(&spec.rotation).any(|x| !x.is_finite()) {
+        if spec
+            .position
+            .iter()
+            .chain(&spec.velocity)
+            .chain(&spec.rotation)
+            .any(|x| !x.is_finite())
+        {
             return Err(cx.err(&p("position"), "position, rotation and velocity must be finite"));
         }
         let id = b.add_body(ShapeRef { kind, index }, material, spec.position, spec.rotation, spec.velocity);

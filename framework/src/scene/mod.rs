@@ -138,10 +138,7 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
     let cx = Ctx { text, file };
     let sf: SceneFile = parse(text, file)?;
     if sf.dimension != 2 {
-        return Err(cx.err(
-            &[k("dimension")],
-            format!("dimension {} is not supported: 2 or 3", sf.dimension),
-        ));
+        return Err(cx.err(&[k("dimension")], format!("dimension {} is not supported: 2 or 3", sf.dimension)));
     }
     if sf.gravity.len() != 2 || sf.gravity.iter().any(|g| !g.is_finite()) {
         return Err(cx.err(&[k("gravity")], "gravity must be 2 finite numbers in 2D"));

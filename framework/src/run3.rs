@@ -1,0 +1,85 @@
+//! Running a loaded 3D scene to its end and writing its outputs in a directory
+//! ([`crate::output::out3`]): the 3D counterpart of [`crate::run::run`].
+
+use crate::engine::StepReport;
+use crate::output::out3::{final_json3, write_vtk3, History3};
+use crate::output::vtk::VtkWriter;
+use crate::run::{RunError, RunSummary, SUSPECT_FACTOR};
+use crate::scene::load3::Scene3;
+use crate::world3::World3;
+use std::io::Write;
+use std::path::Path;
+use std::time::Instant;
+
+fn io(dir: &Path, what: &str) -> impl Fn(std::io::Error) -> RunError {
+    let d = dir.display().to_string();
+    let what = what.to_string();
+    move |e| RunError::Io(format!("cannot write {what} in {d}: {e}"))
+}
+
+fn save_state(dir: &Path, name: &str, w: &World3) -> Result<(), RunError> {
+    let tmp = dir.join(format!(".{name}.tmp"));
+    let mut f = std::fs::File::create(&tmp).map_err(io(dir, name))?;
+    f.write_all(final_json3(w).as_bytes()).map_err(io(dir, name))?;
+    drop(f);
+    std::fs::rename(&tmp, dir.join(name)).map_err(io(dir, name))
+}
+
+/// Runs a 3D scene for its number of steps, writing `history.csv`, VTK frames every
+/// `output.every` steps (and at the first and last step), `checkpoint.json` every
+/// `output.checkpoint_every` steps and `final.json` in `dir`.
+pub fn run3(scene: &mut Scene3, dir: &Path, mut on_step: impl FnMut(&World3, &StepReport)) -> Result<RunSummary, RunError> {
+    let start = Instant::now();
+    std::fs::create_dir_all(dir).map_err(io(dir, "the output directory"))?;
+    let w = &mut scene.world;
+    let file = std::fs::File::create(dir.join("history.csv")).map_err(io(dir, "history.csv"))?;
+    let mut hist = History3::new(std::io::BufWriter::new(file), w).map_err(io(dir, "history.csv"))?;
+    let mut vtk = scene.output.vtk.then(VtkWriter::default);
+    let mut frame = 0u32;
+    if let Some(v) = vtk.as_mut() {
+        write_vtk3(v, w, dir, frame).map_err(io(dir, "the first output frame"))?;
+        frame += 1;
+    }
+    let mut sum = RunSummary::default();
+    let steps = w.time.steps;
+    for s in (w.step + 1)..=steps {
+        let rep = match w.step() {
+            Ok(r) => r,
+            Err(d) => {
+                let _ = hist.flush();
+                return Err(RunError::Diverged(d));
+            }
+        };
+        let t0 = Instant::now();
+        if (scene.output.every > 0 && s % scene.output.every == 0) || s == steps {
+            if let Some(v) = vtk.as_mut() {
+                write_vtk3(v, w, dir, frame).map_err(io(dir, "an output frame"))?;
+                frame += 1;
+            }
+            hist.flush().map_err(io(dir, "history.csv"))?;
+        }
+        let t_out = t0.elapsed().as_secs_f64();
+        hist.row(w, &rep, t_out).map_err(io(dir, "history.csv"))?;
+        if scene.output.checkpoint_every > 0 && s % scene.output.checkpoint_every == 0 && s != steps {
+            hist.flush().map_err(io(dir, "history.csv"))?;
+            save_state(dir, "checkpoint.json", w)?;
+        }
+        sum.steps += 1;
+        sum.total_sweeps += rep.solve.sweeps as u64;
+        if !rep.solve.converged {
+            sum.unconverged_steps += 1;
+            sum.first_unconverged.get_or_insert(w.step);
+        } else if rep.solve.residual > SUSPECT_FACTOR * w.solver.tolerance {
+            sum.suspect_steps += 1;
+        }
+        if rep.solve.residual > sum.max_residual {
+            sum.max_residual = rep.solve.residual;
+            sum.max_residual_step = w.step;
+        }
+        on_step(w, &rep);
+    }
+    hist.flush().map_err(io(dir, "history.csv"))?;
+    save_state(dir, "final.json", w)?;
+    sum.wall_seconds = start.elapsed().as_secs_f64();
+    Ok(sum)
+}
