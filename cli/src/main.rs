@@ -4,6 +4,7 @@
 //! 2 bad input (the message names the file, the line and the key).
 
 mod bench;
+mod bench3;
 mod run3;
 
 use clap::{Parser, Subcommand};
@@ -64,7 +65,7 @@ enum Cmd {
     /// Benchmarks: `nlgs` (contact updates per second), `deposit` (time per stage) or
     /// `nscdd` (NSCDD iterations and thread efficiency on the compacted biaxial sample).
     Bench {
-        #[arg(value_parser = ["nlgs", "deposit", "nscdd"])]
+        #[arg(value_parser = ["nlgs", "nlgs3", "deposit", "nscdd"])]
         which: String,
         /// Number of disks (default 10000; nscdd: 2000).
         #[arg(long)]
@@ -336,6 +337,7 @@ fn main() -> ExitCode {
         } => {
             match which.as_str() {
                 "nlgs" => bench::nlgs(&reg, disks.unwrap_or(10000), repeat.unwrap_or(200)),
+                "nlgs3" => bench3::nlgs3(&reg, disks.unwrap_or(10648), repeat.unwrap_or(200)),
                 "deposit" => bench::deposit(&reg, disks.unwrap_or(10000), repeat.unwrap_or(200)),
                 _ => {
                     let list: Result<Vec<_>, _> = subdomains.split(',').map(parse_subdomains).collect();

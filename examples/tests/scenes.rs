@@ -38,3 +38,16 @@ fn biaxial_history_has_the_biaxial_columns() {
     assert!((0.7..0.9).contains(&nu), "the deposit is dense: ν = {nu}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn every_3d_example_loads_and_steps() {
+    let reg = nscdd_spheres::registry();
+    for s in nscdd_examples::SCENES_3D {
+        let text = std::fs::read_to_string(root().join(s)).unwrap();
+        let mut scene = nscdd::scene::load3::load_str(&text, s, &reg).unwrap_or_else(|e| panic!("{e}"));
+        assert!(scene.world.bodies.len() >= 1000, "{s}: a sample of at least 1000 bodies");
+        for _ in 0..5 {
+            scene.world.step().unwrap_or_else(|e| panic!("{s}: {e}"));
+        }
+    }
+}

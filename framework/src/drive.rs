@@ -96,9 +96,33 @@ pub struct Phase {
     /// Imposed force (N or N·m, per unit depth in 2D), added to the loads.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub force: Option<TimeFn>,
+    /// Imposed pressure (Pa) on a wall of a 3D box sample (`[output] box3`): a force
+    /// σ × the current area of the sample's face, pushing into the sample.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pressure: Option<TimeFn>,
+    /// Stress-controlled wall of a 3D box sample: a velocity that closes the gap
+    /// between the target pressure and the stress the grains exert on the wall.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub servo: Option<Servo>,
     /// The phase holds for t < until (the last phase holds for ever).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub until: Option<f64>,
+}
+
+/// A servo-controlled wall (as DEM codes drive stress-controlled walls): at each step
+/// the wall moves into the sample at `v = clamp(gain × (σ_target − σ_wall),
+/// −max_velocity, max_velocity)`, σ_wall being the stress the grains exerted on it
+/// over the previous step. A quasi-static compaction: the walls never build up
+/// momentum, whatever their mass.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Servo {
+    /// Target pressure σ_target (Pa).
+    pub pressure: TimeFn,
+    /// (m/s)/Pa.
+    pub gain: f64,
+    /// m/s.
+    pub max_velocity: f64,
 }
 
 /// A driven degree of freedom: one phase or a list of phases.
@@ -114,6 +138,9 @@ pub enum DofDrive {
 pub enum Imposed {
     Velocity(f64),
     Force(f64),
+    Pressure(f64),
+    /// Target pressure, gain, velocity bound.
+    Servo(f64, f64, f64),
     Free,
 }
 
@@ -131,9 +158,15 @@ impl DofDrive {
             return Err("a drive needs at least one phase".into());
         }
         for (k, p) in ph.iter().enumerate() {
-            match (&p.velocity, &p.force) {
-                (Some(f), None) | (None, Some(f)) => f.validate()?,
-                _ => return Err("each phase imposes exactly one of `velocity` or `force`".into()),
+            match (&p.velocity, &p.force, &p.pressure, &p.servo) {
+                (Some(f), None, None, None) | (None, Some(f), None, None) | (None, None, Some(f), None) => f.validate()?,
+                (None, None, None, Some(sv)) => {
+                    sv.pressure.validate()?;
+                    if !(sv.gain > 0.0 && sv.gain.is_finite() && sv.max_velocity > 0.0 && sv.max_velocity.is_finite()) {
+                        return Err("a servo needs gain > 0 and max_velocity > 0".into());
+                    }
+                }
+                _ => return Err("each phase imposes exactly one of `velocity`, `force`, `pressure` or `servo`".into()),
             }
             if let Some(u) = p.until {
                 if !u.is_finite() {
@@ -154,24 +187,37 @@ impl DofDrive {
     pub fn at(&self, t: f64) -> Imposed {
         for p in self.phases() {
             if p.until.is_none_or(|u| t < u) {
-                return match (&p.velocity, &p.force) {
-                    (Some(v), _) => Imposed::Velocity(v.eval(t)),
-                    (_, Some(f)) => Imposed::Force(f.eval(t)),
-                    _ => Imposed::Free,
-                };
+                return Self::imposed(p, t);
             }
         }
         // after the last phase with `until`, the last phase's function continues
         match self.phases().last() {
-            Some(Phase { velocity: Some(v), .. }) => Imposed::Velocity(v.eval(t)),
-            Some(Phase { force: Some(f), .. }) => Imposed::Force(f.eval(t)),
-            _ => Imposed::Free,
+            Some(p) => Self::imposed(p, t),
+            None => Imposed::Free,
         }
     }
 
     /// Whether the drive imposes a velocity at time t.
+    fn imposed(p: &Phase, t: f64) -> Imposed {
+        match (&p.velocity, &p.force, &p.pressure, &p.servo) {
+            (Some(v), ..) => Imposed::Velocity(v.eval(t)),
+            (_, Some(f), ..) => Imposed::Force(f.eval(t)),
+            (_, _, Some(s), _) => Imposed::Pressure(s.eval(t)),
+            (_, _, _, Some(sv)) => Imposed::Servo(sv.pressure.eval(t), sv.gain, sv.max_velocity),
+            _ => Imposed::Free,
+        }
+    }
+
+    /// Whether any phase imposes a pressure (or a servo): the body must then be a
+    /// wall of a 3D box sample.
+    pub fn has_pressure(&self) -> bool {
+        self.phases().iter().any(|p| p.pressure.is_some() || p.servo.is_some())
+    }
+
+    /// Whether the degree of freedom moves at an imposed velocity at t (velocity and
+    /// servo phases): impulses do not move it.
     pub fn is_velocity_at(&self, t: f64) -> bool {
-        matches!(self.at(t), Imposed::Velocity(_))
+        matches!(self.at(t), Imposed::Velocity(_) | Imposed::Servo(..))
     }
 }
 
@@ -190,11 +236,15 @@ mod tests {
             Phase {
                 velocity: None,
                 force: Some(TimeFn::Constant(5.0)),
+                pressure: None,
+                servo: None,
                 until: Some(1.0),
             },
             Phase {
                 velocity: Some(TimeFn::Constant(-1.0)),
                 force: None,
+                pressure: None,
+                servo: None,
                 until: None,
             },
         ]);

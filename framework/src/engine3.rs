@@ -115,14 +115,46 @@ pub fn free_velocity(w: &mut World3) {
             }
         }
     }
+    // pressure drives: σ × the current face area of the box sample
+    let faces = w.box_walls.as_ref().map(|bw| bw.walls);
+    let extent = w.box_extent();
+    let reaction = &w.reaction;
+    let b = &mut w.bodies;
     for d in &w.drives {
         let k = d.body as usize;
         for dof in 0..6 {
             let Some(drv) = &d.dof[dof] else { continue };
             match drv.at(t_end) {
                 Imposed::Velocity(v) => b.vel[k][dof] = v,
+                Imposed::Servo(sigma, gain, vmax) => {
+                    // the stress the grains exerted on the wall over the last step
+                    if let (Some(f), Some(e)) = (faces, extent) {
+                        if let Some(wall) = f.iter().position(|&x| x as usize == k).filter(|wl| wl / 2 == dof) {
+                            let l = [e[1] - e[0], e[3] - e[2], e[5] - e[4]];
+                            let area = l[(dof + 1) % 3] * l[(dof + 2) % 3];
+                            let sign = if wall % 2 == 0 { 1.0 } else { -1.0 };
+                            let measured = -sign * reaction.get(k).map_or(0.0, |r| r[dof]) / (h * area);
+                            b.vel[k][dof] = sign * (gain * (sigma - measured)).clamp(-vmax, vmax);
+                        }
+                    }
+                }
                 _ => {
-                    if let Imposed::Force(f) = drv.at(t_theta) {
+                    let imposed = match drv.at(t_theta) {
+                        Imposed::Pressure(sigma) => match (faces, extent) {
+                            (Some(f), Some(e)) => match f.iter().position(|&x| x as usize == k) {
+                                Some(wall) if wall / 2 == dof => {
+                                    let l = [e[1] - e[0], e[3] - e[2], e[5] - e[4]];
+                                    let area = l[(dof + 1) % 3] * l[(dof + 2) % 3];
+                                    let sign = if wall % 2 == 0 { 1.0 } else { -1.0 };
+                                    Imposed::Force(sign * sigma * area)
+                                }
+                                _ => Imposed::Free,
+                            },
+                            _ => Imposed::Free,
+                        },
+                        other => other,
+                    };
+                    if let Imposed::Force(f) = imposed {
                         if dof < 3 {
                             b.vel[k][dof] += h * f / b.mass[k];
                         } else {

@@ -20,11 +20,15 @@ use vtkio::model::Attribute;
 /// force resultant, N); with `[output] box3`: `solid_fraction`, `eps1` (along z),
 /// `sigma_xx`, `sigma_yy`, `sigma_zz` (Pa, compression positive), `p`, `q`
 /// (σ_zz − ½(σ_xx + σ_yy)), `q_over_p`, `z` (grain–grain coordination number),
-/// `z_m` (loaded contacts per grain without the rattlers); then the stage timings.
+/// `z_m` (loaded contacts per grain without the rattlers), and away from the walls
+/// (inner box shrunk by 4 largest radii, [`World3::bulk_measures`]) `nu_bulk`,
+/// `z_bulk`, `rattlers_bulk`; then the stage timings.
 pub struct History3<W: Write> {
     out: W,
     tracked: Vec<(u32, String)>,
     has_box: bool,
+    /// Margin of the bulk measures: 4 × the largest grain radius.
+    margin: f64,
 }
 
 impl<W: Write> History3<W> {
@@ -46,11 +50,12 @@ impl<W: Write> History3<W> {
             }
         }
         if has_box {
-            head.push_str(",solid_fraction,eps1,sigma_xx,sigma_yy,sigma_zz,p,q,q_over_p,z,z_m");
+            head.push_str(",solid_fraction,eps1,sigma_xx,sigma_yy,sigma_zz,p,q,q_over_p,z,z_m,nu_bulk,z_bulk,rattlers_bulk");
         }
         head.push_str(",t_detect,t_delassus,t_nlgs,t_update,t_output");
         writeln!(out, "{head}")?;
-        Ok(History3 { out, tracked, has_box })
+        let margin = 4.0 * w.max_grain_size();
+        Ok(History3 { out, tracked, has_box, margin })
     }
 
     pub fn row(&mut self, w: &World3, r: &StepReport, t_output: f64) -> std::io::Result<()> {
@@ -96,8 +101,9 @@ impl<W: Write> History3<W> {
             let p = (sg[0] + sg[1] + sg[2]) / 3.0;
             let q = sg[2] - 0.5 * (sg[0] + sg[1]);
             let (z, zm) = w.coordination();
+            let (nb, zb, rb) = w.bulk_measures(self.margin).unwrap_or((f64::NAN, f64::NAN, f64::NAN));
             s.push_str(&format!(
-                ",{nu:e},{eps1:e},{:e},{:e},{:e},{p:e},{q:e},{:e},{z:e},{zm:e}",
+                ",{nu:e},{eps1:e},{:e},{:e},{:e},{p:e},{q:e},{:e},{z:e},{zm:e},{nb:e},{zb:e},{rb:e}",
                 sg[0],
                 sg[1],
                 sg[2],

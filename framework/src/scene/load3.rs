@@ -191,6 +191,23 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene3, I
             })
         }
     };
+    // a pressure drive pushes a wall of the box sample along the wall's axis
+    for d in &drives {
+        for (dof, drv) in d.dof.iter().enumerate() {
+            if !drv.as_ref().is_some_and(|x| x.has_pressure()) {
+                continue;
+            }
+            let wall = box_walls.as_ref().and_then(|bw| bw.walls.iter().position(|&x| x == d.body));
+            if wall.is_none_or(|wl| wl / 2 != dof) {
+                let name = ["x", "y", "z", "rx", "ry", "rz"][dof];
+                let base = origin_path(b.origins[d.body as usize], "drive");
+                return Err(cx.err(
+                    &at(&base, &[k(name)]),
+                    "a pressure drive needs the body to be a wall of `[output] box3`, driven along its own axis (x for xmin/xmax, ...)",
+                ));
+            }
+        }
+    }
     for (i, w) in sf.output.writers.iter().enumerate() {
         return Err(cx.err(
             &[k("output"), k("writers"), Seg::Index(i)],

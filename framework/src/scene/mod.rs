@@ -143,6 +143,12 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
     if sf.gravity.len() != 2 || sf.gravity.iter().any(|g| !g.is_finite()) {
         return Err(cx.err(&[k("gravity")], "gravity must be 2 finite numbers in 2D"));
     }
+    if sf.output.box3.is_some() {
+        return Err(cx.err(&[k("output"), k("box3")], "`box3` names the 6 walls of a 3D sample; in 2D use `box`"));
+    }
+    if sf.decomposition.as_ref().is_some_and(|d| d.nz.is_some()) {
+        return Err(cx.err(&[k("decomposition"), k("nz")], "`nz` splits along z: 3D scenes only"));
+    }
     let time = time_settings(&cx, &sf)?;
     validate_solver(&cx, &sf.solver)?;
     let materials = materials(&cx, &sf)?;
@@ -537,6 +543,12 @@ fn add_bodies(cx: &Ctx, sf: &SceneFile, b: &mut SceneBuilder2, drives: &mut Vec<
             for (slot, (name, dd)) in [("x", &d.x), ("y", &d.y), ("rot", &d.rot)].into_iter().enumerate() {
                 if let Some(dd) = dd {
                     dd.validate().map_err(|m| cx.err(&at(&base, &[k("drive"), k(name)]), m))?;
+                    if dd.has_pressure() {
+                        return Err(cx.err(
+                            &at(&base, &[k("drive"), k(name)]),
+                            "pressure drives act on the walls of 3D box samples (`[output] box3`); in 2D impose a force",
+                        ));
+                    }
                     dof[slot] = Some(dd.clone());
                 }
             }
