@@ -12,7 +12,9 @@ fn lattice3(n: usize) -> String {
     let r = 0.01;
     let l = 2.0 * r * k as f64;
     let plane = |name: &str, pos: [f64; 3], rot: [f64; 3]| {
-        format!("[[bodies]]\nname = \"{name}\"\nshape = \"plane\"\nmaterial = \"g\"\nposition = {pos:?}\nrotation = {rot:?}\nfixed = true\n")
+        format!(
+            "[[bodies]]\nname = \"{name}\"\nshape = \"plane\"\nmaterial = \"g\"\nposition = {pos:?}\nrotation = {rot:?}\nfixed = true\n"
+        )
     };
     let h = std::f64::consts::FRAC_PI_2;
     format!(

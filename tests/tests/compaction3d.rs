@@ -55,7 +55,10 @@ fn frictionless_spheres_reach_random_close_packing() {
     let (nu, z, ek) = compaction(0.0);
     assert!((0.615..=0.65).contains(&nu), "ν bulk = {nu}");
     assert!((5.5..=6.3).contains(&z), "z bulk = {z}");
-    assert!(ek < 1e-4, "the packing is nearly at rest: translational kinetic energy / (p V) = {ek:e}");
+    assert!(
+        ek < 1e-4,
+        "the packing is nearly at rest: translational kinetic energy / (p V) = {ek:e}"
+    );
 }
 
 #[test]
@@ -63,5 +66,8 @@ fn frictional_spheres_pack_looser_with_fewer_contacts() {
     let (nu, z, ek) = compaction(0.3);
     assert!((0.57..=0.61).contains(&nu), "ν bulk = {nu}");
     assert!((4.0..=5.0).contains(&z), "z bulk = {z}");
-    assert!(ek < 1e-4, "the packing is nearly at rest: translational kinetic energy / (p V) = {ek:e}");
+    assert!(
+        ek < 1e-4,
+        "the packing is nearly at rest: translational kinetic energy / (p V) = {ek:e}"
+    );
 }

@@ -55,7 +55,12 @@ impl<W: Write> History3<W> {
         head.push_str(",t_detect,t_delassus,t_nlgs,t_update,t_output");
         writeln!(out, "{head}")?;
         let margin = 4.0 * w.max_grain_size();
-        Ok(History3 { out, tracked, has_box, margin })
+        Ok(History3 {
+            out,
+            tracked,
+            has_box,
+            margin,
+        })
     }
 
     pub fn row(&mut self, w: &World3, r: &StepReport, t_output: f64) -> std::io::Result<()> {

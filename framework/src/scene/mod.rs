@@ -144,7 +144,10 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
         return Err(cx.err(&[k("gravity")], "gravity must be 2 finite numbers in 2D"));
     }
     if sf.output.box3.is_some() {
-        return Err(cx.err(&[k("output"), k("box3")], "`box3` names the 6 walls of a 3D sample; in 2D use `box`"));
+        return Err(cx.err(
+            &[k("output"), k("box3")],
+            "`box3` names the 6 walls of a 3D sample; in 2D use `box`",
+        ));
     }
     if sf.decomposition.as_ref().is_some_and(|d| d.nz.is_some()) {
         return Err(cx.err(&[k("decomposition"), k("nz")], "`nz` splits along z: 3D scenes only"));
