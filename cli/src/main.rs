@@ -61,6 +61,19 @@ enum Cmd {
         /// Check the stopping test every k sweeps.
         #[arg(long, default_value_t = 1)]
         check_every: u32,
+        /// Also write the problem as read (FCLIB global problems: condensed) in the
+        /// JSON exchange format (`.gz`: compressed).
+        #[arg(long, value_name = "FILE")]
+        export_json: Option<PathBuf>,
+    },
+    /// Run a scene (2D or 3D) for N steps and write the local problem of its last
+    /// step in the JSON exchange format (`.gz`: compressed).
+    ExportFc {
+        scene: PathBuf,
+        #[arg(long)]
+        steps: u64,
+        #[arg(long, value_name = "FILE")]
+        out: PathBuf,
     },
     /// Benchmarks: `nlgs` (contact updates per second), `deposit` (time per stage) or
     /// `nscdd` (NSCDD iterations and thread efficiency on the compacted biaxial sample).
@@ -134,6 +147,23 @@ fn apply_decomposition(
         let w = &s.world;
         let movable = (0..w.bodies.len()).filter(|&b| w.bodies.movable(b)).count();
         c.check_capacity(movable).map_err(|(_, m)| format!("--subdomains: {m}"))?;
+    }
+    Ok(())
+}
+
+/// Writes a problem in the JSON exchange format (gzip for `.gz`).
+fn write_problem(p: &nscdd::fc::FcProblem, path: &std::path::Path) -> Result<(), String> {
+    use std::io::Write;
+    let err = |e: std::io::Error| format!("cannot write {}: {e}", path.display());
+    let f = std::fs::File::create(path).map_err(err)?;
+    if path.to_string_lossy().ends_with(".gz") {
+        let mut z = flate2::write::GzEncoder::new(f, flate2::Compression::fast());
+        z.write_all(p.to_json().as_bytes()).map_err(err)?;
+        z.finish().map_err(err)?;
+    } else {
+        let mut w = std::io::BufWriter::new(f);
+        w.write_all(p.to_json().as_bytes()).map_err(err)?;
+        w.flush().map_err(err)?;
     }
     Ok(())
 }
@@ -299,6 +329,7 @@ fn main() -> ExitCode {
             max_sweeps,
             norm,
             check_every,
+            export_json,
         } => {
             let norm = match norm.as_str() {
                 "natural" => FcNorm::Natural,
@@ -310,23 +341,59 @@ fn main() -> ExitCode {
             if !(tol > 0.0) || max_sweeps == 0 || check_every == 0 {
                 return input_error("--tol must be > 0, --max-sweeps and --check-every ≥ 1");
             }
-            match nscdd::fc::solve_file(
-                &problem,
-                &FcOptions {
-                    tol,
-                    max_sweeps,
-                    check_every,
-                    norm,
-                },
-            ) {
-                Ok(sol) => {
-                    println!("{}", serde_json::to_string(&sol).expect("plain data"));
-                    if !sol.converged {
-                        eprintln!("warning: not converged after {} sweeps (residual {:e})", sol.sweeps, sol.residual);
+            let p = match nscdd::fc::read_any(&problem) {
+                Ok(p) => p,
+                Err(e) => return input_error(e),
+            };
+            if let Some(path) = &export_json {
+                if let Err(e) = write_problem(&p, path) {
+                    eprintln!("error: {e}");
+                    return ExitCode::from(1);
+                }
+            }
+            let sol = p.solve(&FcOptions {
+                tol,
+                max_sweeps,
+                check_every,
+                norm,
+            });
+            println!("{}", serde_json::to_string(&sol).expect("plain data"));
+            if !sol.converged {
+                eprintln!("warning: not converged after {} sweeps (residual {:e})", sol.sweeps, sol.residual);
+            }
+            ExitCode::SUCCESS
+        }
+        Cmd::ExportFc { scene, steps, out } => {
+            let p = match nscdd::scene::load_any(&scene, &reg) {
+                Err(e) => return input_error(e),
+                Ok(nscdd::scene::AnyScene::D2(mut s)) => {
+                    for _ in 0..steps {
+                        if let Err(e) = s.world.step() {
+                            eprintln!("error: {e}");
+                            return ExitCode::from(1);
+                        }
                     }
+                    nscdd::fc::problem_from_world(&s.world)
+                }
+                Ok(nscdd::scene::AnyScene::D3(mut s)) => {
+                    for _ in 0..steps {
+                        if let Err(e) = s.world.step() {
+                            eprintln!("error: {e}");
+                            return ExitCode::from(1);
+                        }
+                    }
+                    nscdd::fc::problem_from_world3(&s.world)
+                }
+            };
+            match write_problem(&p, &out) {
+                Ok(()) => {
+                    eprintln!("{} contacts (dim {}) written to {}", p.nc, p.dim, out.display());
                     ExitCode::SUCCESS
                 }
-                Err(e) => input_error(e),
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::from(1)
+                }
             }
         }
         Cmd::Bench {

@@ -85,3 +85,99 @@ pub fn problem_from_world(w: &World2) -> FcProblem {
         meta: Some(meta),
     }
 }
+
+/// The local problem of the last step of a 3D world (call it right after
+/// [`crate::world3::World3::step`]): with `H_bᵀ` (3 × 6) of contact α seen from body b,
+/// rows `(e_k, d_b × e_k)` for the frame vectors e_k = n, t1, t2 (+ for the candidate,
+/// − for the antagonist), `W_αβ = Σ_b H_bαᵀ M̂_b⁻¹ H_bβ` with `M̂_b⁻¹ = diag(m⁻¹) ⊕
+/// I_w⁻¹`, and `q_α = (u_free,n − ū, u_free,t1, u_free,t2)`.
+pub fn problem_from_world3(w: &crate::world3::World3) -> FcProblem {
+    use crate::rigid3d::bodies::cross;
+    let c = &w.contacts;
+    let b = &w.bodies;
+    let nc = c.len();
+    let h_of = |a: usize, d: [f64; 3], s: f64| -> [[f64; 6]; 3] {
+        let f = &c.frame[a];
+        std::array::from_fn(|k| {
+            let e = f.basis[k];
+            let m = cross(d, e);
+            [s * e[0], s * e[1], s * e[2], s * m[0], s * m[1], s * m[2]]
+        })
+    };
+    let mut inc: Vec<(u32, u32, [[f64; 6]; 3])> = Vec::with_capacity(2 * nc);
+    for a in 0..nc {
+        let [i, j] = c.bodies[a];
+        if b.movable(i as usize) {
+            inc.push((i, a as u32, h_of(a, c.frame[a].d_i, 1.0)));
+        }
+        if b.movable(j as usize) {
+            inc.push((j, a as u32, h_of(a, c.frame[a].d_j, -1.0)));
+        }
+    }
+    inc.sort_by_key(|x| (x.0, x.1));
+    let mut contrib: Vec<(u32, u32, [[f64; 3]; 3])> = Vec::new();
+    let mut g0 = 0;
+    while g0 < inc.len() {
+        let body = inc[g0].0 as usize;
+        let g1 = g0 + inc[g0..].iter().take_while(|x| x.0 as usize == body).count();
+        let (im, ii) = (b.inv_m[body], b.inv_i[body]);
+        // M̂⁻¹ h for a row h of Hᵀ
+        let minv = |h: &[f64; 6]| -> [f64; 6] {
+            let w = crate::rigid3d::coulomb::mul(&ii, [h[3], h[4], h[5]]);
+            [im[0] * h[0], im[1] * h[1], im[2] * h[2], w[0], w[1], w[2]]
+        };
+        for x in g0..g1 {
+            for y in x..g1 {
+                let ((_, ca, ha), (_, cb, hb)) = (inc[x], inc[y]);
+                let blk: [[f64; 3]; 3] = std::array::from_fn(|p| {
+                    let mp = minv(&ha[p]);
+                    std::array::from_fn(|q| (0..6).map(|k| mp[k] * hb[q][k]).sum::<f64>())
+                });
+                contrib.push((ca, cb, blk));
+            }
+        }
+        g0 = g1;
+    }
+    contrib.sort_by_key(|x| (x.0, x.1));
+    let mut trip: Vec<(usize, usize, f64)> = Vec::with_capacity(9 * contrib.len());
+    let mut k = 0;
+    while k < contrib.len() {
+        let (ca, cb, mut blk) = contrib[k];
+        k += 1;
+        while k < contrib.len() && (contrib[k].0, contrib[k].1) == (ca, cb) {
+            for p in 0..3 {
+                for q in 0..3 {
+                    blk[p][q] += contrib[k].2[p][q];
+                }
+            }
+            k += 1;
+        }
+        let (ra, rb) = (3 * ca as usize, 3 * cb as usize);
+        for p in 0..3 {
+            for q in 0..3 {
+                trip.push((ra + p, rb + q, blk[p][q]));
+                if ca != cb {
+                    trip.push((rb + q, ra + p, blk[p][q]));
+                }
+            }
+        }
+    }
+    trip.sort_by_key(|x| (x.0, x.1));
+    let mut q = Vec::with_capacity(3 * nc);
+    for a in 0..nc {
+        q.push(c.u_free[a][0] - c.target[a].u_target);
+        q.push(c.u_free[a][1]);
+        q.push(c.u_free[a][2]);
+    }
+    let meta = serde_json::json!({
+        "source": format!("nscdd: 3D world after step {} (t = {} s), {} bodies", w.step, w.t, b.len()),
+    });
+    FcProblem {
+        dim: 3,
+        nc,
+        w: CooMatrix::from_triplets(3 * nc, &trip),
+        q,
+        mu: c.target.iter().map(|t| t.mu).collect(),
+        meta: Some(meta),
+    }
+}
