@@ -53,25 +53,25 @@ impl std::fmt::Display for Diverged {
     }
 }
 
-/// The contact-solve stage of a step, between the construction of the contact set
-/// and the position update: the one-domain NLGS ([`Nlgs`]) or NSCDD
-/// (`crate::dd::Nscdd`). The rest of the step is the same for both
-/// ([`World2::step_with`]).
-pub trait ContactStage {
+/// The contact-solve stage of a step of a world `W`, between the construction of
+/// the contact set and the position update: the one-domain NLGS ([`Nlgs`]) or NSCDD
+/// (`crate::dd::NscddOf`). The rest of the step is the same for both
+/// ([`World2::step_with`], `World3::step_with`).
+pub trait ContactStage<W> {
     /// After the free velocity (the bodies hold V_free), before the contact set is
     /// built and the warm-start impulses are applied.
-    fn after_free_velocity(&mut self, _w: &World2) {}
+    fn after_free_velocity(&mut self, _w: &W) {}
     /// After the contact set and the visiting order are built (timed with the
     /// Delassus stage).
-    fn prepare(&mut self, _w: &mut World2) {}
-    /// Solves the contact problem: V⁺ in `w.bodies.vel`, r in `w.contacts.r`.
-    fn solve(&mut self, w: &mut World2) -> SolveReport;
+    fn prepare(&mut self, _w: &mut W) {}
+    /// Solves the contact problem: V⁺ in the bodies' velocities, r in the contacts.
+    fn solve(&mut self, w: &mut W) -> SolveReport;
 }
 
 /// The one-domain NLGS stage.
 pub struct Nlgs;
 
-impl ContactStage for Nlgs {
+impl ContactStage<World2> for Nlgs {
     fn solve(&mut self, w: &mut World2) -> SolveReport {
         nlgs::solve(&mut w.contacts, &mut w.bodies.vel, &w.bodies.inv_mass, &w.scratch.order, &w.solver)
     }
@@ -84,7 +84,7 @@ impl World2 {
     }
 
     /// Advances the scene by one step with the given contact-solve stage.
-    pub fn step_with(&mut self, stage: &mut impl ContactStage) -> Result<StepReport, Diverged> {
+    pub fn step_with(&mut self, stage: &mut impl ContactStage<World2>) -> Result<StepReport, Diverged> {
         let mut rep = StepReport::default();
         let t0 = Instant::now();
         free_velocity(self);

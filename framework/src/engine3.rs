@@ -15,19 +15,33 @@
 //! are removed from M̂⁻¹ (rotations: the world inertia restricted to the free axes).
 
 use crate::drive::Imposed;
-use crate::engine::{Diverged, StageTimes, StepReport};
+use crate::engine::{ContactStage, Diverged, Nlgs, StageTimes, StepReport};
 use crate::law::target_velocity;
 use crate::rigid2d::contacts::{ContactKey, Target};
 use crate::rigid2d::nlgs::make_order;
 use crate::rigid3d::bodies::{cross, from_rotation_vector, normalize, quat_mul, ALL_FREE};
 use crate::rigid3d::contacts::{local_velocity, tangents, Block3, Frame3};
 use crate::rigid3d::{coulomb, nlgs, Contacts3};
+use crate::solver::SolveReport;
 use crate::world3::World3;
 use std::time::Instant;
 
+impl ContactStage<World3> for Nlgs {
+    fn solve(&mut self, w: &mut World3) -> SolveReport {
+        let b = &mut w.bodies;
+        nlgs::solve(&mut w.contacts, &mut b.vel, &b.inv_m, &b.inv_i, &w.scratch.order, &w.solver)
+    }
+}
+
 impl World3 {
-    /// Advances the scene by one step.
+    /// Advances the scene by one step, contacts solved by NLGS.
     pub fn step(&mut self) -> Result<StepReport, Diverged> {
+        self.step_with(&mut Nlgs)
+    }
+
+    /// Advances the scene by one step with the given contact-solve stage (NLGS or
+    /// NSCDD, `crate::dd::Nscdd3`).
+    pub fn step_with(&mut self, stage: &mut impl ContactStage<World3>) -> Result<StepReport, Diverged> {
         let mut rep = StepReport::default();
         let t0 = Instant::now();
         free_velocity(self);
@@ -35,18 +49,12 @@ impl World3 {
             .detector
             .detect(&self.bodies, &self.shapes, &self.detectors, self.alert, &mut self.scratch.raw);
         let t1 = Instant::now();
+        stage.after_free_velocity(self);
         build_contacts(self);
         make_order(&mut self.scratch.order, self.contacts.len(), &self.solver, self.step);
+        stage.prepare(self);
         let t2 = Instant::now();
-        let b = &mut self.bodies;
-        rep.solve = nlgs::solve(
-            &mut self.contacts,
-            &mut b.vel,
-            &b.inv_m,
-            &b.inv_i,
-            &self.scratch.order,
-            &self.solver,
-        );
+        rep.solve = stage.solve(self);
         let t3 = Instant::now();
         update_positions(self)?;
         let t4 = Instant::now();

@@ -27,7 +27,8 @@
 //! with m_link the multiplicity m_i of the body the link belongs to (each body's m_i
 //! − 1 links together weigh (m_i − 1)/m_i: a corner body does not count three times
 //! a face body) and |·| the body's kinetic norm per unit mass,
-//! |V|² = v_x² + v_y² + (I/m) ω², so that translation and rotation add in m/s.
+//! |V|² = |v|² + (I/m) |ω|² (in 3D I/m the mean of the principal moments over m), so
+//! that translation and rotation add in m/s.
 //! It is made dimensionless by the same velocity scale as LMGC90's QuadDV, QuadWR =
 //! √(SumWRWR / Nactif) (the mean velocity that contact impulses produce; it stays
 //! finite in a pile at rest, where the copies' own velocities vanish):
@@ -83,44 +84,75 @@ impl GluePartial {
     }
 }
 
-/// |V|² = v_x² + v_y² + ρ² ω² with ρ² = I/m.
+/// |V|² = |v|² + ρ² |ω|² with ρ² = I/m: the first `space` components of V are
+/// translations, the others rotations.
 #[inline]
-pub fn norm2(v: [f64; 3], rho2: f64) -> f64 {
-    v[0] * v[0] + v[1] * v[1] + rho2 * v[2] * v[2]
+pub fn norm2<V: AsRef<[f64]>>(v: &V, space: usize, rho2: f64) -> f64 {
+    let v = v.as_ref();
+    let mut s = 0.0;
+    for &x in &v[..space] {
+        s += x * x;
+    }
+    for &x in &v[space..] {
+        s += rho2 * x * x;
+    }
+    s
+}
+
+/// V_{l+1} − V_l.
+#[inline]
+fn diff<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>>(a: &V, b: &V) -> V {
+    let mut out = V::default();
+    for ((o, x), y) in out.as_mut().iter_mut().zip(a.as_ref()).zip(b.as_ref()) {
+        *o = x - y;
+    }
+    out
 }
 
 /// Σ_l |V_{l+1} − V_l|² / m over the links of one chain of m copies.
-pub fn link_sum(v: &[[f64; 3]], rho2: f64) -> f64 {
+pub fn link_sum<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>>(v: &[V], space: usize, rho2: f64) -> f64 {
     let m = v.len() as f64;
     let mut s = 0.0;
     for l in 1..v.len() {
-        let j = [v[l][0] - v[l - 1][0], v[l][1] - v[l - 1][1], v[l][2] - v[l - 1][2]];
-        s += norm2(j, rho2) / m;
+        let j = diff(&v[l], &v[l - 1]);
+        s += norm2(&j, space, rho2) / m;
     }
     s
 }
 
 /// Reusable buffers of [`chain_increments`].
-#[derive(Default)]
-pub struct ChainScratch {
+pub struct ChainScratch<V> {
     c: Vec<f64>,
-    d: Vec<[f64; 3]>,
+    d: Vec<V>,
+}
+
+impl<V> Default for ChainScratch<V> {
+    fn default() -> Self {
+        ChainScratch {
+            c: Vec::new(),
+            d: Vec::new(),
+        }
+    }
 }
 
 /// ΔV_k = y_k − y_{k−1} with y = L⁻¹ [V] for the copies `v` (chain order), written
 /// to `dv` (same length). One link in closed form, a Thomas solve beyond.
-pub fn chain_increments(v: &[[f64; 3]], dv: &mut [[f64; 3]], s: &mut ChainScratch) {
+pub fn chain_increments<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>>(v: &[V], dv: &mut [V], s: &mut ChainScratch<V>) {
     let m = v.len();
     debug_assert_eq!(dv.len(), m);
-    let jump = |l: usize| [v[l + 1][0] - v[l][0], v[l + 1][1] - v[l][1], v[l + 1][2] - v[l][2]];
+    let jump = |l: usize| diff(&v[l + 1], &v[l]);
     match m {
         0 => {}
-        1 => dv[0] = [0.0; 3],
+        1 => dv[0] = V::default(),
         2 => {
             let j = jump(0);
-            let y = [0.5 * j[0], 0.5 * j[1], 0.5 * j[2]];
+            let (mut y, mut ny) = (V::default(), V::default());
+            for ((a, b), x) in y.as_mut().iter_mut().zip(ny.as_mut()).zip(j.as_ref()) {
+                *a = 0.5 * x;
+                *b = -*a;
+            }
             dv[0] = y;
-            dv[1] = [-y[0], -y[1], -y[2]];
+            dv[1] = ny;
         }
         _ => {
             // Thomas: L = tridiag(−1, 2, −1), n = m − 1 unknowns per degree of freedom
@@ -129,23 +161,26 @@ pub fn chain_increments(v: &[[f64; 3]], dv: &mut [[f64; 3]], s: &mut ChainScratc
             s.d.clear();
             for l in 0..n {
                 let j = jump(l);
-                let (cp, dp) = if l == 0 { (0.0, [0.0; 3]) } else { (s.c[l - 1], s.d[l - 1]) };
+                let (cp, dp) = if l == 0 { (0.0, V::default()) } else { (s.c[l - 1], s.d[l - 1]) };
                 let den = 2.0 + cp; // b − a c'_{l−1} with a = −1, b = 2
                 s.c.push(-1.0 / den);
-                s.d.push([(j[0] + dp[0]) / den, (j[1] + dp[1]) / den, (j[2] + dp[2]) / den]);
+                let mut d = V::default();
+                for ((o, x), p) in d.as_mut().iter_mut().zip(j.as_ref()).zip(dp.as_ref()) {
+                    *o = (x + p) / den;
+                }
+                s.d.push(d);
             }
             // back substitution into s.d (y)
             for l in (0..n - 1).rev() {
                 let (c, y1) = (s.c[l], s.d[l + 1]);
-                let y = &mut s.d[l];
-                y[0] -= c * y1[0];
-                y[1] -= c * y1[1];
-                y[2] -= c * y1[2];
+                for (y, x1) in s.d[l].as_mut().iter_mut().zip(y1.as_ref()) {
+                    *y -= c * x1;
+                }
             }
             for (k, out) in dv.iter_mut().enumerate() {
-                let yk = if k < n { s.d[k] } else { [0.0; 3] };
-                let ykm = if k > 0 { s.d[k - 1] } else { [0.0; 3] };
-                *out = [yk[0] - ykm[0], yk[1] - ykm[1], yk[2] - ykm[2]];
+                let yk = if k < n { s.d[k] } else { V::default() };
+                let ykm = if k > 0 { s.d[k - 1] } else { V::default() };
+                *out = diff(&yk, &ykm);
             }
         }
     }
@@ -156,10 +191,10 @@ mod tests {
     use super::*;
     #[test]
     fn chains_go_to_the_mean() {
-        let mut s = ChainScratch::default();
         for m in 1..7 {
             let v: Vec<[f64; 3]> = (0..m).map(|k| [k as f64 * 1.5 - 2.0, (k * k) as f64, 0.3 * k as f64]).collect();
             let mut dv = vec![[0.0; 3]; m];
+            let mut s: ChainScratch<[f64; 3]> = ChainScratch::default();
             chain_increments(&v, &mut dv, &mut s);
             let mean: Vec<f64> = (0..3).map(|d| v.iter().map(|x| x[d]).sum::<f64>() / m as f64).collect();
             for k in 0..m {

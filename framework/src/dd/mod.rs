@@ -1,7 +1,9 @@
-//! NSCDD: non-smooth contact domain decomposition (DESIGN.md §3), 2D rigid bodies.
+//! NSCDD: non-smooth contact domain decomposition (DESIGN.md §3), written once for
+//! every body family ([`family::Family`]: 2D rigid bodies [`Nscdd`], 3D rigid bodies
+//! [`Nscdd3`]).
 //!
-//! One step with [`Nscdd::step`]: free velocity, detection and the contact set as in
-//! [`crate::engine`]; then the contact set is split over an nx × ny grid
+//! One step with [`NscddOf::step`]: free velocity, detection and the contact set as in
+//! [`crate::engine`]; then the contact set is split over an nx × ny (× nz) grid
 //! ([`partition`]), each subdomain holding copies of its bodies with M̂_E = M̂/m
 //! ([`subdomain`]); then, until convergence,
 //!
@@ -39,6 +41,7 @@
 //! only its own data and every reduction runs in subdomain order, so the result does
 //! not depend on the number of threads.
 
+pub mod family;
 pub mod gluing;
 pub mod partition;
 pub mod schemes;
@@ -47,16 +50,15 @@ pub mod team;
 pub mod transport;
 
 use crate::rigid2d::contacts::ContactKey;
+pub use family::{Family, Rigid2, Rigid3};
 pub use partition::{Decomposition, FGammaStore, Grid, Interface};
 pub use schemes::Scheme;
-pub use subdomain::{Subdomain2, SubdomainSolver};
+pub use subdomain::{Subdomain, Subdomain2, Subdomain3, SubdomainSolver};
 pub use transport::{InProcess, Transport, TransportStats};
 
 use crate::engine::{ContactStage, Diverged, StageTimes};
 use crate::norms::{Norms, VANISHING};
-use crate::rigid2d::nlgs;
 use crate::solver::SolveReport;
-use crate::world::World2;
 use gluing::GluePartial;
 use schemes::{glue_stage, GlueBuffers};
 
@@ -67,6 +69,8 @@ pub struct DdSettings {
     /// Grid of subdomains over the contact points' bounding box.
     pub nx: u32,
     pub ny: u32,
+    /// 3D only (1 in 2D).
+    pub nz: u32,
     pub scheme: Scheme,
     /// NLGS sweeps per gluing stage (LMGC90: 1).
     pub sweeps_per_gluing: u32,
@@ -79,6 +83,7 @@ impl Default for DdSettings {
         DdSettings {
             nx: 1,
             ny: 1,
+            nz: 1,
             scheme: Scheme::Decentralized,
             sweeps_per_gluing: 1,
             threads: 1,
@@ -110,19 +115,26 @@ impl DdConfig {
         Nscdd::new(self.dd.clone()).with_repartition_every(self.repartition_every)
     }
 
+    /// The solver state for a 3D run.
+    pub fn solver3(&self) -> Nscdd3 {
+        Nscdd3::new(self.dd.clone()).with_repartition_every(self.repartition_every)
+    }
+
     /// Whether the sample can hold the grid: `nx × ny` may not exceed the number of
     /// movable bodies (a subdomain is a set of contacts, each touching a movable
     /// body, and a body's contacts can split over several subdomains only if there
     /// are more bodies than subdomains). Err: (the key at fault, the message).
     pub fn check_capacity(&self, movable: usize) -> Result<(), (&'static str, String)> {
-        let n = self.dd.nx as u64 * self.dd.ny as u64;
+        let n = self.dd.nx as u64 * self.dd.ny as u64 * self.dd.nz.max(1) as u64;
         if n > movable as u64 {
+            let dims = if self.dd.nz > 1 {
+                format!("{} × {} × {}", self.dd.nx, self.dd.ny, self.dd.nz)
+            } else {
+                format!("{} × {}", self.dd.nx, self.dd.ny)
+            };
             return Err((
                 "nx",
-                format!(
-                    "{} × {} = {n} subdomains is more than the sample can hold: at most one subdomain per movable body ({movable})",
-                    self.dd.nx, self.dd.ny
-                ),
+                format!("{dims} = {n} subdomains is more than the sample can hold: at most one subdomain per movable body ({movable})"),
             ));
         }
         Ok(())
@@ -200,19 +212,18 @@ pub struct DdView {
     pub body_subdomain: Vec<i32>,
     /// Number of subdomains holding a copy of the body (0: no contacts).
     pub multiplicity: Vec<u32>,
-    /// Subdomain of each contact of `World2::contacts`.
+    /// Subdomain of each contact of the world's contact set.
     pub contact_subdomain: Vec<u32>,
 }
 
-/// The NSCDD solver state kept between steps.
-#[derive(Default)]
-pub struct Nscdd {
+/// The NSCDD solver state kept between steps, for the body family `D`.
+pub struct NscddOf<D: Family> {
     pub settings: DdSettings,
     /// F_Γ of the last step's interface copies.
-    pub store: FGammaStore,
+    pub store: FGammaStore<D::V>,
     /// The last step's decomposition (copies as after the last gluing, before the
     /// averaging).
-    pub last: Decomposition,
+    pub last: Decomposition<D>,
     /// Re-partition over a new grid every this many steps (0 counts as 1); between
     /// repartitions persisting contacts keep their subdomain and new ones go to the
     /// cell of the last grid that holds their point.
@@ -228,17 +239,31 @@ pub struct Nscdd {
     /// Whether the last grid was made over no contact (then the next step
     /// re-partitions).
     grid_empty: bool,
-    transport: InProcess,
-    bufs: GlueBuffers,
-    v_free: Vec<[f64; 3]>,
+    transport: InProcess<D::V>,
+    bufs: GlueBuffers<D::V>,
+    v_free: Vec<D::V>,
 }
 
-impl Nscdd {
+/// NSCDD of 2D rigid bodies.
+pub type Nscdd = NscddOf<Rigid2>;
+/// NSCDD of 3D rigid bodies.
+pub type Nscdd3 = NscddOf<Rigid3>;
+
+impl<D: Family> NscddOf<D> {
     pub fn new(settings: DdSettings) -> Self {
-        Nscdd {
+        NscddOf {
             settings,
+            store: FGammaStore::default(),
+            last: Decomposition::default(),
             repartition_every: 1,
-            ..Default::default()
+            steps: 0,
+            grid: None,
+            pending: DdStepReport::default(),
+            kept: Vec::new(),
+            grid_empty: false,
+            transport: InProcess::default(),
+            bufs: GlueBuffers::default(),
+            v_free: Vec::new(),
         }
     }
 
@@ -250,21 +275,22 @@ impl Nscdd {
 
     /// The last step's subdomain of each body and contact of `w` and the bodies'
     /// multiplicities (all −1 / 0 before the first step).
-    pub fn view(&self, w: &World2) -> DdView {
-        let nb = w.bodies.len();
+    pub fn view(&self, w: &D::World) -> DdView {
+        let nb = D::n_bodies(w);
+        let c = D::contacts(w);
         let d = &self.last;
         let mut v = DdView {
             body_subdomain: vec![-1; nb],
             multiplicity: (0..nb).map(|b| d.mult.get(b).copied().unwrap_or(0)).collect(),
             contact_subdomain: Vec::new(),
         };
-        if d.owner.len() != w.contacts.len() {
+        if d.owner.len() != D::len(c) {
             return v;
         }
         v.contact_subdomain.clone_from(&d.owner);
         let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(2 * d.owner.len());
         for (a, &s) in d.owner.iter().enumerate() {
-            for g in w.contacts.bodies[a] {
+            for g in D::bodies(c, a) {
                 pairs.push((g, s));
             }
         }
@@ -286,25 +312,26 @@ impl Nscdd {
 
     /// This step's decomposition of `w.contacts`: a new grid every
     /// `repartition_every` steps, else the kept owners.
-    fn partition(&mut self, w: &World2, rep: &mut DdStepReport) {
+    fn partition(&mut self, w: &D::World, rep: &mut DdStepReport) {
         let s = &self.settings;
         let k = self.repartition_every.max(1) as u64;
-        let c = &w.contacts;
+        let c = D::contacts(w);
+        let nc = D::len(c);
         let repart = self.grid.is_none() || self.grid_empty || self.steps.is_multiple_of(k);
         let (grid, owner) = match self.grid {
-            Some(g) if !repart => (g, partition::kept_owners(c, &g, &self.kept)),
+            Some(g) if !repart => (g, partition::kept_owners::<D>(c, &g, &self.kept)),
             _ => {
-                let g = Grid::over(&c.point, s.nx, s.ny);
-                (g, c.point.iter().map(|&p| g.cell_of(p)).collect())
+                let g = Grid::over((0..nc).map(|a| D::point(c, a)), s.nx, s.ny, s.nz);
+                (g, (0..nc).map(|a| g.cell_of(D::point(c, a))).collect())
             }
         };
-        let nb = w.bodies.len();
+        let nb = D::n_bodies(w);
         let before = (repart && self.steps > 0).then(|| partition::body_sets(&self.last, nb));
         if repart {
             self.grid = Some(grid);
-            self.grid_empty = c.is_empty();
+            self.grid_empty = nc == 0;
         }
-        self.last = partition::decompose_owned(c, &w.bodies, &self.v_free, &w.scratch.order, grid, owner, &self.store);
+        self.last = partition::decompose_owned::<D>(w, &self.v_free, grid, owner, &self.store);
         rep.repartitioned = repart;
         if let Some(before) = before {
             let after = partition::body_sets(&self.last, nb);
@@ -315,15 +342,15 @@ impl Nscdd {
                 .count();
         }
         self.kept.clear();
-        self.kept.extend(c.key.iter().copied().zip(self.last.owner.iter().copied()));
+        self.kept.extend((0..nc).map(|a| D::key(c, a)).zip(self.last.owner.iter().copied()));
         self.kept.sort_unstable_by_key(|e| e.0);
         self.steps += 1;
     }
 
     /// Advances `w` by one step, the contact problem solved by NSCDD.
-    pub fn step(&mut self, w: &mut World2) -> Result<DdStepReport, Diverged> {
+    pub fn step(&mut self, w: &mut D::World) -> Result<DdStepReport, Diverged> {
         self.pending = DdStepReport::default();
-        let base = w.step_with(self)?;
+        let base = D::step_with(w, self)?;
         let mut rep = std::mem::take(&mut self.pending);
         rep.solve = base.solve;
         rep.contacts = base.contacts;
@@ -332,17 +359,17 @@ impl Nscdd {
     }
 
     /// The NSCDD iteration on `self.last`, then the write-back into `w`.
-    fn solve(&mut self, w: &mut World2, rep: &mut DdStepReport) {
+    fn solve(&mut self, w: &mut D::World, rep: &mut DdStepReport) {
         let set = self.settings.clone();
-        let sv = w.solver.clone();
+        let sv = D::solver(w).clone();
         let d = &mut self.last;
         self.transport.resize(d.subs.len());
         self.transport.reset_stats();
-        rep.subdomains = d.subs.iter().filter(|s| !s.contacts.is_empty()).count();
+        rep.subdomains = d.subs.iter().filter(|s| D::len(&s.contacts) > 0).count();
         rep.interface_bodies = d.iface.len();
         rep.links = d.iface.links();
         rep.max_multiplicity = d.mult.iter().copied().max().unwrap_or(0);
-        if w.contacts.is_empty() {
+        if D::len(D::contacts(w)) == 0 {
             rep.solve.converged = true;
             self.store.keep(&d.subs);
             return;
@@ -391,61 +418,71 @@ impl Nscdd {
         rep.exchange = self.transport.stats();
         write_back(d, w);
         self.store.keep(&d.subs);
-        rep.solve.residual = nlgs::residual(&w.contacts, &w.bodies.vel);
+        rep.solve.residual = D::residual(w);
     }
 }
 
 /// Global impulses and velocities from the subdomains: a body with one copy takes
 /// its velocity, an interface body the average of its copies (chain order); an
 /// immovable body copied several times keeps its first copy's.
-pub fn write_back(d: &Decomposition, w: &mut World2) {
-    let mut done = vec![false; w.bodies.len()];
+pub fn write_back<D: Family>(d: &Decomposition<D>, w: &mut D::World) {
+    let nb = D::n_bodies(w);
+    let movable: Vec<bool> = (0..nb).map(|g| D::movable(w, g)).collect();
+    let mut done = vec![false; nb];
     for s in &d.subs {
+        let c = D::contacts_mut(w);
         for (la, &ga) in s.contact_global.iter().enumerate() {
-            w.contacts.r[ga as usize] = s.contacts.r[la];
+            D::copy_r(c, ga as usize, &s.contacts, la);
         }
+        let vel = D::vel_mut(w);
         for (l, &g) in s.body_global.iter().enumerate() {
             let g = g as usize;
-            if !done[g] && (d.mult[g] == 1 || !w.bodies.movable(g)) {
-                w.bodies.vel[g] = s.vel[l];
+            if !done[g] && (d.mult[g] == 1 || !movable[g]) {
+                vel[g] = s.vel[l];
                 done[g] = true;
             }
         }
     }
     let ifc = &d.iface;
+    let vel = D::vel_mut(w);
     for ib in 0..ifc.len() {
         let r = ifc.copies(ib);
         let m = r.len() as f64;
-        let mut v = [0.0; 3];
+        let mut v = D::V::default();
         for c in r {
             let vc = d.subs[ifc.sub[c] as usize].interface_velocity(ifc.slot[c] as usize);
-            for k in 0..3 {
-                v[k] += vc[k];
+            for (x, y) in v.as_mut().iter_mut().zip(vc.as_ref()) {
+                *x += y;
             }
         }
-        w.bodies.vel[ifc.body[ib] as usize] = [v[0] / m, v[1] / m, v[2] / m];
+        for x in v.as_mut() {
+            *x /= m;
+        }
+        vel[ifc.body[ib] as usize] = v;
     }
 }
 
 /// One NSCDD step of `w` with a solver state (F_Γ kept in `state` between steps).
-pub fn step(w: &mut World2, state: &mut Nscdd) -> Result<DdStepReport, Diverged> {
+pub fn step(w: &mut crate::world::World2, state: &mut Nscdd) -> Result<DdStepReport, Diverged> {
     state.step(w)
 }
 
-/// NSCDD as the contact-solve stage of [`World2::step_with`]: it keeps V_free, splits
-/// the contact set (timed with the Delassus stage), and runs the NSCDD iteration.
-impl ContactStage for Nscdd {
-    fn after_free_velocity(&mut self, w: &World2) {
-        self.v_free.clone_from(&w.bodies.vel);
+/// NSCDD as the contact-solve stage of the world's `step_with`: it keeps V_free,
+/// splits the contact set (timed with the Delassus stage), and runs the NSCDD
+/// iteration.
+impl<D: Family> ContactStage<D::World> for NscddOf<D> {
+    fn after_free_velocity(&mut self, w: &D::World) {
+        self.v_free.clear();
+        self.v_free.extend_from_slice(D::vel(w));
     }
-    fn prepare(&mut self, w: &mut World2) {
+    fn prepare(&mut self, w: &mut D::World) {
         let mut rep = std::mem::take(&mut self.pending);
         self.partition(w, &mut rep);
         self.pending = rep;
     }
-    fn solve(&mut self, w: &mut World2) -> SolveReport {
+    fn solve(&mut self, w: &mut D::World) -> SolveReport {
         let mut rep = std::mem::take(&mut self.pending);
-        Nscdd::solve(self, w, &mut rep);
+        NscddOf::solve(self, w, &mut rep);
         let s = rep.solve;
         self.pending = rep;
         s

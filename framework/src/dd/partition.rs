@@ -1,54 +1,57 @@
 //! Partition of one step's contact set into subdomains, and the interface bodies.
 //!
-//! Each contact belongs to exactly one subdomain: the cell of an nx × ny grid over
-//! the bounding box of the contact points that holds its point (points on the upper
-//! edges go to the last cell). A body belongs to every subdomain that owns one of
+//! Each contact belongs to exactly one subdomain: the cell of an nx × ny (× nz in
+//! 3D) grid over the bounding box of the contact points that holds its point (points
+//! on the upper edges go to the last cell). A body belongs to every subdomain that owns one of
 //! its contacts; its multiplicity m is that count. Movable bodies with m ≥ 2 are the
 //! interface bodies, one copy per subdomain, glued; immovable bodies (M̂⁻¹ = 0) are
 //! copied into every subdomain that needs them without gluing. Between repartitions
 //! ([`kept_owners`]) persisting contacts keep their subdomain.
 
-use super::subdomain::{Neighbor, Subdomain2, OWN};
+use super::family::Family;
+use super::subdomain::{Neighbor, Subdomain, OWN};
 use crate::rigid2d::contacts::ContactKey;
-use crate::rigid2d::{Bodies2, Contacts2};
 
-/// The grid of subdomains over the contact points' bounding box.
+/// The grid of subdomains over the contact points' bounding box (nz = 1 in 2D,
+/// whose points have z = 0).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Grid {
     pub nx: u32,
     pub ny: u32,
-    pub origin: [f64; 2],
-    pub cell: [f64; 2],
+    pub nz: u32,
+    pub origin: [f64; 3],
+    pub cell: [f64; 3],
 }
 
 impl Grid {
-    pub fn over(points: &[[f64; 2]], nx: u32, ny: u32) -> Grid {
-        let (nx, ny) = (nx.max(1), ny.max(1));
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for p in points.iter().filter(|p| p[0].is_finite() && p[1].is_finite()) {
-            for d in 0..2 {
+    pub fn over(points: impl Iterator<Item = [f64; 3]>, nx: u32, ny: u32, nz: u32) -> Grid {
+        let n = [nx.max(1), ny.max(1), nz.max(1)];
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for p in points.filter(|p| p.iter().all(|x| x.is_finite())) {
+            for d in 0..3 {
                 lo[d] = lo[d].min(p[d]);
                 hi[d] = hi[d].max(p[d]);
             }
         }
         if lo[0] > hi[0] {
-            (lo, hi) = ([0.0; 2], [0.0; 2]);
+            (lo, hi) = ([0.0; 3], [0.0; 3]);
         }
         Grid {
-            nx,
-            ny,
+            nx: n[0],
+            ny: n[1],
+            nz: n[2],
             origin: lo,
-            cell: [(hi[0] - lo[0]) / nx as f64, (hi[1] - lo[1]) / ny as f64],
+            cell: std::array::from_fn(|d| (hi[d] - lo[d]) / n[d] as f64),
         }
     }
     pub fn len(&self) -> usize {
-        (self.nx * self.ny) as usize
+        (self.nx * self.ny * self.nz) as usize
     }
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
-    /// Subdomain id `cx + nx cy` of a point.
-    pub fn cell_of(&self, p: [f64; 2]) -> u32 {
+    /// Subdomain id `cx + nx (cy + ny cz)` of a point.
+    pub fn cell_of(&self, p: [f64; 3]) -> u32 {
         let c = |d: usize, n: u32| {
             // a flat box (or NaN) puts every point in the first cell
             if self.cell[d].is_nan() || self.cell[d] <= 0.0 {
@@ -61,7 +64,7 @@ impl Grid {
                 0
             }
         };
-        c(0, self.nx) + self.nx * c(1, self.ny)
+        c(0, self.nx) + self.nx * (c(1, self.ny) + self.ny * c(2, self.nz))
     }
 }
 
@@ -98,13 +101,19 @@ impl Interface {
 }
 
 /// F_Γ of the interface copies, kept between steps: (body, subdomain) → impulse.
-#[derive(Clone, Debug, Default)]
-pub struct FGammaStore {
-    entries: Vec<(u32, u32, [f64; 3])>,
+#[derive(Clone, Debug)]
+pub struct FGammaStore<V> {
+    entries: Vec<(u32, u32, V)>,
 }
 
-impl FGammaStore {
-    pub fn get(&self, body: u32, sub: u32) -> Option<[f64; 3]> {
+impl<V> Default for FGammaStore<V> {
+    fn default() -> Self {
+        FGammaStore { entries: Vec::new() }
+    }
+}
+
+impl<V: Copy> FGammaStore<V> {
+    pub fn get(&self, body: u32, sub: u32) -> Option<V> {
         self.entries
             .binary_search_by_key(&(body, sub), |e| (e.0, e.1))
             .ok()
@@ -120,14 +129,14 @@ impl FGammaStore {
         self.entries.len()
     }
     /// (body, subdomain, F_Γ), by body then subdomain.
-    pub fn iter(&self) -> impl Iterator<Item = (u32, u32, [f64; 3])> + '_ {
+    pub fn iter(&self) -> impl Iterator<Item = (u32, u32, V)> + '_ {
         self.entries.iter().copied()
     }
     pub fn is_empty(&self) -> bool {
         self.entries.is_empty()
     }
     /// Replaces the store by the subdomains' current F_Γ.
-    pub fn keep(&mut self, subs: &[Subdomain2]) {
+    pub fn keep<D: Family<V = V>>(&mut self, subs: &[Subdomain<D>]) {
         self.entries.clear();
         for s in subs {
             for (q, &l) in s.iface.iter().enumerate() {
@@ -139,40 +148,43 @@ impl FGammaStore {
 }
 
 /// One step's decomposition.
-#[derive(Clone, Debug, Default)]
-pub struct Decomposition {
+#[derive(Clone, Debug)]
+pub struct Decomposition<D: Family> {
     pub grid: Option<Grid>,
     /// Subdomain of each global contact.
     pub owner: Vec<u32>,
     /// Number of subdomains holding a copy of each global body (0: none).
     pub mult: Vec<u32>,
-    pub subs: Vec<Subdomain2>,
+    pub subs: Vec<Subdomain<D>>,
     pub iface: Interface,
 }
 
-/// Splits the contact set `c` (built on `b`) over an nx × ny grid; copies start at
-/// V_free + M̂_E⁻¹(F_Γ + H_E r). `order` is the one-domain visiting order (empty:
-/// storage order).
-pub fn decompose(c: &Contacts2, b: &Bodies2, v_free: &[[f64; 3]], order: &[u32], nx: u32, ny: u32, store: &FGammaStore) -> Decomposition {
-    let grid = Grid::over(&c.point, nx, ny);
-    let owner: Vec<u32> = c.point.iter().map(|&p| grid.cell_of(p)).collect();
-    decompose_owned(c, b, v_free, order, grid, owner, store)
+impl<D: Family> Default for Decomposition<D> {
+    fn default() -> Self {
+        Decomposition {
+            grid: None,
+            owner: Vec::new(),
+            mult: Vec::new(),
+            subs: Vec::new(),
+            iface: Interface::default(),
+        }
+    }
 }
 
 /// The owners between repartitions: a contact whose key is in `kept` (sorted by key)
 /// stays in its subdomain; a new contact goes to the cell of `grid` (the grid of the
 /// last repartition) that holds its point.
-pub fn kept_owners(c: &Contacts2, grid: &Grid, kept: &[(ContactKey, u32)]) -> Vec<u32> {
-    (0..c.len())
-        .map(|a| match kept.binary_search_by_key(&c.key[a], |e| e.0) {
+pub fn kept_owners<D: Family>(c: &D::Contacts, grid: &Grid, kept: &[(ContactKey, u32)]) -> Vec<u32> {
+    (0..D::len(c))
+        .map(|a| match kept.binary_search_by_key(&D::key(c, a), |e| e.0) {
             Ok(p) => kept[p].1,
-            Err(_) => grid.cell_of(c.point[a]),
+            Err(_) => grid.cell_of(D::point(c, a)),
         })
         .collect()
 }
 
 /// The subdomains of each body (ascending), `out[b]`, from a decomposition.
-pub fn body_sets(d: &Decomposition, nb: usize) -> Vec<Vec<u32>> {
+pub fn body_sets<D: Family>(d: &Decomposition<D>, nb: usize) -> Vec<Vec<u32>> {
     let mut out = vec![Vec::new(); nb];
     for s in &d.subs {
         for &g in &s.body_global {
@@ -184,21 +196,22 @@ pub fn body_sets(d: &Decomposition, nb: usize) -> Vec<Vec<u32>> {
     out
 }
 
-/// Splits the contact set `c` over the subdomains given by `owner` (one per contact,
-/// each below `grid.len()`); see [`decompose`].
-pub fn decompose_owned(
-    c: &Contacts2,
-    b: &Bodies2,
-    v_free: &[[f64; 3]],
-    order: &[u32],
+/// Splits the contact set of `w` over the subdomains given by `owner` (one per
+/// contact, each below `grid.len()`); copies start at V_free + M̂_E⁻¹(F_Γ + H_E r).
+/// The world's visiting order (empty: storage order) is restricted to each subdomain.
+pub fn decompose_owned<D: Family>(
+    w: &D::World,
+    v_free: &[D::V],
     grid: Grid,
     owner: Vec<u32>,
-    store: &FGammaStore,
-) -> Decomposition {
+    store: &FGammaStore<D::V>,
+) -> Decomposition<D> {
+    let c = D::contacts(w);
+    let order = D::order(w);
     let ns = grid.len();
-    let nb = b.len();
-    let mut subs: Vec<Subdomain2> = (0..ns)
-        .map(|s| Subdomain2 {
+    let nb = D::n_bodies(w);
+    let mut subs: Vec<Subdomain<D>> = (0..ns)
+        .map(|s| Subdomain {
             id: s as u32,
             ..Default::default()
         })
@@ -213,7 +226,7 @@ pub fn decompose_owned(
     let mut copy_of: Vec<(u32, u32, u32)> = Vec::new(); // (body, sub, local)
     for (s, sub) in subs.iter_mut().enumerate() {
         // one allocation per field (growing them by push cost 0.4 ms of 4000 contacts)
-        sub.contacts.reserve(by_sub[s].len());
+        D::reserve(&mut sub.contacts, by_sub[s].len());
         sub.contact_global.reserve(by_sub[s].len());
         for &a in &by_sub[s] {
             let a = a as usize;
@@ -228,20 +241,18 @@ pub fn decompose_owned(
                 }
                 local[gi]
             };
-            let (li, lj) = (id(c.bodies[a][0]), id(c.bodies[a][1]));
+            let [bi, bj] = D::bodies(c, a);
+            let (li, lj) = (id(bi), id(bj));
             sub.push_contact(c, a, li, lj);
         }
     }
     // copies' M̂_E⁻¹ and W_αα; the visiting order restricted to each subdomain
-    let mut local_of = vec![0u32; c.len()];
+    let mut local_of = vec![0u32; D::len(c)];
     for sub in subs.iter_mut() {
         sub.inv_mass = sub
             .body_global
             .iter()
-            .map(|&g| {
-                let (im, m) = (b.inv_mass[g as usize], mult[g as usize] as f64);
-                [im[0] * m, im[1] * m, im[2] * m]
-            })
+            .map(|&g| D::scale_inv(D::inv_mass(w, g as usize), mult[g as usize] as f64))
             .collect();
         sub.copy_delassus();
         for (la, &ga) in sub.contact_global.iter().enumerate() {
@@ -263,33 +274,29 @@ pub fn decompose_owned(
         let m = mult[g as usize] as usize;
         let copies = &copy_of[p..p + m];
         p += m;
-        if m < 2 || !b.movable(g as usize) {
+        if m < 2 || !D::movable(w, g as usize) {
             continue;
         }
         let ib = iface.body.len() as u32;
-        let ms = b.mass[g as usize];
         iface.body.push(g);
-        iface.rho2.push(if ms[0] > 0.0 && ms[0].is_finite() && ms[2].is_finite() {
-            ms[2] / ms[0]
-        } else {
-            0.0
-        });
+        iface.rho2.push(D::rho2(w, g as usize));
         // F_Γ from the previous step where the same subdomain held a copy, made to sum to zero
         let mut fresh = store.count(g) != m;
-        let mut f: Vec<[f64; 3]> = copies
+        let mut f: Vec<D::V> = copies
             .iter()
             .map(|&(_, s, _)| {
                 store.get(g, s).unwrap_or_else(|| {
                     fresh = true;
-                    [0.0; 3]
+                    D::V::default()
                 })
             })
             .collect();
         if fresh {
-            let mean: Vec<f64> = (0..3).map(|d| f.iter().map(|x| x[d]).sum::<f64>() / m as f64).collect();
+            let ndof = D::V::default().as_ref().len();
+            let mean: Vec<f64> = (0..ndof).map(|d| f.iter().map(|x| x.as_ref()[d]).sum::<f64>() / m as f64).collect();
             for x in f.iter_mut() {
-                for d in 0..3 {
-                    x[d] -= mean[d];
+                for (v, mu) in x.as_mut().iter_mut().zip(&mean) {
+                    *v -= mu;
                 }
             }
         }

@@ -16,9 +16,10 @@
 //! order (slot order; the links of a body counted by the subdomain of its first
 //! copy), so the residuals agree bitwise as well.
 
+use super::family::Family;
 use super::gluing::{chain_increments, link_sum, norm2, ChainScratch, GluePartial};
 use super::partition::Interface;
-use super::subdomain::{Subdomain2, SubdomainSolver, OWN};
+use super::subdomain::{Subdomain, SubdomainSolver, OWN};
 use super::transport::Transport;
 
 /// The communication scheme of the gluing stage.
@@ -30,32 +31,50 @@ pub enum Scheme {
 }
 
 /// Buffers reused between gluing stages.
-#[derive(Default)]
-pub struct GlueBuffers {
-    packets: Vec<Vec<[f64; 3]>>,
-    c: ChainBuffers,
-    send: Vec<[f64; 3]>,
+pub struct GlueBuffers<V> {
+    packets: Vec<Vec<V>>,
+    c: ChainBuffers<V>,
+    send: Vec<V>,
+}
+
+impl<V> Default for GlueBuffers<V> {
+    fn default() -> Self {
+        GlueBuffers {
+            packets: Vec::new(),
+            c: ChainBuffers::default(),
+            send: Vec::new(),
+        }
+    }
 }
 
 /// Buffers of the chain solves of one subdomain's gluing ([`glue_sub`]).
-#[derive(Default)]
-pub struct ChainBuffers {
-    chain: Vec<[f64; 3]>,
-    dv: Vec<[f64; 3]>,
-    scratch: ChainScratch,
+pub struct ChainBuffers<V> {
+    chain: Vec<V>,
+    dv: Vec<V>,
+    scratch: ChainScratch<V>,
+}
+
+impl<V> Default for ChainBuffers<V> {
+    fn default() -> Self {
+        ChainBuffers {
+            chain: Vec::new(),
+            dv: Vec::new(),
+            scratch: ChainScratch::default(),
+        }
+    }
 }
 
 /// One gluing stage: exchange, chain solves, F_Γ and velocity updates. Returns each
 /// subdomain's share of the gluing residual, measured on the velocities before the
 /// update. With `only_fresh`, only the bodies marked fresh are updated (the start of
 /// a step).
-pub fn glue_stage(
-    subs: &mut [&mut Subdomain2],
+pub fn glue_stage<D: Family>(
+    subs: &mut [&mut Subdomain<D>],
     iface: &Interface,
     scheme: Scheme,
-    t: &mut dyn Transport,
+    t: &mut dyn Transport<D::V>,
     only_fresh: bool,
-    b: &mut GlueBuffers,
+    b: &mut GlueBuffers<D::V>,
 ) -> Vec<GluePartial> {
     match scheme {
         Scheme::Decentralized => decentralized(subs, iface, t, only_fresh, b),
@@ -63,12 +82,12 @@ pub fn glue_stage(
     }
 }
 
-fn decentralized(
-    subs: &mut [&mut Subdomain2],
+fn decentralized<D: Family>(
+    subs: &mut [&mut Subdomain<D>],
     iface: &Interface,
-    t: &mut dyn Transport,
+    t: &mut dyn Transport<D::V>,
     only_fresh: bool,
-    b: &mut GlueBuffers,
+    b: &mut GlueBuffers<D::V>,
 ) -> Vec<GluePartial> {
     for s in subs.iter() {
         for nbr in &s.neighbors {
@@ -90,7 +109,7 @@ fn decentralized(
 
 /// The decentralized scheme's packets of subdomain `s`: `out[ni]` its copies'
 /// velocities of the bodies shared with neighbor `ni` (what [`decentralized`] sends).
-pub fn post(s: &Subdomain2, out: &mut Vec<Vec<[f64; 3]>>) {
+pub fn post<D: Family>(s: &Subdomain<D>, out: &mut Vec<Vec<D::V>>) {
     out.resize_with(s.neighbors.len(), Vec::new);
     for (o, nbr) in out.iter_mut().zip(&s.neighbors) {
         o.clear();
@@ -102,7 +121,13 @@ pub fn post(s: &Subdomain2, out: &mut Vec<Vec<[f64; 3]>>) {
 /// (`packets[ni]`: what neighbor `ni` posted to `s`): each interface body's chain
 /// solved, the own copy's increment applied. Returns the subdomain's residual share,
 /// measured on the velocities before the update.
-pub fn glue_sub(s: &mut Subdomain2, packets: &[Vec<[f64; 3]>], iface: &Interface, only_fresh: bool, b: &mut ChainBuffers) -> GluePartial {
+pub fn glue_sub<D: Family>(
+    s: &mut Subdomain<D>,
+    packets: &[Vec<D::V>],
+    iface: &Interface,
+    only_fresh: bool,
+    b: &mut ChainBuffers<D::V>,
+) -> GluePartial {
     let mut part = GluePartial::default();
     for q in 0..s.iface.len() {
         let ib = s.iface_ib[q] as usize;
@@ -115,9 +140,9 @@ pub fn glue_sub(s: &mut Subdomain2, packets: &[Vec<[f64; 3]>], iface: &Interface
                 packets[ni as usize][p as usize]
             });
         }
-        accumulate(&mut part, &b.chain, k, iface.rho2[ib]);
+        accumulate(&mut part, &b.chain, k, D::SPACE, iface.rho2[ib]);
         if !only_fresh || iface.fresh[ib] {
-            b.dv.resize(b.chain.len(), [0.0; 3]);
+            b.dv.resize(b.chain.len(), D::V::default());
             chain_increments(&b.chain, &mut b.dv, &mut b.scratch);
             s.glue(q, b.dv[k]);
         }
@@ -126,23 +151,23 @@ pub fn glue_sub(s: &mut Subdomain2, packets: &[Vec<[f64; 3]>], iface: &Interface
 }
 
 /// The residual share of one copy: its chain's links if it is the first copy.
-fn accumulate(part: &mut GluePartial, chain: &[[f64; 3]], k: usize, rho2: f64) {
+fn accumulate<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>>(part: &mut GluePartial, chain: &[V], k: usize, space: usize, rho2: f64) {
     if k == 0 {
-        part.jump2 += link_sum(chain, rho2);
+        part.jump2 += link_sum(chain, space, rho2);
         part.links += chain.len() as u64 - 1;
     }
-    part.v2 += norm2(chain[k], rho2);
+    part.v2 += norm2(&chain[k], space, rho2);
     part.copies += 1;
 }
 
 const ROOT: u32 = 0;
 
-fn centralized(
-    subs: &mut [&mut Subdomain2],
+fn centralized<D: Family>(
+    subs: &mut [&mut Subdomain<D>],
     iface: &Interface,
-    t: &mut dyn Transport,
+    t: &mut dyn Transport<D::V>,
     only_fresh: bool,
-    b: &mut GlueBuffers,
+    b: &mut GlueBuffers<D::V>,
 ) -> Vec<GluePartial> {
     let ns = subs.len();
     // gather
@@ -158,7 +183,7 @@ fn centralized(
     for s in 0..ns {
         t.recv(ROOT, s as u32, &mut all[s]);
         out[s].clear();
-        out[s].resize(all[s].len(), [0.0; 3]);
+        out[s].resize(all[s].len(), D::V::default());
     }
     // solve every chain once, at the root
     let mut parts = vec![GluePartial::default(); ns];
@@ -168,7 +193,7 @@ fn centralized(
         b.c.chain
             .extend(r.clone().map(|c| all[iface.sub[c] as usize][iface.slot[c] as usize]));
         if !only_fresh || iface.fresh[ib] {
-            b.c.dv.resize(b.c.chain.len(), [0.0; 3]);
+            b.c.dv.resize(b.c.chain.len(), D::V::default());
             chain_increments(&b.c.chain, &mut b.c.dv, &mut b.c.scratch);
             for (k, c) in r.enumerate() {
                 out[iface.sub[c] as usize][iface.slot[c] as usize] = b.c.dv[k];
@@ -182,7 +207,7 @@ fn centralized(
             b.c.chain.clear();
             b.c.chain
                 .extend(iface.copies(ib).map(|c| all[iface.sub[c] as usize][iface.slot[c] as usize]));
-            accumulate(part, &b.c.chain, subs[s].iface_k[q] as usize, iface.rho2[ib]);
+            accumulate(part, &b.c.chain, subs[s].iface_k[q] as usize, D::SPACE, iface.rho2[ib]);
         }
     }
     // scatter

@@ -1,4 +1,5 @@
-//! One subdomain of 2D rigid bodies: its contacts and its copies of bodies.
+//! One subdomain: its contacts and its copies of bodies, for any body family
+//! ([`super::family::Family`]; `Subdomain2` for 2D rigid bodies, `Subdomain3` for 3D).
 //!
 //! Local ids are dense `u32`s. Copy l of global body g = `body_global[l]` has the
 //! iteration matrix M̂_E = M̂/m_g (partition of unity), stored as its inverse
@@ -6,8 +7,8 @@
 //! glued). Its loads are F̂/m_g, so its free velocity is the body's V_free:
 //! (F̂/m)/(M̂/m) = M̂⁻¹F̂. The contacts' Delassus blocks W_αα are those of the copies.
 
+use super::family::{Family, Rigid2, Rigid3};
 use crate::norms::Sums;
-use crate::rigid2d::{nlgs, Contacts2};
 
 /// Marks, in a chain entry, the subdomain's own copy.
 pub const OWN: u32 = u32::MAX;
@@ -23,11 +24,11 @@ pub struct Neighbor {
 
 /// Struct-of-arrays subdomain.
 #[derive(Clone, Debug, Default)]
-pub struct Subdomain2 {
+pub struct Subdomain<D: Family> {
     pub id: u32,
     /// The subdomain's contacts, `bodies` as local body ids; `block` with the
     /// copies' M̂_E⁻¹.
-    pub contacts: Contacts2,
+    pub contacts: D::Contacts,
     /// Global index of each local contact.
     pub contact_global: Vec<u32>,
     /// Visiting order (local ids; empty: storage order), the global order restricted.
@@ -35,9 +36,9 @@ pub struct Subdomain2 {
     /// Global id of each local body copy.
     pub body_global: Vec<u32>,
     /// Copy velocities V_E.
-    pub vel: Vec<[f64; 3]>,
+    pub vel: Vec<D::V>,
     /// Copy M̂_E⁻¹ = m M̂⁻¹.
-    pub inv_mass: Vec<[f64; 3]>,
+    pub inv_mass: Vec<D::InvMass>,
     /// Local ids of the interface copies (ascending global id): the slots.
     pub iface: Vec<u32>,
     /// Per slot: index of the body in [`super::partition::Interface`].
@@ -45,7 +46,7 @@ pub struct Subdomain2 {
     /// Per slot: position of this copy in the body's chain.
     pub iface_k: Vec<u32>,
     /// Per slot: F_Γ, the net interface impulse on the copy (N·s).
-    pub f_gamma: Vec<[f64; 3]>,
+    pub f_gamma: Vec<D::V>,
     pub neighbors: Vec<Neighbor>,
     /// Per slot, the body's chain: `chain[chain_start[q]..chain_start[q + 1]]` holds,
     /// for each copy in chain order, (neighbor index, position in its packet), or
@@ -56,87 +57,73 @@ pub struct Subdomain2 {
     pub sums: Sums,
 }
 
+/// A subdomain of 2D rigid bodies.
+pub type Subdomain2 = Subdomain<Rigid2>;
+/// A subdomain of 3D rigid bodies.
+pub type Subdomain3 = Subdomain<Rigid3>;
+
 /// What the NSCDD coordinator needs from a subdomain (DESIGN.md §3, §4).
 pub trait SubdomainSolver {
+    /// Generalized velocity of a copy.
+    type V;
     /// `n` NLGS sweeps with relaxation ω; the last one is a check pass when `check`
     /// (its sums are then in [`Self::sums`], else those are zero).
     fn sweeps(&mut self, n: u32, omega: f64, check: bool);
     fn sums(&self) -> &Sums;
     /// Velocities of the interface copies given by `slots`, appended to `out`.
-    fn interface_velocities(&self, slots: &[u32], out: &mut Vec<[f64; 3]>);
+    fn interface_velocities(&self, slots: &[u32], out: &mut Vec<Self::V>);
     /// Velocity of the interface copy in `slot`.
-    fn interface_velocity(&self, slot: usize) -> [f64; 3];
+    fn interface_velocity(&self, slot: usize) -> Self::V;
     /// Gluing increment of one interface copy: ΔF_Γ = M̂_E ΔV, applied through
     /// M̂_E⁻¹ (so the copy moves by ΔV on its free degrees of freedom).
-    fn glue(&mut self, slot: usize, dv: [f64; 3]);
+    fn glue(&mut self, slot: usize, dv: Self::V);
 }
 
-impl SubdomainSolver for Subdomain2 {
+impl<D: Family> SubdomainSolver for Subdomain<D> {
+    type V = D::V;
     fn sweeps(&mut self, n: u32, omega: f64, check: bool) {
         self.sums = Sums::default();
         for k in 0..n {
             let sums = if check && k + 1 == n { Some(&mut self.sums) } else { None };
-            nlgs::sweep(&mut self.contacts, &mut self.vel, &self.inv_mass, &self.order, omega, sums);
+            D::sweep(&mut self.contacts, &mut self.vel, &self.inv_mass, &self.order, omega, sums);
         }
     }
     fn sums(&self) -> &Sums {
         &self.sums
     }
-    fn interface_velocities(&self, slots: &[u32], out: &mut Vec<[f64; 3]>) {
+    fn interface_velocities(&self, slots: &[u32], out: &mut Vec<D::V>) {
         out.extend(slots.iter().map(|&q| self.vel[self.iface[q as usize] as usize]));
     }
-    fn interface_velocity(&self, slot: usize) -> [f64; 3] {
+    fn interface_velocity(&self, slot: usize) -> D::V {
         self.vel[self.iface[slot] as usize]
     }
-    fn glue(&mut self, slot: usize, dv: [f64; 3]) {
+    fn glue(&mut self, slot: usize, dv: D::V) {
         let l = self.iface[slot] as usize;
-        let im = self.inv_mass[l];
-        for d in 0..3 {
-            if im[d] != 0.0 {
-                self.vel[l][d] += dv[d];
-                self.f_gamma[slot][d] += dv[d] / im[d];
-            }
-        }
+        D::glue(&mut self.vel[l], &mut self.f_gamma[slot], &self.inv_mass[l], &dv);
     }
 }
 
-impl Subdomain2 {
+impl<D: Family> Subdomain<D> {
     /// Appends global contact `a` of `c`, with local body ids `li`, `lj`.
-    pub(crate) fn push_contact(&mut self, c: &Contacts2, a: usize, li: u32, lj: u32) {
-        self.contacts.push_from(c, a, li, lj);
+    pub(crate) fn push_contact(&mut self, c: &D::Contacts, a: usize, li: u32, lj: u32) {
+        D::push_contact(&mut self.contacts, c, a, li, lj);
         self.contact_global.push(a as u32);
     }
 
     /// W_αα and its precomputed inverses from the copies' M̂_E⁻¹.
     pub(crate) fn copy_delassus(&mut self) {
-        let c = &mut self.contacts;
-        for a in 0..c.len() {
-            let [i, j] = c.bodies[a];
-            let w = Contacts2::delassus(&c.frame[a], self.inv_mass[i as usize], self.inv_mass[j as usize]);
-            c.block[a] = crate::rigid2d::contacts::Block2 {
-                w,
-                pre: crate::rigid2d::coulomb::precompute(w, c.target[a].mu),
-            };
-        }
+        D::copy_delassus(&mut self.contacts, &self.inv_mass);
     }
 
     /// V_E = V_free + M̂_E⁻¹ (F_Γ + H_E r) with the warm-start impulses, applied in
     /// storage order (as the one-domain engine does).
-    pub(crate) fn init_velocities(&mut self, v_free: &[[f64; 3]]) {
+    pub(crate) fn init_velocities(&mut self, v_free: &[D::V]) {
         self.vel.clear();
         self.vel.extend(self.body_global.iter().map(|&g| v_free[g as usize]));
         for (q, &l) in self.iface.iter().enumerate() {
-            let (l, g) = (l as usize, self.f_gamma[q]);
-            let (v, im) = (&mut self.vel[l], self.inv_mass[l]);
-            for d in 0..3 {
-                v[d] += im[d] * g[d];
-            }
+            let l = l as usize;
+            D::apply_impulse(&mut self.vel[l], &self.inv_mass[l], &self.f_gamma[q]);
         }
-        let c = &self.contacts;
-        for a in 0..c.len() {
-            if c.r[a] != [0.0, 0.0] {
-                c.apply(a, c.r[a], &mut self.vel, &self.inv_mass);
-            }
-        }
+        D::warm_start(&self.contacts, &mut self.vel, &self.inv_mass);
     }
 }

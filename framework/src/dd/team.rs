@@ -25,10 +25,11 @@
 //! ([`schemes::glue_stage`]) and every reduction runs in subdomain order, so the
 //! result does not depend on the number of threads.
 
+use super::family::Family;
 use super::gluing::GluePartial;
 use super::partition::Interface;
 use super::schemes::{self, glue_stage, ChainBuffers, GlueBuffers, Scheme};
-use super::subdomain::{Subdomain2, SubdomainSolver};
+use super::subdomain::{Subdomain, SubdomainSolver};
 use super::transport::Transport;
 use crate::norms::Sums;
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicUsize, Ordering::SeqCst};
@@ -98,13 +99,13 @@ struct Cmd {
 }
 
 /// A subdomain's packets of one stage parity, one per neighbor (neighbor order).
-type Outbox = Mutex<Vec<Vec<[f64; 3]>>>;
+type Outbox<V> = Mutex<Vec<Vec<V>>>;
 
 /// What the threads share.
-struct Shared<'a, 'b> {
-    cells: &'a [Mutex<&'b mut Subdomain2>],
+struct Shared<'a, 'b, D: Family> {
+    cells: &'a [Mutex<&'b mut Subdomain<D>>],
     /// Per subdomain and parity: one packet per neighbor, neighbor order.
-    outbox: &'a [[Outbox; 2]],
+    outbox: &'a [[Outbox<D::V>; 2]],
     /// Per subdomain, per neighbor: (neighbor, index of the subdomain among its neighbors).
     back: &'a [Vec<(usize, usize)>],
     /// Per subdomain: residual share of its last gluing.
@@ -121,14 +122,22 @@ struct Shared<'a, 'b> {
 }
 
 /// Per-thread buffers.
-#[derive(Default)]
-struct Scratch {
-    packets: Vec<Vec<[f64; 3]>>,
-    chain: ChainBuffers,
+struct Scratch<V> {
+    packets: Vec<Vec<V>>,
+    chain: ChainBuffers<V>,
 }
 
-impl Shared<'_, '_> {
-    fn run_group(&self, g: usize, c: Cmd, buf: &mut Scratch) {
+impl<V> Default for Scratch<V> {
+    fn default() -> Self {
+        Scratch {
+            packets: Vec::new(),
+            chain: ChainBuffers::default(),
+        }
+    }
+}
+
+impl<D: Family> Shared<'_, '_, D> {
+    fn run_group(&self, g: usize, c: Cmd, buf: &mut Scratch<D::V>) {
         for &k in &self.groups[g] {
             let mut s = lock(&self.cells[k]);
             if let Some(q) = c.glue_from {
@@ -150,8 +159,8 @@ impl Shared<'_, '_> {
     }
 
     fn work(&self, g: usize) {
-        struct Fail<'s, 'a, 'b>(&'s Shared<'a, 'b>);
-        impl Drop for Fail<'_, '_, '_> {
+        struct Fail<'s, 'a, 'b, D: Family>(&'s Shared<'a, 'b, D>);
+        impl<D: Family> Drop for Fail<'_, '_, '_, D> {
             fn drop(&mut self) {
                 if std::thread::panicking() {
                     self.0.failed.store(true, SeqCst);
@@ -177,9 +186,9 @@ impl Shared<'_, '_> {
 }
 
 /// The coordinator's handle on the subdomains of a step.
-pub struct Team<'s, 'a, 'b> {
-    sh: &'s Shared<'a, 'b>,
-    buf: Scratch,
+pub struct Team<'s, 'a, 'b, D: Family> {
+    sh: &'s Shared<'a, 'b, D>,
+    buf: Scratch<D::V>,
     phases: usize,
     /// Stage parity of the next post.
     parity: usize,
@@ -189,7 +198,7 @@ pub struct Team<'s, 'a, 'b> {
     links: Vec<(u32, u32, usize)>,
 }
 
-impl Team<'_, '_, '_> {
+impl<D: Family> Team<'_, '_, '_, D> {
     /// Runs `c` on every group, group 0 here; returns when all are done.
     fn phase(&mut self, c: Cmd) {
         let sh = self.sh;
@@ -240,8 +249,8 @@ impl Team<'_, '_, '_> {
         omega: f64,
         check: bool,
         scheme: Scheme,
-        t: &mut dyn Transport,
-        bufs: &mut GlueBuffers,
+        t: &mut dyn Transport<D::V>,
+        bufs: &mut GlueBuffers<D::V>,
     ) -> (Sums, Vec<GluePartial>) {
         let iface = self.sh.iface;
         let parts = if scheme == Scheme::Decentralized && !iface.is_empty() {
@@ -286,17 +295,17 @@ impl Team<'_, '_, '_> {
     }
 
     /// Runs `f` on all the subdomains, in subdomain order, on the coordinator.
-    pub fn with_all<R>(&mut self, f: impl FnOnce(&mut [&mut Subdomain2]) -> R) -> R {
+    pub fn with_all<R>(&mut self, f: impl FnOnce(&mut [&mut Subdomain<D>]) -> R) -> R {
         self.flush();
         let mut guards: Vec<_> = self.sh.cells.iter().map(lock).collect();
-        let mut subs: Vec<&mut Subdomain2> = guards.iter_mut().map(|g| &mut ***g).collect();
+        let mut subs: Vec<&mut Subdomain<D>> = guards.iter_mut().map(|g| &mut ***g).collect();
         f(&mut subs)
     }
 }
 
 /// Releases the workers when the coordinator leaves (also on a panic).
-struct StopOnDrop<'s, 'a, 'b>(&'s Shared<'a, 'b>);
-impl Drop for StopOnDrop<'_, '_, '_> {
+struct StopOnDrop<'s, 'a, 'b, D: Family>(&'s Shared<'a, 'b, D>);
+impl<D: Family> Drop for StopOnDrop<'_, '_, '_, D> {
     fn drop(&mut self) {
         let sh = self.0;
         if sh.groups.len() > 1 {
@@ -309,15 +318,15 @@ impl Drop for StopOnDrop<'_, '_, '_> {
 
 /// Groups of subdomains, one per thread, balanced by contact count (largest first to
 /// the least loaded group; ties to the smaller id); each group in subdomain order.
-fn groups(subs: &[Subdomain2], threads: usize) -> Vec<Vec<usize>> {
+fn groups<D: Family>(subs: &[Subdomain<D>], threads: usize) -> Vec<Vec<usize>> {
     let n = threads.clamp(1, subs.len().max(1));
     let mut by_load: Vec<usize> = (0..subs.len()).collect();
-    by_load.sort_by_key(|&k| (std::cmp::Reverse(subs[k].contacts.len()), k));
+    by_load.sort_by_key(|&k| (std::cmp::Reverse(D::len(&subs[k].contacts)), k));
     let mut g = vec![Vec::new(); n];
     let mut load = vec![0usize; n];
     for k in by_load {
         let i = (0..n).min_by_key(|&i| (load[i], i)).unwrap_or(0);
-        load[i] += subs[k].contacts.len();
+        load[i] += D::len(&subs[k].contacts);
         g[i].push(k);
     }
     for x in g.iter_mut() {
@@ -332,7 +341,12 @@ fn groups(subs: &[Subdomain2], threads: usize) -> Vec<Vec<usize>> {
 
 /// Runs `driver` with a [`Team`] of `threads` threads over `subs`, glued across
 /// `iface`; a gluing left pending is applied before returning.
-pub fn with_team<R>(subs: &mut [Subdomain2], threads: usize, iface: &Interface, driver: impl FnOnce(&mut Team<'_, '_, '_>) -> R) -> R {
+pub fn with_team<D: Family, R>(
+    subs: &mut [Subdomain<D>],
+    threads: usize,
+    iface: &Interface,
+    driver: impl FnOnce(&mut Team<'_, '_, '_, D>) -> R,
+) -> R {
     let groups = groups(subs, threads);
     let mut links = Vec::new();
     let back: Vec<Vec<(usize, usize)>> = subs
@@ -349,9 +363,9 @@ pub fn with_team<R>(subs: &mut [Subdomain2], threads: usize, iface: &Interface, 
                 .collect()
         })
         .collect();
-    let outbox: Vec<[Outbox; 2]> = subs.iter().map(|_| Default::default()).collect();
+    let outbox: Vec<[Outbox<D::V>; 2]> = subs.iter().map(|_| [Mutex::new(Vec::new()), Mutex::new(Vec::new())]).collect();
     let partials: Vec<Mutex<GluePartial>> = subs.iter().map(|_| Default::default()).collect();
-    let cells: Vec<Mutex<&mut Subdomain2>> = subs.iter_mut().map(Mutex::new).collect();
+    let cells: Vec<Mutex<&mut Subdomain<D>>> = subs.iter_mut().map(Mutex::new).collect();
     let sh = Shared {
         cells: &cells,
         outbox: &outbox,

@@ -1,7 +1,7 @@
 //! Exchange of interface data between subdomains.
 //!
-//! The gluing stage only moves short packets of copy velocities (`[f64; 3]` per
-//! interface copy) between subdomains, addressed by subdomain id. [`Transport`] is
+//! The gluing stage only moves short packets of copy velocities (one generalized
+//! velocity `V` per interface copy: `[f64; 3]` in 2D, `[f64; 6]` in 3D) between subdomains, addressed by subdomain id. [`Transport`] is
 //! that point-to-point layer: [`InProcess`] keeps one mailbox per (receiver, sender)
 //! pair for threads and tests; an MPI transport (cargo feature `mpi`, later) maps
 //! subdomains to ranks. Both schemes of [`super::schemes`] are written against it.
@@ -19,13 +19,14 @@ pub struct TransportStats {
     pub values: u64,
 }
 
-/// Point-to-point exchange of interface packets between subdomains.
-pub trait Transport {
+/// Point-to-point exchange of interface packets (of copy velocities `V`) between
+/// subdomains.
+pub trait Transport<V> {
     /// Posts `data` from subdomain `from` to subdomain `to`.
-    fn send(&mut self, from: u32, to: u32, data: &[[f64; 3]]);
+    fn send(&mut self, from: u32, to: u32, data: &[V]);
     /// Takes the packet that `from` posted to `to` in this round into `out`
     /// (cleared first; left empty when none was posted).
-    fn recv(&mut self, to: u32, from: u32, out: &mut Vec<[f64; 3]>);
+    fn recv(&mut self, to: u32, from: u32, out: &mut Vec<V>);
     fn stats(&self) -> TransportStats;
     /// Counts a packet of `len` copies from `from` to `to` that went through shared
     /// memory instead (the threads of [`super::team`]), as `send` would.
@@ -33,14 +34,23 @@ pub trait Transport {
 }
 
 /// In-process transport: one mailbox per (receiver, sender) pair, buffers reused.
-#[derive(Default)]
-pub struct InProcess {
+pub struct InProcess<V> {
     n: usize,
-    boxes: Vec<Vec<[f64; 3]>>,
+    boxes: Vec<Vec<V>>,
     stats: TransportStats,
 }
 
-impl InProcess {
+impl<V> Default for InProcess<V> {
+    fn default() -> Self {
+        InProcess {
+            n: 0,
+            boxes: Vec::new(),
+            stats: TransportStats::default(),
+        }
+    }
+}
+
+impl<V> InProcess<V> {
     /// Makes room for `n` subdomains (keeps the counts).
     pub fn resize(&mut self, n: usize) {
         if n != self.n {
@@ -54,14 +64,14 @@ impl InProcess {
     }
 }
 
-impl Transport for InProcess {
-    fn send(&mut self, from: u32, to: u32, data: &[[f64; 3]]) {
+impl<V: Copy + AsRef<[f64]> + Default> Transport<V> for InProcess<V> {
+    fn send(&mut self, from: u32, to: u32, data: &[V]) {
         let b = &mut self.boxes[to as usize * self.n + from as usize];
         b.clear();
         b.extend_from_slice(data);
         self.record(from, to, data.len());
     }
-    fn recv(&mut self, to: u32, from: u32, out: &mut Vec<[f64; 3]>) {
+    fn recv(&mut self, to: u32, from: u32, out: &mut Vec<V>) {
         out.clear();
         std::mem::swap(out, &mut self.boxes[to as usize * self.n + from as usize]);
     }
@@ -71,7 +81,7 @@ impl Transport for InProcess {
     fn record(&mut self, from: u32, to: u32, len: usize) {
         if from != to {
             self.stats.messages += 1;
-            self.stats.values += 3 * len as u64;
+            self.stats.values += (V::default().as_ref().len() * len) as u64;
         }
     }
 }

@@ -83,18 +83,63 @@ fn sym_mul(w: &Sym3, v: [f64; 3]) -> [f64; 3] {
     super::coulomb::mul(w, v)
 }
 
+/// M̂⁻¹ of one 3D rigid body: translational diagonal and rotational block.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct InvMass3 {
+    pub m: [f64; 3],
+    pub i: Sym3,
+}
+
+/// Where a sweep reads the bodies' M̂⁻¹: the world's two arrays ([`Split`]) or a
+/// subdomain's copies (`[InvMass3]`). Monomorphized: no dispatch per contact.
+pub trait InvMassOf {
+    fn inv_m(&self, b: usize) -> [f64; 3];
+    fn inv_i(&self, b: usize) -> &Sym3;
+}
+
+/// The world's `inv_m` and `inv_i` arrays.
+pub struct Split<'a>(pub &'a [[f64; 3]], pub &'a [Sym3]);
+
+impl InvMassOf for Split<'_> {
+    #[inline(always)]
+    fn inv_m(&self, b: usize) -> [f64; 3] {
+        self.0[b]
+    }
+    #[inline(always)]
+    fn inv_i(&self, b: usize) -> &Sym3 {
+        &self.1[b]
+    }
+}
+
+impl InvMassOf for [InvMass3] {
+    #[inline(always)]
+    fn inv_m(&self, b: usize) -> [f64; 3] {
+        self[b].m
+    }
+    #[inline(always)]
+    fn inv_i(&self, b: usize) -> &Sym3 {
+        &self[b].i
+    }
+}
+
 /// Adds the velocity change of an impulse `dr` (local) to both bodies.
 #[inline(always)]
 pub fn apply(f: &Frame3, dr: [f64; 3], bi: usize, bj: usize, vel: &mut [[f64; 6]], inv_m: &[[f64; 3]], inv_i: &[Sym3]) {
+    apply_with(f, dr, bi, bj, vel, &Split(inv_m, inv_i));
+}
+
+/// [`apply`] with the masses read through an [`InvMassOf`].
+#[inline(always)]
+pub fn apply_with<M: InvMassOf + ?Sized>(f: &Frame3, dr: [f64; 3], bi: usize, bj: usize, vel: &mut [[f64; 6]], inv: &M) {
     let b = &f.basis;
     let p = [
         b[0][0] * dr[0] + b[1][0] * dr[1] + b[2][0] * dr[2],
         b[0][1] * dr[0] + b[1][1] * dr[1] + b[2][1] * dr[2],
         b[0][2] * dr[0] + b[1][2] * dr[1] + b[2][2] * dr[2],
     ];
-    let (mi, mj) = (inv_m[bi], inv_m[bj]);
-    let wi = sym_mul(&inv_i[bi], cross(f.d_i, p));
-    let wj = sym_mul(&inv_i[bj], cross(f.d_j, p));
+    let (mi, mj) = (inv.inv_m(bi), inv.inv_m(bj));
+    let wi = sym_mul(inv.inv_i(bi), cross(f.d_i, p));
+    let wj = sym_mul(inv.inv_i(bj), cross(f.d_j, p));
     let vi = &mut vel[bi];
     for k in 0..3 {
         vi[k] += mi[k] * p[k];
@@ -131,6 +176,31 @@ impl Contacts3 {
     pub fn is_empty(&self) -> bool {
         self.bodies.is_empty()
     }
+    pub fn reserve(&mut self, n: usize) {
+        self.bodies.reserve(n);
+        self.frame.reserve(n);
+        self.block.reserve(n);
+        self.target.reserve(n);
+        self.r.reserve(n);
+        self.u_free.reserve(n);
+        self.gap.reserve(n);
+        self.point.reserve(n);
+        self.key.reserve(n);
+    }
+
+    /// Appends contact `a` of `other` with its bodies renamed (i, j).
+    pub fn push_from(&mut self, other: &Contacts3, a: usize, i: u32, j: u32) {
+        self.bodies.push([i, j]);
+        self.frame.push(other.frame[a]);
+        self.block.push(other.block[a]);
+        self.target.push(other.target[a]);
+        self.r.push(other.r[a]);
+        self.u_free.push(other.u_free[a]);
+        self.gap.push(other.gap[a]);
+        self.point.push(other.point[a]);
+        self.key.push(other.key[a]);
+    }
+
     pub fn clear(&mut self) {
         self.bodies.clear();
         self.frame.clear();

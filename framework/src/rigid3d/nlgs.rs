@@ -3,7 +3,7 @@
 //! one-contact solver ([`super::coulomb`]). The check pass, the stopping test and the
 //! natural-map residual are the dimension-free ones of [`crate::norms`].
 
-use super::contacts::{apply, local_velocity, Contacts3};
+use super::contacts::{apply_with, local_velocity, Contacts3, InvMass3, InvMassOf, Split};
 use super::coulomb::{self, Sym3};
 use crate::norms::{natural_map_sq, Norms, Sums};
 use crate::solver::{SolveReport, SolverSettings};
@@ -16,6 +16,24 @@ pub fn sweep(
     vel: &mut [[f64; 6]],
     inv_m: &[[f64; 3]],
     inv_i: &[Sym3],
+    order: &[u32],
+    omega: f64,
+    sums: Option<&mut Sums>,
+) {
+    sweep_with(c, vel, &Split(inv_m, inv_i), order, omega, sums);
+}
+
+/// [`sweep`] over copies whose M̂⁻¹ are [`InvMass3`] (NSCDD subdomains).
+#[inline(never)]
+pub fn sweep_split(c: &mut Contacts3, vel: &mut [[f64; 6]], inv: &[InvMass3], order: &[u32], omega: f64, sums: Option<&mut Sums>) {
+    sweep_with(c, vel, inv, order, omega, sums);
+}
+
+#[inline(always)]
+fn sweep_with<M: InvMassOf + ?Sized>(
+    c: &mut Contacts3,
+    vel: &mut [[f64; 6]],
+    inv: &M,
     order: &[u32],
     omega: f64,
     mut sums: Option<&mut Sums>,
@@ -46,7 +64,7 @@ pub fn sweep(
         if dr != [0.0; 3] {
             c.r[a] = rn;
             let f = c.frame[a];
-            apply(&f, dr, bi, bj, vel, inv_m, inv_i);
+            apply_with(&f, dr, bi, bj, vel, inv);
         }
     };
     if order.is_empty() {
