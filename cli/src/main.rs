@@ -31,7 +31,8 @@ enum Cmd {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
-        /// NSCDD over NXxNY subdomains (e.g. 2x2); overrides [decomposition].
+        /// NSCDD over NXxNY subdomains (e.g. 2x2; NXxNYxNZ in 3D); overrides
+        /// [decomposition].
         #[arg(long, value_name = "NXxNY", allow_hyphen_values = true)]
         subdomains: Option<String>,
         /// Gluing scheme: decentralized or centralized (needs a decomposition).
@@ -97,13 +98,24 @@ fn input_error(e: impl std::fmt::Display) -> ExitCode {
     ExitCode::from(2)
 }
 
-/// `NXxNY` with NX, NY ≥ 1.
+/// `NXxNY` (or `NXxNYxNZ` for 3D scenes) with integers ≥ 1.
 fn parse_subdomains(v: &str) -> Result<(u32, u32), String> {
-    let bad = || format!("--subdomains: expected NXxNY with integers NX, NY ≥ 1 (e.g. 2x2), got `{v}`");
-    let (a, b) = v.split_once(['x', 'X']).ok_or_else(bad)?;
+    match parse_subdomains3(v)? {
+        (nx, ny, 1) if v.matches(['x', 'X']).count() == 1 => Ok((nx, ny)),
+        _ => Err(format!(
+            "--subdomains: expected NXxNY with integers NX, NY ≥ 1 (e.g. 2x2), got `{v}`"
+        )),
+    }
+}
+
+/// `NXxNY` or `NXxNYxNZ` with integers ≥ 1.
+fn parse_subdomains3(v: &str) -> Result<(u32, u32, u32), String> {
+    let bad = || format!("--subdomains: expected NXxNY or NXxNYxNZ with integers ≥ 1 (e.g. 2x2 or 2x2x1), got `{v}`");
+    let parts: Vec<&str> = v.split(['x', 'X']).collect();
     let n = |t: &str| t.trim().parse::<u32>().ok().filter(|&k| k >= 1);
-    match (n(a), n(b)) {
-        (Some(nx), Some(ny)) => Ok((nx, ny)),
+    match parts.as_slice() {
+        [a, b] => Ok((n(a).ok_or_else(bad)?, n(b).ok_or_else(bad)?, 1)),
+        [a, b, c] => Ok((n(a).ok_or_else(bad)?, n(b).ok_or_else(bad)?, n(c).ok_or_else(bad)?)),
         _ => Err(bad()),
     }
 }
@@ -116,20 +128,41 @@ fn apply_decomposition(
     scheme: Option<&str>,
     threads: Option<&str>,
 ) -> Result<(), String> {
+    let w = &s.world;
+    let movable = (0..w.bodies.len()).filter(|&b| w.bodies.movable(b)).count();
+    apply_decomposition_to(&mut s.decomposition, movable, false, subdomains, scheme, threads)
+}
+
+/// The command line's decomposition flags over a scene's `[decomposition]` (`dim3`:
+/// NXxNYxNZ accepted).
+pub(crate) fn apply_decomposition_to(
+    decomposition: &mut Option<nscdd::dd::DdConfig>,
+    movable: usize,
+    dim3: bool,
+    subdomains: Option<&str>,
+    scheme: Option<&str>,
+    threads: Option<&str>,
+) -> Result<(), String> {
     if let Some(v) = subdomains {
-        let (nx, ny) = parse_subdomains(v)?;
-        let c = s.decomposition.get_or_insert_with(Default::default);
+        let (nx, ny, nz) = if dim3 {
+            parse_subdomains3(v)?
+        } else {
+            let (nx, ny) = parse_subdomains(v)?;
+            (nx, ny, 1)
+        };
+        let c = decomposition.get_or_insert_with(Default::default);
         c.dd.nx = nx;
         c.dd.ny = ny;
+        c.dd.nz = nz;
     }
     for (flag, given) in [("--scheme", scheme.is_some()), ("--threads", threads.is_some())] {
-        if given && s.decomposition.is_none() {
+        if given && decomposition.is_none() {
             return Err(format!(
                 "{flag} needs a decomposition: give --subdomains NXxNY or a [decomposition] section"
             ));
         }
     }
-    let Some(c) = s.decomposition.as_mut() else {
+    let Some(c) = decomposition.as_mut() else {
         return Ok(());
     };
     if let Some(v) = scheme {
@@ -144,8 +177,6 @@ fn apply_decomposition(
             .ok_or_else(|| format!("--threads: expected an integer ≥ 1, got `{v}`"))?;
     }
     if subdomains.is_some() {
-        let w = &s.world;
-        let movable = (0..w.bodies.len()).filter(|&b| w.bodies.movable(b)).count();
         c.check_capacity(movable).map_err(|(_, m)| format!("--subdomains: {m}"))?;
     }
     Ok(())
@@ -223,13 +254,15 @@ fn main() -> ExitCode {
         } => {
             let loaded = match nscdd::scene::load_any(&scene, &reg) {
                 Ok(nscdd::scene::AnyScene::D3(s3)) => {
-                    let flags = [
-                        ("--subdomains", subdomains.is_some()),
-                        ("--scheme", scheme.is_some()),
-                        ("--threads", threads.is_some()),
-                        ("--restart", restart.is_some()),
-                    ];
-                    return run3::run(s3, &out, quiet, &flags);
+                    return run3::run(
+                        s3,
+                        &out,
+                        quiet,
+                        subdomains.as_deref(),
+                        scheme.as_deref(),
+                        threads.as_deref(),
+                        restart.is_some(),
+                    );
                 }
                 Ok(nscdd::scene::AnyScene::D2(s)) => Ok(s),
                 Err(e) => Err(e.to_string()),

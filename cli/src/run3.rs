@@ -4,10 +4,23 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::path::Path;
 use std::process::ExitCode;
 
-/// Runs a loaded 3D scene; `flags` are the 2D-only flags given on the command line.
-pub fn run(mut s: nscdd::scene::load3::Scene3, out: &Path, quiet: bool, flags: &[(&str, bool)]) -> ExitCode {
-    if let Some((flag, _)) = flags.iter().find(|f| f.1) {
-        let msg = format!("{flag}: not available for 3D scenes yet (NSCDD and restarts are 2D for now)");
+/// Runs a loaded 3D scene with the command line's decomposition flags.
+pub fn run(
+    mut s: nscdd::scene::load3::Scene3,
+    out: &Path,
+    quiet: bool,
+    subdomains: Option<&str>,
+    scheme: Option<&str>,
+    threads: Option<&str>,
+    restart: bool,
+) -> ExitCode {
+    let movable = (0..s.world.bodies.len()).filter(|&b| s.world.bodies.movable(b)).count();
+    let flags = if restart {
+        Err("--restart: not available for 3D scenes yet (restarts are 2D for now)".to_string())
+    } else {
+        crate::apply_decomposition_to(&mut s.decomposition, movable, true, subdomains, scheme, threads)
+    };
+    if let Err(msg) = flags {
         if std::fs::create_dir_all(out).is_ok() {
             let _ = std::fs::write(out.join("error.txt"), format!("{msg}\n"));
         }
@@ -42,8 +55,15 @@ pub fn run(mut s: nscdd::scene::load3::Scene3, out: &Path, quiet: bool, flags: &
                     sum.first_unconverged.unwrap_or(0)
                 );
             }
+            let dd = match &s.decomposition {
+                Some(c) => format!(
+                    " ({}x{}x{} subdomains, {:?}, {} migrations)",
+                    c.dd.nx, c.dd.ny, c.dd.nz, c.dd.scheme, sum.migrations
+                ),
+                None => String::new(),
+            };
             eprintln!(
-                "{} steps, {} sweeps, {:.2} s; outputs in {}",
+                "{} steps{dd}, {} sweeps, {:.2} s; outputs in {}",
                 sum.steps,
                 sum.total_sweeps,
                 sum.wall_seconds,

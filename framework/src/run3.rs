@@ -27,7 +27,8 @@ fn save_state(dir: &Path, name: &str, w: &World3) -> Result<(), RunError> {
 
 /// Runs a 3D scene for its number of steps, writing `history.csv`, VTK frames every
 /// `output.every` steps (and at the first and last step), `checkpoint.json` every
-/// `output.checkpoint_every` steps and `final.json` in `dir`.
+/// `output.checkpoint_every` steps and `final.json` in `dir`. With
+/// `scene.decomposition`, every step is an NSCDD step ([`crate::dd::Nscdd3`]).
 pub fn run3(scene: &mut Scene3, dir: &Path, mut on_step: impl FnMut(&World3, &StepReport)) -> Result<RunSummary, RunError> {
     let start = Instant::now();
     std::fs::create_dir_all(dir).map_err(io(dir, "the output directory"))?;
@@ -42,8 +43,21 @@ pub fn run3(scene: &mut Scene3, dir: &Path, mut on_step: impl FnMut(&World3, &St
     }
     let mut sum = RunSummary::default();
     let steps = w.time.steps;
+    // a decomposed run steps with NSCDD (the same multiplier stage as in 2D)
+    let mut dd = scene.decomposition.as_ref().map(|c| c.solver3());
     for s in (w.step + 1)..=steps {
-        let rep = match w.step() {
+        let stepped = match &mut dd {
+            Some(n) => n.step(w).map(|r| {
+                sum.migrations += r.migrations as u64;
+                StepReport {
+                    solve: r.solve,
+                    contacts: r.contacts,
+                    times: r.times,
+                }
+            }),
+            None => w.step(),
+        };
+        let rep = match stepped {
             Ok(r) => r,
             Err(d) => {
                 let _ = hist.flush();

@@ -244,3 +244,102 @@ position = [0.1, 0.2, {R:?}]
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// NSCDD in 3D: a 6 × 6 × 4 stack of spheres on a floor, split 2 × 2 × 1 (and
+/// 2 × 2 × 2, which puts bodies in up to 8 subdomains), agrees with one domain: the
+/// contact forces of the stack are determinate (each vertical chain carries its
+/// spheres' weight, the lateral contacts nothing), so the impulses of both solves
+/// match to the solver's tolerance; the gluing leaves no jump between copies.
+#[test]
+fn nscdd_3d_pile_agrees_with_one_domain() {
+    let scene = |dec: &str| {
+        format!(
+            r#"
+dimension = 3
+[time]
+step = 1e-3
+steps = 3
+[solver]
+tolerance = 1e-8
+norm = "Quad"
+max_sweeps = 100000
+{dec}
+[[materials]]
+name = "m"
+density = {RHO:?}
+[[laws]]
+materials = ["m", "m"]
+friction = 0.4
+[[bodies]]
+name = "floor"
+shape = "plane"
+material = "m"
+position = [0.0, 0.0, 0.0]
+fixed = true
+[[generate]]
+kind = "sphere_lattice"
+material = "m"
+nx = 6
+ny = 6
+nz = 4
+radius = {R:?}
+origin = [{R:?}, {R:?}, {R:?}]
+"#
+        )
+    };
+    let mut one = load(&scene(""));
+    steps(&mut one, 3);
+    let m = one.world.bodies.mass[1];
+    let h = one.world.time.h;
+    for dec in [
+        "[decomposition]\nnx = 2\nny = 2",
+        "[decomposition]\nnx = 2\nny = 2\nnz = 2\nscheme = \"centralized\"",
+    ] {
+        let mut s = load(&scene(dec));
+        let mut n = s.decomposition.as_ref().unwrap().solver3();
+        let mut last = None;
+        for _ in 0..3 {
+            let r = n.step(&mut s.world).unwrap();
+            assert!(r.solve.converged, "{dec}: {r:?}");
+            last = Some(r);
+        }
+        let r = last.unwrap();
+        let dec = dec.replace('\n', " ");
+        println!(
+            "{dec}: {} subdomains, {} interface bodies, max multiplicity {}, egluing {:.2e}, stages {}",
+            r.subdomains, r.interface_bodies, r.max_multiplicity, r.egluing, r.stages
+        );
+        assert!(r.interface_bodies > 0 && r.subdomains >= 4);
+        assert!(r.egluing_rel < 1e-8);
+        let (a, b) = (&one.world.contacts, &s.world.contacts);
+        assert_eq!(a.len(), b.len());
+        let mut worst: f64 = 0.0;
+        for k in 0..a.len() {
+            assert_eq!(a.key[k], b.key[k]);
+            for d in 0..3 {
+                worst = worst.max((a.r[k][d] - b.r[k][d]).abs());
+            }
+        }
+        // relative to the weight of one sphere over a step
+        let rel = worst / (m * G * h);
+        println!("{dec}: max |Δr| = {rel:.2e} × m g h");
+        assert!(rel < 1e-6, "{dec}: impulses differ by {rel} m g h");
+        // 2 threads: bitwise the same
+        let mut t2 = load(&scene(&format!("{dec}\nthreads = 2").replace(' ', "\n").replace("\n=\n", " = ")));
+        let mut n2 = t2.decomposition.as_ref().unwrap().solver3();
+        for _ in 0..3 {
+            n2.step(&mut t2.world).unwrap();
+        }
+        assert_eq!(t2.world.bodies.vel, s.world.bodies.vel, "{dec}: threads change the result");
+        assert_eq!(t2.world.contacts.r, s.world.contacts.r);
+        let v = s
+            .world
+            .bodies
+            .vel
+            .iter()
+            .map(|v| v.iter().map(|x| x.abs()).fold(0.0, f64::max))
+            .fold(0.0, f64::max);
+        // at rest: within 1e-6 of the speed gravity adds in a step
+        assert!(v < 1e-6 * G * h, "{dec}: the stack stays at rest, max |V| = {v}");
+    }
+}

@@ -19,6 +19,8 @@ use crate::world3::{BodyDrive3, BoxWalls3, World3};
 pub struct Scene3 {
     pub world: World3,
     pub output: OutputSettings,
+    /// NSCDD settings (`[decomposition]`, nx × ny × nz); `None`: one domain.
+    pub decomposition: Option<crate::dd::DdConfig>,
 }
 
 /// Loads a 3D scene from its text; `file` names it in messages.
@@ -31,12 +33,6 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene3, I
         3 if sf.gravity.iter().all(|g| g.is_finite()) => [sf.gravity[0], sf.gravity[1], sf.gravity[2]],
         _ => return Err(cx.err(&[k("gravity")], "gravity must be 3 finite numbers in 3D")),
     };
-    if sf.decomposition.is_some() {
-        return Err(cx.err(
-            &[k("decomposition")],
-            "NSCDD subdomains are not available for 3D scenes yet: remove [decomposition]",
-        ));
-    }
     if sf.output.box_walls.is_some() {
         return Err(cx.err(&[k("output"), k("box")], "`box` names the 4 walls of a 2D sample; in 3D use `box3`"));
     }
@@ -214,6 +210,11 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene3, I
             format!("unknown writer `{w}` for a 3D scene"),
         ));
     }
+    let movable = (0..n).filter(|&i| b.bodies.movable(i)).count();
+    let decomposition = match &sf.decomposition {
+        None => None,
+        Some(d) => Some(super::decomposition(&cx, d, movable)?),
+    };
     let world = World3 {
         bodies: b.bodies,
         names: b.names,
@@ -243,6 +244,7 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene3, I
             writers: vec![],
             checkpoint_every: sf.output.checkpoint_every,
         },
+        decomposition,
     })
 }
 

@@ -356,6 +356,7 @@ pub(crate) fn decomposition(cx: &Ctx, d: &schema::DecompositionSpec, movable: us
     let mut c = crate::dd::DdConfig::default();
     c.dd.nx = int("nx", d.nx, 1, def.nx as i64)? as u32;
     c.dd.ny = int("ny", d.ny, 1, def.ny as i64)? as u32;
+    c.dd.nz = int("nz", d.nz, 1, 1)? as u32;
     c.dd.sweeps_per_gluing = int("sweeps_per_gluing", d.sweeps_per_gluing, 1, 1)? as u32;
     c.dd.threads = int("threads", d.threads, 1, 1)? as usize;
     c.repartition_every = int("repartition_every", d.repartition_every, 1, 1)? as u32;
@@ -364,9 +365,10 @@ pub(crate) fn decomposition(cx: &Ctx, d: &schema::DecompositionSpec, movable: us
     }
     c.check_capacity(movable).map_err(|(key, m)| {
         // name a key the section has
-        let key = match (d.nx.is_some(), d.ny.is_some()) {
-            (true, _) | (false, false) => key,
-            (false, true) => "ny",
+        let key = match (d.nx.is_some(), d.ny.is_some(), d.nz.is_some()) {
+            (true, _, _) | (false, false, false) => key,
+            (false, true, _) => "ny",
+            (false, false, true) => "nz",
         };
         cx.err(&p(key), m)
     })?;
