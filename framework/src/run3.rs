@@ -34,7 +34,8 @@ pub fn run3(scene: &mut Scene3, dir: &Path, mut on_step: impl FnMut(&World3, &St
     std::fs::create_dir_all(dir).map_err(io(dir, "the output directory"))?;
     let w = &mut scene.world;
     let file = std::fs::File::create(dir.join("history.csv")).map_err(io(dir, "history.csv"))?;
-    let mut hist = History3::new(std::io::BufWriter::new(file), w).map_err(io(dir, "history.csv"))?;
+    let mut hist =
+        History3::with_columns(std::io::BufWriter::new(file), w, scene.decomposition.is_some()).map_err(io(dir, "history.csv"))?;
     let mut vtk = scene.output.vtk.then(VtkWriter::default);
     let mut frame = 0u32;
     if let Some(v) = vtk.as_mut() {
@@ -49,15 +50,16 @@ pub fn run3(scene: &mut Scene3, dir: &Path, mut on_step: impl FnMut(&World3, &St
         let stepped = match &mut dd {
             Some(n) => n.step(w).map(|r| {
                 sum.migrations += r.migrations as u64;
-                StepReport {
+                let plain = StepReport {
                     solve: r.solve,
                     contacts: r.contacts,
                     times: r.times,
-                }
+                };
+                (plain, Some(r))
             }),
-            None => w.step(),
+            None => w.step().map(|r| (r, None)),
         };
-        let rep = match stepped {
+        let (rep, dd_rep) = match stepped {
             Ok(r) => r,
             Err(d) => {
                 let _ = hist.flush();
@@ -73,7 +75,7 @@ pub fn run3(scene: &mut Scene3, dir: &Path, mut on_step: impl FnMut(&World3, &St
             hist.flush().map_err(io(dir, "history.csv"))?;
         }
         let t_out = t0.elapsed().as_secs_f64();
-        hist.row(w, &rep, t_out).map_err(io(dir, "history.csv"))?;
+        hist.row_dd(w, &rep, dd_rep.as_ref(), t_out).map_err(io(dir, "history.csv"))?;
         if scene.output.checkpoint_every > 0 && s % scene.output.checkpoint_every == 0 && s != steps {
             hist.flush().map_err(io(dir, "history.csv"))?;
             save_state(dir, "checkpoint.json", w)?;

@@ -115,20 +115,7 @@ impl<W: Write> History<W> {
             tm.detect, tm.delassus, tm.nlgs, tm.update, t_output
         ));
         if self.dd {
-            match dd {
-                Some(d) => s.push_str(&format!(
-                    ",{},{:e},{:e},{},{},{},{},{}",
-                    d.stages,
-                    d.egluing,
-                    d.egluing_rel,
-                    d.interface_bodies,
-                    d.links,
-                    d.migrations,
-                    d.prevailing.name(),
-                    d.subdomains
-                )),
-                None => s.push_str(&",".repeat(DD_COLUMNS.len())),
-            }
+            s.push_str(&dd_fields(dd));
         }
         writeln!(self.out, "{s}")
     }
@@ -153,4 +140,22 @@ pub fn box_measures(w: &World2) -> (f64, f64, f64, f64, f64) {
     let sphi = if s1 + s2 > 0.0 { (s1 - s2) / (s1 + s2) } else { 0.0 };
     let eps1 = w.box_h0.map(|h0| (h0 - height) / h0).unwrap_or(0.0);
     (w.solid_fraction().unwrap_or(f64::NAN), eps1, s1, s2, sphi)
+}
+
+/// The NSCDD fields of a history row (empty fields without a report).
+pub fn dd_fields(dd: Option<&DdStepReport>) -> String {
+    match dd {
+        Some(d) => format!(
+            ",{},{:e},{:e},{},{},{},{},{}",
+            d.stages,
+            d.egluing,
+            d.egluing_rel,
+            d.interface_bodies,
+            d.links,
+            d.migrations,
+            d.prevailing.name(),
+            d.subdomains
+        ),
+        None => ",".repeat(DD_COLUMNS.len()),
+    }
 }

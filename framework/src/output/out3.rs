@@ -27,12 +27,19 @@ pub struct History3<W: Write> {
     out: W,
     tracked: Vec<(u32, String)>,
     has_box: bool,
+    /// The NSCDD columns of 2D histories ([`super::history::DD_COLUMNS`]).
+    dd: bool,
     /// Margin of the bulk measures: 4 × the largest grain radius.
     margin: f64,
 }
 
 impl<W: Write> History3<W> {
-    pub fn new(mut out: W, w: &World3) -> std::io::Result<Self> {
+    pub fn new(out: W, w: &World3) -> std::io::Result<Self> {
+        Self::with_columns(out, w, false)
+    }
+
+    /// With `dd`, the NSCDD columns follow the timings (as in 2D).
+    pub fn with_columns(mut out: W, w: &World3, dd: bool) -> std::io::Result<Self> {
         let mut tracked = vec![];
         for b in 0..w.bodies.len() {
             let driven = w.drives.iter().any(|d| d.body as usize == b);
@@ -53,17 +60,29 @@ impl<W: Write> History3<W> {
             head.push_str(",solid_fraction,eps1,sigma_xx,sigma_yy,sigma_zz,p,q,q_over_p,z,z_m,nu_bulk,z_bulk,rattlers_bulk");
         }
         head.push_str(",t_detect,t_delassus,t_nlgs,t_update,t_output");
+        if dd {
+            for c in super::history::DD_COLUMNS {
+                head.push(',');
+                head.push_str(c);
+            }
+        }
         writeln!(out, "{head}")?;
         let margin = 4.0 * w.max_grain_size();
         Ok(History3 {
             out,
             tracked,
             has_box,
+            dd,
             margin,
         })
     }
 
     pub fn row(&mut self, w: &World3, r: &StepReport, t_output: f64) -> std::io::Result<()> {
+        self.row_dd(w, r, None, t_output)
+    }
+
+    /// A row; `dd` fills the NSCDD columns.
+    pub fn row_dd(&mut self, w: &World3, r: &StepReport, dd: Option<&crate::dd::DdStepReport>, t_output: f64) -> std::io::Result<()> {
         let n = &r.solve.norms;
         let (ek, ep) = w.energies();
         let mut s = format!(
@@ -120,6 +139,9 @@ impl<W: Write> History3<W> {
             ",{:e},{:e},{:e},{:e},{:e}",
             tm.detect, tm.delassus, tm.nlgs, tm.update, t_output
         ));
+        if self.dd {
+            s.push_str(&super::history::dd_fields(dd));
+        }
         writeln!(self.out, "{s}")
     }
 
