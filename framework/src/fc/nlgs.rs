@@ -125,7 +125,7 @@ impl<const D: usize> Blocks<D> {
 
     /// The one-contact solution of contact α.
     #[inline(always)]
-    fn local(&self, a: usize, u0: [f64; D], mu: f64) -> [f64; D] {
+    fn local(&self, a: usize, u0: [f64; D], mu: f64, prev: [f64; D]) -> [f64; D] {
         let mut out = [0.0; D];
         if D == 2 {
             let w = &self.diag[a];
@@ -134,7 +134,7 @@ impl<const D: usize> Blocks<D> {
         } else {
             let (w, pre, full) = &self.pre3[a];
             let r = match full {
-                None => c3::solve_pre(w, pre, [u0[0], u0[1], u0[2]], 0.0, mu),
+                None => c3::solve_pre_warm(w, pre, [u0[0], u0[1], u0[2]], 0.0, mu, [prev[0], prev[1], prev[2]]),
                 Some(f) => c3::solve_full(f, [u0[0], u0[1], u0[2]], 0.0, mu),
             };
             out[..3].copy_from_slice(&r);
@@ -148,7 +148,7 @@ impl<const D: usize> Blocks<D> {
         for a in 0..q.len() {
             let u0 = self.off_sum(a, q[a], r);
             let ro = r[a];
-            let rn = self.local(a, u0, mu[a]);
+            let rn = self.local(a, u0, mu[a], ro);
             if let Some(s) = sums.as_deref_mut() {
                 let w = &self.diag[a];
                 let (mut wr_old, mut wr, mut du) = ([0.0; D], [0.0; D], [0.0; D]);

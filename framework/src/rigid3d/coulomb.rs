@@ -229,6 +229,15 @@ pub fn solve(w: &Sym3, u0: [f64; 3], u_target: f64, mu: f64) -> [f64; 3] {
 /// [`solve`] with the block's precomputed data.
 #[inline]
 pub fn solve_pre(w: &Sym3, pre: &Pre3, u0: [f64; 3], u_target: f64, mu: f64) -> [f64; 3] {
+    solve_pre_warm(w, pre, u0, u_target, mu, [0.0; 3])
+}
+
+/// [`solve_pre`] with the contact's previous impulse `prev`: a sliding solution of a
+/// coupled block is searched first from `prev`'s slip direction (in NLGS the
+/// iterates change little from sweep to sweep, so the secant steps start next to
+/// the root). The result is the same solution up to round-off.
+#[inline]
+pub fn solve_pre_warm(w: &Sym3, pre: &Pre3, u0: [f64; 3], u_target: f64, mu: f64, prev: [f64; 3]) -> [f64; 3] {
     let s0 = u0[0] - u_target;
     // 1. no contact
     if s0 >= 0.0 {
@@ -268,7 +277,9 @@ pub fn solve_pre(w: &Sym3, pre: &Pre3, u0: [f64; 3], u_target: f64, mu: f64) -> 
     }
     // 4. slide, general block: a few secant steps on the slip angle from the
     // direction of the sticking impulse, then the bracketing scan
-    let guess = if pre.singular == 0 {
+    let guess = if prev[1] != 0.0 || prev[2] != 0.0 {
+        prev[2].atan2(prev[1])
+    } else if pre.singular == 0 {
         let r = mul(&pre.inv, [-s0, -u0[1], -u0[2]]);
         r[2].atan2(r[1])
     } else {

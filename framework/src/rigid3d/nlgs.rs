@@ -49,7 +49,7 @@ fn sweep_with<M: InvMassOf + ?Sized>(
         let wr_old = coulomb::mul(&blk.w, r);
         let u0 = [u[0] - wr_old[0], u[1] - wr_old[1], u[2] - wr_old[2]];
         let t = c.target[a];
-        let mut rn = coulomb::solve_pre(&blk.w, &blk.pre, u0, t.u_target, t.mu);
+        let mut rn = coulomb::solve_pre_warm(&blk.w, &blk.pre, u0, t.u_target, t.mu, r);
         if omega != 1.0 {
             for k in 0..3 {
                 rn[k] = omega * rn[k] + (1.0 - omega) * r[k];
