@@ -12,14 +12,17 @@ pub fn run(
     subdomains: Option<&str>,
     scheme: Option<&str>,
     threads: Option<&str>,
-    restart: bool,
+    restart: Option<&Path>,
 ) -> ExitCode {
     let movable = (0..s.world.bodies.len()).filter(|&b| s.world.bodies.movable(b)).count();
-    let flags = if restart {
-        Err("--restart: not available for 3D scenes yet (restarts are 2D for now)".to_string())
-    } else {
-        crate::apply_decomposition_to(&mut s.decomposition, movable, true, subdomains, scheme, threads)
-    };
+    let flags =
+        crate::apply_decomposition_to(&mut s.decomposition, movable, true, subdomains, scheme, threads).and_then(|()| match restart {
+            Some(state) => {
+                crate::check_restart_dir(out, state)?;
+                nscdd::scene::restart3::restart3(&mut s.world, state).map_err(|e| e.to_string())
+            }
+            None => Ok(()),
+        });
     if let Err(msg) = flags {
         if std::fs::create_dir_all(out).is_ok() {
             let _ = std::fs::write(out.join("error.txt"), format!("{msg}\n"));
@@ -29,6 +32,7 @@ pub fn run(
     }
     let steps = s.world.time.steps;
     let bar = if quiet { ProgressBar::hidden() } else { ProgressBar::new(steps) };
+    bar.set_position(s.world.step);
     bar.set_style(
         ProgressStyle::with_template("{bar:30} step {pos}/{len} | {msg} | {elapsed_precise} elapsed, {eta_precise} left")
             .expect("valid template"),

@@ -343,3 +343,73 @@ origin = [{R:?}, {R:?}, {R:?}]
         assert!(v < 1e-6 * G * h, "{dec}: the stack stays at rest, max |V| = {v}");
     }
 }
+
+/// A 3D run stopped at step 40 and continued from its final.json ends bitwise where
+/// the uninterrupted run ends (spheres poured on a tilted box: rotations, friction,
+/// warm-started impulses).
+#[test]
+fn restart_3d_continues_bitwise() {
+    let scene = |steps: u64| {
+        format!(
+            r#"
+dimension = 3
+[time]
+step = 1e-3
+steps = {steps}
+[output]
+vtk = false
+[[materials]]
+name = "m"
+density = {RHO:?}
+[[laws]]
+materials = ["m", "m"]
+friction = 0.4
+[[bodies]]
+name = "table"
+shape = "box"
+material = "m"
+half_extents = [0.3, 0.3, 0.02]
+position = [0.0, 0.0, -0.02]
+rotation = [0.1, 0.05, 0.0]
+fixed = true
+[[generate]]
+kind = "sphere_packing"
+material = "m"
+count = 40
+radius_min = 0.01
+radius_max = 0.02
+box = [-0.1, -0.1, 0.02, 0.1, 0.1, 0.15]
+seed = 9
+"#
+        )
+    };
+    let tmp = |n: &str| std::env::temp_dir().join(format!("nscdd-restart3-{}-{n}", std::process::id()));
+    let (a, b, c) = (tmp("whole"), tmp("first"), tmp("second"));
+    let mut whole = load(&scene(80));
+    nscdd::run3::run3(&mut whole, &a, |_, _| {}).unwrap();
+    let mut first = load(&scene(40));
+    nscdd::run3::run3(&mut first, &b, |_, _| {}).unwrap();
+    let mut second = load(&scene(80));
+    nscdd::scene::restart3::restart3(&mut second.world, &b.join("final.json")).unwrap();
+    nscdd::run3::run3(&mut second, &c, |_, _| {}).unwrap();
+    let (x, y) = (
+        std::fs::read_to_string(a.join("final.json")).unwrap(),
+        std::fs::read_to_string(c.join("final.json")).unwrap(),
+    );
+    for (k, (p, q)) in x.lines().zip(y.lines()).enumerate() {
+        assert_eq!(p, q, "line {} of final.json", k + 1);
+    }
+    assert!(whole.world.contacts.len() > 10);
+    // a 2D state is refused, naming the key
+    let mut third = load(&scene(80));
+    let e = nscdd::scene::restart3::restart3_str(
+        &mut third.world,
+        "{\"dimension\": 2, \"step\": 1, \"time\": 0.001, \"bodies\": [], \"contacts\": []}",
+        "s.json",
+    )
+    .unwrap_err();
+    assert_eq!(e.key, "dimension", "{e}");
+    for d in [a, b, c] {
+        let _ = std::fs::remove_dir_all(d);
+    }
+}

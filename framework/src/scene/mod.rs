@@ -12,6 +12,7 @@ pub mod builder3;
 pub mod load3;
 pub mod locate;
 pub mod restart;
+pub mod restart3;
 pub mod schema;
 
 use crate::detect::{Detector, DetectorTable};
