@@ -323,23 +323,8 @@ fn main() -> ExitCode {
             bar.finish_and_clear();
             match res {
                 Ok(sum) => {
-                    if sum.unconverged_steps > 0 {
-                        eprintln!(
-                            "warning: the contact solver did not converge in {} of {} steps (first: step {}); see the `converged` column of history.csv",
-                            sum.unconverged_steps,
-                            sum.steps,
-                            sum.first_unconverged.unwrap_or(0)
-                        );
-                    }
-                    if sum.suspect_steps > 0 {
-                        eprintln!(
-                            "warning: {} steps met the {} criterion with a natural-map residual above {} × tolerance (largest {:.2e} at step {}): the solve stalled; lower solver.tolerance (docs/EXTREMES.md)",
-                            sum.suspect_steps,
-                            s.world.solver.norm.name(),
-                            nscdd::run::SUSPECT_FACTOR,
-                            sum.max_residual,
-                            sum.max_residual_step
-                        );
+                    for line in sum.warnings(s.world.solver.norm.name()) {
+                        eprintln!("{line}");
                     }
                     let dd = match &s.decomposition {
                         Some(c) => format!(

@@ -51,13 +51,8 @@ pub fn run(
     bar.finish_and_clear();
     match res {
         Ok(sum) => {
-            if sum.unconverged_steps > 0 {
-                eprintln!(
-                    "warning: the contact solver did not converge in {} of {} steps (first: step {}); see the `converged` column of history.csv",
-                    sum.unconverged_steps,
-                    sum.steps,
-                    sum.first_unconverged.unwrap_or(0)
-                );
+            for line in sum.warnings(s.world.solver.norm.name()) {
+                eprintln!("{line}");
             }
             let dd = match &s.decomposition {
                 Some(c) => format!(

@@ -52,6 +52,45 @@ pub struct RunSummary {
 /// counted as suspect.
 pub const SUSPECT_FACTOR: f64 = 100.0;
 
+impl RunSummary {
+    /// Counts one finished step (its solve report, its number, the tolerance).
+    pub fn record(&mut self, solve: &crate::solver::SolveReport, step: u64, tolerance: f64) {
+        self.steps += 1;
+        self.total_sweeps += solve.sweeps as u64;
+        if !solve.converged {
+            self.unconverged_steps += 1;
+            self.first_unconverged.get_or_insert(step);
+        } else if solve.residual > SUSPECT_FACTOR * tolerance {
+            self.suspect_steps += 1;
+        }
+        if solve.residual > self.max_residual {
+            self.max_residual = solve.residual;
+            self.max_residual_step = step;
+        }
+    }
+
+    /// The warnings a finished run prints (unconverged and suspect steps), one per
+    /// line; `norm` names the criterion.
+    pub fn warnings(&self, norm: &str) -> Vec<String> {
+        let mut out = vec![];
+        if self.unconverged_steps > 0 {
+            out.push(format!(
+                "warning: the contact solver did not converge in {} of {} steps (first: step {}); see the `converged` column of history.csv",
+                self.unconverged_steps,
+                self.steps,
+                self.first_unconverged.unwrap_or(0)
+            ));
+        }
+        if self.suspect_steps > 0 {
+            out.push(format!(
+                "warning: {} steps met the {norm} criterion with a natural-map residual above {SUSPECT_FACTOR} × tolerance (largest {:.2e} at step {}): the solve stalled; lower solver.tolerance (docs/EXTREMES.md)",
+                self.suspect_steps, self.max_residual, self.max_residual_step
+            ));
+        }
+        out
+    }
+}
+
 fn io(dir: &Path, what: &str) -> impl Fn(std::io::Error) -> RunError {
     let d = dir.display().to_string();
     let what = what.to_string();
@@ -143,18 +182,7 @@ pub fn run(
         if let Some(r) = &dd_rep {
             sum.migrations += r.migrations as u64;
         }
-        sum.steps += 1;
-        sum.total_sweeps += rep.solve.sweeps as u64;
-        if !rep.solve.converged {
-            sum.unconverged_steps += 1;
-            sum.first_unconverged.get_or_insert(w.step);
-        } else if rep.solve.residual > SUSPECT_FACTOR * w.solver.tolerance {
-            sum.suspect_steps += 1;
-        }
-        if rep.solve.residual > sum.max_residual {
-            sum.max_residual = rep.solve.residual;
-            sum.max_residual_step = w.step;
-        }
+        sum.record(&rep.solve, w.step, w.solver.tolerance);
         on_step(w, &rep);
     }
     hist.flush().map_err(io(dir, "history.csv"))?;

@@ -4,7 +4,7 @@
 use crate::engine::StepReport;
 use crate::output::out3::{final_json3, write_vtk3, History3};
 use crate::output::vtk::VtkWriter;
-use crate::run::{RunError, RunSummary, SUSPECT_FACTOR};
+use crate::run::{RunError, RunSummary};
 use crate::scene::load3::Scene3;
 use crate::world3::World3;
 use std::io::Write;
@@ -80,18 +80,7 @@ pub fn run3(scene: &mut Scene3, dir: &Path, mut on_step: impl FnMut(&World3, &St
             hist.flush().map_err(io(dir, "history.csv"))?;
             save_state(dir, "checkpoint.json", w)?;
         }
-        sum.steps += 1;
-        sum.total_sweeps += rep.solve.sweeps as u64;
-        if !rep.solve.converged {
-            sum.unconverged_steps += 1;
-            sum.first_unconverged.get_or_insert(w.step);
-        } else if rep.solve.residual > SUSPECT_FACTOR * w.solver.tolerance {
-            sum.suspect_steps += 1;
-        }
-        if rep.solve.residual > sum.max_residual {
-            sum.max_residual = rep.solve.residual;
-            sum.max_residual_step = w.step;
-        }
+        sum.record(&rep.solve, w.step, w.solver.tolerance);
         on_step(w, &rep);
     }
     hist.flush().map_err(io(dir, "history.csv"))?;

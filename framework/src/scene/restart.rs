@@ -64,77 +64,23 @@ pub fn restart(w: &mut World2, path: &Path) -> Result<(), InputError> {
 
 /// [`restart`] from the text of a saved state; `file` names it in messages.
 pub fn restart_str(w: &mut World2, text: &str, file: &str) -> Result<(), InputError> {
-    let err = |line: Option<usize>, key: String, message: String| InputError {
-        file: file.to_string(),
-        line,
-        key,
-        message,
-    };
+    let ck = StateChecks { text, file };
     let saved: Saved =
-        serde_json::from_str(text).map_err(|e| err(Some(e.line()), String::new(), format!("not a saved state (final.json): {e}")))?;
-    // the line of the k-th occurrence of `"key":` (the file is written one field per line)
-    let line_of = |key: &str, k: usize| -> Option<usize> {
-        let pat = format!("\"{key}\":");
-        text.match_indices(&pat).nth(k).map(|(o, _)| crate::error::line_of(text, o))
-    };
+        serde_json::from_str(text).map_err(|e| ck.err(Some(e.line()), String::new(), format!("not a saved state (final.json): {e}")))?;
     let nb = w.bodies.len();
-    if saved.bodies.len() != nb {
-        return Err(err(
-            line_of("bodies", 0),
-            "bodies".into(),
-            format!(
-                "the saved state has {} bodies, the scene {nb}: a restart needs the scene that wrote it",
-                saved.bodies.len()
-            ),
-        ));
-    }
-    for (k, sb) in saved.bodies.iter().enumerate() {
-        if sb.id as usize != k {
-            return Err(err(
-                line_of("id", k),
-                format!("bodies[{k}].id"),
-                format!("expected id {k}, found {}", sb.id),
-            ));
-        }
-        if sb.kind != w.kind_name(k) {
-            return Err(err(
-                line_of("kind", k),
-                format!("bodies[{k}].kind"),
-                format!("the saved body is a `{}`, the scene's body {k} a `{}`", sb.kind, w.kind_name(k)),
-            ));
-        }
-        let finite = sb.position.iter().chain(&sb.velocity).all(|x| x.is_finite()) && sb.rotation.is_finite();
-        if !finite {
-            return Err(err(line_of("position", k), format!("bodies[{k}]"), "non-finite state".into()));
-        }
-    }
-    let expected = saved.step as f64 * w.time.h;
-    if !(saved.time.is_finite() && (saved.time - expected).abs() <= 1e-9 * expected.abs().max(w.time.h)) {
-        return Err(err(
-            line_of("time", 0),
-            "time".into(),
-            format!(
-                "the saved time {} s is not step {} × h = {expected} s: a restart keeps the scene's step h",
-                saved.time, saved.step
-            ),
-        ));
-    }
-    if saved.step >= w.time.steps {
-        return Err(err(
-            line_of("step", 0),
-            "step".into(),
-            format!(
-                "the saved state is at step {}, the scene ends at step {}: nothing left to run (raise time.steps or time.duration)",
-                saved.step, w.time.steps
-            ),
-        ));
-    }
+    let finite = |sb: &SavedBody| sb.position.iter().chain(&sb.velocity).all(|x| x.is_finite()) && sb.rotation.is_finite();
+    ck.bodies(
+        saved.bodies.iter().map(|sb| (sb.id, sb.kind.as_str(), finite(sb))),
+        |k| w.kind_name(k),
+        nb,
+    )?;
+    let expected = ck.time(saved.step, saved.time, &w.time)?;
     let mut c = Contacts2::default();
     for (a, sc) in saved.contacts.iter().enumerate() {
         let [i, j] = sc.bodies;
         if i as usize >= nb || j as usize >= nb {
-            return Err(err(
-                line_of("bodies", a + 1),
+            return Err(ck.err(
+                ck.line_of("bodies", a + 1),
                 format!("contacts[{a}].bodies"),
                 format!("body ids must be below {nb}"),
             ));
@@ -167,4 +113,91 @@ pub fn restart_str(w: &mut World2, text: &str, file: &str) -> Result<(), InputEr
     w.t = expected;
     w.box_h0 = saved.box_h0;
     Ok(())
+}
+
+/// The checks every restart file gets, whatever the dimension: errors name the
+/// file, the line (the k-th occurrence of a key: the file is written one field per
+/// line) and the key.
+pub(crate) struct StateChecks<'a> {
+    pub text: &'a str,
+    pub file: &'a str,
+}
+
+impl StateChecks<'_> {
+    pub fn err(&self, line: Option<usize>, key: String, message: String) -> InputError {
+        InputError {
+            file: self.file.to_string(),
+            line,
+            key,
+            message,
+        }
+    }
+    pub fn line_of(&self, key: &str, k: usize) -> Option<usize> {
+        let pat = format!("\"{key}\":");
+        self.text
+            .match_indices(&pat)
+            .nth(k)
+            .map(|(o, _)| crate::error::line_of(self.text, o))
+    }
+    /// The saved bodies are the scene's: same count, ids in order, same kinds,
+    /// finite states. `bodies[k]` = (id, kind, finite).
+    pub fn bodies<'k>(
+        &self,
+        saved: impl ExactSizeIterator<Item = (u32, &'k str, bool)>,
+        kinds: impl Fn(usize) -> &'static str,
+        nb: usize,
+    ) -> Result<(), InputError> {
+        if saved.len() != nb {
+            return Err(self.err(
+                self.line_of("bodies", 0),
+                "bodies".into(),
+                format!(
+                    "the saved state has {} bodies, the scene {nb}: a restart needs the scene that wrote it",
+                    saved.len()
+                ),
+            ));
+        }
+        for (k, (id, kind, finite)) in saved.enumerate() {
+            if id as usize != k {
+                return Err(self.err(
+                    self.line_of("id", k),
+                    format!("bodies[{k}].id"),
+                    format!("expected id {k}, found {id}"),
+                ));
+            }
+            if kind != kinds(k) {
+                return Err(self.err(
+                    self.line_of("kind", k),
+                    format!("bodies[{k}].kind"),
+                    format!("the saved body is a `{kind}`, the scene's body {k} a `{}`", kinds(k)),
+                ));
+            }
+            if !finite {
+                return Err(self.err(self.line_of("position", k), format!("bodies[{k}]"), "non-finite state".into()));
+            }
+        }
+        Ok(())
+    }
+    /// The saved time is step × h and the scene has steps left; returns the time.
+    pub fn time(&self, step: u64, time: f64, t: &crate::world::TimeSettings) -> Result<f64, InputError> {
+        let expected = step as f64 * t.h;
+        if !(time.is_finite() && (time - expected).abs() <= 1e-9 * expected.abs().max(t.h)) {
+            return Err(self.err(
+                self.line_of("time", 0),
+                "time".into(),
+                format!("the saved time {time} s is not step {step} × h = {expected} s: a restart keeps the scene's step h"),
+            ));
+        }
+        if step >= t.steps {
+            return Err(self.err(
+                self.line_of("step", 0),
+                "step".into(),
+                format!(
+                    "the saved state is at step {step}, the scene ends at step {}: nothing left to run (raise time.steps or time.duration)",
+                    t.steps
+                ),
+            ));
+        }
+        Ok(expected)
+    }
 }

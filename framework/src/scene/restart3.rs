@@ -4,6 +4,7 @@
 //! ([`super::restart`]): the scene that wrote the state, the same step h; a
 //! continued one-domain run is bitwise the uninterrupted one.
 
+use super::restart::StateChecks;
 use crate::error::InputError;
 use crate::rigid2d::contacts::ContactKey;
 use crate::rigid3d::contacts::Frame3;
@@ -56,87 +57,35 @@ pub fn restart3(w: &mut World3, path: &Path) -> Result<(), InputError> {
 
 /// [`restart3`] from the text of a saved state; `file` names it in messages.
 pub fn restart3_str(w: &mut World3, text: &str, file: &str) -> Result<(), InputError> {
-    let err = |line: Option<usize>, key: String, message: String| InputError {
-        file: file.to_string(),
-        line,
-        key,
-        message,
-    };
+    let ck = StateChecks { text, file };
     let saved: Saved = serde_json::from_str(text).map_err(|e| {
-        err(
+        ck.err(
             Some(e.line()),
             String::new(),
             format!("not a saved 3D state (final.json of a 3D run): {e}"),
         )
     })?;
-    let line_of = |key: &str, k: usize| -> Option<usize> {
-        let pat = format!("\"{key}\":");
-        text.match_indices(&pat).nth(k).map(|(o, _)| crate::error::line_of(text, o))
-    };
     if saved.dimension != 3 {
-        return Err(err(
-            line_of("dimension", 0),
+        return Err(ck.err(
+            ck.line_of("dimension", 0),
             "dimension".into(),
             format!("the state is {}D, the scene 3D", saved.dimension),
         ));
     }
     let nb = w.bodies.len();
-    if saved.bodies.len() != nb {
-        return Err(err(
-            line_of("bodies", 0),
-            "bodies".into(),
-            format!(
-                "the saved state has {} bodies, the scene {nb}: a restart needs the scene that wrote it",
-                saved.bodies.len()
-            ),
-        ));
-    }
-    for (k, sb) in saved.bodies.iter().enumerate() {
-        if sb.id as usize != k {
-            return Err(err(
-                line_of("id", k),
-                format!("bodies[{k}].id"),
-                format!("expected id {k}, found {}", sb.id),
-            ));
-        }
-        if sb.kind != w.kind_name(k) {
-            return Err(err(
-                line_of("kind", k),
-                format!("bodies[{k}].kind"),
-                format!("the saved body is a `{}`, the scene's body {k} a `{}`", sb.kind, w.kind_name(k)),
-            ));
-        }
-        if !sb.position.iter().chain(&sb.velocity).chain(&sb.quaternion).all(|x| x.is_finite()) {
-            return Err(err(line_of("position", k), format!("bodies[{k}]"), "non-finite state".into()));
-        }
-    }
-    let expected = saved.step as f64 * w.time.h;
-    if !(saved.time.is_finite() && (saved.time - expected).abs() <= 1e-9 * expected.abs().max(w.time.h)) {
-        return Err(err(
-            line_of("time", 0),
-            "time".into(),
-            format!(
-                "the saved time {} s is not step {} × h = {expected} s: a restart keeps the scene's step h",
-                saved.time, saved.step
-            ),
-        ));
-    }
-    if saved.step >= w.time.steps {
-        return Err(err(
-            line_of("step", 0),
-            "step".into(),
-            format!(
-                "the saved state is at step {}, the scene ends at step {}: nothing left to run (raise time.steps or time.duration)",
-                saved.step, w.time.steps
-            ),
-        ));
-    }
+    let finite = |sb: &SavedBody| sb.position.iter().chain(&sb.velocity).chain(&sb.quaternion).all(|x| x.is_finite());
+    ck.bodies(
+        saved.bodies.iter().map(|sb| (sb.id, sb.kind.as_str(), finite(sb))),
+        |k| w.kind_name(k),
+        nb,
+    )?;
+    let expected = ck.time(saved.step, saved.time, &w.time)?;
     let mut c = Contacts3::default();
     for (a, sc) in saved.contacts.iter().enumerate() {
         let [i, j] = sc.bodies;
         if i as usize >= nb || j as usize >= nb {
-            return Err(err(
-                line_of("bodies", a + 1),
+            return Err(ck.err(
+                ck.line_of("bodies", a + 1),
                 format!("contacts[{a}].bodies"),
                 format!("body ids must be below {nb}"),
             ));
