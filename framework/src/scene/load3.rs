@@ -8,7 +8,9 @@ use super::builder::Origin;
 use super::builder3::SceneBuilder3;
 use super::locate::Seg;
 use super::schema::{BodySpec3, SceneFile};
-use super::{at, k, laws, materials, parse, time_settings, validate_solver, Ctx, OutputSettings};
+use super::{
+    at, k, laws, laws_and_detectors, materials, origin_path, parse, time_settings, validate_solver, BodyInfo, Ctx, OutputSettings,
+};
 use crate::detect3::{Detector3, DetectorTable3};
 use crate::error::InputError;
 use crate::registry::{ParamError, Registry};
@@ -63,66 +65,21 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene3, I
     if b.bodies.is_empty() {
         return Err(cx.err(&[], "the scene has no bodies"));
     }
-    let origin_path = |o: Origin, key: &str| match o {
-        Origin::Body(i) => vec![k("bodies"), Seg::Index(i), k(key)],
-        Origin::Generated(i) => vec![k("generate"), Seg::Index(i)],
-    };
     let n = b.bodies.len();
     let driven: Vec<bool> = (0..n).map(|i| drives.iter().any(|d: &BodyDrive3| d.body as usize == i)).collect();
-    let nk = b.shapes.len();
-    let mut first_mat = vec![None; nm];
-    let mut mat_count = vec![0usize; nm];
-    let mut mat_movable = vec![false; nm];
-    let mut first_kind = vec![None; nk];
-    let mut kind_movable = vec![false; nk];
-    let mut kind_mats = vec![false; nk * nm];
-    for i in 0..n {
-        let (m, kd) = (b.bodies.material[i] as usize, b.bodies.shape[i].kind as usize);
-        let mv = b.bodies.movable(i) || driven[i];
-        first_mat[m].get_or_insert(b.origins[i]);
-        mat_count[m] += 1;
-        first_kind[kd].get_or_insert(b.origins[i]);
-        kind_mats[kd * nm + m] = true;
-        mat_movable[m] |= mv;
-        kind_movable[kd] |= mv;
-    }
-    for ma in 0..nm {
-        for mb in ma..nm {
-            if let (Some(oa), Some(_)) = (first_mat[ma], first_mat[mb]) {
-                let can_touch = ma != mb || mat_count[ma] >= 2;
-                if can_touch && (mat_movable[ma] || mat_movable[mb]) && !declared[ma * nm + mb] {
-                    let (x, y) = (&b.materials[ma].name, &b.materials[mb].name);
-                    return Err(cx.err(
-                        &origin_path(oa, "material"),
-                        format!("no law for the material pair (`{x}`, `{y}`): add a [[laws]] entry with materials = [\"{x}\", \"{y}\"]"),
-                    ));
-                }
-            }
-        }
-    }
-    let mut table = DetectorTable3 {
-        nk,
-        table: vec![None; nk * nk],
+    let info: Vec<BodyInfo> = (0..n)
+        .map(|i| BodyInfo {
+            material: b.bodies.material[i] as usize,
+            kind: b.bodies.shape[i].kind as usize,
+            movable: b.bodies.movable(i) || driven[i],
+            origin: b.origins[i],
+        })
+        .collect();
+    let kinds: Vec<&'static str> = b.shapes.iter().map(|x| x.kind()).collect();
+    let table = DetectorTable3 {
+        nk: kinds.len(),
+        table: laws_and_detectors(&cx, &info, &b.materials, &kinds, &laws, &declared, |x, y| registry.detector3(x, y))?,
     };
-    for ka in 0..nk {
-        for kb in 0..nk {
-            let (na, nb) = (b.shapes[ka].kind(), b.shapes[kb].kind());
-            // a detector is needed where a law can act between the two kinds' materials
-            let interact =
-                (0..nm).any(|ma| (0..nm).any(|mb| kind_mats[ka * nm + ma] && kind_mats[kb * nm + mb] && laws[ma * nm + mb].is_some()));
-            match registry.detector3(na, nb) {
-                Some(d) => table.table[ka * nk + kb] = Some(d),
-                None if interact && (kind_movable[ka] || kind_movable[kb]) => {
-                    let o = first_kind[ka].or(first_kind[kb]).unwrap_or(Origin::Body(0));
-                    return Err(cx.err(
-                        &origin_path(o, "shape"),
-                        format!("no contact detector for the shape pair (`{na}`, `{nb}`) among the installed plugins"),
-                    ));
-                }
-                None => {}
-            }
-        }
-    }
     let sizes: Vec<f64> = (0..n)
         .map(|i| b.shapes[b.bodies.shape[i].kind as usize].size(b.bodies.shape[i].index))
         .collect();

@@ -105,6 +105,88 @@ pub(crate) fn parse<T: serde::de::DeserializeOwned>(text: &str, file: &str) -> R
     })
 }
 
+/// What the law and detector checks need of a body.
+pub(crate) struct BodyInfo {
+    pub material: usize,
+    pub kind: usize,
+    /// Movable or driven.
+    pub movable: bool,
+    pub origin: Origin,
+}
+
+pub(crate) fn origin_path(o: Origin, key: &str) -> Vec<Seg> {
+    match o {
+        Origin::Body(i) => vec![k("bodies"), Seg::Index(i), k(key)],
+        Origin::Generated(i) => vec![k("generate"), Seg::Index(i)],
+    }
+}
+
+/// Checks that every pair of materials that can touch (two bodies, one of them
+/// movable) has a law, and makes the detector table of the kinds (`kinds[id]`: the
+/// kind names) with `lookup` (the registry's 2D or 3D detectors). A pair of kinds
+/// needs a detector when a law acts between their materials and one of them moves.
+pub(crate) fn laws_and_detectors<T>(
+    cx: &Ctx,
+    bodies: &[BodyInfo],
+    materials: &[Material],
+    kinds: &[&'static str],
+    laws: &[Option<crate::law::ContactLaw>],
+    declared: &[bool],
+    lookup: impl Fn(&str, &str) -> Option<T>,
+) -> Result<Vec<Option<T>>, InputError> {
+    let (nm, nk) = (materials.len(), kinds.len());
+    let mut first_mat = vec![None; nm];
+    let mut mat_count = vec![0usize; nm];
+    let mut mat_movable = vec![false; nm];
+    let mut first_kind = vec![None; nk];
+    let mut kind_movable = vec![false; nk];
+    let mut kind_mats = vec![false; nk * nm];
+    for bi in bodies {
+        let (m, kd) = (bi.material, bi.kind);
+        first_mat[m].get_or_insert(bi.origin);
+        mat_count[m] += 1;
+        first_kind[kd].get_or_insert(bi.origin);
+        kind_mats[kd * nm + m] = true;
+        mat_movable[m] |= bi.movable;
+        kind_movable[kd] |= bi.movable;
+    }
+    for ma in 0..nm {
+        for mb in ma..nm {
+            if let (Some(oa), Some(_)) = (first_mat[ma], first_mat[mb]) {
+                // a material touches itself only if two bodies are made of it
+                let can_touch = ma != mb || mat_count[ma] >= 2;
+                if can_touch && (mat_movable[ma] || mat_movable[mb]) && !declared[ma * nm + mb] {
+                    let (x, y) = (&materials[ma].name, &materials[mb].name);
+                    return Err(cx.err(
+                        &origin_path(oa, "material"),
+                        format!("no law for the material pair (`{x}`, `{y}`): add a [[laws]] entry with materials = [\"{x}\", \"{y}\"]"),
+                    ));
+                }
+            }
+        }
+    }
+    let mut table: Vec<Option<T>> = (0..nk * nk).map(|_| None).collect();
+    for ka in 0..nk {
+        for kb in 0..nk {
+            let (na, nb) = (kinds[ka], kinds[kb]);
+            let interact =
+                (0..nm).any(|ma| (0..nm).any(|mb| kind_mats[ka * nm + ma] && kind_mats[kb * nm + mb] && laws[ma * nm + mb].is_some()));
+            match lookup(na, nb) {
+                Some(d) => table[ka * nk + kb] = Some(d),
+                None if interact && (kind_movable[ka] || kind_movable[kb]) => {
+                    let o = first_kind[ka].or(first_kind[kb]).unwrap_or(Origin::Body(0));
+                    return Err(cx.err(
+                        &origin_path(o, "shape"),
+                        format!("no contact detector for the shape pair (`{na}`, `{nb}`) among the installed plugins"),
+                    ));
+                }
+                None => {}
+            }
+        }
+    }
+    Ok(table)
+}
+
 /// A loaded scene of either dimension.
 pub enum AnyScene {
     D2(Scene),
@@ -180,66 +262,20 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
     }
     let nm = b.materials.len();
     let (laws, declared) = laws(&cx, &sf, registry, nm, &b.materials)?;
-    let origin_path = |o: Origin, key: &str| match o {
-        Origin::Body(i) => vec![k("bodies"), Seg::Index(i), k(key)],
-        Origin::Generated(i) => vec![k("generate"), Seg::Index(i)],
-    };
     // every pair of materials that can touch needs a law; every pair of kinds a detector
-    let nk = b.shapes.len();
-    let mut first_mat = vec![None; nm];
-    let mut mat_count = vec![0usize; nm];
-    let mut mat_movable = vec![false; nm];
-    let mut first_kind = vec![None; nk];
-    let mut kind_movable = vec![false; nk];
-    for i in 0..b.bodies.len() {
-        let (m, kd, mv) = (
-            b.bodies.material[i] as usize,
-            b.bodies.shape[i].kind as usize,
-            b.bodies.movable(i) || drives.iter().any(|d: &BodyDrive2| d.body as usize == i),
-        );
-        first_mat[m].get_or_insert(b.origins[i]);
-        mat_count[m] += 1;
-        first_kind[kd].get_or_insert(b.origins[i]);
-        mat_movable[m] |= mv;
-        kind_movable[kd] |= mv;
-    }
-    for ma in 0..nm {
-        for mb in ma..nm {
-            if let (Some(oa), Some(_)) = (first_mat[ma], first_mat[mb]) {
-                // a material touches itself only if two bodies are made of it
-                let can_touch = ma != mb || mat_count[ma] >= 2;
-                if can_touch && (mat_movable[ma] || mat_movable[mb]) && !declared[ma * nm + mb] {
-                    return Err(cx.err(
-                        &origin_path(oa, "material"),
-                        format!(
-                            "no law for the material pair (`{}`, `{}`): add a [[laws]] entry with materials = [\"{}\", \"{}\"]",
-                            b.materials[ma].name, b.materials[mb].name, b.materials[ma].name, b.materials[mb].name
-                        ),
-                    ));
-                }
-            }
-        }
-    }
-    let mut table = DetectorTable {
-        nk,
-        table: vec![None; nk * nk],
+    let info: Vec<BodyInfo> = (0..b.bodies.len())
+        .map(|i| BodyInfo {
+            material: b.bodies.material[i] as usize,
+            kind: b.bodies.shape[i].kind as usize,
+            movable: b.bodies.movable(i) || drives.iter().any(|d: &BodyDrive2| d.body as usize == i),
+            origin: b.origins[i],
+        })
+        .collect();
+    let kinds: Vec<&'static str> = b.shapes.iter().map(|x| x.kind()).collect();
+    let table = DetectorTable {
+        nk: kinds.len(),
+        table: laws_and_detectors(&cx, &info, &b.materials, &kinds, &laws, &declared, |x, y| registry.detector(x, y))?,
     };
-    for ka in 0..nk {
-        for kb in 0..nk {
-            let (na, nb) = (b.shapes[ka].kind(), b.shapes[kb].kind());
-            match registry.detector(na, nb) {
-                Some((d, swapped)) => table.table[ka * nk + kb] = Some((d, swapped)),
-                None if kind_movable[ka] || kind_movable[kb] => {
-                    let o = first_kind[ka].or(first_kind[kb]).unwrap_or(Origin::Body(0));
-                    return Err(cx.err(
-                        &origin_path(o, "shape"),
-                        format!("no contact detector for the shape pair (`{na}`, `{nb}`) among the installed plugins"),
-                    ));
-                }
-                None => {}
-            }
-        }
-    }
     let sizes: Vec<f64> = (0..b.bodies.len())
         .map(|i| b.shapes[b.bodies.shape[i].kind as usize].size(b.bodies.shape[i].index))
         .collect();
