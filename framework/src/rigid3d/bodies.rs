@@ -100,17 +100,9 @@ impl Bodies3 {
         }
         let rot_free: Vec<usize> = (0..3).filter(|k| f & (1 << (3 + k)) != 0).collect();
         let iw = self.world_inertia(b);
-        let full = |a: usize, c: usize| {
-            let (a, c) = if a <= c { (a, c) } else { (c, a) };
-            iw[[0, 1, 2, 3, 4, 5][match (a, c) {
-                (0, 0) => 0,
-                (0, 1) => 1,
-                (0, 2) => 2,
-                (1, 1) => 3,
-                (1, 2) => 4,
-                _ => 5,
-            }]]
-        };
+        // entry (a, c) of the symmetric tensor stored as [xx, xy, xz, yy, yz, zz]
+        const IDX: [[usize; 3]; 3] = [[0, 1, 2], [1, 3, 4], [2, 4, 5]];
+        let full = |a: usize, c: usize| iw[IDX[a][c]];
         let mut out = [[0.0; 3]; 3];
         match rot_free.len() {
             0 => {}
