@@ -24,6 +24,7 @@ def main():
     ap.add_argument("--sizes", default="2000,12000")
     ap.add_argument("--eps1", type=float, default=0.35, help="eps1 reached by the smaller samples")
     ap.add_argument("--eps1-large", type=float, default=0.05, help="eps1 reached by samples above 5000 disks")
+    ap.add_argument("--only", default="", help="run only these (e.g. S0,S2,S0r) and write no document: to run parts in parallel")
     ap.add_argument("--nscdd", default="target/release/nscdd")
     ap.add_argument("--out", default="out/biaxial_study")
     ap.add_argument("--docs", default="docs")
@@ -44,12 +45,19 @@ def main():
     for n in [int(s) for s in a.sizes.split(",")]:
         eps1 = a.eps1 if n <= 5000 else a.eps1_large
         res = {}
+        only = [x for x in a.only.split(",") if x]
         for name, dec in DECOMPOSITIONS:
+            if only and name not in only:
+                continue
             nx, ny = dec.split("x")
             text = sc.biaxial_scene(n, eps1)
             out = os.path.join(a.out, f"{n}", name)
             print(f"[biaxial] N = {n}, {name} ({dec}) to eps1 = {eps1} ...", flush=True)
             res[name] = sc.run(a.nscdd, text, out, ["--subdomains", dec], cpu=True)
+        if only:
+            if "S0r" in only:
+                sc.run(a.nscdd, sc.biaxial_scene(n, eps1, ordering="reversed"), os.path.join(a.out, f"{n}", "S0r"), cpu=True)
+            continue
         # the scatter of the test itself: S0 visiting the contacts in reversed order
         print(f"[biaxial] N = {n}, S0 reversed order ...", flush=True)
         rev = sc.run(a.nscdd, sc.biaxial_scene(n, eps1, ordering="reversed"), os.path.join(a.out, f"{n}", "S0r"), cpu=True)

@@ -27,6 +27,8 @@ def biaxial_scene(n, eps1_max, tol=1e-3, norm="Quad", max_sweeps=1000, decomposi
     h0 = 0.52 * scale  # compacted height, for the lateral force
     duration = T_COMPACT if compact_only else T_COMPACT + eps1_max * h0 / V_TOP + 0.01
     t = 0.02
+    # the default order writes no line (so that cached runs keep their key)
+    order_line = "" if ordering == "stored" else f'ordering = "{ordering}"'
     dec = ""
     if decomposition:
         dec = "[decomposition]\n" + "".join(f"{k} = {v!r}\n".replace("'", '"') for k, v in decomposition.items())
@@ -41,7 +43,7 @@ tolerance = {tol}
 norm = "{norm}"
 max_sweeps = {max_sweeps}
 check_every = 10
-ordering = "{ordering}"
+{order_line}
 [detection]
 alert = 5e-4
 [output]
