@@ -24,9 +24,6 @@ pub struct Blocks<const D: usize> {
     /// 3D: the precomputed data of the diagonal blocks, and the full block of those
     /// that are not symmetric.
     pre3: Vec<(c3::Sym3, c3::Pre3, Option<c3::Full3>)>,
-    /// W_βα = W_αβᵀ for every stored pair: then `ptr`/`col`/`blk` hold only the upper
-    /// blocks (β > α), each read once per sweep and used for both products.
-    pub symmetric: bool,
 }
 
 impl<const D: usize> Blocks<D> {
@@ -92,64 +89,12 @@ impl<const D: usize> Blocks<D> {
                 }
             }
         }
-        let mut b = Blocks {
-            diag,
-            ptr,
-            col,
-            blk,
-            pre3,
-            symmetric: false,
-        };
-        b.keep_upper_if_symmetric();
-        b
+        Blocks { diag, ptr, col, blk, pre3 }
     }
 
-    /// When every off-diagonal block is the transpose of its mirror (to 1e-14 of the
-    /// largest entry), keeps only the upper ones: the sweep then streams half the
-    /// memory ([`Self::sweep`]).
-    fn keep_upper_if_symmetric(&mut self) {
-        let nc = self.diag.len();
-        let scale = self.blk.iter().flatten().flatten().fold(0.0_f64, |m, x| m.max(x.abs()));
-        let find = |a: usize, b: u32| -> Option<usize> {
-            let row = &self.col[self.ptr[a]..self.ptr[a + 1]];
-            row.binary_search(&b).ok().map(|k| self.ptr[a] + k)
-        };
-        for a in 0..nc {
-            for k in self.ptr[a]..self.ptr[a + 1] {
-                let b = self.col[k] as usize;
-                let Some(m) = find(b, a as u32) else { return };
-                let (x, y) = (&self.blk[k], &self.blk[m]);
-                for i in 0..D {
-                    for j in 0..D {
-                        if (x[i][j] - y[j][i]).abs() > 1e-14 * scale {
-                            return;
-                        }
-                    }
-                }
-            }
-        }
-        let (mut ptr, mut col, mut blk) = (vec![0usize; nc + 1], Vec::new(), Vec::new());
-        for a in 0..nc {
-            for k in self.ptr[a]..self.ptr[a + 1] {
-                if self.col[k] as usize > a {
-                    col.push(self.col[k]);
-                    blk.push(self.blk[k]);
-                }
-            }
-            ptr[a + 1] = col.len();
-        }
-        (self.ptr, self.col, self.blk, self.symmetric) = (ptr, col, blk, true);
-    }
-
-    /// `q_α + Σ_{β≠α} W_αβ r_β` (full storage).
+    /// `q_α + Σ_{β≠α} W_αβ r_β`.
     #[inline(always)]
     fn off_sum(&self, a: usize, q: [f64; D], r: &[[f64; D]]) -> [f64; D] {
-        self.off_sum_from(a, q, r)
-    }
-
-    /// `u + Σ_k W_αβ_k r_β_k` over the stored blocks of row α.
-    #[inline(always)]
-    fn off_sum_from(&self, a: usize, q: [f64; D], r: &[[f64; D]]) -> [f64; D] {
         let mut u = q;
         for k in self.ptr[a]..self.ptr[a + 1] {
             let (m, rb) = (&self.blk[k], &r[self.col[k] as usize]);
@@ -166,27 +111,6 @@ impl<const D: usize> Blocks<D> {
 
     /// u = W r + q.
     pub fn velocity(&self, q: &[[f64; D]], r: &[[f64; D]], u: &mut [[f64; D]]) {
-        if self.symmetric {
-            u.copy_from_slice(q);
-            for a in 0..q.len() {
-                let w = &self.diag[a];
-                for x in 0..D {
-                    for y in 0..D {
-                        u[a][x] += w[x][y] * r[a][y];
-                    }
-                }
-                for k in self.ptr[a]..self.ptr[a + 1] {
-                    let (m, b) = (&self.blk[k], self.col[k] as usize);
-                    for x in 0..D {
-                        for y in 0..D {
-                            u[a][x] += m[x][y] * r[b][y];
-                            u[b][y] += m[x][y] * r[a][x];
-                        }
-                    }
-                }
-            }
-            return;
-        }
         for a in 0..q.len() {
             let mut v = self.off_sum(a, q[a], r);
             let w = &self.diag[a];
@@ -218,25 +142,11 @@ impl<const D: usize> Blocks<D> {
         out
     }
 
-    /// One NLGS sweep in storage order; accumulates LMGC90's sums when asked. With
-    /// symmetric storage, `acc[β]` collects Σ_{α<β} W_βα r_α (new impulses) as the
-    /// sweep goes, from the upper blocks W_αβ = W_βαᵀ read once; `acc` is scratch.
+    /// One NLGS sweep in storage order; accumulates LMGC90's sums when asked.
     #[inline(never)]
-    pub fn sweep(&self, q: &[[f64; D]], mu: &[f64], r: &mut [[f64; D]], acc: &mut Vec<[f64; D]>, mut sums: Option<&mut Sums>) {
-        if self.symmetric {
-            acc.clear();
-            acc.resize(q.len(), [0.0; D]);
-        }
+    pub fn sweep(&self, q: &[[f64; D]], mu: &[f64], r: &mut [[f64; D]], mut sums: Option<&mut Sums>) {
         for a in 0..q.len() {
-            let u0 = if self.symmetric {
-                let mut u = q[a];
-                for x in 0..D {
-                    u[x] += acc[a][x];
-                }
-                self.off_sum_from(a, u, r)
-            } else {
-                self.off_sum(a, q[a], r)
-            };
+            let u0 = self.off_sum(a, q[a], r);
             let ro = r[a];
             let rn = self.local(a, u0, mu[a], ro);
             if let Some(s) = sums.as_deref_mut() {
@@ -252,18 +162,6 @@ impl<const D: usize> Blocks<D> {
                 s.add(&ro, &rn, &du, &wr_old, &wr);
             }
             r[a] = rn;
-            if self.symmetric {
-                for k in self.ptr[a]..self.ptr[a + 1] {
-                    let (m, b) = (&self.blk[k], self.col[k] as usize);
-                    for y in 0..D {
-                        let mut dot = 0.0;
-                        for x in 0..D {
-                            dot += m[x][y] * rn[x];
-                        }
-                        acc[b][y] += dot;
-                    }
-                }
-            }
         }
     }
 }
@@ -289,7 +187,6 @@ pub fn solve<const D: usize>(p: &FcProblem, opts: &FcOptions) -> FcSolution {
     let qs = q_scale(&p.q);
     let mut r = vec![[0.0; D]; nc];
     let mut u = vec![[0.0; D]; nc];
-    let mut acc = Vec::new();
     let k = opts.check_every.max(1);
     let mut sweeps = 0;
     let mut converged = nc == 0;
@@ -298,7 +195,7 @@ pub fn solve<const D: usize>(p: &FcProblem, opts: &FcOptions) -> FcSolution {
         let check = sweeps % k == 0 || sweeps == opts.max_sweeps;
         match opts.norm {
             FcNorm::Natural => {
-                b.sweep(&q, &p.mu, &mut r, &mut acc, None);
+                b.sweep(&q, &p.mu, &mut r, None);
                 if check {
                     b.velocity(&q, &r, &mut u);
                     converged = residual(&u, &r, &p.mu, qs) < opts.tol;
@@ -306,10 +203,10 @@ pub fn solve<const D: usize>(p: &FcProblem, opts: &FcOptions) -> FcSolution {
             }
             FcNorm::Lmgc(c) if check => {
                 let mut sums = Sums::default();
-                b.sweep(&q, &p.mu, &mut r, &mut acc, Some(&mut sums));
+                b.sweep(&q, &p.mu, &mut r, Some(&mut sums));
                 converged = Norms::from_sums(&sums, opts.tol).converged(c);
             }
-            FcNorm::Lmgc(_) => b.sweep(&q, &p.mu, &mut r, &mut acc, None),
+            FcNorm::Lmgc(_) => b.sweep(&q, &p.mu, &mut r, None),
         }
     }
     b.velocity(&q, &r, &mut u);
