@@ -9,7 +9,8 @@ use super::builder3::SceneBuilder3;
 use super::locate::Seg;
 use super::schema::{BodySpec3, SceneFile};
 use super::{
-    at, k, laws, laws_and_detectors, materials, origin_path, parse, time_settings, validate_solver, BodyInfo, Ctx, OutputSettings,
+    alert_distance, at, check_overlaps, k, laws, laws_and_detectors, materials, origin_path, parse, time_settings, validate_solver,
+    BodyInfo, Ctx, OutputSettings,
 };
 use crate::detect3::{Detector3, DetectorTable3};
 use crate::error::InputError;
@@ -29,11 +30,10 @@ pub struct Scene3 {
 pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene3, InputError> {
     let cx = Ctx { text, file };
     let sf: SceneFile<BodySpec3> = parse(text, file)?;
-    let gravity = match sf.gravity.len() {
-        // the 2D default when the key is absent
-        2 if sf.gravity == [0.0, -9.81] && !text.contains("gravity") => [0.0, 0.0, -9.81],
-        3 if sf.gravity.iter().all(|g| g.is_finite()) => [sf.gravity[0], sf.gravity[1], sf.gravity[2]],
-        _ => return Err(cx.err(&[k("gravity")], "gravity must be 3 finite numbers in 3D")),
+    let gravity = match sf.gravity.as_deref() {
+        None => [0.0, 0.0, -9.81],
+        Some(&[x, y, z]) if [x, y, z].iter().all(|g| g.is_finite()) => [x, y, z],
+        Some(_) => return Err(cx.err(&[k("gravity")], "gravity must be 3 finite numbers in 3D")),
     };
     if sf.output.box_walls.is_some() {
         return Err(cx.err(&[k("output"), k("box")], "`box` names the 4 walls of a 2D sample; in 3D use `box3`"));
@@ -83,44 +83,12 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene3, I
     let sizes: Vec<f64> = (0..n)
         .map(|i| b.shapes[b.bodies.shape[i].kind as usize].size(b.bodies.shape[i].index))
         .collect();
-    let alert = match sf.detection.alert {
-        Some(a) if !(a >= 0.0 && a.is_finite()) => return Err(cx.err(&[k("detection"), k("alert")], format!("must be ≥ 0, got {a}"))),
-        Some(a) => a,
-        None => {
-            let mut s: Vec<f64> = sizes.iter().copied().filter(|x| x.is_finite() && *x > 0.0).collect();
-            s.sort_by(|a, c| a.total_cmp(c));
-            0.1 * s.get(s.len() / 2).copied().unwrap_or(1.0)
-        }
-    };
-    let tol = sf.detection.overlap_tolerance;
-    if !(tol >= 0.0) {
-        return Err(cx.err(&[k("detection"), k("overlap_tolerance")], "must be ≥ 0"));
-    }
+    let alert = alert_distance(&cx, &sf.detection, &sizes)?;
     let mut raw = vec![];
     Detector3::default().detect(&b.bodies, &b.shapes, &table, 0.0, &mut raw);
-    for rc in &raw {
-        let (i, j) = (rc.i as usize, rc.j as usize);
-        if laws[b.bodies.material[i] as usize * nm + b.bodies.material[j] as usize].is_none() {
-            continue;
-        }
-        let lim = tol * sizes[i].min(sizes[j]);
-        if rc.gap < -lim {
-            let label = |x: usize| match &b.names[x] {
-                Some(nm) => format!("{x} (`{nm}`)"),
-                None => format!("{x}"),
-            };
-            return Err(cx.err(
-                &origin_path(b.origins[i], "position"),
-                format!(
-                    "bodies {} and {} overlap by {:.3e} m, more than the tolerance {:.3e} m (detection.overlap_tolerance × the smaller size)",
-                    label(i),
-                    label(j),
-                    -rc.gap,
-                    lim
-                ),
-            ));
-        }
-    }
+    let contacts = raw.iter().map(|rc| (rc.i as usize, rc.j as usize, rc.gap));
+    let material = |x: usize| b.bodies.material[x] as usize;
+    check_overlaps(&cx, &sf.detection, contacts, &sizes, &laws, nm, material, &b.names, &b.origins)?;
     let box_walls = match &sf.output.box3 {
         None => None,
         Some(bs) => {
@@ -161,9 +129,9 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene3, I
             }
         }
     }
-    for (i, w) in sf.output.writers.iter().enumerate() {
+    if let Some(w) = sf.output.writers.first() {
         return Err(cx.err(
-            &[k("output"), k("writers"), Seg::Index(i)],
+            &[k("output"), k("writers"), Seg::Index(0)],
             format!("unknown writer `{w}` for a 3D scene"),
         ));
     }

@@ -187,6 +187,62 @@ pub(crate) fn laws_and_detectors<T>(
     Ok(table)
 }
 
+/// The alert distance: `detection.alert`, or 0.1 × the median shape size.
+pub(crate) fn alert_distance(cx: &Ctx, d: &schema::DetectionSpec, sizes: &[f64]) -> Result<f64, InputError> {
+    match d.alert {
+        Some(a) if !(a >= 0.0 && a.is_finite()) => Err(cx.err(&[k("detection"), k("alert")], format!("must be ≥ 0, got {a}"))),
+        Some(a) => Ok(a),
+        None => {
+            let mut s: Vec<f64> = sizes.iter().copied().filter(|x| x.is_finite() && *x > 0.0).collect();
+            s.sort_by(|a, c| a.total_cmp(c));
+            Ok(0.1 * s.get(s.len() / 2).copied().unwrap_or(1.0))
+        }
+    }
+}
+
+/// Initial interpenetrations beyond `detection.overlap_tolerance` × the smaller
+/// shape size, among the detected `(i, j, gap)` of materials that interact.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn check_overlaps(
+    cx: &Ctx,
+    d: &schema::DetectionSpec,
+    contacts: impl Iterator<Item = (usize, usize, f64)>,
+    sizes: &[f64],
+    laws: &[Option<crate::law::ContactLaw>],
+    nm: usize,
+    material: impl Fn(usize) -> usize,
+    names: &[Option<String>],
+    origins: &[Origin],
+) -> Result<(), InputError> {
+    let tol = d.overlap_tolerance;
+    if !(tol >= 0.0) {
+        return Err(cx.err(&[k("detection"), k("overlap_tolerance")], "must be ≥ 0"));
+    }
+    for (i, j, gap) in contacts {
+        if laws[material(i) * nm + material(j)].is_none() {
+            continue; // materials declared never to interact
+        }
+        let lim = tol * sizes[i].min(sizes[j]);
+        if gap < -lim {
+            let label = |x: usize| match &names[x] {
+                Some(n) => format!("{x} (`{n}`)"),
+                None => format!("{x}"),
+            };
+            return Err(cx.err(
+                &origin_path(origins[i], "position"),
+                format!(
+                    "bodies {} and {} overlap by {:.3e} m, more than the tolerance {:.3e} m (detection.overlap_tolerance × the smaller size)",
+                    label(i),
+                    label(j),
+                    -gap,
+                    lim
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// A loaded scene of either dimension.
 pub enum AnyScene {
     D2(Scene),
@@ -223,9 +279,11 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
     if sf.dimension != 2 {
         return Err(cx.err(&[k("dimension")], format!("dimension {} is not supported: 2 or 3", sf.dimension)));
     }
-    if sf.gravity.len() != 2 || sf.gravity.iter().any(|g| !g.is_finite()) {
-        return Err(cx.err(&[k("gravity")], "gravity must be 2 finite numbers in 2D"));
-    }
+    let gravity = match sf.gravity.as_deref() {
+        None => [0.0, -9.81],
+        Some(&[x, y]) if x.is_finite() && y.is_finite() => [x, y],
+        Some(_) => return Err(cx.err(&[k("gravity")], "gravity must be 2 finite numbers in 2D")),
+    };
     if sf.output.box3.is_some() {
         return Err(cx.err(
             &[k("output"), k("box3")],
@@ -279,36 +337,13 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
     let sizes: Vec<f64> = (0..b.bodies.len())
         .map(|i| b.shapes[b.bodies.shape[i].kind as usize].size(b.bodies.shape[i].index))
         .collect();
-    let alert = match sf.detection.alert {
-        Some(a) if !(a >= 0.0 && a.is_finite()) => return Err(cx.err(&[k("detection"), k("alert")], format!("must be ≥ 0, got {a}"))),
-        Some(a) => a,
-        None => {
-            let mut s: Vec<f64> = sizes.iter().copied().filter(|x| x.is_finite() && *x > 0.0).collect();
-            s.sort_by(|a, c| a.total_cmp(c));
-            0.1 * s.get(s.len() / 2).copied().unwrap_or(1.0)
-        }
-    };
-    let tol = sf.detection.overlap_tolerance;
-    if !(tol >= 0.0) {
-        return Err(cx.err(&[k("detection"), k("overlap_tolerance")], "must be ≥ 0"));
-    }
+    let alert = alert_distance(&cx, &sf.detection, &sizes)?;
     // initial interpenetrations beyond the tolerance
     let mut raw = vec![];
     Detector::default().detect(&b.bodies, &b.shapes, &table, 0.0, &mut raw);
-    for rc in &raw {
-        let (i, j) = (rc.i as usize, rc.j as usize);
-        if laws[b.bodies.material[i] as usize * nm + b.bodies.material[j] as usize].is_none() {
-            continue; // materials declared never to interact
-        }
-        let lim = tol * sizes[i].min(sizes[j]);
-        if rc.gap < -lim {
-            let label = |x: usize| match &b.names[x] {
-                Some(n) => format!("{x} (`{n}`)"),
-                None => format!("{x}"),
-            };
-            return Err(cx.err(&origin_path(b.origins[i], "position"), format!("bodies {} and {} overlap by {:.3e} m, more than the tolerance {:.3e} m (detection.overlap_tolerance × the smaller size)", label(i), label(j), -rc.gap, lim)));
-        }
-    }
+    let contacts = raw.iter().map(|rc| (rc.i as usize, rc.j as usize, rc.gap));
+    let material = |x: usize| b.bodies.material[x] as usize;
+    check_overlaps(&cx, &sf.detection, contacts, &sizes, &laws, nm, material, &b.names, &b.origins)?;
     let box_walls = match &sf.output.box_walls {
         None => None,
         Some(bs) => {
@@ -346,7 +381,7 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, In
         materials: b.materials,
         laws,
         drives,
-        gravity: [sf.gravity[0], sf.gravity[1]],
+        gravity,
         time,
         solver: sf.solver,
         alert,

@@ -12,9 +12,6 @@ fn two() -> u8 {
 fn half() -> f64 {
     0.5
 }
-fn gravity() -> Vec<f64> {
-    vec![0.0, -9.81]
-}
 fn yes() -> bool {
     true
 }
@@ -34,8 +31,8 @@ pub struct SceneFile<B = BodySpec> {
     #[serde(default = "two")]
     pub dimension: u8,
     /// Gravity vector (m/s²), default (0, −9.81) in 2D, (0, 0, −9.81) in 3D.
-    #[serde(default = "gravity")]
-    pub gravity: Vec<f64>,
+    /// Absent: the dimension's default (the loaders fill it in).
+    pub gravity: Option<Vec<f64>>,
     pub time: TimeSpec,
     #[serde(default)]
     pub solver: SolverSettings,
