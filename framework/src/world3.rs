@@ -73,6 +73,20 @@ impl World3 {
             None => format!("body {b} ({})", self.kind_name(b)),
         }
     }
+    /// Number of contacts carrying a normal impulse, per body.
+    fn loaded_contacts(&self) -> Vec<u32> {
+        let mut count = vec![0u32; self.bodies.len()];
+        let c = &self.contacts;
+        for a in 0..c.len() {
+            if c.r[a][0] > 0.0 {
+                for b in c.bodies[a] {
+                    count[b as usize] += 1;
+                }
+            }
+        }
+        count
+    }
+
     /// Whether body b is a grain (a movable body of a grain shape).
     pub fn is_grain(&self, b: usize) -> bool {
         let s = self.bodies.shape[b];
@@ -127,15 +141,8 @@ impl World3 {
     pub fn coordination(&self) -> (f64, f64) {
         let n = self.bodies.len();
         let grain: Vec<bool> = (0..n).map(|b| self.is_grain(b)).collect();
-        let mut count = vec![0u32; n];
+        let count = self.loaded_contacts();
         let c = &self.contacts;
-        for a in 0..c.len() {
-            if c.r[a][0] > 0.0 {
-                for b in c.bodies[a] {
-                    count[b as usize] += 1;
-                }
-            }
-        }
         let ng = grain.iter().filter(|&&g| g).count();
         let mut ngg = 0usize;
         let (mut sum_m, mut n_m) = (0usize, 0usize);
@@ -174,15 +181,7 @@ impl World3 {
             return None;
         }
         let n = self.bodies.len();
-        let mut count = vec![0u32; n];
-        let c = &self.contacts;
-        for a in 0..c.len() {
-            if c.r[a][0] > 0.0 {
-                for b in c.bodies[a] {
-                    count[b as usize] += 1;
-                }
-            }
-        }
+        let count = self.loaded_contacts();
         let (mut vol, mut zsum, mut nz, mut ninner, mut rattlers) = (0.0, 0u64, 0u64, 0u64, 0u64);
         for b in 0..n {
             if !self.is_grain(b) {

@@ -98,13 +98,21 @@ impl Bodies3 {
         for k in 0..3 {
             self.inv_m[b][k] = if f & (1 << k) != 0 { 1.0 / m } else { 0.0 };
         }
-        let rot_free: Vec<usize> = (0..3).filter(|k| f & (1 << (3 + k)) != 0).collect();
+        // the free rotational axes, without allocating (this runs every step for
+        // bodies whose world inertia turns with them)
+        let (mut rot_free, mut nfree) = ([0usize; 3], 0);
+        for k in 0..3 {
+            if f & (1 << (3 + k)) != 0 {
+                rot_free[nfree] = k;
+                nfree += 1;
+            }
+        }
         let iw = self.world_inertia(b);
         // entry (a, c) of the symmetric tensor stored as [xx, xy, xz, yy, yz, zz]
         const IDX: [[usize; 3]; 3] = [[0, 1, 2], [1, 3, 4], [2, 4, 5]];
         let full = |a: usize, c: usize| iw[IDX[a][c]];
         let mut out = [[0.0; 3]; 3];
-        match rot_free.len() {
+        match nfree {
             0 => {}
             1 => {
                 let a = rot_free[0];
