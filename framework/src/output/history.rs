@@ -44,7 +44,7 @@ impl<W: Write> History<W> {
             }
         }
         let has_box = w.box_walls.is_some();
-        let mut head = String::from("step,time,bodies,contacts,active,sweeps,converged,QuadDV,QuadDVR,MaxmDV,MaxmDVR,MeanDVoR,residual,kinetic_energy,potential_energy");
+        let mut head = String::from(SOLVER_COLUMNS);
         for (_, n) in &tracked {
             for c in ["x", "y", "rot", "fx", "fy", "m"] {
                 head.push_str(&format!(",{n}_{c}"));
@@ -71,26 +71,8 @@ impl<W: Write> History<W> {
     /// A row; `dd` fills the NSCDD columns (empty when the history has them and
     /// `dd` is `None`).
     pub fn row_dd(&mut self, w: &World2, r: &StepReport, dd: Option<&DdStepReport>, t_output: f64) -> std::io::Result<()> {
-        let n = &r.solve.norms;
         let (ek, ep) = w.energies();
-        let mut s = format!(
-            "{},{},{},{},{},{},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
-            w.step,
-            w.t,
-            w.bodies.len(),
-            r.contacts,
-            n.nactif,
-            r.solve.sweeps,
-            r.solve.converged as u8,
-            n.quad_dv,
-            n.quad_dvr,
-            n.maxm_dv,
-            n.maxm_dvr,
-            n.mean_dvor,
-            r.solve.residual,
-            ek,
-            ep
-        );
+        let mut s = solver_fields(w.step, w.t, w.bodies.len(), r, ek, ep);
         let h = w.time.h;
         for (b, _) in &self.tracked {
             let b = *b as usize;
@@ -158,4 +140,31 @@ pub fn dd_fields(dd: Option<&DdStepReport>) -> String {
         ),
         None => ",".repeat(DD_COLUMNS.len()),
     }
+}
+
+/// The first columns of every history (2D and 3D): the step and its solve.
+pub const SOLVER_COLUMNS: &str =
+    "step,time,bodies,contacts,active,sweeps,converged,QuadDV,QuadDVR,MaxmDV,MaxmDVR,MeanDVoR,residual,kinetic_energy,potential_energy";
+
+/// The fields of [`SOLVER_COLUMNS`] for one step.
+pub fn solver_fields(step: u64, t: f64, bodies: usize, r: &StepReport, ek: f64, ep: f64) -> String {
+    let n = &r.solve.norms;
+    format!(
+        "{},{},{},{},{},{},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+        step,
+        t,
+        bodies,
+        r.contacts,
+        n.nactif,
+        r.solve.sweeps,
+        r.solve.converged as u8,
+        n.quad_dv,
+        n.quad_dvr,
+        n.maxm_dv,
+        n.maxm_dvr,
+        n.mean_dvor,
+        r.solve.residual,
+        ek,
+        ep
+    )
 }

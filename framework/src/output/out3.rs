@@ -5,6 +5,7 @@
 //! `r_t` = |r_t|, `f_n`, `gap`), with the series `bodies.pvd`, `walls.pvd`,
 //! `contacts.pvd`.
 
+use super::history::{solver_fields, SOLVER_COLUMNS};
 use super::vtk::{cells, export, piece, VtkWriter};
 use crate::engine::StepReport;
 use crate::registry3::Glyph3;
@@ -50,7 +51,7 @@ impl<W: Write> History3<W> {
             }
         }
         let has_box = w.box_walls.is_some();
-        let mut head = String::from("step,time,bodies,contacts,active,sweeps,converged,QuadDV,QuadDVR,MaxmDV,MaxmDVR,MeanDVoR,residual,kinetic_energy,potential_energy");
+        let mut head = String::from(SOLVER_COLUMNS);
         for (_, n) in &tracked {
             for c in ["x", "y", "z", "fx", "fy", "fz"] {
                 head.push_str(&format!(",{n}_{c}"));
@@ -83,26 +84,8 @@ impl<W: Write> History3<W> {
 
     /// A row; `dd` fills the NSCDD columns.
     pub fn row_dd(&mut self, w: &World3, r: &StepReport, dd: Option<&crate::dd::DdStepReport>, t_output: f64) -> std::io::Result<()> {
-        let n = &r.solve.norms;
         let (ek, ep) = w.energies();
-        let mut s = format!(
-            "{},{},{},{},{},{},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
-            w.step,
-            w.t,
-            w.bodies.len(),
-            r.contacts,
-            n.nactif,
-            r.solve.sweeps,
-            r.solve.converged as u8,
-            n.quad_dv,
-            n.quad_dvr,
-            n.maxm_dv,
-            n.maxm_dvr,
-            n.mean_dvor,
-            r.solve.residual,
-            ek,
-            ep
-        );
+        let mut s = solver_fields(w.step, w.t, w.bodies.len(), r, ek, ep);
         let h = w.time.h;
         for (b, _) in &self.tracked {
             let b = *b as usize;
