@@ -91,20 +91,25 @@ impl RunSummary {
     }
 }
 
-fn io(dir: &Path, what: &str) -> impl Fn(std::io::Error) -> RunError {
+pub(crate) fn io(dir: &Path, what: &str) -> impl Fn(std::io::Error) -> RunError {
     let d = dir.display().to_string();
     let what = what.to_string();
     move |e| RunError::Io(format!("cannot write {what} in {d}: {e}"))
 }
 
-/// Writes the state (a restart file) as `name` in `dir`, through a temporary file
-/// renamed into place, so that a run killed while writing keeps the previous one.
-fn save_state(dir: &Path, name: &str, w: &World2) -> Result<(), RunError> {
+/// Writes a saved state (a restart file, `text`) as `name` in `dir`, through a
+/// temporary file renamed into place, so that a run killed while writing keeps the
+/// previous one.
+pub(crate) fn save_state_text(dir: &Path, name: &str, text: &str) -> Result<(), RunError> {
     let tmp = dir.join(format!(".{name}.tmp"));
     let mut f = std::fs::File::create(&tmp).map_err(io(dir, name))?;
-    f.write_all(final_json(w).as_bytes()).map_err(io(dir, name))?;
+    f.write_all(text.as_bytes()).map_err(io(dir, name))?;
     drop(f);
     std::fs::rename(&tmp, dir.join(name)).map_err(io(dir, name))
+}
+
+fn save_state(dir: &Path, name: &str, w: &World2) -> Result<(), RunError> {
+    save_state_text(dir, name, &final_json(w))
 }
 
 /// Runs `scene` for its number of steps, writing `history.csv`, the writers' frames

@@ -4,25 +4,14 @@
 use crate::engine::StepReport;
 use crate::output::out3::{final_json3, write_vtk3, History3};
 use crate::output::vtk::VtkWriter;
-use crate::run::{RunError, RunSummary};
+use crate::run::{io, save_state_text, RunError, RunSummary};
 use crate::scene::load3::Scene3;
 use crate::world3::World3;
-use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
-fn io(dir: &Path, what: &str) -> impl Fn(std::io::Error) -> RunError {
-    let d = dir.display().to_string();
-    let what = what.to_string();
-    move |e| RunError::Io(format!("cannot write {what} in {d}: {e}"))
-}
-
 fn save_state(dir: &Path, name: &str, w: &World3) -> Result<(), RunError> {
-    let tmp = dir.join(format!(".{name}.tmp"));
-    let mut f = std::fs::File::create(&tmp).map_err(io(dir, name))?;
-    f.write_all(final_json3(w).as_bytes()).map_err(io(dir, name))?;
-    drop(f);
-    std::fs::rename(&tmp, dir.join(name)).map_err(io(dir, name))
+    save_state_text(dir, name, &final_json3(w))
 }
 
 /// Runs a 3D scene for its number of steps, writing `history.csv`, VTK frames every

@@ -16,6 +16,20 @@ pub enum Origin {
     Generated(usize),
 }
 
+/// Material id by name (2D and 3D builders).
+pub(crate) fn material_id(materials: &[Material], name: &str) -> Option<u16> {
+    materials.iter().position(|m| m.name == name).map(|i| i as u16)
+}
+
+/// Material id named by the key `key` of `params`, or a clear error.
+pub(crate) fn material_param(materials: &[Material], params: &toml::Table, key: &str) -> Result<u16, ParamError> {
+    let name = params
+        .get(key)
+        .and_then(|v| v.as_str())
+        .ok_or_else(|| ParamError::new(key, "missing material name"))?;
+    material_id(materials, name).ok_or_else(|| ParamError::new(key, format!("unknown material `{name}`; declare it in [[materials]]")))
+}
+
 /// Bodies under construction, with the shape stores of the kinds they use.
 pub struct SceneBuilder2<'r> {
     pub(crate) registry: &'r Registry,
@@ -44,17 +58,12 @@ impl<'r> SceneBuilder2<'r> {
 
     /// Material id by name.
     pub fn material(&self, name: &str) -> Option<u16> {
-        self.materials.iter().position(|m| m.name == name).map(|i| i as u16)
+        material_id(&self.materials, name)
     }
 
     /// Material id of the key `key` of `params`, or a clear error.
     pub fn material_param(&self, params: &toml::Table, key: &str) -> Result<u16, ParamError> {
-        let name = params
-            .get(key)
-            .and_then(|v| v.as_str())
-            .ok_or_else(|| ParamError::new(key, "missing material name"))?;
-        self.material(name)
-            .ok_or_else(|| ParamError::new(key, format!("unknown material `{name}`; declare it in [[materials]]")))
+        material_param(&self.materials, params, key)
     }
 
     /// Kind id of a shape kind, creating its store on first use.

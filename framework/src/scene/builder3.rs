@@ -40,17 +40,12 @@ impl<'r> SceneBuilder3<'r> {
 
     /// Material id by name.
     pub fn material(&self, name: &str) -> Option<u16> {
-        self.materials.iter().position(|m| m.name == name).map(|i| i as u16)
+        super::builder::material_id(&self.materials, name)
     }
 
     /// Material id of the key `key` of `params`, or a clear error.
     pub fn material_param(&self, params: &toml::Table, key: &str) -> Result<u16, ParamError> {
-        let name = params
-            .get(key)
-            .and_then(|v| v.as_str())
-            .ok_or_else(|| ParamError::new(key, "missing material name"))?;
-        self.material(name)
-            .ok_or_else(|| ParamError::new(key, format!("unknown material `{name}`; declare it in [[materials]]")))
+        super::builder::material_param(&self.materials, params, key)
     }
 
     /// Kind id of a 3D shape kind, creating its store on first use.

@@ -535,10 +535,7 @@ pub(crate) fn laws<B>(
         };
         let mut ids = [0u16; 2];
         for (s, name) in l.materials.iter().enumerate() {
-            ids[s] = materials
-                .iter()
-                .position(|m| m.name == *name)
-                .map(|i| i as u16)
+            ids[s] = builder::material_id(materials, name)
                 .ok_or_else(|| cx.err(&at(&base, &[k("materials"), Seg::Index(s)]), format!("unknown material `{name}`")))?;
         }
         let law = match def {
