@@ -5,10 +5,10 @@
 
 mod bench;
 mod bench3;
+mod report;
 mod run3;
 
 use clap::{Parser, Subcommand};
-use indicatif::{ProgressBar, ProgressStyle};
 use nscdd::fc::{FcNorm, FcOptions};
 use nscdd::norms::Criterion;
 use std::path::PathBuf;
@@ -93,7 +93,7 @@ enum Cmd {
     },
 }
 
-fn input_error(e: impl std::fmt::Display) -> ExitCode {
+pub(crate) fn input_error(e: impl std::fmt::Display) -> ExitCode {
     eprintln!("error: {e}");
     ExitCode::from(2)
 }
@@ -294,59 +294,20 @@ fn main() -> ExitCode {
             });
             let mut s = match loaded {
                 Ok(s) => s,
-                Err(e) => {
-                    // nothing in DIR but the error
-                    if std::fs::create_dir_all(&out).is_ok() {
-                        let _ = std::fs::write(out.join("error.txt"), format!("{e}\n"));
-                    }
-                    return input_error(e);
-                }
+                Err(e) => return report::input_error_in(&out, e),
             };
             let steps = s.world.time.steps;
-            let bar = if quiet { ProgressBar::hidden() } else { ProgressBar::new(steps) };
-            bar.set_position(s.world.step);
-            bar.set_style(
-                ProgressStyle::with_template("{bar:30} step {pos}/{len} | {msg} | {elapsed_precise} elapsed, {eta_precise} left")
-                    .expect("valid template"),
-            );
-            let res = nscdd::run::run(&mut s, &reg, &out, |w, rep| {
-                bar.set_position(w.step);
-                if w.step % 10 == 0 || w.step == steps {
-                    bar.set_message(format!(
-                        "{} contacts, {} sweeps{}",
-                        rep.contacts,
-                        rep.solve.sweeps,
-                        if rep.solve.converged { "" } else { " (not converged)" }
-                    ));
-                }
-            });
+            let bar = report::progress(quiet, steps, s.world.step);
+            let res = nscdd::run::run(&mut s, &reg, &out, |w, rep| report::on_step(&bar, steps, w.step, rep));
             bar.finish_and_clear();
-            match res {
-                Ok(sum) => {
-                    for line in sum.warnings(s.world.solver.norm.name()) {
-                        eprintln!("{line}");
-                    }
-                    let dd = match &s.decomposition {
-                        Some(c) => format!(
-                            " ({}x{} subdomains, {:?}, {} migrations)",
-                            c.dd.nx, c.dd.ny, c.dd.scheme, sum.migrations
-                        ),
-                        None => String::new(),
-                    };
-                    eprintln!(
-                        "{} steps{dd}, {} sweeps, {:.2} s; outputs in {}",
-                        sum.steps,
-                        sum.total_sweeps,
-                        sum.wall_seconds,
-                        out.display()
-                    );
-                    ExitCode::SUCCESS
-                }
-                Err(e) => {
-                    eprintln!("error: {e}; the outputs written so far are kept in {}", out.display());
-                    ExitCode::from(1)
-                }
-            }
+            let dd = |sum: &nscdd::run::RunSummary| match &s.decomposition {
+                Some(c) => format!(
+                    " ({}x{} subdomains, {:?}, {} migrations)",
+                    c.dd.nx, c.dd.ny, c.dd.scheme, sum.migrations
+                ),
+                None => String::new(),
+            };
+            report::finish(res, s.world.solver.norm.name(), dd, &out)
         }
         Cmd::SolveFc {
             problem,
