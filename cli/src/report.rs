@@ -1,0 +1,65 @@
+//! What `nscdd run` shows and returns, for 2D and 3D runs alike: the progress bar,
+//! the input error left in DIR, and the run's summary and exit code.
+
+use indicatif::{ProgressBar, ProgressStyle};
+use nscdd::engine::StepReport;
+use nscdd::run::{RunError, RunSummary};
+use std::path::Path;
+use std::process::ExitCode;
+
+/// A progress bar over `steps` steps starting at `start` (hidden with `quiet`).
+pub fn progress(quiet: bool, steps: u64, start: u64) -> ProgressBar {
+    let bar = if quiet { ProgressBar::hidden() } else { ProgressBar::new(steps) };
+    bar.set_position(start);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:30} step {pos}/{len} | {msg} | {elapsed_precise} elapsed, {eta_precise} left")
+            .expect("valid template"),
+    );
+    bar
+}
+
+/// The bar after step `step` of `steps`.
+pub fn on_step(bar: &ProgressBar, steps: u64, step: u64, rep: &StepReport) {
+    bar.set_position(step);
+    if step % 10 == 0 || step == steps {
+        bar.set_message(format!(
+            "{} contacts, {} sweeps{}",
+            rep.contacts,
+            rep.solve.sweeps,
+            if rep.solve.converged { "" } else { " (not converged)" }
+        ));
+    }
+}
+
+/// Bad input to `run`: the message in DIR/error.txt (nothing else) and exit code 2.
+pub fn input_error_in(out: &Path, e: impl std::fmt::Display) -> ExitCode {
+    if std::fs::create_dir_all(out).is_ok() {
+        let _ = std::fs::write(out.join("error.txt"), format!("{e}\n"));
+    }
+    crate::input_error(e)
+}
+
+/// The end of a run: warnings and summary (`dd`: the decomposition's description),
+/// or the error that stopped it (exit code 1).
+pub fn finish(res: Result<RunSummary, RunError>, norm: &str, dd: impl Fn(&RunSummary) -> String, out: &Path) -> ExitCode {
+    match res {
+        Ok(sum) => {
+            for line in sum.warnings(norm) {
+                eprintln!("{line}");
+            }
+            eprintln!(
+                "{} steps{}, {} sweeps, {:.2} s; outputs in {}",
+                sum.steps,
+                dd(&sum),
+                sum.total_sweeps,
+                sum.wall_seconds,
+                out.display()
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}; the outputs written so far are kept in {}", out.display());
+            ExitCode::from(1)
+        }
+    }
+}
