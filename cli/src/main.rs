@@ -5,6 +5,7 @@
 
 mod bench;
 mod bench3;
+mod ranks;
 mod report;
 mod run3;
 
@@ -269,17 +270,20 @@ fn main() -> ExitCode {
             threads,
             restart,
         } => {
+            let ranks = match ranks::Ranks::start() {
+                Ok(r) => r,
+                Err(e) => return input_error(e),
+            };
+            let quiet = quiet || !ranks.root();
             let loaded = match nscdd::scene::load_any(&scene, &reg) {
                 Ok(nscdd::scene::AnyScene::D3(s3)) => {
-                    return run3::run(
-                        s3,
-                        &out,
-                        quiet,
-                        subdomains.as_deref(),
-                        scheme.as_deref(),
-                        threads.as_deref(),
-                        restart.as_deref(),
-                    );
+                    let flags = run3::Flags {
+                        subdomains: subdomains.as_deref(),
+                        scheme: scheme.as_deref(),
+                        threads: threads.as_deref(),
+                        restart: restart.as_deref(),
+                    };
+                    return run3::run(s3, &out, quiet, flags, &ranks);
                 }
                 Ok(nscdd::scene::AnyScene::D2(s)) => Ok(s),
                 Err(e) => Err(e.to_string()),
@@ -292,22 +296,30 @@ fn main() -> ExitCode {
                 }
                 Ok(s)
             });
-            let mut s = match loaded {
-                Ok(s) => s,
-                Err(e) => return report::input_error_in(&out, e),
-            };
+            let digest = loaded.as_ref().map_err(Clone::clone).map(|s| {
+                let w = &s.world;
+                ranks::digest(&nscdd::output::final_json(w), (&s.decomposition, &w.time, &w.solver))
+            });
+            if let Err(code) = ranks.agree(digest, &out) {
+                return code;
+            }
+            let Ok(mut s) = loaded else { unreachable!("agreed on a loaded scene") };
             let steps = s.world.time.steps;
             let bar = report::progress(quiet, steps, s.world.step);
-            let res = nscdd::run::run(&mut s, &reg, &out, |w, rep| report::on_step(&bar, steps, w.step, rep));
+            let res = nscdd::run::run_on(&mut s, &reg, &out, ranks.cluster(), |w, rep| report::on_step(&bar, steps, w.step, rep));
             bar.finish_and_clear();
             let dd = |sum: &nscdd::run::RunSummary| match &s.decomposition {
                 Some(c) => format!(
-                    " ({}x{} subdomains, {:?}, {} migrations)",
-                    c.dd.nx, c.dd.ny, c.dd.scheme, sum.migrations
+                    " ({}x{} subdomains, {:?}, {} migrations{})",
+                    c.dd.nx,
+                    c.dd.ny,
+                    c.dd.scheme,
+                    sum.migrations,
+                    report::on_ranks(ranks.size())
                 ),
                 None => String::new(),
             };
-            report::finish(res, s.world.solver.norm.name(), dd, &out)
+            report::finish_on(&ranks, res, s.world.solver.norm.name(), dd, &out)
         }
         Cmd::SolveFc {
             problem,

@@ -63,3 +63,41 @@ pub fn finish(res: Result<RunSummary, RunError>, norm: &str, dd: impl Fn(&RunSum
         }
     }
 }
+
+/// ", on P ranks" for a multi-process run.
+pub fn on_ranks(size: u32) -> String {
+    if size > 1 {
+        format!(", on {size} ranks")
+    } else {
+        String::new()
+    }
+}
+
+/// [`finish`] for one of `ranks`: rank 0 reports; a decomposition that does not fit
+/// the ranks is bad input (exit 2 on every rank); an output that rank 0 cannot write
+/// stops every rank ([`crate::ranks::Ranks::abort_others`]).
+pub fn finish_on(
+    ranks: &crate::ranks::Ranks,
+    res: Result<RunSummary, RunError>,
+    norm: &str,
+    dd: impl Fn(&RunSummary) -> String,
+    out: &Path,
+) -> ExitCode {
+    match &res {
+        Err(RunError::Ranks(m)) => {
+            return if ranks.root() {
+                input_error_in(out, m)
+            } else {
+                ExitCode::from(2)
+            }
+        }
+        Err(RunError::Io(m)) if ranks.size() > 1 => {
+            return ranks.abort_others(1, &format!("{m}; the outputs written so far are kept in {}", out.display()))
+        }
+        _ => {}
+    }
+    if !ranks.root() {
+        return if res.is_ok() { ExitCode::SUCCESS } else { ExitCode::from(1) };
+    }
+    finish(res, norm, dd, out)
+}

@@ -17,6 +17,8 @@ pub enum RunError {
     Io(String),
     /// A non-finite state; what was written so far is kept.
     Diverged(Diverged),
+    /// A multi-process run that cannot start (ranks against the decomposition).
+    Ranks(String),
 }
 
 impl std::fmt::Display for RunError {
@@ -24,6 +26,7 @@ impl std::fmt::Display for RunError {
         match self {
             RunError::Io(m) => write!(f, "{m}"),
             RunError::Diverged(d) => write!(f, "{d}"),
+            RunError::Ranks(m) => write!(f, "{m}"),
         }
     }
 }
@@ -108,6 +111,50 @@ pub(crate) fn save_state_text(dir: &Path, name: &str, text: &str) -> Result<(), 
     std::fs::rename(&tmp, dir.join(name)).map_err(io(dir, name))
 }
 
+/// The outputs of a run: written by one process only (rank 0 of a multi-process
+/// run); the others step the same world and write nothing.
+pub(crate) fn history_sink(dir: &Path, root: bool) -> Result<Box<dyn Write>, RunError> {
+    if !root {
+        return Ok(Box::new(std::io::sink()));
+    }
+    std::fs::create_dir_all(dir).map_err(io(dir, "the output directory"))?;
+    let file = std::fs::File::create(dir.join("history.csv")).map_err(io(dir, "history.csv"))?;
+    Ok(Box::new(std::io::BufWriter::new(file)))
+}
+
+/// The NSCDD solver of a decomposed scene, over the ranks of `cluster` when given.
+pub(crate) fn dd_solver<D: crate::dd::Family>(
+    c: Option<&crate::dd::DdConfig>,
+    cluster: Option<Box<dyn crate::dd::Cluster>>,
+) -> Result<Option<crate::dd::NscddOf<D>>, RunError> {
+    let Some(c) = c else {
+        return match cluster {
+            Some(cl) if cl.size() > 1 => Err(RunError::Ranks(format!(
+                "{} ranks but the scene has no decomposition: give --subdomains or a [decomposition] section",
+                cl.size()
+            ))),
+            _ => Ok(None),
+        };
+    };
+    let n = crate::dd::NscddOf::<D>::new(c.dd.clone()).with_repartition_every(c.repartition_every);
+    match cluster {
+        Some(cl) => n.with_cluster(cl).map(Some).map_err(RunError::Ranks),
+        None => Ok(Some(n)),
+    }
+}
+
+/// The end of a multi-process run (collective): every rank's exchange totals in
+/// `ranks.json`, written by rank 0.
+pub(crate) fn write_rank_totals<D: crate::dd::Family>(dd: &mut Option<crate::dd::NscddOf<D>>, dir: &Path) -> Result<(), RunError> {
+    if let Some(rs) = dd.as_mut().and_then(|n| n.ranks_mut()) {
+        let text = crate::dd::ranks::totals_json(rs);
+        if rs.cluster.rank() == 0 {
+            save_state_text(dir, "ranks.json", &text)?;
+        }
+    }
+    Ok(())
+}
+
 fn save_state(dir: &Path, name: &str, w: &World2) -> Result<(), RunError> {
     save_state_text(dir, name, &final_json(w))
 }
@@ -121,20 +168,32 @@ pub fn run(
     scene: &mut Scene,
     registry: &Registry,
     dir: &Path,
+    on_step: impl FnMut(&World2, &StepReport),
+) -> Result<RunSummary, RunError> {
+    run_on(scene, registry, dir, None, on_step)
+}
+
+/// [`run`], as one rank of a multi-process run when `cluster` is given: every rank
+/// steps the whole world and sweeps its subdomains ([`crate::dd::ranks`]); rank 0
+/// writes the outputs (the same files as one process, and `ranks.json`).
+pub fn run_on(
+    scene: &mut Scene,
+    registry: &Registry,
+    dir: &Path,
+    cluster: Option<Box<dyn crate::dd::Cluster>>,
     mut on_step: impl FnMut(&World2, &StepReport),
 ) -> Result<RunSummary, RunError> {
     let start = Instant::now();
-    std::fs::create_dir_all(dir).map_err(io(dir, "the output directory"))?;
-    let w = &mut scene.world;
+    let root = cluster.as_ref().is_none_or(|c| c.rank() == 0);
     // a decomposed run steps with NSCDD; outputs take its report and view
-    let mut dd = scene.decomposition.as_ref().map(|c| c.solver());
-    let file = std::fs::File::create(dir.join("history.csv")).map_err(io(dir, "history.csv"))?;
-    let mut hist = History::with_columns(std::io::BufWriter::new(file), w, dd.is_some()).map_err(io(dir, "history.csv"))?;
+    let mut dd: Option<Nscdd> = dd_solver(scene.decomposition.as_ref(), cluster)?;
+    let w = &mut scene.world;
+    let mut hist = History::with_columns(history_sink(dir, root)?, w, dd.is_some()).map_err(io(dir, "history.csv"))?;
     let mut writers: Vec<Box<dyn Writer2>> = vec![];
-    if scene.output.vtk {
+    if scene.output.vtk && root {
         writers.push((registry.writers["vtk"])());
     }
-    for name in &scene.output.writers {
+    for name in scene.output.writers.iter().filter(|_| root) {
         writers.push((registry.writers[name.as_str()])());
     }
     let mut frame = 0u32;
@@ -180,7 +239,7 @@ pub fn run(
         }
         let t_out = t0.elapsed().as_secs_f64();
         hist.row_dd(w, &rep, dd_rep.as_ref(), t_out).map_err(io(dir, "history.csv"))?;
-        if scene.output.checkpoint_every > 0 && s % scene.output.checkpoint_every == 0 && s != steps {
+        if root && scene.output.checkpoint_every > 0 && s % scene.output.checkpoint_every == 0 && s != steps {
             hist.flush().map_err(io(dir, "history.csv"))?;
             save_state(dir, "checkpoint.json", w)?;
         }
@@ -194,7 +253,10 @@ pub fn run(
     for wr in writers.iter_mut() {
         wr.finish(dir).map_err(io(dir, "the output series"))?;
     }
-    save_state(dir, "final.json", w)?;
+    write_rank_totals(&mut dd, dir)?;
+    if root {
+        save_state(dir, "final.json", w)?;
+    }
     sum.wall_seconds = start.elapsed().as_secs_f64();
     Ok(sum)
 }

@@ -4,7 +4,8 @@
 use crate::engine::StepReport;
 use crate::output::out3::{final_json3, write_vtk3, History3};
 use crate::output::vtk::VtkWriter;
-use crate::run::{io, save_state_text, RunError, RunSummary};
+use crate::dd::Nscdd3;
+use crate::run::{dd_solver, history_sink, io, save_state_text, write_rank_totals, RunError, RunSummary};
 use crate::scene::load3::Scene3;
 use crate::world3::World3;
 use std::path::Path;
@@ -18,14 +19,25 @@ fn save_state(dir: &Path, name: &str, w: &World3) -> Result<(), RunError> {
 /// `output.every` steps (and at the first and last step), `checkpoint.json` every
 /// `output.checkpoint_every` steps and `final.json` in `dir`. With
 /// `scene.decomposition`, every step is an NSCDD step ([`crate::dd::Nscdd3`]).
-pub fn run3(scene: &mut Scene3, dir: &Path, mut on_step: impl FnMut(&World3, &StepReport)) -> Result<RunSummary, RunError> {
+pub fn run3(scene: &mut Scene3, dir: &Path, on_step: impl FnMut(&World3, &StepReport)) -> Result<RunSummary, RunError> {
+    run3_on(scene, dir, None, on_step)
+}
+
+/// [`run3`], as one rank of a multi-process run when `cluster` is given (see
+/// [`crate::run::run_on`]).
+pub fn run3_on(
+    scene: &mut Scene3,
+    dir: &Path,
+    cluster: Option<Box<dyn crate::dd::Cluster>>,
+    mut on_step: impl FnMut(&World3, &StepReport),
+) -> Result<RunSummary, RunError> {
     let start = Instant::now();
-    std::fs::create_dir_all(dir).map_err(io(dir, "the output directory"))?;
+    let root = cluster.as_ref().is_none_or(|c| c.rank() == 0);
+    // a decomposed run steps with NSCDD (the same multiplier stage as in 2D)
+    let mut dd: Option<Nscdd3> = dd_solver(scene.decomposition.as_ref(), cluster)?;
     let w = &mut scene.world;
-    let file = std::fs::File::create(dir.join("history.csv")).map_err(io(dir, "history.csv"))?;
-    let mut hist =
-        History3::with_columns(std::io::BufWriter::new(file), w, scene.decomposition.is_some()).map_err(io(dir, "history.csv"))?;
-    let mut vtk = scene.output.vtk.then(VtkWriter::default);
+    let mut hist = History3::with_columns(history_sink(dir, root)?, w, dd.is_some()).map_err(io(dir, "history.csv"))?;
+    let mut vtk = (scene.output.vtk && root).then(VtkWriter::default);
     let mut frame = 0u32;
     if let Some(v) = vtk.as_mut() {
         write_vtk3(v, w, dir, frame).map_err(io(dir, "the first output frame"))?;
@@ -33,8 +45,6 @@ pub fn run3(scene: &mut Scene3, dir: &Path, mut on_step: impl FnMut(&World3, &St
     }
     let mut sum = RunSummary::default();
     let steps = w.time.steps;
-    // a decomposed run steps with NSCDD (the same multiplier stage as in 2D)
-    let mut dd = scene.decomposition.as_ref().map(|c| c.solver3());
     for s in (w.step + 1)..=steps {
         let stepped = match &mut dd {
             Some(n) => n.step(w).map(|r| {
@@ -65,7 +75,7 @@ pub fn run3(scene: &mut Scene3, dir: &Path, mut on_step: impl FnMut(&World3, &St
         }
         let t_out = t0.elapsed().as_secs_f64();
         hist.row_dd(w, &rep, dd_rep.as_ref(), t_out).map_err(io(dir, "history.csv"))?;
-        if scene.output.checkpoint_every > 0 && s % scene.output.checkpoint_every == 0 && s != steps {
+        if root && scene.output.checkpoint_every > 0 && s % scene.output.checkpoint_every == 0 && s != steps {
             hist.flush().map_err(io(dir, "history.csv"))?;
             save_state(dir, "checkpoint.json", w)?;
         }
@@ -73,7 +83,10 @@ pub fn run3(scene: &mut Scene3, dir: &Path, mut on_step: impl FnMut(&World3, &St
         on_step(w, &rep);
     }
     hist.flush().map_err(io(dir, "history.csv"))?;
-    save_state(dir, "final.json", w)?;
+    write_rank_totals(&mut dd, dir)?;
+    if root {
+        save_state(dir, "final.json", w)?;
+    }
     sum.wall_seconds = start.elapsed().as_secs_f64();
     Ok(sum)
 }

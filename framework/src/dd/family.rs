@@ -32,6 +32,10 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     fn point(c: &Self::Contacts, a: usize) -> [f64; 3];
     /// dst.r[ga] = src.r[la].
     fn copy_r(dst: &mut Self::Contacts, ga: usize, src: &Self::Contacts, la: usize);
+    /// The impulse of contact `a` (local frame: normal first), for the exchange
+    /// between processes.
+    fn r(c: &Self::Contacts, a: usize) -> &[f64];
+    fn r_mut(c: &mut Self::Contacts, a: usize) -> &mut [f64];
     /// W_αα (and its precomputed data) from the copies' M̂_E⁻¹.
     fn copy_delassus(c: &mut Self::Contacts, inv: &[Self::InvMass]);
     /// V += M̂⁻¹ H r for every contact with r ≠ 0, in storage order.
@@ -96,6 +100,12 @@ impl Family for Rigid2 {
     }
     fn copy_r(dst: &mut Self::Contacts, ga: usize, src: &Self::Contacts, la: usize) {
         dst.r[ga] = src.r[la];
+    }
+    fn r(c: &Self::Contacts, a: usize) -> &[f64] {
+        &c.r[a]
+    }
+    fn r_mut(c: &mut Self::Contacts, a: usize) -> &mut [f64] {
+        &mut c.r[a]
     }
     fn copy_delassus(c: &mut Self::Contacts, inv: &[Self::InvMass]) {
         for a in 0..c.len() {
@@ -209,6 +219,12 @@ impl Family for Rigid3 {
     }
     fn copy_r(dst: &mut Self::Contacts, ga: usize, src: &Self::Contacts, la: usize) {
         dst.r[ga] = src.r[la];
+    }
+    fn r(c: &Self::Contacts, a: usize) -> &[f64] {
+        &c.r[a]
+    }
+    fn r_mut(c: &mut Self::Contacts, a: usize) -> &mut [f64] {
+        &mut c.r[a]
     }
     fn copy_delassus(c: &mut Self::Contacts, inv: &[Self::InvMass]) {
         for a in 0..c.len() {

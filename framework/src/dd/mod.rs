@@ -41,9 +41,13 @@
 //! only its own data and every reduction runs in subdomain order, so the result does
 //! not depend on the number of threads.
 
+pub mod cluster;
 pub mod family;
 pub mod gluing;
+#[cfg(feature = "mpi")]
+pub mod mpi;
 pub mod partition;
+pub mod ranks;
 pub mod schemes;
 pub mod subdomain;
 pub mod team;
@@ -54,10 +58,12 @@ pub use family::{Family, Rigid2, Rigid3};
 pub use partition::{Decomposition, FGammaStore, Grid, Interface};
 pub use schemes::Scheme;
 pub use subdomain::{Subdomain, Subdomain2, Subdomain3, SubdomainSolver};
+pub use cluster::{Cluster, Solo};
+pub use ranks::RankState;
 pub use transport::{InProcess, Transport, TransportStats};
 
 use crate::engine::{ContactStage, Diverged, StageTimes};
-use crate::norms::{Norms, VANISHING};
+use crate::norms::{Norms, Sums, VANISHING};
 use crate::solver::SolveReport;
 use gluing::GluePartial;
 use schemes::{glue_stage, GlueBuffers};
@@ -242,6 +248,9 @@ pub struct NscddOf<D: Family> {
     transport: InProcess<D::V>,
     bufs: GlueBuffers<D::V>,
     v_free: Vec<D::V>,
+    /// Set for a multi-process run ([`ranks`]): this process sweeps and glues only
+    /// its ranks' subdomains.
+    ranks: Option<RankState<D::V>>,
 }
 
 /// NSCDD of 2D rigid bodies.
@@ -264,7 +273,29 @@ impl<D: Family> NscddOf<D> {
             transport: InProcess::default(),
             bufs: GlueBuffers::default(),
             v_free: Vec::new(),
+            ranks: None,
         }
+    }
+
+    /// Runs the subdomains over the ranks of `cluster` ([`ranks`]); every rank must
+    /// step the same world with the same settings. Err: the grid has fewer
+    /// subdomains than there are ranks.
+    pub fn with_cluster(mut self, cluster: Box<dyn Cluster>) -> Result<Self, String> {
+        let s = &self.settings;
+        let n = s.nx as u64 * s.ny as u64 * s.nz.max(1) as u64;
+        if (cluster.size() as u64) > n {
+            return Err(format!(
+                "{} ranks for {n} subdomains: every rank needs at least one subdomain (use at most {n} ranks or a finer [decomposition])",
+                cluster.size()
+            ));
+        }
+        self.ranks = Some(RankState::new(cluster));
+        Ok(self)
+    }
+
+    /// The multi-process state (None in one process).
+    pub fn ranks_mut(&mut self) -> Option<&mut RankState<D::V>> {
+        self.ranks.as_mut()
     }
 
     /// Re-partitions every `k` steps (see [`Nscdd::repartition_every`]).
@@ -377,45 +408,56 @@ impl<D: Family> NscddOf<D> {
         let per = set.sweeps_per_gluing.max(1);
         let max_stages = sv.max_sweeps.div_ceil(per).max(1);
         let k = sv.check_every.max(1);
-        let (iface, transport, bufs) = (&d.iface, &mut self.transport, &mut self.bufs);
         let mut before: Option<(bool, bool)> = None;
-        let stages = team::with_team(&mut d.subs, set.threads, iface, |team| {
-            if iface.fresh.iter().any(|&f| f) {
-                team.with_all(|subs| glue_stage(subs, iface, set.scheme, transport, true, bufs));
-            }
-            let mut stages = 0;
-            while stages < max_stages {
-                stages += 1;
-                let check = stages % k == 0 || stages == max_stages;
-                // sweeps and gluing; with `check`, the sums reduced in subdomain order
-                let (sums, parts) = team.stage(per, sv.relaxation, check, set.scheme, transport, bufs);
-                if check {
-                    let mut g = GluePartial::default();
-                    for p in &parts {
-                        g.merge(p);
-                    }
-                    rep.solve.norms = Norms::from_sums(&sums, sv.tolerance);
-                    let quad_wr = if sums.nactif > 0 && sums.sum_wrwr > VANISHING && sums.sum_wrr > VANISHING {
-                        (sums.sum_wrwr / sums.nactif as f64).sqrt()
-                    } else {
-                        0.0
-                    };
-                    rep.egluing = g.egluing();
-                    rep.egluing_rel = g.relative(quad_wr);
-                    let now = (rep.solve.norms.converged(sv.norm), rep.egluing_rel < sv.tolerance);
-                    rep.prevailing = Prevailing::of(now, before);
-                    before = Some(now);
-                    if now == (true, true) {
-                        rep.solve.converged = true;
-                        break;
+        let mut converged = |sums: &Sums, g: &GluePartial, rep: &mut DdStepReport| {
+            rep.solve.norms = Norms::from_sums(sums, sv.tolerance);
+            let quad_wr = if sums.nactif > 0 && sums.sum_wrwr > VANISHING && sums.sum_wrr > VANISHING {
+                (sums.sum_wrwr / sums.nactif as f64).sqrt()
+            } else {
+                0.0
+            };
+            rep.egluing = g.egluing();
+            rep.egluing_rel = g.relative(quad_wr);
+            let now = (rep.solve.norms.converged(sv.norm), rep.egluing_rel < sv.tolerance);
+            rep.prevailing = Prevailing::of(now, before);
+            before = Some(now);
+            rep.solve.converged = now == (true, true);
+            rep.solve.converged
+        };
+        let stages = if let Some(rs) = self.ranks.as_mut() {
+            let remap = rep.repartitioned;
+            let (stages, stats) = ranks::iterate(rs, d, set.scheme, (per, sv.relaxation), max_stages, k, remap, |s, g| converged(s, g, rep));
+            rep.exchange = stats;
+            stages
+        } else {
+            let (iface, transport, bufs) = (&d.iface, &mut self.transport, &mut self.bufs);
+            let stages = team::with_team(&mut d.subs, set.threads, iface, |team| {
+                if iface.fresh.iter().any(|&f| f) {
+                    team.with_all(|subs| glue_stage(subs, iface, set.scheme, transport, true, bufs));
+                }
+                let mut stages = 0;
+                while stages < max_stages {
+                    stages += 1;
+                    let check = stages % k == 0 || stages == max_stages;
+                    // sweeps and gluing; with `check`, the sums reduced in subdomain order
+                    let (sums, parts) = team.stage(per, sv.relaxation, check, set.scheme, transport, bufs);
+                    if check {
+                        let mut g = GluePartial::default();
+                        for p in &parts {
+                            g.merge(p);
+                        }
+                        if converged(&sums, &g, rep) {
+                            break;
+                        }
                     }
                 }
-            }
+                stages
+            });
+            rep.exchange = self.transport.stats();
             stages
-        });
+        };
         rep.stages = stages;
         rep.solve.sweeps = stages * per;
-        rep.exchange = self.transport.stats();
         write_back(d, w);
         self.store.keep(&d.subs);
         rep.solve.residual = D::residual(w);

@@ -162,6 +162,51 @@ fn accumulate<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>>(part: &mut GluePa
 
 const ROOT: u32 = 0;
 
+/// The root's part of the centralized gluing: from `all[s]` (subdomain s's
+/// interface velocities, slot order) every chain solved once, `out[s]` the copies'
+/// increments (zero where not updated) and `parts[s]` the residual shares, per
+/// subdomain in slot order (as the decentralized scheme). `meta(s)`: subdomain s's
+/// (`iface_ib`, `iface_k`). Shared by the in-process and the multi-process schemes.
+pub(super) fn root_solve<'m, D: Family>(
+    all: &[Vec<D::V>],
+    out: &mut [Vec<D::V>],
+    parts: &mut [GluePartial],
+    iface: &Interface,
+    meta: impl Fn(usize) -> (&'m [u32], &'m [u32]),
+    only_fresh: bool,
+    c: &mut ChainBuffers<D::V>,
+) {
+    for (o, a) in out.iter_mut().zip(all) {
+        o.clear();
+        o.resize(a.len(), D::V::default());
+    }
+    // solve every chain once
+    for ib in 0..iface.len() {
+        let r = iface.copies(ib);
+        c.chain.clear();
+        c.chain
+            .extend(r.clone().map(|k| all[iface.sub[k] as usize][iface.slot[k] as usize]));
+        if !only_fresh || iface.fresh[ib] {
+            c.dv.resize(c.chain.len(), D::V::default());
+            chain_increments(&c.chain, &mut c.dv, &mut c.scratch);
+            for (k, x) in r.enumerate() {
+                out[iface.sub[x] as usize][iface.slot[x] as usize] = c.dv[k];
+            }
+        }
+    }
+    // residual shares, per subdomain in slot order
+    for (s, part) in parts.iter_mut().enumerate() {
+        let (ibs, ks) = meta(s);
+        for q in 0..all[s].len() {
+            let ib = ibs[q] as usize;
+            c.chain.clear();
+            c.chain
+                .extend(iface.copies(ib).map(|x| all[iface.sub[x] as usize][iface.slot[x] as usize]));
+            accumulate(part, &c.chain, ks[q] as usize, D::SPACE, iface.rho2[ib]);
+        }
+    }
+}
+
 fn centralized<D: Family>(
     subs: &mut [&mut Subdomain<D>],
     iface: &Interface,
@@ -182,34 +227,9 @@ fn centralized<D: Family>(
     let (all, out) = b.packets.split_at_mut(ns);
     for s in 0..ns {
         t.recv(ROOT, s as u32, &mut all[s]);
-        out[s].clear();
-        out[s].resize(all[s].len(), D::V::default());
     }
-    // solve every chain once, at the root
     let mut parts = vec![GluePartial::default(); ns];
-    for ib in 0..iface.len() {
-        let r = iface.copies(ib);
-        b.c.chain.clear();
-        b.c.chain
-            .extend(r.clone().map(|c| all[iface.sub[c] as usize][iface.slot[c] as usize]));
-        if !only_fresh || iface.fresh[ib] {
-            b.c.dv.resize(b.c.chain.len(), D::V::default());
-            chain_increments(&b.c.chain, &mut b.c.dv, &mut b.c.scratch);
-            for (k, c) in r.enumerate() {
-                out[iface.sub[c] as usize][iface.slot[c] as usize] = b.c.dv[k];
-            }
-        }
-    }
-    // residual shares, per subdomain in slot order (as the decentralized scheme)
-    for (s, part) in parts.iter_mut().enumerate() {
-        for q in 0..all[s].len() {
-            let ib = subs[s].iface_ib[q] as usize;
-            b.c.chain.clear();
-            b.c.chain
-                .extend(iface.copies(ib).map(|c| all[iface.sub[c] as usize][iface.slot[c] as usize]));
-            accumulate(part, &b.c.chain, subs[s].iface_k[q] as usize, D::SPACE, iface.rho2[ib]);
-        }
-    }
+    root_solve::<D>(all, out, &mut parts, iface, |s| (&subs[s].iface_ib, &subs[s].iface_k), only_fresh, &mut b.c);
     // scatter
     for (s, o) in out.iter().enumerate().take(ns) {
         t.send(ROOT, s as u32, o);

@@ -1,0 +1,132 @@
+//! `nscdd run` as one rank of a multi-process run (`mpirun -n P nscdd run …`, cargo
+//! feature `mpi`): starting MPI when a launcher started this process, the agreement
+//! of the ranks on the scene before stepping, and the failures of one rank.
+//!
+//! Failures: a rank that cannot load the scene (or its flags) stops every rank at the
+//! agreement that follows loading (exit code 2, the failing rank's message on
+//! stderr); ranks that read different scenes stop there too. A rank that fails
+//! while the others step (an unwritable output on rank 0) prints its message and
+//! aborts every rank (`MPI_Abort`): never a hang. A divergence happens on every rank
+//! at once (each holds the whole world): rank 0 reports it, every rank exits 1.
+
+use nscdd::dd::Cluster;
+use std::hash::{Hash, Hasher};
+use std::path::Path;
+use std::process::ExitCode;
+
+/// This process's place among the ranks (one process: rank 0 of 1, no MPI).
+pub struct Ranks {
+    #[cfg(feature = "mpi")]
+    session: Option<nscdd::dd::mpi::MpiSession>,
+}
+
+/// The rank count an MPI launcher gave this process (1 without a launcher).
+#[cfg_attr(feature = "mpi", allow(dead_code))]
+fn launched_size() -> u32 {
+    ["OMPI_COMM_WORLD_SIZE", "PMI_SIZE"]
+        .iter()
+        .find_map(|v| std::env::var(v).ok()?.parse().ok())
+        .unwrap_or(1)
+}
+
+impl Ranks {
+    /// Starts MPI when this process was started by an MPI launcher.
+    pub fn start() -> Result<Ranks, String> {
+        #[cfg(feature = "mpi")]
+        {
+            Ok(Ranks {
+                session: nscdd::dd::mpi::MpiSession::from_launcher(),
+            })
+        }
+        #[cfg(not(feature = "mpi"))]
+        {
+            let n = launched_size();
+            if n > 1 {
+                return Err(format!(
+                    "started as one of {n} MPI ranks, but this nscdd was built without MPI: build it with `cargo build --release --features mpi` (README, \"Running on many cores with MPI\")"
+                ));
+            }
+            Ok(Ranks {})
+        }
+    }
+
+    pub fn rank(&self) -> u32 {
+        #[cfg(feature = "mpi")]
+        if let Some(s) = &self.session {
+            return s.rank();
+        }
+        0
+    }
+
+    pub fn size(&self) -> u32 {
+        #[cfg(feature = "mpi")]
+        if let Some(s) = &self.session {
+            return s.size();
+        }
+        1
+    }
+
+    pub fn root(&self) -> bool {
+        self.rank() == 0
+    }
+
+    /// A cluster over the ranks (None without a launcher).
+    pub fn cluster(&self) -> Option<Box<dyn Cluster>> {
+        #[cfg(feature = "mpi")]
+        if let Some(s) = &self.session {
+            return Some(s.cluster());
+        }
+        None
+    }
+
+    /// After loading: every rank says whether it loaded the scene (`Ok(digest)` of
+    /// what it will run) or why not. Returns the exit code when the run must stop:
+    /// some rank failed (it prints its message; rank 0 also writes it, or a note,
+    /// in OUT/error.txt) or the ranks disagree on the scene.
+    pub fn agree(&self, loaded: Result<u64, String>, out: &Path) -> Result<(), ExitCode> {
+        let Some(mut cl) = self.cluster() else {
+            return loaded.map(|_| ()).map_err(|e| crate::report::input_error_in(out, e));
+        };
+        let (_, failed) = cl.min_max(loaded.is_err() as u64);
+        if failed == 1 {
+            let r = self.rank();
+            return Err(match loaded {
+                Err(e) if r == 0 => crate::report::input_error_in(out, e),
+                Err(e) => crate::input_error(format!("rank {r}: {e}")),
+                Ok(_) if r == 0 => crate::report::input_error_in(out, "another rank could not load the scene (its message is above)"),
+                Ok(_) => ExitCode::from(2),
+            });
+        }
+        let digest = loaded.unwrap_or(0);
+        let (lo, hi) = cl.min_max(digest);
+        if lo != hi {
+            return Err(if self.root() {
+                crate::report::input_error_in(out, "the ranks read different scenes or options: every rank must run the same scene with the same flags")
+            } else {
+                ExitCode::from(2)
+            });
+        }
+        Ok(())
+    }
+
+    /// A run that stopped on this rank: with other ranks still stepping, prints the
+    /// message with the rank and stops every rank (exit `code`).
+    pub fn abort_others(&self, code: i32, msg: &str) -> ExitCode {
+        match self.cluster() {
+            Some(cl) if self.size() > 1 => {
+                eprintln!("rank {}: error: {msg}", self.rank());
+                cl.abort(code)
+            }
+            _ => ExitCode::from(code as u8),
+        }
+    }
+}
+
+/// What every rank must agree on: the initial state (its saved form), the
+/// decomposition and the run's settings.
+pub fn digest(state: &str, settings: impl std::fmt::Debug) -> u64 {
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    state.hash(&mut h);
+    format!("{settings:?}").hash(&mut h);
+    h.finish()
+}

@@ -1,0 +1,79 @@
+//! The processes of a multi-process run, as the NSCDD coordinator sees them.
+//!
+//! [`Cluster`] is the handful of operations [`super::ranks`] needs: a point-to-point
+//! round with a few peers, gathers and a scatter of `f64` buffers, an agreement and
+//! an abort. The MPI implementation is [`super::mpi::MpiCluster`] (cargo feature
+//! `mpi`); nothing else in the framework names MPI. [`Solo`] is the one-process
+//! cluster (every operation a copy), which runs the multi-process code path in one
+//! process for tests.
+//!
+//! Every operation but [`Cluster::exchange`] is collective: every rank calls it, in
+//! the same order, with the same `counts`.
+
+/// A group of processes (ranks 0..size) running one simulation together.
+pub trait Cluster {
+    fn rank(&self) -> u32;
+    fn size(&self) -> u32;
+    /// One point-to-point round: sends `out[i]` to rank `peers[i]` and receives
+    /// `inbox[i]` (resized to the message) from it. The relation is symmetric: each
+    /// peer calls `exchange` with this rank among its peers in the same round.
+    /// Sends and receives are non-blocking and waited for together.
+    fn exchange(&mut self, peers: &[u32], out: &[Vec<f64>], inbox: &mut [Vec<f64>]);
+    /// `all` = every rank's `mine` concatenated in rank order (`counts[r]`: rank r's
+    /// length, the same on every rank).
+    fn all_gather(&mut self, mine: &[f64], counts: &[usize], all: &mut Vec<f64>);
+    /// As [`Cluster::all_gather`], into rank 0 only (`all` untouched elsewhere).
+    fn gather(&mut self, mine: &[f64], counts: &[usize], all: &mut Vec<f64>);
+    /// Rank r receives `all[displ_r .. displ_r + counts[r]]` of rank 0's `all` into
+    /// `mine` (displ_r = counts[0] + … + counts[r − 1]).
+    fn scatter(&mut self, all: &[f64], counts: &[usize], mine: &mut Vec<f64>);
+    /// The smallest and largest of `x` over the ranks.
+    fn min_max(&mut self, x: u64) -> (u64, u64);
+    /// Stops every rank at once with exit code `code` (MPI_Abort): for a failure on
+    /// one rank, which the others would wait for forever.
+    fn abort(&self, code: i32) -> !;
+}
+
+/// The one-process cluster.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Solo;
+
+impl Cluster for Solo {
+    fn rank(&self) -> u32 {
+        0
+    }
+    fn size(&self) -> u32 {
+        1
+    }
+    fn exchange(&mut self, peers: &[u32], _out: &[Vec<f64>], _inbox: &mut [Vec<f64>]) {
+        assert!(peers.is_empty(), "a one-process cluster has no peers");
+    }
+    fn all_gather(&mut self, mine: &[f64], _counts: &[usize], all: &mut Vec<f64>) {
+        all.clear();
+        all.extend_from_slice(mine);
+    }
+    fn gather(&mut self, mine: &[f64], counts: &[usize], all: &mut Vec<f64>) {
+        self.all_gather(mine, counts, all);
+    }
+    fn scatter(&mut self, all: &[f64], counts: &[usize], mine: &mut Vec<f64>) {
+        mine.clear();
+        mine.extend_from_slice(&all[..counts[0]]);
+    }
+    fn min_max(&mut self, x: u64) -> (u64, u64) {
+        (x, x)
+    }
+    fn abort(&self, code: i32) -> ! {
+        std::process::exit(code)
+    }
+}
+
+/// Displacements of `counts` (exclusive prefix sums).
+pub fn displacements(counts: &[usize]) -> Vec<usize> {
+    let mut d = Vec::with_capacity(counts.len());
+    let mut acc = 0;
+    for &c in counts {
+        d.push(acc);
+        acc += c;
+    }
+    d
+}

@@ -1,0 +1,621 @@
+//! NSCDD across processes: the subdomains spread over the ranks of a [`Cluster`].
+//!
+//! Every rank holds the whole world (replicated data): it computes the free
+//! velocities, detects the contacts and splits them over the grid exactly as a
+//! one-process run does (the same code on the same data gives the same numbers).
+//! Then each rank sweeps and glues only its own subdomains:
+//!
+//! ```text
+//! ranks:   a contiguous run of subdomain ids per rank, balanced by contact count
+//!          (ids follow the grid x-first, so a rank's subdomains are neighbors and
+//!          few ranks share interface bodies); chosen again at every repartition
+//! repeat {
+//!     own subdomains: `sweeps_per_gluing` NLGS sweeps
+//!     decentralized: one message to each rank that shares interface bodies with
+//!         this one (non-blocking sends and receives), then each own subdomain
+//!         glues its copies ([`super::schemes`], unchanged)
+//!     centralized:   gather the interface velocities on rank 0, solve every
+//!         chain there, scatter each rank its copies' increments
+//!     check stages:  every rank's per-subdomain sums and residual shares gathered
+//!         on every rank (one all-gather), merged in subdomain order
+//! }
+//! the converged impulses, copy velocities and F_Γ of every subdomain gathered on
+//! every rank (one all-gather), then the write-back and F_Γ store as in one process
+//! ```
+//!
+//! Since every subdomain is swept and glued by the same arithmetic as in one process
+//! and every reduction runs in subdomain order, a run gives bitwise the results of
+//! the same decomposition run in one process, whatever the number of ranks.
+//!
+//! What is not distributed yet (docs/SCALING.md): detection, partition and the
+//! position update run on every rank over the whole sample, and the end-of-step
+//! all-gather carries every contact's impulse. A subdomain that changes rank at a
+//! repartition needs no migration message: its bodies and the impulses of its
+//! contacts are already on every rank after the previous step's all-gather.
+
+use super::cluster::Cluster;
+use super::family::Family;
+use super::gluing::GluePartial;
+use super::partition::Decomposition;
+use super::schemes::{self, glue_stage, ChainBuffers, GlueBuffers, Scheme};
+use super::subdomain::{Subdomain, SubdomainSolver};
+use super::transport::{InProcess, Transport, TransportStats};
+use crate::norms::Sums;
+use std::time::Instant;
+
+/// Values per subdomain in a check stage's all-gather: the 8 sums and the 4 fields
+/// of the gluing residual share.
+const CHECK_VALUES: usize = 12;
+
+/// Rank of each subdomain: contiguous runs of ids, one or more per rank, balanced by
+/// `loads` (each rank gets at least one subdomain; needs `loads.len() ≥ ranks`).
+/// A rank's run ends once the loads so far reach its share of the total, or when
+/// the remaining subdomains are just enough for the remaining ranks.
+pub fn contiguous_ranks(loads: &[usize], ranks: u32) -> Vec<u32> {
+    let (n, p) = (loads.len(), ranks.max(1) as usize);
+    assert!(n >= p, "{n} subdomains cannot feed {p} ranks");
+    let total: u128 = loads.iter().map(|&l| l as u128).sum();
+    let mut out = vec![0u32; n];
+    let (mut r, mut acc) = (0usize, 0u128);
+    for (k, &l) in loads.iter().enumerate() {
+        out[k] = r as u32;
+        acc += l as u128;
+        let (subs_left, ranks_left) = (n - k - 1, p - r - 1);
+        if ranks_left > 0 && (subs_left == ranks_left || acc * p as u128 >= total * (r as u128 + 1)) {
+            r += 1;
+        }
+    }
+    out
+}
+
+/// Buffers of the decentralized exchange between ranks, kept between steps.
+pub struct RankLink<V> {
+    me: u32,
+    rank_of: Vec<u32>,
+    /// Ranks sharing interface bodies with this one (ascending).
+    peers: Vec<u32>,
+    /// Per peer: packet headers (from, to, copies) and values, then the message.
+    head: Vec<Vec<f64>>,
+    data: Vec<Vec<f64>>,
+    out: Vec<Vec<f64>>,
+    inbox: Vec<Vec<f64>>,
+    /// (to, from, peer, offset, copies) of the received packets, sorted.
+    index: Vec<(u32, u32, u32, u32, u32)>,
+    /// Packets between two subdomains of this rank.
+    local: InProcess<V>,
+    pending: bool,
+    /// This step's counts (messages sent by this rank) and exchange rounds.
+    stats: TransportStats,
+    rounds: u64,
+    /// Rounds of the last step.
+    rounds_step: u64,
+    /// Seconds spent in the exchanges this step.
+    seconds: f64,
+}
+
+impl<V> Default for RankLink<V> {
+    fn default() -> Self {
+        RankLink {
+            me: 0,
+            rank_of: Vec::new(),
+            peers: Vec::new(),
+            head: Vec::new(),
+            data: Vec::new(),
+            out: Vec::new(),
+            inbox: Vec::new(),
+            index: Vec::new(),
+            local: InProcess::default(),
+            pending: false,
+            stats: TransportStats::default(),
+            rounds: 0,
+            rounds_step: 0,
+            seconds: 0.0,
+        }
+    }
+}
+
+impl<V> RankLink<V> {
+    /// Peers of this step's decomposition: the ranks of the own subdomains' neighbors.
+    fn setup<D: Family<V = V>>(&mut self, subs: &[Subdomain<D>], rank_of: &[u32], me: u32) {
+        self.me = me;
+        self.rank_of.clear();
+        self.rank_of.extend_from_slice(rank_of);
+        self.peers.clear();
+        for s in subs.iter().filter(|s| rank_of[s.id as usize] == me) {
+            self.peers.extend(s.neighbors.iter().map(|n| rank_of[n.sub as usize]).filter(|&r| r != me));
+        }
+        self.peers.sort_unstable();
+        self.peers.dedup();
+        let np = self.peers.len();
+        for v in [&mut self.head, &mut self.data, &mut self.out, &mut self.inbox] {
+            v.resize_with(np, Vec::new);
+            v.iter_mut().for_each(Vec::clear);
+        }
+        self.local.resize(subs.len());
+        self.index.clear();
+        self.pending = false;
+    }
+}
+
+/// The decentralized scheme's [`Transport`] across ranks: packets to subdomains of
+/// other ranks are collected per rank and sent as one message per peer when the
+/// first packet of the round is read; packets between subdomains of this rank stay
+/// in memory. A message is `[n, (from, to, copies) × n, values…]`.
+struct RankTransport<'a, V> {
+    link: &'a mut RankLink<V>,
+    cl: &'a mut dyn Cluster,
+}
+
+impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankTransport<'_, V> {
+    fn exchange(&mut self) {
+        let l = &mut *self.link;
+        l.pending = false;
+        if l.peers.is_empty() {
+            return;
+        }
+        let t0 = Instant::now();
+        for p in 0..l.peers.len() {
+            let o = &mut l.out[p];
+            o.clear();
+            o.push((l.head[p].len() / 3) as f64);
+            o.extend_from_slice(&l.head[p]);
+            o.extend_from_slice(&l.data[p]);
+            l.head[p].clear();
+            l.data[p].clear();
+            l.stats.messages += 1;
+            l.stats.values += o.len() as u64;
+        }
+        self.cl.exchange(&l.peers, &l.out, &mut l.inbox);
+        let ndof = V::default().as_ref().len();
+        l.index.clear();
+        for (p, m) in l.inbox.iter().enumerate() {
+            let n = m.first().copied().unwrap_or(0.0) as usize;
+            let mut off = 1 + 3 * n;
+            for h in m[1..1 + 3 * n].chunks_exact(3) {
+                let len = h[2] as usize;
+                l.index.push((h[1] as u32, h[0] as u32, p as u32, off as u32, len as u32));
+                off += len * ndof;
+            }
+            assert_eq!(off, m.len(), "malformed interface message from rank {}", l.peers[p]);
+        }
+        l.index.sort_unstable();
+        l.rounds += 1;
+        l.seconds += t0.elapsed().as_secs_f64();
+    }
+}
+
+impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> Transport<V> for RankTransport<'_, V> {
+    fn send(&mut self, from: u32, to: u32, data: &[V]) {
+        let l = &mut *self.link;
+        let r = l.rank_of[to as usize];
+        if r == l.me {
+            return l.local.send(from, to, data);
+        }
+        let p = l.peers.binary_search(&r).expect("a neighbor's rank is a peer");
+        l.head[p].extend([from as f64, to as f64, data.len() as f64]);
+        for v in data {
+            l.data[p].extend_from_slice(v.as_ref());
+        }
+        l.pending = true;
+    }
+    fn recv(&mut self, to: u32, from: u32, out: &mut Vec<V>) {
+        if self.link.pending {
+            self.exchange();
+        }
+        let l = &mut *self.link;
+        if l.rank_of[from as usize] == l.me {
+            return l.local.recv(to, from, out);
+        }
+        out.clear();
+        if let Ok(i) = l.index.binary_search_by_key(&(to, from), |e| (e.0, e.1)) {
+            let (_, _, p, off, len) = l.index[i];
+            let ndof = V::default().as_ref().len();
+            let m = &l.inbox[p as usize][off as usize..off as usize + len as usize * ndof];
+            out.extend(m.chunks_exact(ndof).map(|c| {
+                let mut v = V::default();
+                v.as_mut().copy_from_slice(c);
+                v
+            }));
+        }
+    }
+    fn stats(&self) -> TransportStats {
+        self.link.stats
+    }
+    fn record(&mut self, _from: u32, _to: u32, _len: usize) {}
+}
+
+/// Totals of one rank over a run.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RankTotals {
+    pub steps: u64,
+    /// Gluing messages and values this rank sent (point to point, or its parts of
+    /// the centralized gather/scatter), and the rounds of gluing exchanges.
+    pub sent: TransportStats,
+    pub rounds: u64,
+    /// This rank's parts of the reductions (check stages' and end-of-step
+    /// all-gathers, counted as one message to each other rank).
+    pub reduce: TransportStats,
+    /// Seconds in gluing exchanges, in the check and end-of-step gathers, and in the
+    /// whole distributed iteration (sweeps included).
+    pub exchange_seconds: f64,
+    pub reduce_seconds: f64,
+    pub solve_seconds: f64,
+    /// Ranks this rank sent gluing messages to, over the run (ascending).
+    pub peers: Vec<u32>,
+}
+
+/// The multi-process state of an NSCDD solver.
+pub struct RankState<V> {
+    pub cluster: Box<dyn Cluster>,
+    /// Rank of each subdomain (the last repartition's).
+    pub rank_of: Vec<u32>,
+    link: RankLink<V>,
+    glue: GlueBuffers<V>,
+    chain: ChainBuffers<V>,
+    send: Vec<f64>,
+    all: Vec<f64>,
+    counts: Vec<usize>,
+    per_sub: Vec<Vec<V>>,
+    per_sub_out: Vec<Vec<V>>,
+    parts: Vec<GluePartial>,
+    pub totals: RankTotals,
+}
+
+impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
+    pub fn new(cluster: Box<dyn Cluster>) -> Self {
+        RankState {
+            cluster,
+            rank_of: Vec::new(),
+            link: RankLink::default(),
+            glue: GlueBuffers::default(),
+            chain: ChainBuffers::default(),
+            send: Vec::new(),
+            all: Vec::new(),
+            counts: Vec::new(),
+            per_sub: Vec::new(),
+            per_sub_out: Vec::new(),
+            parts: Vec::new(),
+            totals: RankTotals::default(),
+        }
+    }
+
+    /// Per-rank counts of `per(subdomain)` values (subdomains of a rank are contiguous).
+    fn counts_by(&mut self, ns: usize, per: impl Fn(usize) -> usize) {
+        self.counts.clear();
+        self.counts.resize(self.cluster.size() as usize, 0);
+        for s in 0..ns {
+            self.counts[self.rank_of[s] as usize] += per(s);
+        }
+    }
+
+    /// Records this rank's part of a gluing collective (centralized scheme).
+    fn sent(&mut self, messages: u64, values: usize) {
+        self.link.stats.messages += messages;
+        self.link.stats.values += values as u64;
+    }
+
+    /// Records this rank's part of a reduction (check stages, end of step): an
+    /// all-gather counted as this rank's values sent to each other rank.
+    fn reduced(&mut self, values: usize) {
+        let others = self.cluster.size() as u64 - 1;
+        self.totals.reduce.messages += others;
+        self.totals.reduce.values += values as u64 * others;
+    }
+
+    /// The centralized gluing across ranks; returns the own subdomains' residual
+    /// shares (subdomain order).
+    fn central<D: Family<V = V>>(&mut self, d: &mut Decomposition<D>, only_fresh: bool, own: &mut Vec<GluePartial>) {
+        let ndof = V::default().as_ref().len();
+        let (me, np, ns) = (self.cluster.rank(), self.cluster.size(), d.subs.len());
+        let t0 = Instant::now();
+        self.send.clear();
+        for s in d.subs.iter().filter(|s| self.rank_of[s.id as usize] == me) {
+            for q in 0..s.iface.len() {
+                self.send.extend_from_slice(s.interface_velocity(q).as_ref());
+            }
+        }
+        self.counts_by(ns, |s| d.subs[s].iface.len() * ndof);
+        if me != 0 {
+            self.sent(1, self.send.len());
+        }
+        self.cluster.gather(&self.send, &self.counts, &mut self.all);
+        if me == 0 {
+            // rank order is subdomain order: unpack per subdomain, solve, pack
+            self.per_sub.resize_with(ns, Vec::new);
+            self.per_sub_out.resize_with(ns, Vec::new);
+            let mut pos = 0;
+            for (s, v) in self.per_sub.iter_mut().enumerate() {
+                v.clear();
+                let n = d.subs[s].iface.len() * ndof;
+                v.extend(self.all[pos..pos + n].chunks_exact(ndof).map(|c| {
+                    let mut x = V::default();
+                    x.as_mut().copy_from_slice(c);
+                    x
+                }));
+                pos += n;
+            }
+            self.parts.clear();
+            self.parts.resize(ns, GluePartial::default());
+            let subs = &d.subs;
+            schemes::root_solve::<D>(
+                &self.per_sub,
+                &mut self.per_sub_out,
+                &mut self.parts,
+                &d.iface,
+                |s| (&subs[s].iface_ib, &subs[s].iface_k),
+                only_fresh,
+                &mut self.chain,
+            );
+            self.all.clear();
+            for s in 0..ns {
+                for v in &self.per_sub_out[s] {
+                    self.all.extend_from_slice(v.as_ref());
+                }
+                let p = &self.parts[s];
+                self.all.extend([p.jump2, p.links as f64, p.v2, p.copies as f64]);
+            }
+            self.sent(np as u64 - 1, self.all.len() - self.counts_scatter(d, ndof, 0));
+        }
+        self.counts_by(ns, |s| d.subs[s].iface.len() * ndof + 4);
+        let mut mine = std::mem::take(&mut self.send);
+        self.cluster.scatter(&self.all, &self.counts, &mut mine);
+        self.link.rounds += 1;
+        self.link.seconds += t0.elapsed().as_secs_f64();
+        let mut pos = 0;
+        own.clear();
+        for s in d.subs.iter_mut().filter(|s| self.rank_of[s.id as usize] == me) {
+            for q in 0..s.iface.len() {
+                let mut dv = V::default();
+                dv.as_mut().copy_from_slice(&mine[pos..pos + ndof]);
+                pos += ndof;
+                if !only_fresh || d.iface.fresh[s.iface_ib[q] as usize] {
+                    s.glue(q, dv);
+                }
+            }
+            let p = &mine[pos..pos + 4];
+            own.push(GluePartial {
+                jump2: p[0],
+                links: p[1] as u64,
+                v2: p[2],
+                copies: p[3] as u64,
+            });
+            pos += 4;
+        }
+        self.send = mine;
+    }
+
+    /// Values of rank `r`'s part of the centralized scatter.
+    fn counts_scatter<D: Family<V = V>>(&self, d: &Decomposition<D>, ndof: usize, r: u32) -> usize {
+        (0..d.subs.len())
+            .filter(|&s| self.rank_of[s] == r)
+            .map(|s| d.subs[s].iface.len() * ndof + 4)
+            .sum()
+    }
+
+    /// One gluing stage over the own subdomains; their residual shares in `own`.
+    fn glue<D: Family<V = V>>(&mut self, d: &mut Decomposition<D>, scheme: Scheme, only_fresh: bool, own: &mut Vec<GluePartial>) {
+        match scheme {
+            Scheme::Centralized => self.central(d, only_fresh, own),
+            Scheme::Decentralized => {
+                let me = self.cluster.rank();
+                let rank_of = &self.rank_of;
+                let mut subs: Vec<&mut Subdomain<D>> = d.subs.iter_mut().filter(|s| rank_of[s.id as usize] == me).collect();
+                let mut t = RankTransport {
+                    link: &mut self.link,
+                    cl: &mut *self.cluster,
+                };
+                *own = glue_stage(&mut subs, &d.iface, Scheme::Decentralized, &mut t, only_fresh, &mut self.glue);
+            }
+        }
+    }
+
+    /// A check stage: every subdomain's sums and residual share, on every rank, merged
+    /// in subdomain order.
+    fn check<D: Family<V = V>>(&mut self, d: &Decomposition<D>, own: &[GluePartial]) -> (Sums, GluePartial) {
+        let me = self.cluster.rank();
+        let t0 = Instant::now();
+        self.send.clear();
+        let mut parts = own.iter();
+        for s in d.subs.iter().filter(|s| self.rank_of[s.id as usize] == me) {
+            let u = &s.sums;
+            let p = parts.next().copied().unwrap_or_default();
+            self.send.extend([
+                u.sum_dvdv,
+                u.sum_wrwr,
+                u.sum_wrr,
+                u.sum_dvdvrr,
+                u.sum_dvor,
+                u.max_dvdv,
+                u.max_dvdvrr,
+                u.nactif as f64,
+                p.jump2,
+                p.links as f64,
+                p.v2,
+                p.copies as f64,
+            ]);
+        }
+        self.counts_by(d.subs.len(), |_| CHECK_VALUES);
+        self.reduced(self.send.len());
+        self.cluster.all_gather(&self.send, &self.counts, &mut self.all);
+        self.totals.reduce_seconds += t0.elapsed().as_secs_f64();
+        let (mut sums, mut g) = (Sums::default(), GluePartial::default());
+        for x in self.all.chunks_exact(CHECK_VALUES) {
+            sums.merge(&Sums {
+                sum_dvdv: x[0],
+                sum_wrwr: x[1],
+                sum_wrr: x[2],
+                sum_dvdvrr: x[3],
+                sum_dvor: x[4],
+                max_dvdv: x[5],
+                max_dvdvrr: x[6],
+                nactif: x[7] as u64,
+            });
+            g.merge(&GluePartial {
+                jump2: x[8],
+                links: x[9] as u64,
+                v2: x[10],
+                copies: x[11] as u64,
+            });
+        }
+        (sums, g)
+    }
+
+    /// Every subdomain's impulses, copy velocities and F_Γ from its rank to all.
+    fn share_results<D: Family<V = V>>(&mut self, d: &mut Decomposition<D>) {
+        let ndof = V::default().as_ref().len();
+        let me = self.cluster.rank();
+        let t0 = Instant::now();
+        let size = |s: &Subdomain<D>| D::len(&s.contacts) * D::SPACE + (s.vel.len() + s.f_gamma.len()) * ndof;
+        self.send.clear();
+        for s in d.subs.iter().filter(|s| self.rank_of[s.id as usize] == me) {
+            for a in 0..D::len(&s.contacts) {
+                self.send.extend_from_slice(D::r(&s.contacts, a));
+            }
+            for v in s.vel.iter().chain(&s.f_gamma) {
+                self.send.extend_from_slice(v.as_ref());
+            }
+        }
+        self.counts_by(d.subs.len(), |k| size(&d.subs[k]));
+        self.reduced(self.send.len());
+        self.cluster.all_gather(&self.send, &self.counts, &mut self.all);
+        let mut pos = 0;
+        for s in d.subs.iter_mut() {
+            if self.rank_of[s.id as usize] == me {
+                pos += size(s);
+                continue;
+            }
+            for a in 0..D::len(&s.contacts) {
+                D::r_mut(&mut s.contacts, a).copy_from_slice(&self.all[pos..pos + D::SPACE]);
+                pos += D::SPACE;
+            }
+            for v in s.vel.iter_mut().chain(s.f_gamma.iter_mut()) {
+                v.as_mut().copy_from_slice(&self.all[pos..pos + ndof]);
+                pos += ndof;
+            }
+        }
+        self.totals.reduce_seconds += t0.elapsed().as_secs_f64();
+    }
+}
+
+/// The NSCDD iteration of one step over the ranks (see the module docs): at most
+/// `max_stages` stages of `per` sweeps (relaxation `omega`) and one gluing, a check
+/// every `k` stages and at the last, `converged(sums, residual share)` deciding on
+/// every rank from the same merged numbers; then every subdomain's results on every
+/// rank. `remap`: choose the ranks of the subdomains again. Returns the stages run
+/// and this step's exchange counts.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn iterate<D: Family>(
+    st: &mut RankState<D::V>,
+    d: &mut Decomposition<D>,
+    scheme: Scheme,
+    (per, omega): (u32, f64),
+    max_stages: u32,
+    k: u32,
+    remap: bool,
+    mut converged: impl FnMut(&Sums, &GluePartial) -> bool,
+) -> (u32, TransportStats) {
+    let t0 = Instant::now();
+    let (me, ns) = (st.cluster.rank(), d.subs.len());
+    if remap || st.rank_of.len() != ns {
+        let loads: Vec<usize> = d.subs.iter().map(|s| D::len(&s.contacts)).collect();
+        st.rank_of = contiguous_ranks(&loads, st.cluster.size());
+    }
+    st.link.setup(&d.subs, &st.rank_of, me);
+    st.link.stats = TransportStats::default();
+    st.link.seconds = 0.0;
+    let mut own = Vec::new();
+    if d.iface.fresh.iter().any(|&f| f) {
+        st.glue(d, scheme, true, &mut own);
+    }
+    let mut stages = 0;
+    while stages < max_stages {
+        stages += 1;
+        let check = stages % k == 0 || stages == max_stages;
+        for s in d.subs.iter_mut().filter(|s| st.rank_of[s.id as usize] == me) {
+            s.sweeps(per, omega, check);
+        }
+        own.clear();
+        if !d.iface.is_empty() {
+            st.glue(d, scheme, false, &mut own);
+        }
+        if check {
+            let (sums, g) = st.check(d, &own);
+            if converged(&sums, &g) {
+                break;
+            }
+        }
+    }
+    st.share_results(d);
+    let t = &mut st.totals;
+    t.steps += 1;
+    t.sent.messages += st.link.stats.messages;
+    t.sent.values += st.link.stats.values;
+    t.rounds += st.link.rounds;
+    st.link.rounds_step = st.link.rounds;
+    st.link.rounds = 0;
+    t.exchange_seconds += st.link.seconds;
+    t.solve_seconds += t0.elapsed().as_secs_f64();
+    let peers: Vec<u32> = match scheme {
+        _ if st.link.rounds_step == 0 => Vec::new(),
+        Scheme::Decentralized => st.link.peers.clone(),
+        Scheme::Centralized if me == 0 => (1..st.cluster.size()).collect(),
+        Scheme::Centralized => vec![0],
+    };
+    for p in peers {
+        if let Err(i) = t.peers.binary_search(&p) {
+            t.peers.insert(i, p);
+        }
+    }
+    (stages, st.link.stats)
+}
+
+/// Every rank's totals, gathered on every rank (collective), as a JSON document:
+/// per rank its gluing messages and values sent, gluing rounds, peers (the ranks it
+/// sent gluing messages to), reduction messages and values, and seconds.
+pub fn totals_json(st: &mut RankState<impl Copy + Default + AsRef<[f64]> + AsMut<[f64]>>) -> String {
+    const H: usize = 10;
+    let p = st.cluster.size() as usize;
+    let t = &st.totals;
+    let mut mine = vec![
+        t.steps as f64,
+        t.sent.messages as f64,
+        t.sent.values as f64,
+        t.rounds as f64,
+        t.exchange_seconds,
+        t.reduce_seconds,
+        t.solve_seconds,
+        t.reduce.messages as f64,
+        t.reduce.values as f64,
+        t.peers.len() as f64,
+    ];
+    mine.extend(t.peers.iter().map(|&x| x as f64));
+    mine.resize(H + p, -1.0);
+    let counts = vec![H + p; p];
+    let mut all = Vec::new();
+    st.cluster.all_gather(&mine, &counts, &mut all);
+    let ranks: Vec<serde_json::Value> = all
+        .chunks_exact(H + p)
+        .enumerate()
+        .map(|(r, x)| {
+            let peers: Vec<u32> = x[H..H + x[H - 1] as usize].iter().map(|&v| v as u32).collect();
+            let subs: Vec<usize> = (0..st.rank_of.len()).filter(|&s| st.rank_of[s] == r as u32).collect();
+            serde_json::json!({
+                "rank": r,
+                "steps": x[0] as u64,
+                "messages": x[1] as u64,
+                "values": x[2] as u64,
+                "rounds": x[3] as u64,
+                "exchange_seconds": x[4],
+                "reduce_seconds": x[5],
+                "solve_seconds": x[6],
+                "reduce_messages": x[7] as u64,
+                "reduce_values": x[8] as u64,
+                "peers": peers,
+                "last_subdomains": subs,
+            })
+        })
+        .collect();
+    let mut s = serde_json::to_string_pretty(&serde_json::json!({ "ranks": p, "per_rank": ranks })).expect("plain data");
+    s.push('\n');
+    s
+}
