@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Installs what the tests need and runs every test (the README's test command).
 #   - Debian's libhdf5-dev (FCLIB problem files, cargo feature `hdf5`)
+#   - OpenMPI (libopenmpi-dev, openmpi-bin) and libclang-dev (rsmpi's bindings),
+#     cargo feature `mpi`: the MPI tests run `mpirun` with oversubscription
 # The default build (`cargo run`) needs none of it: no MPI, no Python, no HDF5.
-# MPI and the Python virtualenv of the deformable bodies join here when they land.
+# The Python virtualenv of the deformable bodies joins here when it lands.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if ! command -v cargo >/dev/null 2>&1; then
@@ -10,7 +12,7 @@ if ! command -v cargo >/dev/null 2>&1; then
   exit 1
 fi
 need=()
-for pkg in libhdf5-dev pkg-config; do
+for pkg in libhdf5-dev pkg-config libopenmpi-dev openmpi-bin libclang-dev; do
   dpkg -s "$pkg" >/dev/null 2>&1 || need+=("$pkg")
 done
 if [ ${#need[@]} -gt 0 ]; then
@@ -21,4 +23,6 @@ if [ ${#need[@]} -gt 0 ]; then
 fi
 # Physics tests run in release mode (heavy); everything else runs there too so that
 # the workspace is built once.
-cargo test --workspace --release --no-fail-fast --features nscdd-cli/hdf5,nscdd-tests/hdf5
+# OpenMPI refuses to run as root unless told; the MPI tests also set these.
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+cargo test --workspace --release --no-fail-fast --features nscdd-cli/hdf5,nscdd-tests/hdf5,nscdd-cli/mpi

@@ -283,7 +283,7 @@ fn main() -> ExitCode {
                         threads: threads.as_deref(),
                         restart: restart.as_deref(),
                     };
-                    return run3::run(s3, &out, quiet, flags, &ranks);
+                    return run3::run(s3, &scene, &out, quiet, flags, &ranks);
                 }
                 Ok(nscdd::scene::AnyScene::D2(s)) => Ok(s),
                 Err(e) => Err(e.to_string()),
@@ -298,7 +298,7 @@ fn main() -> ExitCode {
             });
             let digest = loaded.as_ref().map_err(Clone::clone).map(|s| {
                 let w = &s.world;
-                ranks::digest(&nscdd::output::final_json(w), (&s.decomposition, &w.time, &w.solver))
+                ranks::digest(&scene, &nscdd::output::final_json(w), (&s.decomposition, &w.time, &w.solver))
             });
             if let Err(code) = ranks.agree(digest, &out) {
                 return code;

@@ -70,7 +70,8 @@ impl Ranks {
         self.rank() == 0
     }
 
-    /// A cluster over the ranks (None without a launcher).
+    /// A cluster over the ranks (None without a launcher). Collective: every rank
+    /// calls it at the same point.
     pub fn cluster(&self) -> Option<Box<dyn Cluster>> {
         #[cfg(feature = "mpi")]
         if let Some(s) = &self.session {
@@ -112,20 +113,21 @@ impl Ranks {
     /// A run that stopped on this rank: with other ranks still stepping, prints the
     /// message with the rank and stops every rank (exit `code`).
     pub fn abort_others(&self, code: i32, msg: &str) -> ExitCode {
-        match self.cluster() {
-            Some(cl) if self.size() > 1 => {
-                eprintln!("rank {}: error: {msg}", self.rank());
-                cl.abort(code)
-            }
-            _ => ExitCode::from(code as u8),
+        #[cfg(feature = "mpi")]
+        if let Some(s) = self.session.as_ref().filter(|s| s.size() > 1) {
+            eprintln!("rank {}: error: {msg}", s.rank());
+            s.abort(code)
         }
+        eprintln!("error: {msg}");
+        ExitCode::from(code as u8)
     }
 }
 
-/// What every rank must agree on: the initial state (its saved form), the
-/// decomposition and the run's settings.
-pub fn digest(state: &str, settings: impl std::fmt::Debug) -> u64 {
+/// What every rank must agree on: the scene file's text, the initial state (its
+/// saved form: a restart changes it), the decomposition and the run's settings.
+pub fn digest(scene: &Path, state: &str, settings: impl std::fmt::Debug) -> u64 {
     let mut h = std::collections::hash_map::DefaultHasher::new();
+    std::fs::read(scene).unwrap_or_default().hash(&mut h);
     state.hash(&mut h);
     format!("{settings:?}").hash(&mut h);
     h.finish()

@@ -14,7 +14,7 @@ pub struct Flags<'a> {
 
 /// Runs a loaded 3D scene with the command line's decomposition flags (as one of
 /// `ranks`).
-pub fn run(mut s: nscdd::scene::load3::Scene3, out: &Path, quiet: bool, f: Flags<'_>, ranks: &Ranks) -> ExitCode {
+pub fn run(mut s: nscdd::scene::load3::Scene3, scene: &Path, out: &Path, quiet: bool, f: Flags<'_>, ranks: &Ranks) -> ExitCode {
     let movable = (0..s.world.bodies.len()).filter(|&b| s.world.bodies.movable(b)).count();
     let flags = crate::apply_decomposition_to(&mut s.decomposition, movable, true, f.subdomains, f.scheme, f.threads).and_then(|()| {
         match f.restart {
@@ -27,7 +27,7 @@ pub fn run(mut s: nscdd::scene::load3::Scene3, out: &Path, quiet: bool, f: Flags
     });
     let digest = flags.map(|()| {
         let w = &s.world;
-        crate::ranks::digest(&nscdd::output::out3::final_json3(w), (&s.decomposition, &w.time, &w.solver))
+        crate::ranks::digest(scene, &nscdd::output::out3::final_json3(w), (&s.decomposition, &w.time, &w.solver))
     });
     if let Err(code) = ranks.agree(digest, out) {
         return code;

@@ -422,3 +422,42 @@ fn repartitions_with_migrations_conserve_bodies_and_momentum() {
     assert!(kept > 0, "contacts persisted between repartitions ({kept})");
     assert!(worst < 1e-13, "momentum conserved to round-off: {worst:.3e}");
 }
+
+/// The multi-process driver ([`nscdd::dd::ranks`], what `mpirun` runs on each rank)
+/// in one process ([`nscdd::dd::Solo`]): its exchanges, gathers and ordered
+/// reductions give bitwise the threads' results, with both schemes and with
+/// repartitions (the MPI runs themselves: cli/tests/mpi.rs, feature `mpi`).
+#[test]
+fn the_rank_driver_in_one_process_gives_the_threads_result_bitwise() {
+    use nscdd::dd::{Scheme, Solo};
+    for scheme in [Scheme::Decentralized, Scheme::Centralized] {
+        let settings = DdSettings {
+            nx: 3,
+            ny: 2,
+            scheme,
+            threads: 2,
+            ..Default::default()
+        };
+        let mut a = load(PILE);
+        let mut b = load(PILE);
+        let mut na = Nscdd::new(settings.clone()).with_repartition_every(4);
+        let mut nb = Nscdd::new(settings)
+            .with_repartition_every(4)
+            .with_cluster(Box::new(Solo))
+            .expect("one rank fits 6 subdomains");
+        let (mut stages, mut iface) = (0, 0);
+        for k in 0..20 {
+            let ra = na.step(&mut a.world).unwrap();
+            let rb = nb.step(&mut b.world).unwrap();
+            assert_eq!((ra.stages, ra.solve.converged), (rb.stages, rb.solve.converged), "step {k}");
+            assert_eq!(ra.egluing.to_bits(), rb.egluing.to_bits(), "step {k}");
+            stages += ra.stages;
+            iface += ra.interface_bodies;
+        }
+        assert!(iface > 0, "the test has interface bodies");
+        assert_eq!(a.world.bodies.pos, b.world.bodies.pos, "{scheme:?}: positions");
+        assert_eq!(a.world.bodies.vel, b.world.bodies.vel, "{scheme:?}: velocities");
+        assert_eq!(a.world.contacts.r, b.world.contacts.r, "{scheme:?}: impulses");
+        println!("{scheme:?}: {stages} stages, {iface} interface bodies over 20 steps, bitwise equal");
+    }
+}

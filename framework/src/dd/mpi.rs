@@ -55,7 +55,14 @@ impl MpiSession {
         self.universe.world().size() as u32
     }
 
-    /// A cluster over all the ranks, on its own communicator.
+    /// Stops every rank now (`MPI_Abort` on the world communicator: needs no other
+    /// rank's cooperation).
+    pub fn abort(&self, code: i32) -> ! {
+        self.universe.world().abort(code)
+    }
+
+    /// A cluster over all the ranks, on its own communicator (collective: every rank
+    /// calls it).
     pub fn cluster(&self) -> Box<dyn Cluster> {
         Box::new(MpiCluster {
             comm: self.universe.world().duplicate(),

@@ -1,0 +1,428 @@
+//! `mpirun -n P nscdd run …` (cargo feature `mpi`, issue 5): the same `final.json`
+//! as the same decomposition in one process with threads, bitwise, in 2D and 3D and
+//! with both schemes; decentralized messages only between ranks sharing interface
+//! bodies (counted); failures of one rank end every rank promptly with its message.
+//!
+//! Needs OpenMPI's `mpirun` (Debian `openmpi-bin`; the README's test command
+//! installs it). Ranks beyond the cores run with `--oversubscribe`.
+#![cfg(feature = "mpi")]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+const BIN: &str = env!("CARGO_BIN_EXE_nscdd");
+
+/// No test may take longer: a failure must never hang the ranks.
+const LIMIT: Duration = Duration::from_secs(120);
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("nscdd-mpi-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("scratch dir");
+    d
+}
+
+/// Runs a command to its end or kills it after [`LIMIT`] (then fails the test).
+fn run_limited(mut c: Command) -> Output {
+    let t0 = Instant::now();
+    let mut child = c.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("start the command");
+    loop {
+        if child.try_wait().expect("wait").is_some() {
+            break;
+        }
+        if t0.elapsed() > LIMIT {
+            let _ = child.kill();
+            let o = child.wait_with_output().expect("output");
+            panic!(
+                "still running after {LIMIT:?} (a hang): {}",
+                String::from_utf8_lossy(&o.stderr)
+            );
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.wait_with_output().expect("output")
+}
+
+/// `mpirun` with the settings a root container needs; `apps` are the programs of an
+/// MPMD launch (`-n k nscdd ARGS` each), all run as one job.
+fn mpirun(apps: &[(u32, Vec<String>)]) -> Output {
+    let mut c = Command::new("mpirun");
+    c.env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .env("OMPI_MCA_rmaps_base_oversubscribe", "1")
+        // shared memory between the ranks of one machine, no network probing
+        .env("OMPI_MCA_btl", "self,vader")
+        .arg("--oversubscribe");
+    for (i, (n, args)) in apps.iter().enumerate() {
+        if i > 0 {
+            c.arg(":");
+        }
+        c.arg("-n").arg(n.to_string()).arg(BIN).args(args);
+    }
+    run_limited(c)
+}
+
+fn nscdd(args: &[String]) -> Output {
+    let mut c = Command::new(BIN);
+    c.args(args);
+    run_limited(c)
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+fn args(scene: &Path, out: &Path, extra: &[&str]) -> Vec<String> {
+    let mut v = vec![
+        "run".to_string(),
+        scene.display().to_string(),
+        "--out".into(),
+        out.display().to_string(),
+        "--quiet".into(),
+    ];
+    v.extend(extra.iter().map(|s| s.to_string()));
+    v
+}
+
+fn ok(o: &Output, what: &str) {
+    assert!(
+        o.status.success(),
+        "{what} failed ({:?}):\n{}\n{}",
+        o.status.code(),
+        text(&o.stdout),
+        text(&o.stderr)
+    );
+}
+
+/// 64 disks of a triangular lattice, 16 wide, on a floor between two walls: a pile
+/// wide enough for four strips whose interface bodies are shared by adjacent strips
+/// only.
+const PILE2D: &str = r#"
+[time]
+step = 1e-3
+steps = 15
+[solver]
+tolerance = 1e-5
+norm = "QM/16"
+max_sweeps = 3000
+check_every = 5
+[output]
+every = 5
+[[materials]]
+name = "m"
+density = 1000.0
+[[laws]]
+materials = ["m", "m"]
+friction = 0.3
+[[bodies]]
+shape = "wall"
+material = "m"
+position = [0.16, -0.005]
+length = 0.4
+thickness = 0.01
+fixed = true
+[[bodies]]
+shape = "wall"
+material = "m"
+position = [-0.005, 0.05]
+rotation = 1.5707963267948966
+length = 0.2
+thickness = 0.01
+fixed = true
+[[bodies]]
+shape = "wall"
+material = "m"
+position = [0.335, 0.05]
+rotation = 1.5707963267948966
+length = 0.2
+thickness = 0.01
+fixed = true
+[[generate]]
+kind = "triangular_lattice"
+material = "m"
+nx = 16
+ny = 4
+radius = 0.01
+origin = [0.01, 0.01]
+"#;
+
+/// A 5 × 5 × 3 lattice of spheres, jostled by a tilted gravity, settling on a floor
+/// plane between box walls.
+const PILE3D: &str = r#"
+dimension = 3
+gravity = [1.0, 0.5, -9.81]
+[time]
+step = 1e-3
+steps = 10
+[solver]
+tolerance = 1e-4
+norm = "QM/16"
+max_sweeps = 3000
+check_every = 5
+[output]
+every = 5
+[[materials]]
+name = "m"
+density = 2500.0
+[[laws]]
+materials = ["m", "m"]
+friction = 0.4
+[[bodies]]
+name = "floor"
+shape = "plane"
+material = "m"
+position = [0.0, 0.0, 0.0]
+fixed = true
+[[bodies]]
+shape = "box"
+material = "m"
+position = [0.101, 0.05, 0.05]
+half_extents = [0.001, 0.1, 0.1]
+fixed = true
+[[generate]]
+kind = "sphere_lattice"
+material = "m"
+nx = 5
+ny = 5
+nz = 3
+radius = 0.01
+origin = [0.01, 0.01, 0.01]
+"#;
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).expect("write scene");
+    p
+}
+
+fn final_json(out: &Path) -> String {
+    std::fs::read_to_string(out.join("final.json")).unwrap_or_else(|e| panic!("{}: {e}", out.display()))
+}
+
+/// The scene in one process with 2 threads, then on each rank count: final.json
+/// bitwise the same, history.csv with the same rows' physics.
+fn same_as_threads(scene: &Path, dir: &Path, subdomains: &str, scheme: &str, ranks: &[u32]) {
+    let one = dir.join(format!("threads-{subdomains}-{scheme}"));
+    let o = nscdd(&args(scene, &one, &["--subdomains", subdomains, "--scheme", scheme, "--threads", "2"]));
+    ok(&o, "the one-process run");
+    let reference = final_json(&one);
+    for &n in ranks {
+        let out = dir.join(format!("ranks{n}-{subdomains}-{scheme}"));
+        let o = mpirun(&[(n, args(scene, &out, &["--subdomains", subdomains, "--scheme", scheme]))]);
+        ok(&o, &format!("{n} ranks"));
+        let err = text(&o.stderr);
+        assert!(err.contains(&format!("on {n} ranks")), "rank 0's summary: {err}");
+        assert_eq!(
+            final_json(&out),
+            reference,
+            "{subdomains} {scheme}: final.json on {n} ranks differs from one process"
+        );
+        // the sweeps column (solver iterations) is the same step by step
+        let col = |p: &Path| -> Vec<String> {
+            let h = std::fs::read_to_string(p.join("history.csv")).expect("history.csv");
+            let mut lines = h.lines();
+            let head: Vec<&str> = lines.next().expect("header").split(',').collect();
+            let k = head.iter().position(|c| *c == "sweeps").expect("sweeps column");
+            lines.map(|l| l.split(',').nth(k).unwrap_or("").to_string()).collect()
+        };
+        assert_eq!(col(&out), col(&one), "sweeps per step on {n} ranks");
+        assert!(out.join("ranks.json").exists(), "ranks.json on {n} ranks");
+    }
+}
+
+#[test]
+fn two_and_four_ranks_give_the_one_process_result_2d() {
+    let dir = scratch("same2d");
+    let scene = write(&dir, "pile.toml", PILE2D);
+    same_as_threads(&scene, &dir, "2x2", "decentralized", &[2, 4]);
+    same_as_threads(&scene, &dir, "2x2", "centralized", &[2, 4]);
+    same_as_threads(&scene, &dir, "3x2", "decentralized", &[4]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn two_and_four_ranks_give_the_one_process_result_3d() {
+    let dir = scratch("same3d");
+    let scene = write(&dir, "pile3d.toml", PILE3D);
+    same_as_threads(&scene, &dir, "2x2x1", "decentralized", &[2, 4]);
+    same_as_threads(&scene, &dir, "2x2x2", "centralized", &[4]);
+    same_as_threads(&scene, &dir, "2x2x2", "decentralized", &[4]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+fn per_rank(out: &Path) -> Vec<serde_json::Value> {
+    let t = std::fs::read_to_string(out.join("ranks.json")).expect("ranks.json");
+    let v: serde_json::Value = serde_json::from_str(&t).expect("ranks.json is JSON");
+    v["per_rank"].as_array().expect("per_rank").clone()
+}
+
+fn peers(r: &serde_json::Value) -> Vec<u64> {
+    r["peers"].as_array().expect("peers").iter().map(|x| x.as_u64().unwrap()).collect()
+}
+
+/// Four strips on four ranks: rank r owns strip r (contiguous, balanced), and the
+/// decentralized exchange sends one message per round to each adjacent strip's rank
+/// and to no other; the centralized one only between rank 0 and each rank.
+#[test]
+fn decentralized_messages_go_only_to_ranks_sharing_interface_bodies() {
+    let dir = scratch("messages");
+    let scene = write(&dir, "pile.toml", PILE2D);
+    let out = dir.join("dec");
+    ok(
+        &mpirun(&[(4, args(&scene, &out, &["--subdomains", "4x1", "--scheme", "decentralized"]))]),
+        "4 ranks, 4x1",
+    );
+    let ranks = per_rank(&out);
+    assert_eq!(ranks.len(), 4);
+    let expected: [&[u64]; 4] = [&[1], &[0, 2], &[1, 3], &[2]];
+    for (r, want) in ranks.iter().zip(expected) {
+        println!("{r}");
+        assert_eq!(r["last_subdomains"].as_array().unwrap().len(), 1, "one strip per rank: {r}");
+        assert_eq!(peers(r), want, "rank {}: peers", r["rank"]);
+        let (m, rounds) = (r["messages"].as_u64().unwrap(), r["rounds"].as_u64().unwrap());
+        assert!(rounds > 0, "rank {} exchanged: {r}", r["rank"]);
+        assert_eq!(m, rounds * want.len() as u64, "one message per peer and round: {r}");
+    }
+    // all ranks glue in the same rounds (every stage of every step)
+    let rounds: Vec<u64> = ranks.iter().map(|r| r["rounds"].as_u64().unwrap()).collect();
+    assert!(rounds.iter().all(|&x| x == rounds[0]), "{rounds:?}");
+
+    let out = dir.join("cen");
+    ok(
+        &mpirun(&[(4, args(&scene, &out, &["--subdomains", "4x1", "--scheme", "centralized"]))]),
+        "4 ranks, 4x1, centralized",
+    );
+    let ranks = per_rank(&out);
+    for r in &ranks {
+        let (m, rounds) = (r["messages"].as_u64().unwrap(), r["rounds"].as_u64().unwrap());
+        if r["rank"] == 0 {
+            assert_eq!(peers(r), [1, 2, 3]);
+            assert_eq!(m, 3 * rounds, "the root scatters to every rank: {r}");
+        } else {
+            assert_eq!(peers(r), [0]);
+            assert_eq!(m, rounds, "one gather message per round: {r}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_rank_count_that_does_not_fit_the_decomposition_is_bad_input() {
+    let dir = scratch("fit");
+    let scene = write(&dir, "pile.toml", PILE2D);
+    let out = dir.join("out");
+    let o = mpirun(&[(4, args(&scene, &out, &["--subdomains", "2x1"]))]);
+    let err = text(&o.stderr);
+    println!("{err}");
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("4 ranks for 2 subdomains"), "{err}");
+    assert_eq!(err.matches("4 ranks for 2 subdomains").count(), 1, "rank 0 says it once: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    // no decomposition at all
+    let o = mpirun(&[(2, args(&scene, &out, &[]))]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("no decomposition"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Rank 1 reads a scene with an error (an MPMD launch: the ranks run different
+/// files): every rank stops with exit code 2 and rank 1's message names the file,
+/// line and key.
+#[test]
+fn a_bad_scene_on_one_rank_stops_every_rank() {
+    let dir = scratch("badscene");
+    let good = write(&dir, "good.toml", PILE2D);
+    let bad = write(&dir, "bad.toml", &PILE2D.replace("friction = 0.3", "friction = -0.3"));
+    let out = dir.join("out");
+    let t0 = Instant::now();
+    let o = mpirun(&[
+        (1, args(&good, &out, &["--subdomains", "2x1"])),
+        (1, args(&bad, &out, &["--subdomains", "2x1"])),
+    ]);
+    let err = text(&o.stderr);
+    println!("{err}");
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("rank 1:") && err.contains("bad.toml") && err.contains("friction"), "{err}");
+    assert!(t0.elapsed() < Duration::from_secs(60), "promptly");
+    assert!(!out.join("final.json").exists());
+    // two valid but different scenes: the ranks disagree
+    let other = write(&dir, "other.toml", &PILE2D.replace("friction = 0.3", "friction = 0.5"));
+    let o = mpirun(&[
+        (1, args(&good, &out, &["--subdomains", "2x1"])),
+        (1, args(&other, &out, &["--subdomains", "2x1"])),
+    ]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("different scenes"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Rank 0 cannot create its output directory while rank 1 steps on: every rank
+/// stops, promptly, with rank 0's message and a non-zero code.
+#[test]
+fn an_unwritable_output_on_rank_0_stops_every_rank() {
+    let dir = scratch("unwritable");
+    let scene = write(&dir, "pile.toml", &PILE2D.replace("steps = 15", "steps = 100000"));
+    let blocker = dir.join("file");
+    std::fs::write(&blocker, "a file, not a directory").unwrap();
+    let out = blocker.join("out");
+    let t0 = Instant::now();
+    let o = mpirun(&[(2, args(&scene, &out, &["--subdomains", "2x1"]))]);
+    let err = text(&o.stderr);
+    println!("{err}");
+    assert!(!o.status.success(), "{err}");
+    assert!(err.contains("rank 0: error: cannot write the output directory"), "{err}");
+    assert!(t0.elapsed() < Duration::from_secs(60), "promptly, not after 100000 steps");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A body that diverges: every rank stops at that step (exit code 1), rank 0 names
+/// the step and the body and keeps the history written so far.
+#[test]
+fn a_diverging_body_stops_every_rank_and_keeps_the_outputs() {
+    let dir = scratch("diverge");
+    let scene = write(
+        &dir,
+        "diverge.toml",
+        r#"[time]
+step = 1e-3
+steps = 20
+[[materials]]
+name = "grain"
+density = 1e-3
+[[laws]]
+materials = ["grain", "grain"]
+friction = 0.3
+[[bodies]]
+shape = "halfplane"
+material = "grain"
+position = [0.0, 0.0]
+fixed = true
+[[bodies]]
+name = "rocket"
+shape = "disk"
+material = "grain"
+position = [0.0, 0.001]
+radius = 1e-3
+drive.x = { force = { table = [[0.0, 0.0], [0.005, 0.0], [0.0051, 1e308]] } }
+[[bodies]]
+name = "bystander"
+shape = "disk"
+material = "grain"
+position = [0.1, 0.001]
+radius = 1e-3
+"#,
+    );
+    let out = dir.join("out");
+    let o = mpirun(&[(2, args(&scene, &out, &["--subdomains", "2x1"]))]);
+    let err = text(&o.stderr);
+    println!("{err}");
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("step 6") && err.contains("rocket"), "{err}");
+    assert_eq!(err.matches("rocket").count(), 1, "rank 0 reports it once: {err}");
+    let hist = std::fs::read_to_string(out.join("history.csv")).expect("history.csv kept");
+    assert_eq!(hist.lines().count(), 1 + 5, "{hist}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
