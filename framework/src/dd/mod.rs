@@ -362,7 +362,9 @@ impl<D: Family> NscddOf<D> {
             self.grid = Some(grid);
             self.grid_empty = nc == 0;
         }
-        self.last = partition::decompose_owned::<D>(w, &self.v_free, grid, owner, &self.store);
+        // several processes: each builds only the subdomains of its rank
+        let build = self.ranks.as_mut().map(|rs| rs.assign(&owner, grid.len(), repart));
+        self.last = partition::decompose_owned::<D>(w, &self.v_free, grid, owner, &self.store, build.as_deref());
         rep.repartitioned = repart;
         if let Some(before) = before {
             let after = partition::body_sets(&self.last, nb);
@@ -425,8 +427,7 @@ impl<D: Family> NscddOf<D> {
             rep.solve.converged
         };
         let stages = if let Some(rs) = self.ranks.as_mut() {
-            let remap = rep.repartitioned;
-            let (stages, stats) = ranks::iterate(rs, d, set.scheme, (per, sv.relaxation), max_stages, k, remap, |s, g| converged(s, g, rep));
+            let (stages, stats) = ranks::iterate(rs, d, set.scheme, (per, sv.relaxation), max_stages, k, |s, g| converged(s, g, rep));
             rep.exchange = stats;
             stages
         } else {

@@ -199,13 +199,18 @@ pub fn body_sets<D: Family>(d: &Decomposition<D>, nb: usize) -> Vec<Vec<u32>> {
 /// Splits the contact set of `w` over the subdomains given by `owner` (one per
 /// contact, each below `grid.len()`); copies start at V_free + M̂_E⁻¹(F_Γ + H_E r).
 /// The world's visiting order (empty: storage order) is restricted to each subdomain.
+/// With `build`, only the subdomains it marks get their copies' M̂_E⁻¹, W_αα and
+/// starting velocities (the others are swept by another process: their structure
+/// alone is kept, for the exchange of results).
 pub fn decompose_owned<D: Family>(
     w: &D::World,
     v_free: &[D::V],
     grid: Grid,
     owner: Vec<u32>,
     store: &FGammaStore<D::V>,
+    build: Option<&[bool]>,
 ) -> Decomposition<D> {
+    let built = |s: u32| build.is_none_or(|b| b[s as usize]);
     let c = D::contacts(w);
     let order = D::order(w);
     let ns = grid.len();
@@ -249,12 +254,14 @@ pub fn decompose_owned<D: Family>(
     // copies' M̂_E⁻¹ and W_αα; the visiting order restricted to each subdomain
     let mut local_of = vec![0u32; D::len(c)];
     for sub in subs.iter_mut() {
-        sub.inv_mass = sub
-            .body_global
-            .iter()
-            .map(|&g| D::scale_inv(D::inv_mass(w, g as usize), mult[g as usize] as f64))
-            .collect();
-        sub.copy_delassus();
+        if built(sub.id) {
+            sub.inv_mass = sub
+                .body_global
+                .iter()
+                .map(|&g| D::scale_inv(D::inv_mass(w, g as usize), mult[g as usize] as f64))
+                .collect();
+            sub.copy_delassus();
+        }
         for (la, &ga) in sub.contact_global.iter().enumerate() {
             local_of[ga as usize] = la as u32;
         }
@@ -337,7 +344,7 @@ pub fn decompose_owned<D: Family>(
             sub.chain_start.push(sub.chain.len() as u32);
         }
     }
-    for sub in subs.iter_mut() {
+    for sub in subs.iter_mut().filter(|s| built(s.id)) {
         sub.init_velocities(v_free);
     }
     Decomposition {

@@ -279,6 +279,21 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
         }
     }
 
+    /// The ranks of the `ns` subdomains of a step whose contacts go to `owner`:
+    /// chosen again (balanced by contact count) at a repartition, else kept. Returns
+    /// which subdomains are this rank's.
+    pub fn assign(&mut self, owner: &[u32], ns: usize, repartition: bool) -> Vec<bool> {
+        if repartition || self.rank_of.len() != ns {
+            let mut loads = vec![0usize; ns];
+            for &o in owner {
+                loads[o as usize] += 1;
+            }
+            self.rank_of = contiguous_ranks(&loads, self.cluster.size());
+        }
+        let me = self.cluster.rank();
+        self.rank_of.iter().map(|&r| r == me).collect()
+    }
+
     /// Per-rank counts of `per(subdomain)` values (subdomains of a rank are contiguous).
     fn counts_by(&mut self, ns: usize, per: impl Fn(usize) -> usize) {
         self.counts.clear();
@@ -465,7 +480,8 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
         let ndof = V::default().as_ref().len();
         let me = self.cluster.rank();
         let t0 = Instant::now();
-        let size = |s: &Subdomain<D>| D::len(&s.contacts) * D::SPACE + (s.vel.len() + s.f_gamma.len()) * ndof;
+        // copies of other ranks' subdomains were not given starting velocities
+        let size = |s: &Subdomain<D>| D::len(&s.contacts) * D::SPACE + (s.body_global.len() + s.f_gamma.len()) * ndof;
         self.send.clear();
         for s in d.subs.iter().filter(|s| self.rank_of[s.id as usize] == me) {
             for a in 0..D::len(&s.contacts) {
@@ -488,6 +504,7 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
                 D::r_mut(&mut s.contacts, a).copy_from_slice(&self.all[pos..pos + D::SPACE]);
                 pos += D::SPACE;
             }
+            s.vel.resize(s.body_global.len(), V::default());
             for v in s.vel.iter_mut().chain(s.f_gamma.iter_mut()) {
                 v.as_mut().copy_from_slice(&self.all[pos..pos + ndof]);
                 pos += ndof;
@@ -501,9 +518,8 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
 /// `max_stages` stages of `per` sweeps (relaxation `omega`) and one gluing, a check
 /// every `k` stages and at the last, `converged(sums, residual share)` deciding on
 /// every rank from the same merged numbers; then every subdomain's results on every
-/// rank. `remap`: choose the ranks of the subdomains again. Returns the stages run
-/// and this step's exchange counts.
-#[allow(clippy::too_many_arguments)]
+/// rank. The subdomains' ranks are those of [`RankState::assign`] at the partition.
+/// Returns the stages run and this step's exchange counts.
 pub(super) fn iterate<D: Family>(
     st: &mut RankState<D::V>,
     d: &mut Decomposition<D>,
@@ -511,15 +527,11 @@ pub(super) fn iterate<D: Family>(
     (per, omega): (u32, f64),
     max_stages: u32,
     k: u32,
-    remap: bool,
     mut converged: impl FnMut(&Sums, &GluePartial) -> bool,
 ) -> (u32, TransportStats) {
     let t0 = Instant::now();
-    let (me, ns) = (st.cluster.rank(), d.subs.len());
-    if remap || st.rank_of.len() != ns {
-        let loads: Vec<usize> = d.subs.iter().map(|s| D::len(&s.contacts)).collect();
-        st.rank_of = contiguous_ranks(&loads, st.cluster.size());
-    }
+    let me = st.cluster.rank();
+    assert_eq!(st.rank_of.len(), d.subs.len(), "subdomains assigned to ranks at the partition");
     st.link.setup(&d.subs, &st.rank_of, me);
     st.link.stats = TransportStats::default();
     st.link.seconds = 0.0;
