@@ -238,6 +238,9 @@ fn two_and_four_ranks_give_the_one_process_result_2d() {
     same_as_threads(&scene, &dir, "2x2", "decentralized", &[2, 4]);
     same_as_threads(&scene, &dir, "2x2", "centralized", &[2, 4]);
     same_as_threads(&scene, &dir, "3x2", "decentralized", &[4]);
+    // 3 strips on 2 ranks: not contiguous when a greedy assignment balances better
+    same_as_threads(&scene, &dir, "3x1", "decentralized", &[2]);
+    same_as_threads(&scene, &dir, "3x1", "centralized", &[2]);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

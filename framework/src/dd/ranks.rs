@@ -8,7 +8,9 @@
 //! ```text
 //! ranks:   a contiguous run of subdomain ids per rank, balanced by contact count
 //!          (ids follow the grid x-first, so a rank's subdomains are neighbors and
-//!          few ranks share interface bodies); chosen again at every repartition
+//!          few ranks share interface bodies), or a greedy assignment when that is
+//!          much better balanced ([`balanced_ranks`]); chosen again at every
+//!          repartition
 //! repeat {
 //!     own subdomains: `sweeps_per_gluing` NLGS sweeps
 //!     decentralized: one message to each rank that shares interface bodies with
@@ -66,6 +68,38 @@ pub fn contiguous_ranks(loads: &[usize], ranks: u32) -> Vec<u32> {
         }
     }
     out
+}
+
+/// Rank of each subdomain: the contiguous runs of [`contiguous_ranks`] (few peers)
+/// unless their largest load exceeds by more than 5 % that of a greedy assignment
+/// (largest subdomain first to the least loaded rank, ties to the smaller rank),
+/// which then wins: with few subdomains per rank, contiguous runs can be far from
+/// balanced (3 subdomains on 2 ranks), and a rank waits for the slowest at every
+/// gluing.
+pub fn balanced_ranks(loads: &[usize], ranks: u32) -> Vec<u32> {
+    let p = ranks.max(1) as usize;
+    let max_load = |of: &[u32]| {
+        let mut l = vec![0usize; p];
+        for (s, &r) in of.iter().enumerate() {
+            l[r as usize] += loads[s];
+        }
+        l.into_iter().max().unwrap_or(0)
+    };
+    let runs = contiguous_ranks(loads, ranks);
+    let mut by_load: Vec<usize> = (0..loads.len()).collect();
+    by_load.sort_by_key(|&s| (std::cmp::Reverse(loads[s]), s));
+    let (mut greedy, mut acc) = (vec![0u32; loads.len()], vec![0usize; p]);
+    for (k, &s) in by_load.iter().enumerate() {
+        // the first p subdomains go one to each rank, so that none is left empty
+        let r = if k < p { k } else { (0..p).min_by_key(|&r| (acc[r], r)).unwrap_or(0) };
+        acc[r] += loads[s];
+        greedy[s] = r as u32;
+    }
+    if max_load(&runs) as f64 > 1.05 * max_load(&greedy) as f64 {
+        greedy
+    } else {
+        runs
+    }
 }
 
 /// Buffers of the decentralized exchange between ranks, kept between steps.
@@ -288,19 +322,33 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
             for &o in owner {
                 loads[o as usize] += 1;
             }
-            self.rank_of = contiguous_ranks(&loads, self.cluster.size());
+            self.rank_of = balanced_ranks(&loads, self.cluster.size());
         }
         let me = self.cluster.rank();
         self.rank_of.iter().map(|&r| r == me).collect()
     }
 
-    /// Per-rank counts of `per(subdomain)` values (subdomains of a rank are contiguous).
-    fn counts_by(&mut self, ns: usize, per: impl Fn(usize) -> usize) {
+    /// Per-rank counts of `per(subdomain)` values, and where each subdomain's values
+    /// start in the gathered buffer (rank order, then subdomain order in a rank).
+    fn counts_by(&mut self, ns: usize, per: impl Fn(usize) -> usize) -> Vec<usize> {
         self.counts.clear();
         self.counts.resize(self.cluster.size() as usize, 0);
-        for s in 0..ns {
-            self.counts[self.rank_of[s] as usize] += per(s);
+        let mut at = vec![0usize; ns];
+        for (s, a) in at.iter_mut().enumerate() {
+            let r = self.rank_of[s] as usize;
+            *a = self.counts[r];
+            self.counts[r] += per(s);
         }
+        let mut start = 0;
+        let mut displ = vec![0usize; self.counts.len()];
+        for (d, &c) in displ.iter_mut().zip(&self.counts) {
+            *d = start;
+            start += c;
+        }
+        for (s, a) in at.iter_mut().enumerate() {
+            *a += displ[self.rank_of[s] as usize];
+        }
+        at
     }
 
     /// Records this rank's part of a gluing collective (centralized scheme).
@@ -329,25 +377,23 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
                 self.send.extend_from_slice(s.interface_velocity(q).as_ref());
             }
         }
-        self.counts_by(ns, |s| d.subs[s].iface.len() * ndof);
+        let at = self.counts_by(ns, |s| d.subs[s].iface.len() * ndof);
         if me != 0 {
             self.sent(1, self.send.len());
         }
         self.cluster.gather(&self.send, &self.counts, &mut self.all);
         if me == 0 {
-            // rank order is subdomain order: unpack per subdomain, solve, pack
+            // unpack per subdomain, solve, pack per rank
             self.per_sub.resize_with(ns, Vec::new);
             self.per_sub_out.resize_with(ns, Vec::new);
-            let mut pos = 0;
             for (s, v) in self.per_sub.iter_mut().enumerate() {
                 v.clear();
-                let n = d.subs[s].iface.len() * ndof;
+                let (pos, n) = (at[s], d.subs[s].iface.len() * ndof);
                 v.extend(self.all[pos..pos + n].chunks_exact(ndof).map(|c| {
                     let mut x = V::default();
                     x.as_mut().copy_from_slice(c);
                     x
                 }));
-                pos += n;
             }
             self.parts.clear();
             self.parts.resize(ns, GluePartial::default());
@@ -362,16 +408,18 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
                 &mut self.chain,
             );
             self.all.clear();
-            for s in 0..ns {
-                for v in &self.per_sub_out[s] {
-                    self.all.extend_from_slice(v.as_ref());
+            for r in 0..np {
+                for s in (0..ns).filter(|&s| self.rank_of[s] == r) {
+                    for v in &self.per_sub_out[s] {
+                        self.all.extend_from_slice(v.as_ref());
+                    }
+                    let p = &self.parts[s];
+                    self.all.extend([p.jump2, p.links as f64, p.v2, p.copies as f64]);
                 }
-                let p = &self.parts[s];
-                self.all.extend([p.jump2, p.links as f64, p.v2, p.copies as f64]);
             }
             self.sent(np as u64 - 1, self.all.len() - self.counts_scatter(d, ndof, 0));
         }
-        self.counts_by(ns, |s| d.subs[s].iface.len() * ndof + 4);
+        let _ = self.counts_by(ns, |s| d.subs[s].iface.len() * ndof + 4);
         let mut mine = std::mem::take(&mut self.send);
         self.cluster.scatter(&self.all, &self.counts, &mut mine);
         self.link.rounds += 1;
@@ -449,12 +497,14 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
                 p.copies as f64,
             ]);
         }
-        self.counts_by(d.subs.len(), |_| CHECK_VALUES);
+        let at = self.counts_by(d.subs.len(), |_| CHECK_VALUES);
         self.reduced(self.send.len());
         self.cluster.all_gather(&self.send, &self.counts, &mut self.all);
         self.totals.reduce_seconds += t0.elapsed().as_secs_f64();
         let (mut sums, mut g) = (Sums::default(), GluePartial::default());
-        for x in self.all.chunks_exact(CHECK_VALUES) {
+        // merged in subdomain order
+        for &a in &at {
+            let x = &self.all[a..a + CHECK_VALUES];
             sums.merge(&Sums {
                 sum_dvdv: x[0],
                 sum_wrwr: x[1],
@@ -491,15 +541,14 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
                 self.send.extend_from_slice(v.as_ref());
             }
         }
-        self.counts_by(d.subs.len(), |k| size(&d.subs[k]));
+        let at = self.counts_by(d.subs.len(), |k| size(&d.subs[k]));
         self.reduced(self.send.len());
         self.cluster.all_gather(&self.send, &self.counts, &mut self.all);
-        let mut pos = 0;
         for s in d.subs.iter_mut() {
             if self.rank_of[s.id as usize] == me {
-                pos += size(s);
                 continue;
             }
+            let mut pos = at[s.id as usize];
             for a in 0..D::len(&s.contacts) {
                 D::r_mut(&mut s.contacts, a).copy_from_slice(&self.all[pos..pos + D::SPACE]);
                 pos += D::SPACE;
@@ -630,4 +679,33 @@ pub fn totals_json(st: &mut RankState<impl Copy + Default + AsRef<[f64]> + AsMut
     let mut s = serde_json::to_string_pretty(&serde_json::json!({ "ranks": p, "per_rank": ranks })).expect("plain data");
     s.push('\n');
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn contiguous_runs_feed_every_rank_and_balance() {
+        assert_eq!(contiguous_ranks(&[5, 5, 5, 5], 2), [0, 0, 1, 1]);
+        assert_eq!(contiguous_ranks(&[5, 5, 5, 5], 4), [0, 1, 2, 3]);
+        assert_eq!(contiguous_ranks(&[0, 0, 0, 0], 3), [0, 1, 2, 2]);
+        assert_eq!(contiguous_ranks(&[100, 1, 1, 1], 2), [0, 1, 1, 1]);
+        // the last ranks still get one subdomain each
+        assert_eq!(contiguous_ranks(&[1, 1, 1, 100], 3), [0, 0, 1, 2]);
+    }
+
+    #[test]
+    fn a_much_better_balanced_greedy_assignment_wins() {
+        // runs: {0,1} 10, {2} 6 is within 5 % of the best: contiguous kept
+        assert_eq!(balanced_ranks(&[5, 5, 6, 4], 2), [0, 0, 1, 1]);
+        // runs give 12 + 4 = 16 against 10; greedy: {8, 2} and {6, 4} = 10 / 10
+        assert_eq!(contiguous_ranks(&[8, 6, 4, 2], 2), [0, 0, 1, 1]);
+        assert_eq!(balanced_ranks(&[8, 6, 4, 2], 2), [0, 1, 1, 0]);
+        // every rank gets a subdomain
+        let r = balanced_ranks(&[50, 1, 1, 1, 1], 4);
+        for k in 0..4 {
+            assert!(r.contains(&k), "{r:?}");
+        }
+    }
 }
