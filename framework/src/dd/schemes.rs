@@ -225,8 +225,8 @@ fn centralized<D: Family>(
     }
     b.packets.resize_with(b.packets.len().max(2 * ns), Vec::new);
     let (all, out) = b.packets.split_at_mut(ns);
-    for s in 0..ns {
-        t.recv(ROOT, s as u32, &mut all[s]);
+    for (s, a) in all.iter_mut().enumerate() {
+        t.recv(ROOT, s as u32, a);
     }
     let mut parts = vec![GluePartial::default(); ns];
     root_solve::<D>(all, out, &mut parts, iface, |s| (&subs[s].iface_ib, &subs[s].iface_k), only_fresh, &mut b.c);
