@@ -24,5 +24,6 @@ fi
 # Physics tests run in release mode (heavy); everything else runs there too so that
 # the workspace is built once.
 # OpenMPI refuses to run as root unless told; the MPI tests also set these.
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+# Containers often forbid the cross-memory attach OpenMPI uses for large messages.
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_btl_vader_single_copy_mechanism=none
 cargo test --workspace --release --no-fail-fast --features nscdd-cli/hdf5,nscdd-tests/hdf5,nscdd-cli/mpi

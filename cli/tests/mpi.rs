@@ -53,6 +53,8 @@ fn mpirun(apps: &[(u32, Vec<String>)]) -> Output {
         .env("OMPI_MCA_rmaps_base_oversubscribe", "1")
         // shared memory between the ranks of one machine, no network probing
         .env("OMPI_MCA_btl", "self,vader")
+        // containers often forbid the cross-memory attach of large messages
+        .env("OMPI_MCA_btl_vader_single_copy_mechanism", "none")
         .arg("--oversubscribe");
     for (i, (n, args)) in apps.iter().enumerate() {
         if i > 0 {
