@@ -303,10 +303,14 @@ fn main() -> ExitCode {
             if let Err(code) = ranks.agree(digest, &out) {
                 return code;
             }
-            let Ok(mut s) = loaded else { unreachable!("agreed on a loaded scene") };
+            let Ok(mut s) = loaded else {
+                unreachable!("agreed on a loaded scene")
+            };
             let steps = s.world.time.steps;
             let bar = report::progress(quiet, steps, s.world.step);
-            let res = nscdd::run::run_on(&mut s, &reg, &out, ranks.cluster(), |w, rep| report::on_step(&bar, steps, w.step, rep));
+            let res = nscdd::run::run_on(&mut s, &reg, &out, ranks.cluster(), |w, rep| {
+                report::on_step(&bar, steps, w.step, rep)
+            });
             bar.finish_and_clear();
             let dd = |sum: &nscdd::run::RunSummary| match &s.decomposition {
                 Some(c) => format!(

@@ -102,7 +102,10 @@ impl Ranks {
         let (lo, hi) = cl.min_max(digest);
         if lo != hi {
             return Err(if self.root() {
-                crate::report::input_error_in(out, "the ranks read different scenes or options: every rank must run the same scene with the same flags")
+                crate::report::input_error_in(
+                    out,
+                    "the ranks read different scenes or options: every rank must run the same scene with the same flags",
+                )
             } else {
                 ExitCode::from(2)
             });

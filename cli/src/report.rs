@@ -84,13 +84,7 @@ pub fn finish_on(
     out: &Path,
 ) -> ExitCode {
     match &res {
-        Err(RunError::Ranks(m)) => {
-            return if ranks.root() {
-                input_error_in(out, m)
-            } else {
-                ExitCode::from(2)
-            }
-        }
+        Err(RunError::Ranks(m)) => return if ranks.root() { input_error_in(out, m) } else { ExitCode::from(2) },
         Err(RunError::Io(m)) if ranks.size() > 1 => {
             return ranks.abort_others(1, &format!("{m}; the outputs written so far are kept in {}", out.display()))
         }

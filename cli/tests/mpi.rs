@@ -34,10 +34,7 @@ fn run_limited(mut c: Command) -> Output {
         if t0.elapsed() > LIMIT {
             let _ = child.kill();
             let o = child.wait_with_output().expect("output");
-            panic!(
-                "still running after {LIMIT:?} (a hang): {}",
-                String::from_utf8_lossy(&o.stderr)
-            );
+            panic!("still running after {LIMIT:?} (a hang): {}", String::from_utf8_lossy(&o.stderr));
         }
         std::thread::sleep(Duration::from_millis(20));
     }
@@ -206,7 +203,11 @@ fn final_json(out: &Path) -> String {
 /// bitwise the same, history.csv with the same rows' physics.
 fn same_as_threads(scene: &Path, dir: &Path, subdomains: &str, scheme: &str, ranks: &[u32]) {
     let one = dir.join(format!("threads-{subdomains}-{scheme}"));
-    let o = nscdd(&args(scene, &one, &["--subdomains", subdomains, "--scheme", scheme, "--threads", "2"]));
+    let o = nscdd(&args(
+        scene,
+        &one,
+        &["--subdomains", subdomains, "--scheme", scheme, "--threads", "2"],
+    ));
     ok(&o, "the one-process run");
     let reference = final_json(&one);
     for &n in ranks {
@@ -349,7 +350,10 @@ fn a_bad_scene_on_one_rank_stops_every_rank() {
     let err = text(&o.stderr);
     println!("{err}");
     assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(err.contains("rank 1:") && err.contains("bad.toml") && err.contains("friction"), "{err}");
+    assert!(
+        err.contains("rank 1:") && err.contains("bad.toml") && err.contains("friction"),
+        "{err}"
+    );
     assert!(t0.elapsed() < Duration::from_secs(60), "promptly");
     assert!(!out.join("final.json").exists());
     // two valid but different scenes: the ranks disagree

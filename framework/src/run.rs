@@ -164,12 +164,7 @@ fn save_state(dir: &Path, name: &str, w: &World2) -> Result<(), RunError> {
 /// `dir`. `on_step` is called after every step (progress display). With
 /// `scene.decomposition` set, every step is an NSCDD step ([`Nscdd`]), history.csv
 /// gains the NSCDD columns and the VTK frames the subdomain arrays.
-pub fn run(
-    scene: &mut Scene,
-    registry: &Registry,
-    dir: &Path,
-    on_step: impl FnMut(&World2, &StepReport),
-) -> Result<RunSummary, RunError> {
+pub fn run(scene: &mut Scene, registry: &Registry, dir: &Path, on_step: impl FnMut(&World2, &StepReport)) -> Result<RunSummary, RunError> {
     run_on(scene, registry, dir, None, on_step)
 }
 

@@ -1,10 +1,10 @@
 //! Running a loaded 3D scene to its end and writing its outputs in a directory
 //! ([`crate::output::out3`]): the 3D counterpart of [`crate::run::run`].
 
+use crate::dd::Nscdd3;
 use crate::engine::StepReport;
 use crate::output::out3::{final_json3, write_vtk3, History3};
 use crate::output::vtk::VtkWriter;
-use crate::dd::Nscdd3;
 use crate::run::{dd_solver, history_sink, io, save_state_text, write_rank_totals, RunError, RunSummary};
 use crate::scene::load3::Scene3;
 use crate::world3::World3;

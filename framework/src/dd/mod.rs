@@ -54,12 +54,12 @@ pub mod team;
 pub mod transport;
 
 use crate::rigid2d::contacts::ContactKey;
+pub use cluster::{Cluster, Solo};
 pub use family::{Family, Rigid2, Rigid3};
 pub use partition::{Decomposition, FGammaStore, Grid, Interface};
+pub use ranks::RankState;
 pub use schemes::Scheme;
 pub use subdomain::{Subdomain, Subdomain2, Subdomain3, SubdomainSolver};
-pub use cluster::{Cluster, Solo};
-pub use ranks::RankState;
 pub use transport::{InProcess, Transport, TransportStats};
 
 use crate::engine::{ContactStage, Diverged, StageTimes};

@@ -91,7 +91,11 @@ pub fn balanced_ranks(loads: &[usize], ranks: u32) -> Vec<u32> {
     let (mut greedy, mut acc) = (vec![0u32; loads.len()], vec![0usize; p]);
     for (k, &s) in by_load.iter().enumerate() {
         // the first p subdomains go one to each rank, so that none is left empty
-        let r = if k < p { k } else { (0..p).min_by_key(|&r| (acc[r], r)).unwrap_or(0) };
+        let r = if k < p {
+            k
+        } else {
+            (0..p).min_by_key(|&r| (acc[r], r)).unwrap_or(0)
+        };
         acc[r] += loads[s];
         greedy[s] = r as u32;
     }
@@ -156,7 +160,8 @@ impl<V> RankLink<V> {
         self.rank_of.extend_from_slice(rank_of);
         self.peers.clear();
         for s in subs.iter().filter(|s| rank_of[s.id as usize] == me) {
-            self.peers.extend(s.neighbors.iter().map(|n| rank_of[n.sub as usize]).filter(|&r| r != me));
+            self.peers
+                .extend(s.neighbors.iter().map(|n| rank_of[n.sub as usize]).filter(|&r| r != me));
         }
         self.peers.sort_unstable();
         self.peers.dedup();

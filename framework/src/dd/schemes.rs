@@ -229,7 +229,15 @@ fn centralized<D: Family>(
         t.recv(ROOT, s as u32, a);
     }
     let mut parts = vec![GluePartial::default(); ns];
-    root_solve::<D>(all, out, &mut parts, iface, |s| (&subs[s].iface_ib, &subs[s].iface_k), only_fresh, &mut b.c);
+    root_solve::<D>(
+        all,
+        out,
+        &mut parts,
+        iface,
+        |s| (&subs[s].iface_ib, &subs[s].iface_k),
+        only_fresh,
+        &mut b.c,
+    );
     // scatter
     for (s, o) in out.iter().enumerate().take(ns) {
         t.send(ROOT, s as u32, o);
