@@ -136,7 +136,7 @@ pub(crate) fn dd_solver<D: crate::dd::Family>(
             _ => Ok(None),
         };
     };
-    let n = crate::dd::NscddOf::<D>::new(c.dd.clone()).with_repartition_every(c.repartition_every);
+    let n = c.solver_of::<D>();
     match cluster {
         Some(cl) => n.with_cluster(cl).map(Some).map_err(RunError::Ranks),
         None => Ok(Some(n)),

@@ -116,14 +116,19 @@ impl Default for DdConfig {
 }
 
 impl DdConfig {
+    /// The solver state for a run of the body family `D`.
+    pub fn solver_of<D: Family>(&self) -> NscddOf<D> {
+        NscddOf::new(self.dd.clone()).with_repartition_every(self.repartition_every)
+    }
+
     /// The solver state for a run.
     pub fn solver(&self) -> Nscdd {
-        Nscdd::new(self.dd.clone()).with_repartition_every(self.repartition_every)
+        self.solver_of()
     }
 
     /// The solver state for a 3D run.
     pub fn solver3(&self) -> Nscdd3 {
-        Nscdd3::new(self.dd.clone()).with_repartition_every(self.repartition_every)
+        self.solver_of()
     }
 
     /// Whether the sample can hold the grid: `nx × ny` may not exceed the number of

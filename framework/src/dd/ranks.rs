@@ -422,9 +422,12 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
                     self.all.extend([p.jump2, p.links as f64, p.v2, p.copies as f64]);
                 }
             }
-            self.sent(np as u64 - 1, self.all.len() - self.counts_scatter(d, ndof, 0));
         }
         let _ = self.counts_by(ns, |s| d.subs[s].iface.len() * ndof + 4);
+        if me == 0 {
+            // the root's scatter: everything but its own part
+            self.sent(np as u64 - 1, self.all.len() - self.counts[0]);
+        }
         let mut mine = std::mem::take(&mut self.send);
         self.cluster.scatter(&self.all, &self.counts, &mut mine);
         self.link.rounds += 1;
@@ -450,14 +453,6 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
             pos += 4;
         }
         self.send = mine;
-    }
-
-    /// Values of rank `r`'s part of the centralized scatter.
-    fn counts_scatter<D: Family<V = V>>(&self, d: &Decomposition<D>, ndof: usize, r: u32) -> usize {
-        (0..d.subs.len())
-            .filter(|&s| self.rank_of[s] == r)
-            .map(|s| d.subs[s].iface.len() * ndof + 4)
-            .sum()
     }
 
     /// One gluing stage over the own subdomains; their residual shares in `own`.
