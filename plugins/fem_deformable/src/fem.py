@@ -1,0 +1,99 @@
+"""Finite-element assembly for nscdd's deformable bodies (called from Rust).
+
+Meshes: linear triangles (2D) and linear tetrahedra (3D). Degrees of freedom are
+node-major (dof = dim * node + component), the order nscdd uses. Arrays go back to
+Rust as little-endian bytes (float64 / int64) so that no numpy binding is needed.
+"""
+import numpy as np
+import skfem
+from skfem import Basis, BilinearForm, ElementTetP1, ElementTriP1, ElementVector, MeshTet, MeshTri, asm
+from skfem.helpers import dot
+from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+
+def _mesh_out(points, cells):
+    points = np.ascontiguousarray(points, dtype="<f8")
+    cells = np.ascontiguousarray(cells, dtype="<i8")
+    return points.shape[1], points.tobytes(), cells.shape[1], cells.tobytes()
+
+
+def rectangle(x0, y0, lx, ly, nx, ny):
+    m = MeshTri.init_tensor(np.linspace(x0, x0 + lx, nx + 1), np.linspace(y0, y0 + ly, ny + 1))
+    return _mesh_out(m.p.T, m.t.T)
+
+
+def box(x0, y0, z0, lx, ly, lz, nx, ny, nz):
+    m = MeshTet.init_tensor(
+        np.linspace(x0, x0 + lx, nx + 1), np.linspace(y0, y0 + ly, ny + 1), np.linspace(z0, z0 + lz, nz + 1)
+    )
+    return _mesh_out(m.p.T, m.t.T)
+
+
+def disk(cx, cy, radius, refine):
+    m = MeshTri.init_circle(refine)
+    p = m.p * radius
+    p[0] += cx
+    p[1] += cy
+    return _mesh_out(p.T, m.t.T)
+
+
+def read(path, dim):
+    import meshio
+
+    m = meshio.read(path)
+    want = "triangle" if dim == 2 else "tetra"
+    blocks = [c.data for c in m.cells if c.type == want]
+    if not blocks:
+        kinds = sorted({c.type for c in m.cells})
+        raise ValueError(f"the mesh has no {want} cells (it has: {', '.join(kinds) or 'none'})")
+    cells = np.vstack(blocks)
+    used = np.unique(cells)
+    remap = -np.ones(len(m.points), dtype=np.int64)
+    remap[used] = np.arange(len(used))
+    pts = m.points[used, :dim]
+    return _mesh_out(pts, remap[cells])
+
+
+def _basis(points, cells):
+    dim = points.shape[1]
+    if dim == 2:
+        mesh, elem = MeshTri(points.T, cells.T), ElementTriP1()
+    else:
+        mesh, elem = MeshTet(points.T, cells.T), ElementTetP1()
+    return Basis(mesh, ElementVector(elem)), dim
+
+
+def _csr_out(a, perm):
+    a = a.tocsr()[perm][:, perm].tocsr()
+    a.sort_indices()
+    return (
+        np.ascontiguousarray(a.data, dtype="<f8").tobytes(),
+        np.ascontiguousarray(a.indices, dtype="<i8").tobytes(),
+        np.ascontiguousarray(a.indptr, dtype="<i8").tobytes(),
+    )
+
+
+def assemble(dim, points, cells, young, poisson, density, plane_stress):
+    """Consistent mass M (density rho) and stiffness K of linear elasticity.
+
+    2D: plane strain, or plane stress with lambda* = 2 lambda mu / (lambda + 2 mu).
+    Returns the CSR arrays of M and K in nscdd's node-major dof order.
+    """
+    points = np.frombuffer(points, dtype="<f8").reshape(-1, dim)
+    cells = np.frombuffer(cells, dtype="<i8").reshape(-1, dim + 1)
+    basis, dim = _basis(points, cells)
+    lam, mu = lame_parameters(young, poisson)
+    if dim == 2 and plane_stress:
+        lam = 2.0 * lam * mu / (lam + 2.0 * mu)
+    K = asm(linear_elasticity(lam, mu), basis)
+
+    @BilinearForm
+    def mass(u, v, w):
+        return density * dot(u, v)
+
+    M = asm(mass, basis)
+    # basis.nodal_dofs[c, i]: the dof of component c at node i
+    order = np.asarray(basis.nodal_dofs).T.reshape(-1)
+    perm = np.empty_like(order)
+    perm[np.arange(order.size)] = order
+    return _csr_out(M, perm), _csr_out(K, perm), skfem.__version__

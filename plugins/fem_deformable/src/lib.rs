@@ -1,0 +1,2 @@
+//! # Deformable bodies: linear elastic finite elements, coupled to rigid bodies
+pub mod python;
