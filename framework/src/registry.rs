@@ -108,6 +108,23 @@ pub trait ShapeStore2: Any + Send + Sync {
     fn is_grain(&self) -> bool {
         true
     }
+    /// Contact of shape `s` at a pose with a point `p` (a boundary node of a
+    /// deformable body): the signed distance from the surface (the gap), the unit
+    /// outward normal of the surface at the closest point, and that point. `None`:
+    /// this kind does not meet points (a scene that needs it is refused at load).
+    fn point_contact(&self, _s: u32, _pos: [f64; 2], _rot: f64, _p: [f64; 2]) -> Option<PointContact2> {
+        None
+    }
+}
+
+/// A point against a shape's surface ([`ShapeStore2::point_contact`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointContact2 {
+    pub gap: f64,
+    /// From the shape towards the point.
+    pub normal: [f64; 2],
+    /// Closest point of the surface.
+    pub point: [f64; 2],
 }
 
 /// A raw contact found by a narrow phase, before the law is applied.

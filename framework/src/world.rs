@@ -87,6 +87,11 @@ pub(crate) struct Scratch {
 }
 
 impl World2 {
+    /// V⁻, the velocities at the start of the step being computed (kept by the
+    /// free-velocity stage).
+    pub fn velocity_begin(&self) -> &[[f64; 3]] {
+        &self.scratch.v_begin
+    }
     pub fn law(&self, ma: u16, mb: u16) -> Option<ContactLaw> {
         self.laws[ma as usize * self.materials.len() + mb as usize]
     }

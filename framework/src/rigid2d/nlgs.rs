@@ -149,6 +149,17 @@ pub fn solve(c: &mut Contacts2, vel: &mut [[f64; 3]], inv_mass: &[[f64; 3]], ord
 /// Natural-map residual ‖F(r)‖/‖q‖ of the step's problem, with the normal velocity
 /// shifted by the law's target (u_n − ū) and q the shifted free velocity.
 pub fn residual(c: &Contacts2, vel: &[[f64; 3]]) -> f64 {
+    let (f2, q2) = residual_parts(c, vel);
+    if q2 == 0.0 {
+        f2.sqrt()
+    } else {
+        (f2 / q2).sqrt()
+    }
+}
+
+/// The squared sums (‖F(r)‖², ‖q‖²) of [`residual`], for problems that add other
+/// contacts to these.
+pub fn residual_parts(c: &Contacts2, vel: &[[f64; 3]]) -> (f64, f64) {
     let mut f2 = 0.0;
     let mut q2 = 0.0;
     for a in 0..c.len() {
@@ -159,9 +170,5 @@ pub fn residual(c: &Contacts2, vel: &[[f64; 3]]) -> f64 {
         let q = [c.u_free[a][0] - t.u_target, c.u_free[a][1]];
         q2 += q[0] * q[0] + q[1] * q[1];
     }
-    if q2 == 0.0 {
-        f2.sqrt()
-    } else {
-        (f2 / q2).sqrt()
-    }
+    (f2, q2)
 }

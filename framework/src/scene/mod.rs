@@ -55,9 +55,12 @@ pub fn load(path: &std::path::Path, registry: &Registry) -> Result<Scene, InputE
     load_str(&text, &file, registry)
 }
 
+#[derive(Clone, Copy)]
 pub(crate) struct Ctx<'a> {
     text: &'a str,
     file: &'a str,
+    /// The scene holds deformable bodies (loaded by a plugin).
+    deformable: bool,
 }
 
 impl Ctx<'_> {
@@ -274,8 +277,33 @@ pub fn load_any_str(text: &str, file: &str, registry: &Registry) -> Result<AnySc
 
 /// Loads a scene from its text; `file` names it in messages.
 pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, InputError> {
-    let cx = Ctx { text, file };
-    let sf: SceneFile = parse(text, file)?;
+    load_str_with(text, file, registry, false).map(|(s, _)| s)
+}
+
+/// The message for a scene with deformable bodies given to a program without them.
+pub const NO_DEFORMABLE: &str =
+    "deformable bodies need the fem_deformable plugin: build nscdd with `cargo build --release --features nscdd-cli/fem` (and Python's scikit-fem, see the README)";
+
+/// [`load_str`] that also returns the scene's `[[deformable]]` entries, for a
+/// deformable-body plugin to build; with `deformable = false` a scene holding any is
+/// refused ([`NO_DEFORMABLE`]).
+pub fn load_str_with(text: &str, file: &str, registry: &Registry, deformable: bool) -> Result<(Scene, Vec<toml::Table>), InputError> {
+    let mut sf: SceneFile = parse(text, file)?;
+    let cx = Ctx {
+        text,
+        file,
+        deformable: !sf.deformable.is_empty(),
+    };
+    if !deformable && cx.deformable {
+        return Err(cx.err(&[k("deformable")], NO_DEFORMABLE));
+    }
+    let entries = std::mem::take(&mut sf.deformable);
+    let scene = load_parsed(&cx, sf, registry)?;
+    Ok((scene, entries))
+}
+
+fn load_parsed(cx: &Ctx, sf: SceneFile, registry: &Registry) -> Result<Scene, InputError> {
+    let cx = *cx;
     if sf.dimension != 2 {
         return Err(cx.err(&[k("dimension")], format!("dimension {} is not supported: 2 or 3", sf.dimension)));
     }
@@ -416,6 +444,9 @@ pub fn parse_scheme(name: &str) -> Result<crate::dd::Scheme, String> {
 }
 
 pub(crate) fn decomposition(cx: &Ctx, d: &schema::DecompositionSpec, movable: usize) -> Result<crate::dd::DdConfig, InputError> {
+    if d.by_model == Some(true) && !cx.deformable {
+        return Err(cx.err(&[k("decomposition"), k("by_model")], "subdomains by model need deformable bodies in the scene"));
+    }
     let p = |key: &str| vec![k("decomposition"), k(key)];
     let int = |key: &str, v: Option<i64>, min: i64, def: i64| -> Result<i64, InputError> {
         let v = v.unwrap_or(def);

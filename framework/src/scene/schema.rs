@@ -50,6 +50,10 @@ pub struct SceneFile<B = BodySpec> {
     pub output: OutputSpec,
     /// NSCDD: split the contact set over nx × ny subdomains.
     pub decomposition: Option<DecompositionSpec>,
+    /// `[[deformable]]` bodies: read by a deformable-body plugin
+    /// ([`crate::scene::load_str_with`]); the plain loaders refuse them.
+    #[serde(default)]
+    pub deformable: Vec<toml::Table>,
 }
 
 /// `[decomposition]`: signed integers so that a negative value gets its own message.
@@ -60,6 +64,10 @@ pub struct DecompositionSpec {
     pub ny: Option<i64>,
     /// 3D only.
     pub nz: Option<i64>,
+    /// Scenes with deformable bodies: contacts touching deformable bodies form
+    /// subdomains of their own (split by the same grid), glued to the rigid ones
+    /// through the bodies they share (read by the deformable-body plugin).
+    pub by_model: Option<bool>,
     /// `decentralized` (default) or `centralized`.
     pub scheme: Option<String>,
     pub sweeps_per_gluing: Option<i64>,

@@ -1,2 +1,8 @@
 //! # Deformable bodies: linear elastic finite elements, coupled to rigid bodies
+pub mod body;
+pub mod contact2;
+pub mod coupled;
+pub mod mesh;
 pub mod python;
+pub mod scene;
+pub mod stage2;

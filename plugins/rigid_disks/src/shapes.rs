@@ -2,7 +2,7 @@
 //! LMGC90's JONCx) and half-planes.
 
 use nscdd::params::{number, only_keys, positive};
-use nscdd::registry::{Aabb2, Glyph2, MassProps2, ParamError, ShapeStore2};
+use nscdd::registry::{Aabb2, Glyph2, MassProps2, ParamError, PointContact2, ShapeStore2};
 use std::any::Any;
 use std::f64::consts::PI;
 
@@ -61,6 +61,25 @@ impl ShapeStore2 for Disks {
     fn describe(&self, s: u32) -> serde_json::Value {
         serde_json::json!({ "radius": self.radius[s as usize] })
     }
+    fn point_contact(&self, s: u32, x: [f64; 2], _rot: f64, p: [f64; 2]) -> Option<PointContact2> {
+        round_contact(x, self.radius[s as usize], p)
+    }
+}
+
+/// A point against a disk of radius `r` centred at `c` (also the rounded surface of
+/// a wall).
+fn round_contact(c: [f64; 2], r: f64, p: [f64; 2]) -> Option<PointContact2> {
+    let d = [p[0] - c[0], p[1] - c[1]];
+    let l = d[0].hypot(d[1]);
+    if l < 1e-14 * r.max(1e-300) {
+        return None; // the point sits at the centre: no defined normal
+    }
+    let n = [d[0] / l, d[1] / l];
+    Some(PointContact2 {
+        gap: l - r,
+        normal: n,
+        point: [c[0] + r * n[0], c[1] + r * n[1]],
+    })
 }
 
 /// Walls: a segment of `length` along the body's x axis (rotated by the body's
@@ -131,6 +150,13 @@ impl ShapeStore2 for Walls {
     }
     fn is_grain(&self) -> bool {
         false
+    }
+    /// The closest point of the centre segment, then as for a disk of radius T/2.
+    fn point_contact(&self, s: u32, x: [f64; 2], rot: f64, p: [f64; 2]) -> Option<PointContact2> {
+        let (a, b) = self.ends(s, x, rot);
+        let ab = [b[0] - a[0], b[1] - a[1]];
+        let t = (((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1]) / (ab[0] * ab[0] + ab[1] * ab[1])).clamp(0.0, 1.0);
+        round_contact([a[0] + t * ab[0], a[1] + t * ab[1]], 0.5 * self.thickness[s as usize], p)
     }
 }
 
@@ -219,5 +245,14 @@ impl ShapeStore2 for HalfPlanes {
     }
     fn is_grain(&self) -> bool {
         false
+    }
+    fn point_contact(&self, _s: u32, x: [f64; 2], rot: f64, p: [f64; 2]) -> Option<PointContact2> {
+        let n = Self::normal(rot);
+        let gap = (p[0] - x[0]) * n[0] + (p[1] - x[1]) * n[1];
+        Some(PointContact2 {
+            gap,
+            normal: n,
+            point: [p[0] - gap * n[0], p[1] - gap * n[1]],
+        })
     }
 }

@@ -1,0 +1,324 @@
+//! One linear elastic body: its mesh, M and K, the iteration matrix M̂ and its
+//! Cholesky factor, its state and the θ-method of DESIGN.md §2.
+//!
+//! With the Rayleigh damping C = α M + β K and the θ-weighted internal force
+//! −K(θ u⁺ + (1−θ) u⁻) − C(θ V⁺ + (1−θ) V⁻), where u⁺ = u⁻ + h((1−θ)V⁻ + θV⁺):
+//!
+//! ```text
+//! M̂ (V⁺ − V⁻) = h (F_ext − K (u⁻ + hθ V⁻) − C V⁻) + H r,   M̂ = M + hθ C + h²θ² K
+//! V_free = V⁻ + M̂⁻¹ h (F_ext − K (u⁻ + hθ V⁻) − C V⁻)
+//! u⁺ = u⁻ + h ((1 − θ) V⁻ + θ V⁺)
+//! ```
+//!
+//! θ = ½ conserves the energy ½ VᵀMV + ½ uᵀKu − u·F_ext of a free body; θ > ½
+//! dissipates it. M̂ is factored once (faer's supernodal Cholesky: the symbolic
+//! analysis once per body, a numeric refactorization only when h, θ or the
+//! material change). Degrees of freedom held fixed (Dirichlet, zero velocity) have
+//! their rows and columns of M̂ replaced by the identity and a zero right-hand side.
+//!
+//! Contacts need columns of M̂⁻¹ at their nodes (the Delassus blocks and the NLGS
+//! velocity updates): [`FeBody::column`] solves for the `dim` columns of a node on
+//! first use and caches them while M̂ is unchanged (see docs/DEFORMABLE.md for the
+//! choice and its cost).
+
+use crate::mesh::Mesh;
+use crate::python::Csr;
+use faer::prelude::*;
+use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+use faer::{Mat, Side};
+use std::collections::HashMap;
+
+/// Elastic material of a deformable body.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Elastic {
+    /// Young's modulus E (Pa).
+    pub young: f64,
+    /// Poisson's ratio ν.
+    pub poisson: f64,
+    /// Density ρ (kg/m³).
+    pub density: f64,
+    /// 2D: plane stress instead of plane strain.
+    pub plane_stress: bool,
+    /// Rayleigh damping C = α M + β K: [α (1/s), β (s)].
+    pub rayleigh: [f64; 2],
+}
+
+/// A deformable body (see the module docs).
+pub struct FeBody {
+    pub name: Option<String>,
+    pub mesh: Mesh,
+    pub elastic: Elastic,
+    /// Index of the body's material among the scene's materials (for the laws).
+    pub material: u16,
+    /// Pattern shared by M, K and M̂ (the union of M's and K's), CSC of a symmetric
+    /// matrix; values of M and K on it.
+    pattern: SymbolicSparseColMat<usize>,
+    m_val: Vec<f64>,
+    k_val: Vec<f64>,
+    symbolic: SymbolicLlt<usize>,
+    factor: Option<Llt<usize, f64>>,
+    /// (h, θ) the factor was computed for.
+    factored_for: (f64, f64),
+    /// Fixed degrees of freedom.
+    pub fixed: Vec<bool>,
+    /// Displacement u, velocity V (V⁻ at the start of a step, V⁺ after it),
+    /// V⁻ kept during a step, free velocity.
+    pub u: Vec<f64>,
+    pub v: Vec<f64>,
+    pub v_begin: Vec<f64>,
+    pub v_free: Vec<f64>,
+    /// External load per dof (gravity: M g).
+    pub f_ext: Vec<f64>,
+    /// Cached columns of M̂⁻¹, `dim` per node (node-major inside).
+    columns: HashMap<u32, Vec<f64>>,
+    /// Column solves done since the last refactorization (a measure).
+    pub solves: u64,
+    pub skfem_version: String,
+}
+
+impl FeBody {
+    /// Builds a body from its assembled M and K (same dof order as the mesh).
+    pub fn new(
+        name: Option<String>,
+        mesh: Mesh,
+        elastic: Elastic,
+        material: u16,
+        m: &Csr,
+        k: &Csr,
+        skfem_version: String,
+    ) -> Result<FeBody, String> {
+        let n = mesh.x0.len();
+        if m.n != n || k.n != n {
+            return Err(format!("assembled matrices of size {}, {} for {} dofs", m.n, k.n, n));
+        }
+        // union pattern, column by column (the matrices are symmetric: CSR = CSC)
+        let mut col_ptr = vec![0usize; n + 1];
+        let mut rows = Vec::with_capacity(m.indices.len().max(k.indices.len()));
+        let (mut mv, mut kv) = (Vec::new(), Vec::new());
+        for c in 0..n {
+            let (ma, mb) = (m.indptr[c], m.indptr[c + 1]);
+            let (ka, kb) = (k.indptr[c], k.indptr[c + 1]);
+            let (mut i, mut j) = (ma, ka);
+            while i < mb || j < kb {
+                let ri = if i < mb { m.indices[i] } else { usize::MAX };
+                let rj = if j < kb { k.indices[j] } else { usize::MAX };
+                let r = ri.min(rj);
+                rows.push(r);
+                mv.push(if ri == r { m.data[i] } else { 0.0 });
+                kv.push(if rj == r { k.data[j] } else { 0.0 });
+                if ri == r {
+                    i += 1;
+                }
+                if rj == r {
+                    j += 1;
+                }
+            }
+            col_ptr[c + 1] = rows.len();
+        }
+        let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows);
+        let symbolic = SymbolicLlt::try_new(pattern.as_ref(), Side::Lower).map_err(|e| format!("symbolic Cholesky failed: {e:?}"))?;
+        let mut f_ext = vec![0.0; n];
+        let _ = &mut f_ext;
+        Ok(FeBody {
+            name,
+            mesh,
+            elastic,
+            material,
+            pattern,
+            m_val: mv,
+            k_val: kv,
+            symbolic,
+            factor: None,
+            factored_for: (f64::NAN, f64::NAN),
+            fixed: vec![false; n],
+            u: vec![0.0; n],
+            v: vec![0.0; n],
+            v_begin: vec![0.0; n],
+            v_free: vec![0.0; n],
+            f_ext,
+            columns: HashMap::new(),
+            solves: 0,
+            skfem_version,
+        })
+    }
+
+    pub fn dim(&self) -> usize {
+        self.mesh.dim
+    }
+    pub fn n_dofs(&self) -> usize {
+        self.u.len()
+    }
+    /// Nonzeros of M̂ (both triangles).
+    pub fn nnz(&self) -> usize {
+        self.m_val.len()
+    }
+
+    /// y += a M x + b K x (M and K on the shared pattern).
+    pub fn mul_add(&self, a: f64, b: f64, x: &[f64], y: &mut [f64]) {
+        let cp = self.pattern.col_ptr();
+        let ri = self.pattern.row_idx();
+        for c in 0..self.n_dofs() {
+            let xc = x[c];
+            if xc == 0.0 {
+                continue;
+            }
+            for p in cp[c]..cp[c + 1] {
+                y[ri[p]] += (a * self.m_val[p] + b * self.k_val[p]) * xc;
+            }
+        }
+    }
+
+    /// Loads of gravity: F_ext = M g.
+    pub fn set_gravity(&mut self, g: &[f64]) {
+        let (d, n) = (self.dim(), self.n_dofs());
+        let gv: Vec<f64> = (0..n).map(|i| g[i % d]).collect();
+        let mut f = vec![0.0; n];
+        self.mul_add(1.0, 0.0, &gv, &mut f);
+        self.f_ext = f;
+    }
+
+    /// Holds the given nodes fixed (all their components).
+    pub fn fix_nodes(&mut self, nodes: &[u32]) {
+        let d = self.dim();
+        for &k in nodes {
+            for c in 0..d {
+                self.fixed[d * k as usize + c] = true;
+            }
+        }
+        self.factor = None;
+        self.columns.clear();
+    }
+
+    /// Factors M̂ = (1 + hθα) M + (h²θ² + hθβ) K if (h, θ) changed (the symbolic
+    /// analysis is reused). Returns whether a numeric factorization was done.
+    pub fn factorize(&mut self, h: f64, theta: f64) -> Result<bool, String> {
+        if self.factor.is_some() && self.factored_for == (h, theta) {
+            return Ok(false);
+        }
+        let [al, be] = self.elastic.rayleigh;
+        let (a, b) = (1.0 + h * theta * al, h * h * theta * theta + h * theta * be);
+        let cp = self.pattern.col_ptr();
+        let ri = self.pattern.row_idx();
+        let mut val = Vec::with_capacity(self.m_val.len());
+        for c in 0..self.n_dofs() {
+            for p in cp[c]..cp[c + 1] {
+                let r = ri[p];
+                val.push(if self.fixed[r] || self.fixed[c] {
+                    if r == c {
+                        1.0
+                    } else {
+                        0.0
+                    }
+                } else {
+                    a * self.m_val[p] + b * self.k_val[p]
+                });
+            }
+        }
+        let mat = SparseColMat::new(self.pattern.clone(), val);
+        let llt = Llt::try_new_with_symbolic(self.symbolic.clone(), mat.as_ref(), Side::Lower)
+            .map_err(|e| format!("M̂ = M + h²θ²K is not positive definite ({e:?}): check E, ν, ρ and the mesh"))?;
+        self.factor = Some(llt);
+        self.factored_for = (h, theta);
+        self.columns.clear();
+        self.solves = 0;
+        Ok(true)
+    }
+
+    /// x ← M̂⁻¹ x (fixed dofs get 0).
+    pub fn solve_in_place(&self, x: &mut [f64]) {
+        for (xi, &f) in x.iter_mut().zip(&self.fixed) {
+            if f {
+                *xi = 0.0;
+            }
+        }
+        let llt = self.factor.as_ref().expect("M̂ is factored before any solve");
+        let mut m = Mat::<f64>::from_fn(x.len(), 1, |r, _| x[r]);
+        llt.solve_in_place(m.as_mut());
+        for (r, xi) in x.iter_mut().enumerate() {
+            *xi = m[(r, 0)];
+        }
+    }
+
+    /// The free velocity V_free (module docs); keeps V⁻.
+    pub fn free_velocity(&mut self, h: f64, theta: f64) {
+        let n = self.n_dofs();
+        self.v_begin.clone_from(&self.v);
+        let [al, be] = self.elastic.rayleigh;
+        // rhs = h (F_ext − K (u + hθ V) − C V) = h F_ext − h (α M V) − h K (u + (hθ + β) V)
+        let mut w: Vec<f64> = (0..n).map(|i| self.u[i] + (h * theta + be) * self.v[i]).collect();
+        let mut rhs: Vec<f64> = self.f_ext.iter().map(|f| h * f).collect();
+        self.mul_add(0.0, -h, &w, &mut rhs);
+        if al != 0.0 {
+            self.mul_add(-h * al, 0.0, &self.v, &mut rhs);
+        }
+        self.solve_in_place(&mut rhs);
+        for i in 0..n {
+            w[i] = self.v[i] + rhs[i];
+        }
+        self.v_free = w;
+    }
+
+    /// The `dim` columns of M̂⁻¹ at `node` (component c of the node at
+    /// `[c * n_dofs ..]`), solved on first use and cached.
+    pub fn column(&mut self, node: u32) -> &[f64] {
+        if !self.columns.contains_key(&node) {
+            let (d, n) = (self.dim(), self.n_dofs());
+            let mut out = vec![0.0; d * n];
+            for c in 0..d {
+                let x = &mut out[c * n..(c + 1) * n];
+                x[d * node as usize + c] = 1.0;
+                self.solve_in_place(x);
+            }
+            self.solves += d as u64;
+            self.columns.insert(node, out);
+        }
+        &self.columns[&node]
+    }
+
+    /// Keeps the cached columns of `keep` only (memory bound between steps).
+    pub fn retain_columns(&mut self, keep: &[u32]) {
+        self.columns.retain(|k, _| keep.binary_search(k).is_ok());
+    }
+    pub fn cached_columns(&self) -> usize {
+        self.columns.len()
+    }
+
+    /// Current position of node k.
+    pub fn position(&self, k: usize) -> [f64; 3] {
+        let d = self.dim();
+        let mut p = [0.0; 3];
+        for c in 0..d {
+            p[c] = self.mesh.x0[d * k + c] + self.u[d * k + c];
+        }
+        p
+    }
+
+    /// ½ VᵀMV.
+    pub fn kinetic_energy(&self) -> f64 {
+        let mut mv = vec![0.0; self.n_dofs()];
+        self.mul_add(1.0, 0.0, &self.v, &mut mv);
+        0.5 * dot(&self.v, &mv)
+    }
+    /// ½ uᵀKu.
+    pub fn elastic_energy(&self) -> f64 {
+        let mut ku = vec![0.0; self.n_dofs()];
+        self.mul_add(0.0, 1.0, &self.u, &mut ku);
+        0.5 * dot(&self.u, &ku)
+    }
+    /// −u·F_ext (the potential of the constant external loads, gravity).
+    pub fn load_potential(&self) -> f64 {
+        -dot(&self.u, &self.f_ext)
+    }
+    /// Total mass (Σ of M's entries of one component).
+    pub fn mass(&self) -> f64 {
+        let ones: Vec<f64> = (0..self.n_dofs()).map(|i| if i % self.dim() == 0 { 1.0 } else { 0.0 }).collect();
+        let mut m1 = vec![0.0; self.n_dofs()];
+        self.mul_add(1.0, 0.0, &ones, &mut m1);
+        dot(&ones, &m1)
+    }
+}
+
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}

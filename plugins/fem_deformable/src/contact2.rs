@@ -1,0 +1,333 @@
+//! 2D contacts of deformable bodies: boundary nodes against rigid shapes
+//! (node-to-surface through [`nscdd::registry::ShapeStore2::point_contact`]) and
+//! against the boundary segments of other deformable bodies (node-to-segment).
+//!
+//! A contact α has a candidate side, always one boundary node of a deformable body
+//! (weight 1), and an antagonist side: a rigid body with its lever arm, or a point
+//! of a segment (nodes a, b with weights 1 − ξ, ξ) of another deformable body. The
+//! normal n points from the antagonist to the candidate, t = (−n_y, n_x); the local
+//! velocity is u = Fᵀ(Σ_k w_k v_k)_cand − (H_jᵀ V_j or Fᵀ Σ_k w_k v_k) with
+//! F = [n t]. Node-to-segment is one-sided: the nodes of the body of lower index
+//! against the segments of the other (give the finer mesh the lower index).
+//!
+//! The velocities of the nodes in contact are tracked through the dense block G of
+//! M̂⁻¹ among them ([`NodeSet`]): an impulse P at node k changes every contact node
+//! l of the same body by G_lk P. The Delassus block of α is
+//! W_αα = Σ_kl w_k w_l Fᵀ G_kl F (+ the rigid side's Hᵀ M̂⁻¹ H).
+
+use nscdd::rigid2d::contacts::{Block2, Target};
+use nscdd::world::World2;
+
+/// One side made of deformable-body nodes: body (index among the deformable
+/// bodies), indices of the nodes in that body's [`NodeSet`], weights.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FeSide {
+    pub body: u32,
+    pub k: [u32; 2],
+    pub w: [f64; 2],
+}
+
+/// The antagonist of a contact.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Anta {
+    /// A rigid body of the world and the lever arms (d × n, d × t).
+    Rigid { body: u32, arm: [f64; 2] },
+    Fe(FeSide),
+}
+
+/// Identity of a contact between steps (warm start): deformable body, node,
+/// antagonist (rigid body id, or `1 << 31 | deformable body`), feature (segment).
+pub type FeKey = (u32, u32, u32, u32);
+
+/// The contacts of deformable bodies of one step, one `Vec` per field.
+#[derive(Clone, Debug, Default)]
+pub struct FeContacts2 {
+    pub cand: Vec<FeSide>,
+    pub anta: Vec<Anta>,
+    pub n: Vec<[f64; 2]>,
+    pub block: Vec<Block2>,
+    pub target: Vec<Target>,
+    pub r: Vec<[f64; 2]>,
+    pub u_free: Vec<[f64; 2]>,
+    pub gap: Vec<f64>,
+    pub point: Vec<[f64; 2]>,
+    pub key: Vec<FeKey>,
+}
+
+impl FeContacts2 {
+    pub fn len(&self) -> usize {
+        self.cand.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.cand.is_empty()
+    }
+    pub fn clear(&mut self) {
+        self.cand.clear();
+        self.anta.clear();
+        self.n.clear();
+        self.block.clear();
+        self.target.clear();
+        self.r.clear();
+        self.u_free.clear();
+        self.gap.clear();
+        self.point.clear();
+        self.key.clear();
+    }
+    /// Appends contact `a` of `src` with its sides renamed.
+    pub fn push_from(&mut self, src: &FeContacts2, a: usize, cand: FeSide, anta: Anta) {
+        self.cand.push(cand);
+        self.anta.push(anta);
+        self.n.push(src.n[a]);
+        self.block.push(src.block[a]);
+        self.target.push(src.target[a]);
+        self.r.push(src.r[a]);
+        self.u_free.push(src.u_free[a]);
+        self.gap.push(src.gap[a]);
+        self.point.push(src.point[a]);
+        self.key.push(src.key[a]);
+    }
+}
+
+/// The nodes of one deformable body touched by this step's contacts: their
+/// current velocities and the dense block G of M̂⁻¹ among them (2×2 blocks,
+/// `g[(2k + c) * 2n + 2l + d]`), scaled by `scale` (the multiplicity of a copy).
+#[derive(Clone, Debug, Default)]
+pub struct NodeSet {
+    pub nodes: Vec<u32>,
+    pub v: Vec<[f64; 2]>,
+    pub g: Vec<f64>,
+}
+
+impl NodeSet {
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+    #[inline(always)]
+    pub fn block(&self, k: usize, l: usize) -> [f64; 4] {
+        let n2 = 2 * self.nodes.len();
+        let (r0, r1) = ((2 * k) * n2 + 2 * l, (2 * k + 1) * n2 + 2 * l);
+        [self.g[r0], self.g[r0 + 1], self.g[r1], self.g[r1 + 1]]
+    }
+    /// v_l += G_lk p for every node l of the set.
+    #[inline(always)]
+    pub fn apply(&mut self, k: usize, p: [f64; 2]) {
+        let n2 = 2 * self.nodes.len();
+        // G is symmetric: column k read as row k (contiguous)
+        let (row0, row1) = (&self.g[2 * k * n2..(2 * k + 1) * n2], &self.g[(2 * k + 1) * n2..(2 * k + 2) * n2]);
+        for (l, v) in self.v.iter_mut().enumerate() {
+            v[0] += row0[2 * l] * p[0] + row1[2 * l] * p[1];
+            v[1] += row0[2 * l + 1] * p[0] + row1[2 * l + 1] * p[1];
+        }
+    }
+    /// The velocity of a side: Σ w_k v_k.
+    #[inline(always)]
+    pub fn side_velocity(&self, s: &FeSide) -> [f64; 2] {
+        let (a, b) = (self.v[s.k[0] as usize], self.v[s.k[1] as usize]);
+        [s.w[0] * a[0] + s.w[1] * b[0], s.w[0] * a[1] + s.w[1] * b[1]]
+    }
+    /// Applies the impulse p (global frame) to a side.
+    #[inline(always)]
+    pub fn apply_side(&mut self, s: &FeSide, p: [f64; 2]) {
+        for q in 0..2 {
+            if s.w[q] != 0.0 {
+                self.apply(s.k[q] as usize, [s.w[q] * p[0], s.w[q] * p[1]]);
+            }
+        }
+    }
+    /// Fᵀ (Σ_kl w_k w_l G_kl) F for a side, as [W_nn, W_nt, W_tt].
+    pub fn delassus(&self, s: &FeSide, n: [f64; 2]) -> [f64; 3] {
+        let mut g = [0.0; 4];
+        for p in 0..2 {
+            for q in 0..2 {
+                let ww = s.w[p] * s.w[q];
+                if ww != 0.0 {
+                    let b = self.block(s.k[p] as usize, s.k[q] as usize);
+                    for i in 0..4 {
+                        g[i] += ww * b[i];
+                    }
+                }
+            }
+        }
+        let t = [-n[1], n[0]];
+        let q = |a: [f64; 2], b: [f64; 2]| a[0] * (g[0] * b[0] + g[1] * b[1]) + a[1] * (g[2] * b[0] + g[3] * b[1]);
+        [q(n, n), q(n, t), q(t, t)]
+    }
+}
+
+/// Local velocity (n, t) of a global vector.
+#[inline(always)]
+pub fn local(n: [f64; 2], v: [f64; 2]) -> [f64; 2] {
+    [n[0] * v[0] + n[1] * v[1], -n[1] * v[0] + n[0] * v[1]]
+}
+/// Global vector of local impulse components.
+#[inline(always)]
+pub fn global(n: [f64; 2], r: [f64; 2]) -> [f64; 2] {
+    [r[0] * n[0] - r[1] * n[1], r[0] * n[1] + r[1] * n[0]]
+}
+
+/// H_jᵀ V_j of a rigid antagonist.
+#[inline(always)]
+pub fn rigid_local(n: [f64; 2], arm: [f64; 2], v: [f64; 3]) -> [f64; 2] {
+    let l = local(n, [v[0], v[1]]);
+    [l[0] + arm[0] * v[2], l[1] + arm[1] * v[2]]
+}
+
+/// V_j −= M̂_j⁻¹ H_j Δr of a rigid antagonist.
+#[inline(always)]
+pub fn rigid_apply(n: [f64; 2], arm: [f64; 2], dr: [f64; 2], v: &mut [f64; 3], im: [f64; 3]) {
+    let p = global(n, dr);
+    v[0] -= im[0] * p[0];
+    v[1] -= im[1] * p[1];
+    v[2] -= im[2] * (arm[0] * dr[0] + arm[1] * dr[1]);
+}
+
+/// H_jᵀ M̂_j⁻¹ H_j of a rigid antagonist.
+pub fn rigid_delassus(n: [f64; 2], arm: [f64; 2], im: [f64; 3]) -> [f64; 3] {
+    let t = [-n[1], n[0]];
+    [
+        im[0] * n[0] * n[0] + im[1] * n[1] * n[1] + im[2] * arm[0] * arm[0],
+        im[0] * n[0] * t[0] + im[1] * n[1] * t[1] + im[2] * arm[0] * arm[1],
+        im[0] * t[0] * t[0] + im[1] * t[1] * t[1] + im[2] * arm[1] * arm[1],
+    ]
+}
+
+/// A contact found by detection, before the node sets exist.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RawFe {
+    pub body: u32,
+    pub node: u32,
+    /// Rigid body, or deformable body with segment nodes and ξ.
+    pub anta: RawAnta,
+    pub n: [f64; 2],
+    pub gap: f64,
+    pub point: [f64; 2],
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RawAnta {
+    Rigid(u32),
+    Segment { body: u32, seg: u32, a: u32, b: u32, xi: f64 },
+}
+
+/// Finds node contacts of every deformable body with the rigid bodies of `w`
+/// and with the segments of the other deformable bodies, within `alert`.
+pub fn detect(w: &World2, fe: &[crate::body::FeBody], alert: f64, out: &mut Vec<RawFe>) {
+    out.clear();
+    let boxes: Vec<[f64; 4]> = fe.iter().map(|b| bounds(b)).collect();
+    for (fb, body) in fe.iter().enumerate() {
+        let bb = boxes[fb];
+        for rb in 0..w.bodies.len() {
+            let s = w.bodies.shape[rb];
+            let store = &w.shapes[s.kind as usize];
+            let (x, rot) = (w.bodies.pos[rb], w.bodies.rot[rb]);
+            let a = store.aabb(s.index, x, rot);
+            if !(a.min[0] <= bb[2] + alert && bb[0] <= a.max[0] + alert && a.min[1] <= bb[3] + alert && bb[1] <= a.max[1] + alert) {
+                continue;
+            }
+            if w.law(body.material, w.bodies.material[rb]).is_none() {
+                continue;
+            }
+            for &k in &body.mesh.boundary {
+                let p = body.position(k as usize);
+                let p = [p[0], p[1]];
+                if p[0] < a.min[0] - alert || p[0] > a.max[0] + alert || p[1] < a.min[1] - alert || p[1] > a.max[1] + alert {
+                    continue;
+                }
+                if let Some(pc) = store.point_contact(s.index, x, rot, p) {
+                    if pc.gap <= alert {
+                        out.push(RawFe {
+                            body: fb as u32,
+                            node: k,
+                            anta: RawAnta::Rigid(rb as u32),
+                            n: pc.normal,
+                            gap: pc.gap,
+                            point: pc.point,
+                        });
+                    }
+                }
+            }
+        }
+        // node-to-segment against deformable bodies of higher index
+        for (ob, other) in fe.iter().enumerate().skip(fb + 1) {
+            let o = boxes[ob];
+            if !(o[0] <= bb[2] + alert && bb[0] <= o[2] + alert && o[1] <= bb[3] + alert && bb[1] <= o[3] + alert) {
+                continue;
+            }
+            if w.law(body.material, other.material).is_none() {
+                continue;
+            }
+            for &k in &body.mesh.boundary {
+                let p = body.position(k as usize);
+                let p = [p[0], p[1]];
+                if p[0] < o[0] - alert || p[0] > o[2] + alert || p[1] < o[1] - alert || p[1] > o[3] + alert {
+                    continue;
+                }
+                if let Some(mut c) = nearest_segment(other, p, alert) {
+                    if let RawAnta::Segment { body, .. } = &mut c.0 {
+                        *body = ob as u32;
+                    }
+                    out.push(RawFe {
+                        body: fb as u32,
+                        node: k,
+                        anta: c.0,
+                        n: c.1,
+                        gap: c.2,
+                        point: c.3,
+                    });
+                }
+            }
+        }
+    }
+}
+
+/// [xmin, ymin, xmax, ymax] of a body's current boundary.
+fn bounds(b: &crate::body::FeBody) -> [f64; 4] {
+    let mut bb = [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY];
+    for &k in &b.mesh.boundary {
+        let p = b.position(k as usize);
+        bb = [bb[0].min(p[0]), bb[1].min(p[1]), bb[2].max(p[0]), bb[3].max(p[1])];
+    }
+    bb
+}
+
+/// The boundary segment of `b` closest to p with p projecting inside it, within
+/// (−segment length, alert]: (antagonist, outward normal, gap, projected point).
+fn nearest_segment(b: &crate::body::FeBody, p: [f64; 2], alert: f64) -> Option<(RawAnta, [f64; 2], f64, [f64; 2])> {
+    let mut best: Option<(RawAnta, [f64; 2], f64, [f64; 2])> = None;
+    for s in 0..b.mesh.n_facets() {
+        let f = b.mesh.facet(s);
+        let (pa, pb) = (b.position(f[0] as usize), b.position(f[1] as usize));
+        let e = [pb[0] - pa[0], pb[1] - pa[1]];
+        let l2 = e[0] * e[0] + e[1] * e[1];
+        let xi = ((p[0] - pa[0]) * e[0] + (p[1] - pa[1]) * e[1]) / l2;
+        if !(0.0..=1.0).contains(&xi) {
+            continue;
+        }
+        let l = l2.sqrt();
+        // the body lies on the left of (a, b): outward normal (e_y, −e_x)/|e|
+        let n = [e[1] / l, -e[0] / l];
+        let q = [pa[0] + xi * e[0], pa[1] + xi * e[1]];
+        let gap = (p[0] - q[0]) * n[0] + (p[1] - q[1]) * n[1];
+        if gap > alert || gap < -l {
+            continue;
+        }
+        if best.is_none_or(|bst| gap.abs() < bst.2.abs()) {
+            best = Some((
+                RawAnta::Segment {
+                    body: 0,
+                    seg: s as u32,
+                    a: f[0],
+                    b: f[1],
+                    xi,
+                },
+                n,
+                gap,
+                q,
+            ));
+        }
+    }
+    best
+}

@@ -1,0 +1,259 @@
+//! `[[deformable]]` entries of a 2D scene file and the scene that holds them.
+//!
+//! ```toml
+//! [[deformable]]
+//! name = "foundation"            # optional
+//! material = "soil"              # a [[materials]] name: density ρ and the laws
+//! young = 1e7                    # E (Pa)
+//! poisson = 0.3                  # ν ∈ [0, 0.5)
+//! plane = "strain"               # or "stress" (2D)
+//! rayleigh = [0.0, 0.0]          # C = α M + β K (optional)
+//! velocity = [0.0, 0.0]          # initial, uniform (optional)
+//! fix = ["bottom"]               # hold the nodes of these sides of the mesh's box
+//! mesh = { rectangle = { origin = [0.0, 0.0], size = [1.0, 0.5], cells = [20, 10] } }
+//! # or  mesh = { disk = { centre = [0.0, 1.0], radius = 0.1, refine = 4 } }
+//! # or  mesh = { file = "block.msh" }       (anything meshio reads; relative to the scene)
+//! ```
+
+use crate::body::{Elastic, FeBody};
+use crate::mesh::Mesh;
+use crate::python;
+use crate::stage2::Deformables2;
+use nscdd::error::InputError;
+use nscdd::registry::Registry;
+use nscdd::scene::locate::{locate, path_string, Seg};
+use nscdd::scene::{OutputSettings, Scene};
+use nscdd::world::World2;
+use serde::Deserialize;
+use std::path::Path;
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct DeformableSpec {
+    pub name: Option<String>,
+    pub material: String,
+    pub young: f64,
+    pub poisson: f64,
+    #[serde(default = "strain")]
+    pub plane: String,
+    #[serde(default)]
+    pub rayleigh: [f64; 2],
+    #[serde(default)]
+    pub velocity: Vec<f64>,
+    #[serde(default)]
+    pub fix: Vec<String>,
+    pub mesh: MeshSpec,
+}
+fn strain() -> String {
+    "strain".into()
+}
+
+#[derive(Deserialize, Debug, Clone)]
+#[serde(deny_unknown_fields, rename_all = "lowercase")]
+pub enum MeshSpec {
+    Rectangle { origin: [f64; 2], size: [f64; 2], cells: [i64; 2] },
+    Disk { centre: [f64; 2], radius: f64, refine: i64 },
+    File(String),
+}
+
+/// A 2D scene with deformable bodies: the rigid world, the deformable stage and
+/// the subdomains by model when asked.
+pub struct FeScene2 {
+    pub world: World2,
+    pub fe: Deformables2,
+    pub output: OutputSettings,
+    /// `[decomposition] by_model = true`: the grid (nx, ny) and the settings.
+    pub by_model: Option<crate::coupled::ByModel>,
+}
+
+/// Loads a 2D scene file that may hold `[[deformable]]` entries.
+pub fn load(path: &Path, registry: &Registry) -> Result<FeScene2, InputError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| InputError {
+        file: file.clone(),
+        line: None,
+        key: String::new(),
+        message: format!("cannot read the file: {e}"),
+    })?;
+    load_str(&text, &file, path.parent().unwrap_or(Path::new(".")), registry)
+}
+
+fn err(text: &str, file: &str, path: &[Seg], message: impl Into<String>) -> InputError {
+    InputError {
+        file: file.to_string(),
+        line: locate(text, path).map(|o| nscdd::error::line_of(text, o)),
+        key: path_string(path),
+        message: message.into(),
+    }
+}
+
+/// [`load`] from the text; mesh files are looked up relative to `dir`.
+pub fn load_str(text: &str, file: &str, dir: &Path, registry: &Registry) -> Result<FeScene2, InputError> {
+    let (scene, entries) = nscdd::scene::load_str_with(text, file, registry, true)?;
+    let Scene {
+        world,
+        output,
+        decomposition,
+    } = scene;
+    let mut bodies = Vec::new();
+    for (i, e) in entries.into_iter().enumerate() {
+        let base = vec![Seg::Key("deformable".into()), Seg::Index(i)];
+        let at = |k: &str| {
+            let mut p = base.clone();
+            if !k.is_empty() {
+                p.push(Seg::Key(k.into()));
+            }
+            p
+        };
+        let spec: DeformableSpec = DeformableSpec::deserialize(toml::Value::Table(e)).map_err(|x| {
+            let msg = x.message().to_string();
+            // name the key serde complained about when it says which
+            let key = msg.split('`').nth(1).filter(|k| !k.contains(' ')).unwrap_or("");
+            err(text, file, &at(key), msg.clone())
+        })?;
+        bodies.push(build(&spec, &world, dir).map_err(|(k, m)| err(text, file, &at(k), m))?);
+    }
+    let alert = world.alert;
+    let mut fe = Deformables2::new(bodies, alert);
+    for b in &mut fe.bodies {
+        b.set_gravity(&world.gravity);
+        b.factorize(world.time.h, world.time.theta)
+            .map_err(|m| err(text, file, &[Seg::Key("deformable".into())], m))?;
+    }
+    let by_model = crate::coupled::ByModel::from_scene(text, decomposition.as_ref());
+    Ok(FeScene2 {
+        world,
+        fe,
+        output,
+        by_model,
+    })
+}
+
+/// Builds one deformable body of a spec; errors name the key.
+pub fn build(s: &DeformableSpec, w: &World2, dir: &Path) -> Result<FeBody, (&'static str, String)> {
+    let mat = w
+        .materials
+        .iter()
+        .position(|m| m.name == s.material)
+        .ok_or(("material", format!("unknown material `{}`", s.material)))?;
+    let density = w.materials[mat].density;
+    if !(s.young > 0.0 && s.young.is_finite()) {
+        return Err(("young", format!("must be > 0, got {}", s.young)));
+    }
+    if !(s.poisson >= 0.0 && s.poisson < 0.5) {
+        return Err(("poisson", format!("must lie in [0, 0.5), got {}", s.poisson)));
+    }
+    if !s.rayleigh.iter().all(|x| *x >= 0.0 && x.is_finite()) {
+        return Err(("rayleigh", "α and β must be ≥ 0".into()));
+    }
+    let plane_stress = match s.plane.as_str() {
+        "strain" => false,
+        "stress" => true,
+        o => return Err(("plane", format!("`{o}`: `strain` or `stress`"))),
+    };
+    let raw = match &s.mesh {
+        MeshSpec::Rectangle { origin, size, cells } => {
+            if !(size[0] > 0.0 && size[1] > 0.0) || cells.iter().any(|&c| c < 1) {
+                return Err(("mesh", "a rectangle needs a positive size and at least 1 cell per side".into()));
+            }
+            python::rectangle(*origin, *size, [cells[0] as usize, cells[1] as usize])
+        }
+        MeshSpec::Disk { centre, radius, refine } => {
+            if !(*radius > 0.0) || !(0..=8).contains(refine) {
+                return Err(("mesh", "a disk needs radius > 0 and refine in 0..=8".into()));
+            }
+            python::disk(*centre, *radius, *refine as usize)
+        }
+        MeshSpec::File(f) => {
+            let p = dir.join(f);
+            if !p.exists() {
+                return Err(("mesh", format!("mesh file {} not found", p.display())));
+            }
+            python::read(&p, 2)
+        }
+    }
+    .map_err(|e| ("mesh", e.0))?;
+    let mesh = Mesh::new(raw).map_err(|e| ("mesh", e.0))?;
+    let el = Elastic {
+        young: s.young,
+        poisson: s.poisson,
+        density,
+        plane_stress,
+        rayleigh: s.rayleigh,
+    };
+    let a = python::assemble(&crate::python::RawMesh { dim: 2, points: mesh.x0.clone(), cells: mesh.cells.clone() }, el.young, el.poisson, el.density, plane_stress)
+        .map_err(|e| ("mesh", e.0))?;
+    let mut body = FeBody::new(s.name.clone(), mesh, el, mat as u16, &a.m, &a.k, a.skfem_version).map_err(|m| ("mesh", m))?;
+    let fix: Vec<u32> = fixed_nodes(&body.mesh, &s.fix).map_err(|m| ("fix", m))?;
+    body.fix_nodes(&fix);
+    match s.velocity.as_slice() {
+        [] => {}
+        [vx, vy] => {
+            for k in 0..body.mesh.n_nodes() {
+                if !body.fixed[2 * k] {
+                    body.v[2 * k] = *vx;
+                    body.v[2 * k + 1] = *vy;
+                }
+            }
+        }
+        _ => return Err(("velocity", "2 numbers in 2D".into())),
+    }
+    Ok(body)
+}
+
+/// Nodes on the named sides (`bottom`, `top`, `left`, `right`) of the mesh's box.
+pub fn fixed_nodes(m: &Mesh, sides: &[String]) -> Result<Vec<u32>, String> {
+    let n = m.n_nodes();
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    for k in 0..n {
+        for d in 0..2 {
+            lo[d] = lo[d].min(m.x0[2 * k + d]);
+            hi[d] = hi[d].max(m.x0[2 * k + d]);
+        }
+    }
+    let tol = 1e-9 * (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    let mut out = vec![];
+    for s in sides {
+        let (d, v) = match s.as_str() {
+            "bottom" => (1, lo[1]),
+            "top" => (1, hi[1]),
+            "left" => (0, lo[0]),
+            "right" => (0, hi[0]),
+            o => return Err(format!("unknown side `{o}`: bottom, top, left or right")),
+        };
+        out.extend((0..n as u32).filter(|&k| (m.x0[2 * k as usize + d] - v).abs() <= tol));
+    }
+    out.sort_unstable();
+    out.dedup();
+    Ok(out)
+}
+
+impl FeScene2 {
+    /// One time step of the rigid bodies and the deformable bodies, contacts solved
+    /// in one domain or by model.
+    pub fn step(&mut self) -> Result<nscdd::engine::StepReport, nscdd::engine::Diverged> {
+        let rep = match self.by_model {
+            None => self.world.step_with(&mut self.fe)?,
+            Some(by) => {
+                let mut c = crate::coupled::Coupled {
+                    fe: &mut self.fe,
+                    by,
+                    subdomains: 0,
+                    interface_bodies: 0,
+                    egluing: 0.0,
+                };
+                self.world.step_with(&mut c)?
+            }
+        };
+        if let Some(e) = self.fe.error.take() {
+            return Err(nscdd::engine::Diverged {
+                step: self.world.step,
+                body: 0,
+                message: e,
+            });
+        }
+        self.fe.update(self.world.time.h, self.world.time.theta, self.world.step)?;
+        Ok(rep)
+    }
+}
