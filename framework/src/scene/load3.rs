@@ -28,7 +28,11 @@ pub struct Scene3 {
 
 /// Loads a 3D scene from its text; `file` names it in messages.
 pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene3, InputError> {
-    let cx = Ctx { text, file, deformable: false };
+    let cx = Ctx {
+        text,
+        file,
+        deformable: false,
+    };
     let sf: SceneFile<BodySpec3> = parse(text, file)?;
     if !sf.deformable.is_empty() {
         return Err(cx.err(&[k("deformable")], super::NO_DEFORMABLE));

@@ -445,7 +445,10 @@ pub fn parse_scheme(name: &str) -> Result<crate::dd::Scheme, String> {
 
 pub(crate) fn decomposition(cx: &Ctx, d: &schema::DecompositionSpec, movable: usize) -> Result<crate::dd::DdConfig, InputError> {
     if d.by_model == Some(true) && !cx.deformable {
-        return Err(cx.err(&[k("decomposition"), k("by_model")], "subdomains by model need deformable bodies in the scene"));
+        return Err(cx.err(
+            &[k("decomposition"), k("by_model")],
+            "subdomains by model need deformable bodies in the scene",
+        ));
     }
     let p = |key: &str| vec![k("decomposition"), k(key)];
     let int = |key: &str, v: Option<i64>, min: i64, def: i64| -> Result<i64, InputError> {

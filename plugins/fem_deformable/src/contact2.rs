@@ -31,7 +31,10 @@ pub struct FeSide {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Anta {
     /// A rigid body of the world and the lever arms (d × n, d × t).
-    Rigid { body: u32, arm: [f64; 2] },
+    Rigid {
+        body: u32,
+        arm: [f64; 2],
+    },
     Fe(FeSide),
 }
 

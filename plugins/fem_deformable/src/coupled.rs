@@ -116,7 +116,11 @@ impl ContactStage<World2> for Coupled<'_> {
             if check {
                 report.norms = Norms::from_sums(&sums, s.tolerance);
                 let eg = if links == 0 { 0.0 } else { jump2.sqrt() / links as f64 };
-                let scale = if sums.nactif > 0 { (sums.sum_wrwr / sums.nactif as f64).sqrt() } else { 0.0 };
+                let scale = if sums.nactif > 0 {
+                    (sums.sum_wrwr / sums.nactif as f64).sqrt()
+                } else {
+                    0.0
+                };
                 self.egluing = if scale > 0.0 { eg / scale } else { eg };
                 if report.norms.converged(s.norm) && self.egluing < s.tolerance {
                     report.converged = true;

@@ -50,7 +50,10 @@ impl Mesh {
             let c = &mut cells[e * nv..(e + 1) * nv];
             let v = signed_measure(dim, &points, c);
             if v.abs() < 1e-300 || !v.is_finite() {
-                return Err(MeshError(format!("cell {e} is degenerate (zero {})", if dim == 2 { "area" } else { "volume" })));
+                return Err(MeshError(format!(
+                    "cell {e} is degenerate (zero {})",
+                    if dim == 2 { "area" } else { "volume" }
+                )));
             }
             if v < 0.0 {
                 c.swap(0, 1);

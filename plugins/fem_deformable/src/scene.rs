@@ -181,8 +181,18 @@ pub fn build(s: &DeformableSpec, w: &World2, dir: &Path) -> Result<FeBody, (&'st
         plane_stress,
         rayleigh: s.rayleigh,
     };
-    let a = python::assemble(&crate::python::RawMesh { dim: 2, points: mesh.x0.clone(), cells: mesh.cells.clone() }, el.young, el.poisson, el.density, plane_stress)
-        .map_err(|e| ("mesh", e.0))?;
+    let a = python::assemble(
+        &crate::python::RawMesh {
+            dim: 2,
+            points: mesh.x0.clone(),
+            cells: mesh.cells.clone(),
+        },
+        el.young,
+        el.poisson,
+        el.density,
+        plane_stress,
+    )
+    .map_err(|e| ("mesh", e.0))?;
     let mut body = FeBody::new(s.name.clone(), mesh, el, mat as u16, &a.m, &a.k, a.skfem_version).map_err(|m| ("mesh", m))?;
     let fix: Vec<u32> = fixed_nodes(&body.mesh, &s.fix).map_err(|m| ("fix", m))?;
     body.fix_nodes(&fix);

@@ -109,7 +109,8 @@ impl Deformables2 {
         let t1 = Instant::now();
         let (h, theta) = (w.time.h, w.time.theta);
         self.prev.clear();
-        self.prev.extend(self.contacts.key.iter().copied().zip(self.contacts.r.iter().copied()));
+        self.prev
+            .extend(self.contacts.key.iter().copied().zip(self.contacts.r.iter().copied()));
         self.prev.sort_unstable_by_key(|x| x.0);
         let c = &mut self.contacts;
         c.clear();
@@ -118,7 +119,11 @@ impl Deformables2 {
             let bi = rc.body as usize;
             let set = &self.sets[bi];
             let k = set.nodes.binary_search(&rc.node).unwrap() as u32;
-            let cand = FeSide { body: rc.body, k: [k, k], w: [1.0, 0.0] };
+            let cand = FeSide {
+                body: rc.body,
+                k: [k, k],
+                w: [1.0, 0.0],
+            };
             let n = rc.n;
             let body = &self.bodies[bi];
             let vb_i = local(n, [body.v_begin[2 * rc.node as usize], body.v_begin[2 * rc.node as usize + 1]]);
@@ -147,7 +152,11 @@ impl Deformables2 {
                     let os = &self.sets[ob as usize];
                     let ka = os.nodes.binary_search(&a).unwrap() as u32;
                     let kb = os.nodes.binary_search(&b).unwrap() as u32;
-                    let side = FeSide { body: ob, k: [ka, kb], w: [1.0 - xi, xi] };
+                    let side = FeSide {
+                        body: ob,
+                        k: [ka, kb],
+                        w: [1.0 - xi, xi],
+                    };
                     let wo = os.delassus(&side, n);
                     for q in 0..3 {
                         wb[q] += wo[q];
@@ -198,7 +207,15 @@ impl Deformables2 {
         for a in 0..c.len() {
             let r = c.r[a];
             if r != [0.0, 0.0] {
-                apply(&mut self.sets, &mut w.bodies.vel, &w.bodies.inv_mass, c.cand[a], c.anta[a], c.n[a], r);
+                apply(
+                    &mut self.sets,
+                    &mut w.bodies.vel,
+                    &w.bodies.inv_mass,
+                    c.cand[a],
+                    c.anta[a],
+                    c.n[a],
+                    r,
+                );
             }
         }
         let solves1: u64 = self.bodies.iter().map(|b| b.solves).sum();
@@ -291,7 +308,11 @@ pub fn fill_set(set: &mut NodeSet, body: &mut FeBody, nodes: &[u32], scale: f64)
     set.nodes.clear();
     set.nodes.extend_from_slice(nodes);
     set.v.clear();
-    set.v.extend(nodes.iter().map(|&k| [body.v_free[2 * k as usize], body.v_free[2 * k as usize + 1]]));
+    set.v.extend(
+        nodes
+            .iter()
+            .map(|&k| [body.v_free[2 * k as usize], body.v_free[2 * k as usize + 1]]),
+    );
     set.g.clear();
     set.g.resize(4 * n * n, 0.0);
     for (l, &nl) in nodes.iter().enumerate() {
@@ -383,7 +404,14 @@ impl ContactStage<World2> for Deformables2 {
                 let sm = if check { Some(&mut sums) } else { None };
                 let sm = match sm {
                     Some(x) => {
-                        nlgs::sweep(&mut w.contacts, &mut w.bodies.vel, &w.bodies.inv_mass, &order, s.relaxation, Some(&mut *x));
+                        nlgs::sweep(
+                            &mut w.contacts,
+                            &mut w.bodies.vel,
+                            &w.bodies.inv_mass,
+                            &order,
+                            s.relaxation,
+                            Some(&mut *x),
+                        );
                         Some(x)
                     }
                     None => {
@@ -391,7 +419,14 @@ impl ContactStage<World2> for Deformables2 {
                         None
                     }
                 };
-                sweep(&mut self.contacts, &mut self.sets, &mut w.bodies.vel, &w.bodies.inv_mass, s.relaxation, sm);
+                sweep(
+                    &mut self.contacts,
+                    &mut self.sets,
+                    &mut w.bodies.vel,
+                    &w.bodies.inv_mass,
+                    s.relaxation,
+                    sm,
+                );
                 if check {
                     report.norms = Norms::from_sums(&sums, s.tolerance);
                     if report.norms.converged(s.norm) {
