@@ -92,7 +92,7 @@ fn self_weight_block_pressure_and_settlement_converge() {
     }
     println!("settlement errors {errs:?}, largest pressure deviations {devs:?}");
     assert!(
-        errs.windows(2).all(|e| e[1] < e[0]),
+        errs.windows(2).all(|e| e[1] < e[0] || e[1] < 1e-5), // down to the solver's level
         "settlement does not converge under refinement: {errs:?}"
     );
     assert!(
