@@ -112,15 +112,19 @@ impl ContactStage<World2> for Coupled<'_> {
                 stage2::sweep(&mut sd.fec, &mut sd.sets, &mut sd.vel, &sd.inv, s.relaxation, sm);
                 sums.merge(&part);
             }
-            let (jump2, links) = glue(&mut subs, &ifaces_r, &ifaces_f, w);
+            let (jump2, links, v2, copies) = glue(&mut subs, &ifaces_r, &ifaces_f, w);
             if check {
                 report.norms = Norms::from_sums(&sums, s.tolerance);
                 let eg = if links == 0 { 0.0 } else { jump2.sqrt() / links as f64 };
-                let scale = if sums.nactif > 0 {
+                // QuadWR, or the RMS velocity of the interface copies when the
+                // impulses vanish (as `nscdd::dd::gluing`)
+                let quad_wr = if sums.nactif > 0 {
                     (sums.sum_wrwr / sums.nactif as f64).sqrt()
                 } else {
                     0.0
                 };
+                let rms = if copies > 0 { (v2 / copies as f64).sqrt() } else { 0.0 };
+                let scale = if sums.sum_wrwr > nscdd::norms::VANISHING { quad_wr } else { rms };
                 self.egluing = if scale > 0.0 { eg / scale } else { eg };
                 if report.norms.converged(s.norm) && self.egluing < s.tolerance {
                     report.converged = true;
@@ -335,10 +339,10 @@ impl Coupled<'_> {
     }
 }
 
-/// The gluing of every interface body (module docs); returns (Σ|[V]|²/m, links)
-/// before the update.
-fn glue(subs: &mut [Sub], ifr: &[(u32, Iface)], iff: &[(u32, Iface)], w: &World2) -> (f64, u64) {
-    let (mut jump2, mut links) = (0.0, 0u64);
+/// The gluing of every interface body (module docs); returns (Σ|[V]|²/m, links,
+/// Σ|V_copy|², copies) before the update.
+fn glue(subs: &mut [Sub], ifr: &[(u32, Iface)], iff: &[(u32, Iface)], w: &World2) -> (f64, u64, f64, u64) {
+    let (mut jump2, mut links, mut v2, mut ncopies) = (0.0, 0u64, 0.0, 0u64);
     for (b, copies) in ifr {
         let m = copies.len() as f64;
         let mass = w.bodies.mass[*b as usize];
@@ -347,6 +351,8 @@ fn glue(subs: &mut [Sub], ifr: &[(u32, Iface)], iff: &[(u32, Iface)], w: &World2
         let mut prev: Option<[f64; 3]> = None;
         for &(e, l) in copies {
             let v = subs[e as usize].vel[l as usize];
+            v2 += v[0] * v[0] + v[1] * v[1] + rho2 * v[2] * v[2];
+            ncopies += 1;
             if let Some(p) = prev {
                 let d = [v[0] - p[0], v[1] - p[1], v[2] - p[2]];
                 jump2 += (d[0] * d[0] + d[1] * d[1] + rho2 * d[2] * d[2]) / m;
@@ -400,6 +406,8 @@ fn glue(subs: &mut [Sub], ifr: &[(u32, Iface)], iff: &[(u32, Iface)], w: &World2
             let sd = &mut subs[e as usize];
             let set = &mut sd.sets[l as usize];
             let v = set.v.clone();
+            v2 += v.iter().map(|a| a[0] * a[0] + a[1] * a[1]).sum::<f64>() / v.len().max(1) as f64;
+            ncopies += 1;
             if let Some(p) = &prev {
                 let nn = v.len().max(1) as f64;
                 let s: f64 = v.iter().zip(p).map(|(a, b)| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sum();
@@ -421,5 +429,5 @@ fn glue(subs: &mut [Sub], ifr: &[(u32, Iface)], iff: &[(u32, Iface)], w: &World2
         }
         let _ = b;
     }
-    (jump2, links)
+    (jump2, links, v2, ncopies)
 }

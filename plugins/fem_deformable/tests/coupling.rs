@@ -1,0 +1,177 @@
+//! Subdomains by model against one domain, and stability at the extremes.
+mod common;
+use common::*;
+
+/// Disks resting on a deformable foundation block (fixed at its base): two stacks
+/// of two disks; the lower disks touch the block (deformable contacts) and the
+/// upper disks (rigid contacts).
+fn foundation(decomposition: &str, tol: f64) -> String {
+    format!(
+        r#"
+[time]
+step = 1e-3
+theta = 0.5
+steps = 1
+[solver]
+tolerance = {tol}
+max_sweeps = 100000
+[detection]
+alert = 0.01
+[[materials]]
+name = "soil"
+density = 2000.0
+[[materials]]
+name = "stone"
+density = 2500.0
+[[laws]]
+materials = ["soil", "stone"]
+friction = 0.5
+[[laws]]
+materials = ["stone", "stone"]
+friction = 0.3
+[[bodies]]
+shape = "disk"
+material = "stone"
+radius = 0.1
+position = [0.3, 0.6]
+[[bodies]]
+shape = "disk"
+material = "stone"
+radius = 0.1
+position = [0.3, 0.8]
+[[bodies]]
+shape = "disk"
+material = "stone"
+radius = 0.1
+position = [1.7, 0.6]
+[[bodies]]
+shape = "disk"
+material = "stone"
+radius = 0.1
+position = [1.71, 0.8]
+[[deformable]]
+material = "soil"
+young = 1e6
+poisson = 0.3
+fix = ["bottom"]
+mesh = {{ rectangle = {{ origin = [0.0, 0.0], size = [2.0, 0.5], cells = [20, 5] }} }}
+{decomposition}
+"#
+    )
+}
+
+fn run(text: &str, steps: usize) -> (Vec<[f64; 2]>, Vec<f64>) {
+    let mut s = scene(text);
+    for _ in 0..steps {
+        let rep = s.step().unwrap();
+        assert!(rep.solve.converged, "{:?}", rep.solve);
+    }
+    (s.world.bodies.pos.clone(), s.fe.bodies[0].u.clone())
+}
+
+#[test]
+fn by_model_subdomains_agree_with_one_domain() {
+    let tol = 1e-8;
+    let (p0, u0) = run(&foundation("", tol), 60);
+    let umax = u0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    println!("one domain: disks {p0:?}, umax {umax:e}");
+    assert!(umax > 1e-5, "the block must deform: {umax}");
+    for dec in ["[decomposition]\nby_model = true", "[decomposition]\nby_model = true\nnx = 2"] {
+        let mut s = scene(&foundation(dec, tol));
+        let mut ifaces = 0;
+        for _ in 0..60 {
+            assert!(s.step().unwrap().solve.converged);
+            ifaces = ifaces.max(s.world.contacts.len());
+        }
+        let (p1, u1) = (s.world.bodies.pos.clone(), s.fe.bodies[0].u.clone());
+        let dp = p0
+            .iter()
+            .zip(&p1)
+            .map(|(a, b)| (a[0] - b[0]).hypot(a[1] - b[1]))
+            .fold(0.0, f64::max);
+        let du = u0.iter().zip(&u1).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        println!("{dec:?}: max |Δx| of disks {dp:.3e} m, of the block {du:.3e} m (largest displacement {umax:.3e} m)");
+        assert!(ifaces > 0);
+        assert!(
+            dp < 1e-3 * umax && du < 1e-3 * umax,
+            "by model differs from one domain: {dp:e}, {du:e}"
+        );
+    }
+}
+
+/// A block dropped on a floor, for the extremes: E, h, ν and θ.
+fn drop(young: f64, step: f64, nu: f64, theta: f64, max_sweeps: u32) -> (Vec<f64>, bool) {
+    let text = format!(
+        r#"
+[time]
+step = {step}
+theta = {theta}
+steps = 1
+[solver]
+tolerance = 1e-5
+max_sweeps = {max_sweeps}
+[detection]
+alert = 0.01
+[[materials]]
+name = "m"
+density = 1000.0
+[[materials]]
+name = "g"
+density = 1.0
+[[laws]]
+materials = ["m", "g"]
+friction = 0.3
+[[bodies]]
+shape = "halfplane"
+material = "g"
+position = [0.0, 0.0]
+fixed = true
+[[deformable]]
+material = "m"
+young = {young}
+poisson = {nu}
+velocity = [0.1, -0.5]
+mesh = {{ rectangle = {{ origin = [0.0, 0.001], size = [0.4, 0.2], cells = [8, 4] }} }}
+"#
+    );
+    let mut s = scene(&text);
+    let mut e = vec![fe_energy(&s)];
+    let mut all = true;
+    for _ in 0..40 {
+        let rep = s.step().unwrap();
+        all &= rep.solve.converged;
+        e.push(fe_energy(&s));
+    }
+    (e, all)
+}
+
+#[test]
+fn extremes_stay_finite_and_do_not_gain_energy() {
+    for young in [1e3, 1e6, 1e9, 1e12] {
+        for theta in [0.5, 0.75, 1.0] {
+            let (e, conv) = drop(young, 1e-3, 0.3, theta, 100000);
+            assert!(conv, "E {young} θ {theta}: unconverged");
+            assert!(e.iter().all(|x| x.is_finite()), "E {young}: non-finite energy");
+            let scale = e[0].abs().max(1e-12);
+            assert!(
+                e.iter().all(|&x| x <= e[0] + 1e-6 * scale),
+                "E {young} θ {theta}: energy grew {e:?}"
+            );
+        }
+    }
+    for step in [1e-6, 1e-4, 1e-2] {
+        let (e, conv) = drop(1e7, step, 0.49, 0.5, 100000);
+        assert!(conv, "h {step}: unconverged");
+        let scale = e[0].abs().max(1e-12);
+        assert!(
+            e.iter().all(|&x| x.is_finite() && x <= e[0] + 1e-6 * scale),
+            "h {step} ν 0.49: {e:?}"
+        );
+    }
+}
+
+#[test]
+fn non_convergence_is_reported() {
+    let (_, conv) = drop(1e7, 1e-2, 0.3, 0.5, 1);
+    assert!(!conv, "one sweep cannot meet 1e-5 with a block landing on its base");
+}
