@@ -4,7 +4,8 @@
 #   - OpenMPI (libopenmpi-dev, openmpi-bin) and libclang-dev (rsmpi's bindings),
 #     cargo feature `mpi`: the MPI tests run `mpirun` with oversubscription
 # The default build (`cargo run`) needs none of it: no MPI, no Python, no HDF5.
-# The Python virtualenv of the deformable bodies joins here when it lands.
+#   - a Python virtualenv ./venv with scikit-fem and meshio (deformable bodies, cargo
+#     feature `fem`); Debian's python3-venv and python3-dev if Python cannot make one
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if ! command -v cargo >/dev/null 2>&1; then
@@ -21,9 +22,22 @@ if [ ${#need[@]} -gt 0 ]; then
   $SUDO apt-get update -q
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q "${need[@]}"
 fi
+# Python 3 with venv and a shared libpython (pyenv's, or Debian's python3-dev)
+if ! python3 -c "import venv, ensurepip, sysconfig; assert sysconfig.get_config_var('Py_ENABLE_SHARED')" >/dev/null 2>&1; then
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  $SUDO apt-get update -q
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q python3 python3-venv python3-dev
+fi
+if ! venv/bin/python -c "import skfem, meshio" >/dev/null 2>&1; then
+  python3 -m venv venv
+  venv/bin/pip install -q scikit-fem meshio
+fi
+# pyo3 builds against the virtualenv's Python; at run time nscdd finds scikit-fem there
+export PYO3_PYTHON="$PWD/venv/bin/python" NSCDD_PYTHON_ENV="$PWD/venv"
 # Physics tests run in release mode (heavy); everything else runs there too so that
 # the workspace is built once.
 # OpenMPI refuses to run as root unless told; the MPI tests also set these.
 # Containers often forbid the cross-memory attach OpenMPI uses for large messages.
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_btl_vader_single_copy_mechanism=none
-cargo test --workspace --release --no-fail-fast --features nscdd-cli/hdf5,nscdd-tests/hdf5,nscdd-cli/mpi
+cargo test --workspace --release --no-fail-fast --features nscdd-cli/hdf5,nscdd-tests/hdf5,nscdd-cli/mpi,nscdd-cli/fem

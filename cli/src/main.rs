@@ -5,6 +5,8 @@
 
 mod bench;
 mod bench3;
+#[cfg(feature = "fem")]
+mod fem;
 mod ranks;
 mod report;
 mod run3;
@@ -228,6 +230,25 @@ fn main() -> ExitCode {
     };
     let mut reg = nscdd_rigid_disks::registry();
     reg.add_plugin(&nscdd_spheres::SpheresPlugin);
+    #[cfg(feature = "fem")]
+    match &cli.cmd {
+        Cmd::Check { scene } if fem::has_deformable(scene) => return fem::check(scene, &reg),
+        Cmd::Run {
+            scene,
+            out,
+            quiet,
+            subdomains,
+            restart,
+            ..
+        } if fem::has_deformable(scene) => {
+            let flag = subdomains
+                .as_ref()
+                .map(|_| "--subdomains")
+                .or(restart.as_ref().map(|_| "--restart"));
+            return fem::run(scene, out, *quiet, &reg, flag);
+        }
+        _ => {}
+    }
     match cli.cmd {
         Cmd::Check { scene } => match nscdd::scene::load_any(&scene, &reg) {
             Ok(nscdd::scene::AnyScene::D3(s)) => {

@@ -6,6 +6,8 @@ fn main() {
     if let Some(dir) = cfg.lib_dir() {
         println!("cargo:rustc-link-arg=-Wl,-rpath,{dir}");
         println!("cargo:rustc-env=NSCDD_PYTHON_LIBDIR={dir}");
+        // DEP_NSCDD_PYTHON_LIBDIR for the build scripts of dependents
+        println!("cargo:libdir={dir}");
     }
     println!("cargo:rerun-if-env-changed=PYO3_PYTHON");
     if let Ok(py) = std::env::var("PYO3_PYTHON") {

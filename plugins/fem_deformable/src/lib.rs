@@ -4,5 +4,6 @@ pub mod contact2;
 pub mod coupled;
 pub mod mesh;
 pub mod python;
+pub mod run;
 pub mod scene;
 pub mod stage2;

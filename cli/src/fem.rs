@@ -1,0 +1,85 @@
+//! `nscdd run` / `nscdd check` of scenes with `[[deformable]]` bodies (feature
+//! `fem`): loaded and run by the deformable plugin.
+
+use nscdd::registry::Registry;
+use std::path::Path;
+use std::process::ExitCode;
+
+/// Whether the scene file has a `[[deformable]]` entry (a cheap look; the
+/// loaders report any error).
+pub fn has_deformable(scene: &Path) -> bool {
+    std::fs::read_to_string(scene)
+        .ok()
+        .and_then(|t| toml::from_str::<toml::Table>(&t).ok())
+        .is_some_and(|t| t.get("deformable").and_then(|d| d.as_array()).is_some_and(|a| !a.is_empty()))
+}
+
+pub fn check(scene: &Path, reg: &Registry) -> ExitCode {
+    match nscdd_fem_deformable::scene::load(scene, reg) {
+        Ok(s) => {
+            let nodes: usize = s.fe.bodies.iter().map(|b| b.mesh.n_nodes()).sum();
+            println!(
+                "{}: ok — 2D, {} rigid bodies, {} deformable bodies ({} nodes), {} steps of {} s{}",
+                scene.display(),
+                s.world.bodies.len(),
+                s.fe.bodies.len(),
+                nodes,
+                s.world.time.steps,
+                s.world.time.h,
+                if s.by_model.is_some() { "; subdomains by model" } else { "" }
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+pub fn run(scene: &Path, out: &Path, quiet: bool, reg: &Registry, unsupported: Option<&str>) -> ExitCode {
+    if let Some(flag) = unsupported {
+        eprintln!("error: {flag} is not supported for scenes with deformable bodies (use [decomposition] by_model = true)");
+        return ExitCode::from(2);
+    }
+    let mut s = match nscdd_fem_deformable::scene::load(scene, reg) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let bar = (!quiet).then(|| indicatif::ProgressBar::new(s.world.time.steps));
+    let r = nscdd_fem_deformable::run::run(&mut s, out, |k, _| {
+        if let Some(b) = &bar {
+            b.set_position(k)
+        }
+    });
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    match r {
+        Ok(sum) => {
+            if !quiet {
+                println!(
+                    "{} steps in {:.2} s, {} sweeps; outputs in {}",
+                    sum.steps,
+                    sum.wall_seconds,
+                    sum.total_sweeps,
+                    out.display()
+                );
+            }
+            if sum.unconverged_steps > 0 {
+                eprintln!(
+                    "warning: the contact solver did not converge in {} of {} steps; see the `converged` column of history.csv",
+                    sum.unconverged_steps, sum.steps
+                );
+            }
+            ExitCode::SUCCESS
+        }
+        Err(m) => {
+            eprintln!("error: {m}");
+            ExitCode::from(1)
+        }
+    }
+}
