@@ -52,7 +52,12 @@ mesh = { rectangle = { origin = [0.0, 0.0], size = [2.0, 0.5], cells = [140, 70]
     let mut s = nscdd_fem_deformable::scene::load_str(text, "bench2d", std::path::Path::new("."), &reg).unwrap();
     let load = t0.elapsed().as_secs_f64();
     let b = &s.fe.bodies[0];
-    println!("nodes {}, dofs {}, nnz(M̂) {}, load (Python start, mesh, scikit-fem assembly, symbolic + numeric Cholesky) {load:.3} s", b.mesh.n_nodes(), b.n_dofs(), b.nnz());
+    println!(
+        "nodes {}, dofs {}, nnz(M̂) {}, load (Python start, mesh, scikit-fem assembly, symbolic + numeric Cholesky) {load:.3} s",
+        b.mesh.n_nodes(),
+        b.n_dofs(),
+        b.nnz()
+    );
     let t = Instant::now();
     s.fe.bodies[0].factorize(2e-3, 0.5).unwrap();
     println!("numeric refactorization (h changed) {:.4} s", t.elapsed().as_secs_f64());
