@@ -104,6 +104,9 @@ pub struct DdConfig {
     pub dd: DdSettings,
     /// Re-partition every this many steps (≥ 1).
     pub repartition_every: u32,
+    /// `by_model = true`: subdomains by model as well as by geometry (scenes with
+    /// deformable bodies; run by the deformable-body plugin).
+    pub by_model: bool,
 }
 
 impl Default for DdConfig {
@@ -111,6 +114,7 @@ impl Default for DdConfig {
         DdConfig {
             dd: DdSettings::default(),
             repartition_every: 1,
+            by_model: false,
         }
     }
 }

@@ -460,6 +460,7 @@ pub(crate) fn decomposition(cx: &Ctx, d: &schema::DecompositionSpec, movable: us
     };
     let def = crate::dd::DdSettings::default();
     let mut c = crate::dd::DdConfig::default();
+    c.by_model = d.by_model == Some(true);
     c.dd.nx = int("nx", d.nx, 1, def.nx as i64)? as u32;
     c.dd.ny = int("ny", d.ny, 1, def.ny as i64)? as u32;
     c.dd.nz = int("nz", d.nz, 1, 1)? as u32;

@@ -118,8 +118,7 @@ impl FeBody {
         }
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows);
         let symbolic = SymbolicLlt::try_new(pattern.as_ref(), Side::Lower).map_err(|e| format!("symbolic Cholesky failed: {e:?}"))?;
-        let mut f_ext = vec![0.0; n];
-        let _ = &mut f_ext;
+        let f_ext = vec![0.0; n];
         Ok(FeBody {
             name,
             mesh,

@@ -187,14 +187,15 @@ pub fn rigid_apply(n: [f64; 2], arm: [f64; 2], dr: [f64; 2], v: &mut [f64; 3], i
     v[2] -= im[2] * (arm[0] * dr[0] + arm[1] * dr[1]);
 }
 
-/// H_jᵀ M̂_j⁻¹ H_j of a rigid antagonist.
+/// H_jᵀ M̂_j⁻¹ H_j of a rigid antagonist: the framework's W_αα with the rigid body
+/// as the antagonist and nothing as the candidate.
 pub fn rigid_delassus(n: [f64; 2], arm: [f64; 2], im: [f64; 3]) -> [f64; 3] {
-    let t = [-n[1], n[0]];
-    [
-        im[0] * n[0] * n[0] + im[1] * n[1] * n[1] + im[2] * arm[0] * arm[0],
-        im[0] * n[0] * t[0] + im[1] * n[1] * t[1] + im[2] * arm[0] * arm[1],
-        im[0] * t[0] * t[0] + im[1] * t[1] * t[1] + im[2] * arm[1] * arm[1],
-    ]
+    let f = nscdd::rigid2d::contacts::Frame2 {
+        n,
+        arm_i: [0.0; 2],
+        arm_j: arm,
+    };
+    nscdd::rigid2d::Contacts2::delassus(&f, [0.0; 3], im)
 }
 
 /// A contact found by detection, before the node sets exist.

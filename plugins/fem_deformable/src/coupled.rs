@@ -38,16 +38,13 @@ pub struct ByModel {
 }
 
 impl ByModel {
-    /// From the scene's `[decomposition]` (already validated by the framework).
-    pub fn from_scene(text: &str, d: Option<&nscdd::dd::DdConfig>) -> Option<ByModel> {
-        d?;
-        let t: toml::Table = toml::from_str(text).ok()?;
-        let dec = t.get("decomposition")?.as_table()?;
-        if dec.get("by_model").and_then(|b| b.as_bool()) != Some(true) {
-            return None;
-        }
-        let g = |k: &str| dec.get(k).and_then(|v| v.as_integer()).unwrap_or(1).max(1) as usize;
-        Some(ByModel { nx: g("nx"), ny: g("ny") })
+    /// From the scene's `[decomposition]` (validated by the framework).
+    pub fn from_config(d: Option<&nscdd::dd::DdConfig>) -> Option<ByModel> {
+        let d = d.filter(|d| d.by_model)?;
+        Some(ByModel {
+            nx: d.dd.nx as usize,
+            ny: d.dd.ny as usize,
+        })
     }
 }
 
@@ -71,9 +68,7 @@ struct Sub {
 pub struct Coupled<'a> {
     pub fe: &'a mut Deformables2,
     pub by: ByModel,
-    /// Subdomains used in the last step and gluing iterations done.
-    pub subdomains: usize,
-    pub interface_bodies: usize,
+    /// Relative gluing residual of the last check pass.
     pub egluing: f64,
 }
 
@@ -86,8 +81,6 @@ impl ContactStage<World2> for Coupled<'_> {
     }
     fn solve(&mut self, w: &mut World2) -> SolveReport {
         let (mut subs, ifaces_r, ifaces_f) = self.split(w);
-        self.subdomains = subs.len();
-        self.interface_bodies = ifaces_r.len() + ifaces_f.len();
         let s = w.solver.clone();
         let mut report = SolveReport::default();
         let k = s.check_every.max(1);
@@ -98,17 +91,8 @@ impl ContactStage<World2> for Coupled<'_> {
             let mut sums = Sums::default();
             for sd in subs.iter_mut() {
                 let mut part = Sums::default();
-                let sm = if check { Some(&mut part) } else { None };
-                let sm = match sm {
-                    Some(x) => {
-                        nscdd::rigid2d::nlgs::sweep(&mut sd.contacts, &mut sd.vel, &sd.inv, &[], s.relaxation, Some(&mut *x));
-                        Some(x)
-                    }
-                    None => {
-                        nscdd::rigid2d::nlgs::sweep(&mut sd.contacts, &mut sd.vel, &sd.inv, &[], s.relaxation, None);
-                        None
-                    }
-                };
+                let mut sm = check.then_some(&mut part);
+                nscdd::rigid2d::nlgs::sweep(&mut sd.contacts, &mut sd.vel, &sd.inv, &[], s.relaxation, sm.as_deref_mut());
                 stage2::sweep(&mut sd.fec, &mut sd.sets, &mut sd.vel, &sd.inv, s.relaxation, sm);
                 sums.merge(&part);
             }
@@ -157,7 +141,6 @@ impl ContactStage<World2> for Coupled<'_> {
                 w.bodies.vel[b] = v.map(|x| x / m as f64);
             }
         }
-        let (f1, q1) = nscdd::rigid2d::nlgs::residual_parts(&w.contacts, &w.bodies.vel);
         self.fe.finish_velocities();
         // the deformable sets hold the one-domain velocities again for the residual
         for (bi, set) in self.fe.sets.iter_mut().enumerate() {
@@ -166,9 +149,7 @@ impl ContactStage<World2> for Coupled<'_> {
                 set.v[kk] = [b.v[2 * nd as usize], b.v[2 * nd as usize + 1]];
             }
         }
-        let (f2, q2) = self.fe.residual_parts(&w.bodies.vel);
-        let (f, q) = (f1 + f2, q1 + q2);
-        report.residual = if q == 0.0 { f.sqrt() } else { (f / q).sqrt() };
+        report.residual = self.fe.residual(w);
         report
     }
 }
@@ -254,8 +235,7 @@ impl Coupled<'_> {
         }
         // copies: partition of unity, velocities from V_free (the world's bodies hold
         // V_free plus the warm start; the warm start is re-applied per subdomain)
-        for (e, sd) in subs.iter_mut().enumerate() {
-            let _ = e;
+        for sd in subs.iter_mut() {
             for &b in &sd.rigid {
                 let m = rloc[b as usize].len() as f64;
                 sd.inv.push(w.bodies.inv_mass[b as usize].map(|x| x * m));
@@ -374,7 +354,7 @@ fn glue(subs: &mut [Sub], ifr: &[(u32, Iface)], iff: &[(u32, Iface)], w: &World2
             }
         }
     }
-    for (b, copies) in iff {
+    for (_, copies) in iff {
         let m = copies.len() as f64;
         // b_k = F_Γ,k + H_k r_k at the set's nodes
         let mut bk: Vec<Vec<f64>> = Vec::with_capacity(copies.len());
@@ -427,7 +407,6 @@ fn glue(subs: &mut [Sub], ifr: &[(u32, Iface)], iff: &[(u32, Iface)], w: &World2
                 fg[i] += d[i];
             }
         }
-        let _ = b;
     }
     (jump2, links, v2, ncopies)
 }

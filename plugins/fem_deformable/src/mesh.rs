@@ -73,7 +73,8 @@ impl Mesh {
     fn find_boundary(&mut self) {
         let (dim, nv) = (self.dim, self.dim + 1);
         // every facet with its sorted key; a facet seen once is on the boundary
-        let mut all: Vec<(Vec<u32>, Vec<u32>)> = Vec::with_capacity(self.n_cells() * nv);
+        // (sorted key, facet, the cell's vertex opposite the facet)
+        let mut all: Vec<(Vec<u32>, Vec<u32>, u32)> = Vec::with_capacity(self.n_cells() * nv);
         for e in 0..self.n_cells() {
             let c = self.cell(e).to_vec();
             for skip in 0..nv {
@@ -91,7 +92,7 @@ impl Mesh {
                 };
                 let mut key = f.clone();
                 key.sort_unstable();
-                all.push((key, f));
+                all.push((key, f, c[skip]));
             }
         }
         all.sort_unstable_by(|a, b| a.0.cmp(&b.0));
@@ -103,7 +104,7 @@ impl Mesh {
             }
             if j - i == 1 {
                 let f = &all[i].1;
-                let f = if dim == 3 { self.orient_out(f) } else { f.clone() };
+                let f = if dim == 3 { self.orient_out(f, all[i].2) } else { f.clone() };
                 self.facets.extend_from_slice(&f);
             }
             i = j;
@@ -114,24 +115,18 @@ impl Mesh {
         self.boundary = b;
     }
 
-    /// 3D: orders a boundary face so that its normal points away from the cell
-    /// centroid side (checked geometrically, whatever the convention above).
-    fn orient_out(&self, f: &[u32]) -> Vec<u32> {
+    /// 3D: orders a boundary face so that its normal points away from `opposite`,
+    /// the fourth vertex of its cell (checked geometrically, whatever the
+    /// convention above).
+    fn orient_out(&self, f: &[u32], opposite: u32) -> Vec<u32> {
         let p = |k: u32| [self.x0[3 * k as usize], self.x0[3 * k as usize + 1], self.x0[3 * k as usize + 2]];
-        let (a, b, c) = (p(f[0]), p(f[1]), p(f[2]));
-        let nrm = cross(sub(b, a), sub(c, a));
-        // the cell holding the face: find its fourth vertex by search over cells sharing f[0]
-        for e in 0..self.n_cells() {
-            let cl = self.cell(e);
-            if f.iter().all(|x| cl.contains(x)) {
-                let o = *cl.iter().find(|x| !f.contains(x)).unwrap();
-                if dot(nrm, sub(p(o), a)) > 0.0 {
-                    return vec![f[0], f[2], f[1]];
-                }
-                break;
-            }
+        let a = p(f[0]);
+        let nrm = cross(sub(p(f[1]), a), sub(p(f[2]), a));
+        if dot(nrm, sub(p(opposite), a)) > 0.0 {
+            vec![f[0], f[2], f[1]]
+        } else {
+            f.to_vec()
         }
-        f.to_vec()
     }
 
     /// Facets (boundary segments in 2D, triangles in 3D).

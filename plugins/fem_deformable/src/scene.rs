@@ -120,7 +120,7 @@ pub fn load_str(text: &str, file: &str, dir: &Path, registry: &Registry) -> Resu
         b.factorize(world.time.h, world.time.theta)
             .map_err(|m| err(text, file, &[Seg::Key("deformable".into())], m))?;
     }
-    let by_model = crate::coupled::ByModel::from_scene(text, decomposition.as_ref());
+    let by_model = crate::coupled::ByModel::from_config(decomposition.as_ref());
     Ok(FeScene2 {
         world,
         fe,
@@ -249,8 +249,6 @@ impl FeScene2 {
                 let mut c = crate::coupled::Coupled {
                     fe: &mut self.fe,
                     by,
-                    subdomains: 0,
-                    interface_bodies: 0,
                     egluing: 0.0,
                 };
                 self.world.step_with(&mut c)?

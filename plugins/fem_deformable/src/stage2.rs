@@ -284,6 +284,19 @@ impl Deformables2 {
         Ok(())
     }
 
+    /// Natural-map residual ‖F(r)‖/‖q‖ of the whole step's problem: the world's
+    /// rigid contacts and the deformable ones, from the current velocities.
+    pub fn residual(&self, w: &World2) -> f64 {
+        let (f1, q1) = nlgs::residual_parts(&w.contacts, &w.bodies.vel);
+        let (f2, q2) = self.residual_parts(&w.bodies.vel);
+        let (f, q) = (f1 + f2, q1 + q2);
+        if q == 0.0 {
+            f.sqrt()
+        } else {
+            (f / q).sqrt()
+        }
+    }
+
     /// (‖F(r)‖², ‖q‖²) of the deformable contacts (natural map, as the rigid ones).
     pub fn residual_parts(&self, vel: &[[f64; 3]]) -> (f64, f64) {
         let c = &self.contacts;
@@ -415,24 +428,15 @@ impl ContactStage<World2> for Deformables2 {
                 report.sweeps += 1;
                 let check = report.sweeps % k == 0 || report.sweeps == s.max_sweeps;
                 let mut sums = Sums::default();
-                let sm = if check { Some(&mut sums) } else { None };
-                let sm = match sm {
-                    Some(x) => {
-                        nlgs::sweep(
-                            &mut w.contacts,
-                            &mut w.bodies.vel,
-                            &w.bodies.inv_mass,
-                            &order,
-                            s.relaxation,
-                            Some(&mut *x),
-                        );
-                        Some(x)
-                    }
-                    None => {
-                        nlgs::sweep(&mut w.contacts, &mut w.bodies.vel, &w.bodies.inv_mass, &order, s.relaxation, None);
-                        None
-                    }
-                };
+                let mut sm = check.then_some(&mut sums);
+                nlgs::sweep(
+                    &mut w.contacts,
+                    &mut w.bodies.vel,
+                    &w.bodies.inv_mass,
+                    &order,
+                    s.relaxation,
+                    sm.as_deref_mut(),
+                );
                 sweep(
                     &mut self.contacts,
                     &mut self.sets,
@@ -450,10 +454,7 @@ impl ContactStage<World2> for Deformables2 {
                 }
             }
         }
-        let (f1, q1) = nlgs::residual_parts(&w.contacts, &w.bodies.vel);
-        let (f2, q2) = self.residual_parts(&w.bodies.vel);
-        let (f2, q2) = (f1 + f2, q1 + q2);
-        report.residual = if q2 == 0.0 { f2.sqrt() } else { (f2 / q2).sqrt() };
+        report.residual = self.residual(w);
         let t1 = Instant::now();
         self.finish_velocities();
         self.times.nlgs = (t1 - t0).as_secs_f64();
