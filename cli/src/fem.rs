@@ -15,18 +15,26 @@ pub fn has_deformable(scene: &Path) -> bool {
 }
 
 pub fn check(scene: &Path, reg: &Registry) -> ExitCode {
-    match nscdd_fem_deformable::scene::load(scene, reg) {
+    use nscdd_fem_deformable::scene::FeScene;
+    match nscdd_fem_deformable::scene::load_any(scene, reg) {
         Ok(s) => {
-            let nodes: usize = s.fe.bodies.iter().map(|b| b.mesh.n_nodes()).sum();
+            let (dim, rigid, fe, steps, h, by_model) = match &s {
+                FeScene::D2(s) => (
+                    2,
+                    s.world.bodies.len(),
+                    &s.fe.bodies,
+                    s.world.time.steps,
+                    s.world.time.h,
+                    s.by_model.is_some(),
+                ),
+                FeScene::D3(s) => (3, s.world.bodies.len(), &s.fe.bodies, s.world.time.steps, s.world.time.h, false),
+            };
+            let nodes: usize = fe.iter().map(|b| b.mesh.n_nodes()).sum();
             println!(
-                "{}: ok — 2D, {} rigid bodies, {} deformable bodies ({} nodes), {} steps of {} s{}",
+                "{}: ok — {dim}D, {rigid} rigid bodies, {} deformable bodies ({nodes} nodes), {steps} steps of {h} s{}",
                 scene.display(),
-                s.world.bodies.len(),
-                s.fe.bodies.len(),
-                nodes,
-                s.world.time.steps,
-                s.world.time.h,
-                if s.by_model.is_some() { "; subdomains by model" } else { "" }
+                fe.len(),
+                if by_model { "; subdomains by model" } else { "" }
             );
             ExitCode::SUCCESS
         }
@@ -38,19 +46,24 @@ pub fn check(scene: &Path, reg: &Registry) -> ExitCode {
 }
 
 pub fn run(scene: &Path, out: &Path, quiet: bool, reg: &Registry, unsupported: Option<&str>) -> ExitCode {
+    use nscdd_fem_deformable::scene::FeScene;
     if let Some(flag) = unsupported {
         eprintln!("error: {flag} is not supported for scenes with deformable bodies (use [decomposition] by_model = true)");
         return ExitCode::from(2);
     }
-    let mut s = match nscdd_fem_deformable::scene::load(scene, reg) {
-        Ok(s) => s,
+    match nscdd_fem_deformable::scene::load_any(scene, reg) {
+        Ok(FeScene::D2(mut s)) => run_loaded(&mut s, out, quiet),
+        Ok(FeScene::D3(mut s)) => run_loaded(&mut s, out, quiet),
         Err(e) => {
             eprintln!("error: {e}");
-            return ExitCode::from(2);
+            ExitCode::from(2)
         }
-    };
-    let bar = (!quiet).then(|| indicatif::ProgressBar::new(s.world.time.steps));
-    let r = nscdd_fem_deformable::run::run(&mut s, out, |k, _| {
+    }
+}
+
+fn run_loaded<S: nscdd_fem_deformable::run::FeRunnable>(s: &mut S, out: &Path, quiet: bool) -> ExitCode {
+    let bar = (!quiet).then(|| indicatif::ProgressBar::new(s.clock().2));
+    let r = nscdd_fem_deformable::run::run(s, out, |k, _| {
         if let Some(b) = &bar {
             b.set_position(k)
         }

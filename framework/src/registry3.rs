@@ -71,6 +71,48 @@ pub trait ShapeStore3: Any + Send + Sync {
     fn is_grain(&self) -> bool {
         true
     }
+    /// A point p (world frame) against this shape's surface at a pose (a boundary
+    /// node of a deformable body): the signed distance (the gap), the unit outward
+    /// normal at the closest surface point, and that point. `None`: this kind does
+    /// not meet points.
+    fn point_contact(&self, _s: u32, _pos: [f64; 3], _quat: [f64; 4], _p: [f64; 3]) -> Option<PointContact3> {
+        None
+    }
+    /// A triangle (world frame, a boundary face of a deformable body) against this
+    /// shape at a pose: the closest point of the triangle (barycentric weights),
+    /// the gap, the unit normal from the shape towards the triangle and the point
+    /// of the shape's surface. Kinds that implement it meet deformable bodies by
+    /// their faces instead of by the bodies' nodes (round grains smaller than the
+    /// mesh would otherwise pass between nodes).
+    /// Whether this kind implements [`Self::face_contact`].
+    fn meets_faces(&self) -> bool {
+        false
+    }
+    fn face_contact(&self, _s: u32, _pos: [f64; 3], _quat: [f64; 4], _tri: &[[f64; 3]; 3]) -> Option<FaceContact3> {
+        None
+    }
+}
+
+/// A shape against a triangle ([`ShapeStore3::face_contact`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FaceContact3 {
+    pub gap: f64,
+    /// From the shape towards the triangle.
+    pub normal: [f64; 3],
+    /// Point of the shape's surface.
+    pub point: [f64; 3],
+    /// Weights of the triangle's corners at its closest point.
+    pub bary: [f64; 3],
+}
+
+/// A point against a shape's surface ([`ShapeStore3::point_contact`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointContact3 {
+    pub gap: f64,
+    /// From the shape towards the point.
+    pub normal: [f64; 3],
+    /// Closest point of the surface.
+    pub point: [f64; 3],
 }
 
 /// A raw 3D contact found by a narrow phase.

@@ -64,6 +64,14 @@ pub(crate) struct Scratch3 {
 }
 
 impl World3 {
+    /// V⁻ of the step being solved (the velocities at its start).
+    pub fn velocity_begin(&self) -> &[[f64; 6]] {
+        &self.scratch.v_begin
+    }
+    /// The contact law between two materials (`None`: they do not interact).
+    pub fn law(&self, ma: u16, mb: u16) -> Option<crate::law::ContactLaw> {
+        self.laws[ma as usize * self.materials.len() + mb as usize]
+    }
     pub fn kind_name(&self, b: usize) -> &'static str {
         self.shapes[self.bodies.shape[b].kind as usize].kind()
     }

@@ -114,6 +114,16 @@ pub fn solve(
 
 /// Natural-map residual ‖F(r)‖/‖q‖ with the normal velocity shifted by the target.
 pub fn residual(c: &Contacts3, vel: &[[f64; 6]]) -> f64 {
+    let (f2, q2) = residual_parts(c, vel);
+    if q2 == 0.0 {
+        f2.sqrt()
+    } else {
+        (f2 / q2).sqrt()
+    }
+}
+
+/// (‖F(r)‖², ‖q‖²) of [`residual`], for a stage that adds contacts of its own.
+pub fn residual_parts(c: &Contacts3, vel: &[[f64; 6]]) -> (f64, f64) {
     let (mut f2, mut q2) = (0.0, 0.0);
     for a in 0..c.len() {
         let t = c.target[a];
@@ -123,9 +133,5 @@ pub fn residual(c: &Contacts3, vel: &[[f64; 6]]) -> f64 {
         let q = [c.u_free[a][0] - t.u_target, c.u_free[a][1], c.u_free[a][2]];
         q2 += q[0] * q[0] + q[1] * q[1] + q[2] * q[2];
     }
-    if q2 == 0.0 {
-        f2.sqrt()
-    } else {
-        (f2 / q2).sqrt()
-    }
+    (f2, q2)
 }

@@ -28,15 +28,22 @@ pub struct Scene3 {
 
 /// Loads a 3D scene from its text; `file` names it in messages.
 pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene3, InputError> {
+    load_str_with(text, file, registry, false).map(|(s, _)| s)
+}
+
+/// [`load_str`] that also returns the scene's `[[deformable]]` entries for a
+/// deformable-body plugin (refused with `deformable = false`, as in 2D).
+pub fn load_str_with(text: &str, file: &str, registry: &Registry, deformable: bool) -> Result<(Scene3, Vec<toml::Table>), InputError> {
+    let mut sf: SceneFile<BodySpec3> = parse(text, file)?;
     let cx = Ctx {
         text,
         file,
-        deformable: false,
+        deformable: !sf.deformable.is_empty(),
     };
-    let sf: SceneFile<BodySpec3> = parse(text, file)?;
-    if !sf.deformable.is_empty() {
+    if !deformable && cx.deformable {
         return Err(cx.err(&[k("deformable")], super::NO_DEFORMABLE));
     }
+    let entries = std::mem::take(&mut sf.deformable);
     let gravity = match sf.gravity.as_deref() {
         None => [0.0, 0.0, -9.81],
         Some(&[x, y, z]) if [x, y, z].iter().all(|g| g.is_finite()) => [x, y, z],
@@ -168,16 +175,19 @@ pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene3, I
         reaction: vec![[0.0; 6]; n],
         scratch: Default::default(),
     };
-    Ok(Scene3 {
-        world,
-        output: OutputSettings {
-            every: sf.output.every,
-            vtk: sf.output.vtk,
-            writers: vec![],
-            checkpoint_every: sf.output.checkpoint_every,
+    Ok((
+        Scene3 {
+            world,
+            output: OutputSettings {
+                every: sf.output.every,
+                vtk: sf.output.vtk,
+                writers: vec![],
+                checkpoint_every: sf.output.checkpoint_every,
+            },
+            decomposition,
         },
-        decomposition,
-    })
+        entries,
+    ))
 }
 
 fn add_bodies(cx: &Ctx, sf: &SceneFile<BodySpec3>, b: &mut SceneBuilder3, drives: &mut Vec<BodyDrive3>) -> Result<(), InputError> {

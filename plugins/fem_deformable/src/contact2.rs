@@ -18,14 +18,10 @@
 use nscdd::rigid2d::contacts::{Block2, Target};
 use nscdd::world::World2;
 
-/// One side made of deformable-body nodes: body (index among the deformable
-/// bodies), indices of the nodes in that body's [`NodeSet`], weights.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FeSide {
-    pub body: u32,
-    pub k: [u32; 2],
-    pub w: [f64; 2],
-}
+/// A 2D side: one node, or the two ends of a segment.
+pub type FeSide = crate::nodes::FeSide<2>;
+/// The contact nodes of one body in 2D (see [`crate::nodes`]).
+pub type NodeSet = crate::nodes::NodeSet<2>;
 
 /// The antagonist of a contact.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -91,71 +87,12 @@ impl FeContacts2 {
     }
 }
 
-/// The nodes of one deformable body touched by this step's contacts: their
-/// current velocities and the dense block G of M̂⁻¹ among them (2×2 blocks,
-/// `g[(2k + c) * 2n + 2l + d]`), scaled by `scale` (the multiplicity of a copy).
-#[derive(Clone, Debug, Default)]
-pub struct NodeSet {
-    pub nodes: Vec<u32>,
-    pub v: Vec<[f64; 2]>,
-    pub g: Vec<f64>,
-}
-
 impl NodeSet {
-    pub fn len(&self) -> usize {
-        self.nodes.len()
-    }
-    pub fn is_empty(&self) -> bool {
-        self.nodes.is_empty()
-    }
-    #[inline(always)]
-    pub fn block(&self, k: usize, l: usize) -> [f64; 4] {
-        let n2 = 2 * self.nodes.len();
-        let (r0, r1) = ((2 * k) * n2 + 2 * l, (2 * k + 1) * n2 + 2 * l);
-        [self.g[r0], self.g[r0 + 1], self.g[r1], self.g[r1 + 1]]
-    }
-    /// v_l += G_lk p for every node l of the set.
-    #[inline(always)]
-    pub fn apply(&mut self, k: usize, p: [f64; 2]) {
-        let n2 = 2 * self.nodes.len();
-        // G is symmetric: column k read as row k (contiguous)
-        let (row0, row1) = (&self.g[2 * k * n2..(2 * k + 1) * n2], &self.g[(2 * k + 1) * n2..(2 * k + 2) * n2]);
-        for (l, v) in self.v.iter_mut().enumerate() {
-            v[0] += row0[2 * l] * p[0] + row1[2 * l] * p[1];
-            v[1] += row0[2 * l + 1] * p[0] + row1[2 * l + 1] * p[1];
-        }
-    }
-    /// The velocity of a side: Σ w_k v_k.
-    #[inline(always)]
-    pub fn side_velocity(&self, s: &FeSide) -> [f64; 2] {
-        let (a, b) = (self.v[s.k[0] as usize], self.v[s.k[1] as usize]);
-        [s.w[0] * a[0] + s.w[1] * b[0], s.w[0] * a[1] + s.w[1] * b[1]]
-    }
-    /// Applies the impulse p (global frame) to a side.
-    #[inline(always)]
-    pub fn apply_side(&mut self, s: &FeSide, p: [f64; 2]) {
-        for q in 0..2 {
-            if s.w[q] != 0.0 {
-                self.apply(s.k[q] as usize, [s.w[q] * p[0], s.w[q] * p[1]]);
-            }
-        }
-    }
     /// Fᵀ (Σ_kl w_k w_l G_kl) F for a side, as [W_nn, W_nt, W_tt].
     pub fn delassus(&self, s: &FeSide, n: [f64; 2]) -> [f64; 3] {
-        let mut g = [0.0; 4];
-        for p in 0..2 {
-            for q in 0..2 {
-                let ww = s.w[p] * s.w[q];
-                if ww != 0.0 {
-                    let b = self.block(s.k[p] as usize, s.k[q] as usize);
-                    for i in 0..4 {
-                        g[i] += ww * b[i];
-                    }
-                }
-            }
-        }
+        let g = self.side_block(s);
         let t = [-n[1], n[0]];
-        let q = |a: [f64; 2], b: [f64; 2]| a[0] * (g[0] * b[0] + g[1] * b[1]) + a[1] * (g[2] * b[0] + g[3] * b[1]);
+        let q = |a: [f64; 2], b: [f64; 2]| a[0] * (g[0][0] * b[0] + g[0][1] * b[1]) + a[1] * (g[1][0] * b[0] + g[1][1] * b[1]);
         [q(n, n), q(n, t), q(t, t)]
     }
 }

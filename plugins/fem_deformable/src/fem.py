@@ -56,10 +56,12 @@ def read(path, dim):
 
 def _basis(points, cells):
     dim = points.shape[1]
+    # scikit-fem wants (dim, n) arrays C-contiguous (else it copies and logs it)
+    p, t = np.ascontiguousarray(points.T), np.ascontiguousarray(cells.T)
     if dim == 2:
-        mesh, elem = MeshTri(points.T, cells.T), ElementTriP1()
+        mesh, elem = MeshTri(p, t), ElementTriP1()
     else:
-        mesh, elem = MeshTet(points.T, cells.T), ElementTetP1()
+        mesh, elem = MeshTet(p, t), ElementTetP1()
     return Basis(mesh, ElementVector(elem)), dim
 
 

@@ -1,9 +1,12 @@
 //! # Deformable bodies: linear elastic finite elements, coupled to rigid bodies
 pub mod body;
 pub mod contact2;
+pub mod contact3;
 pub mod coupled;
 pub mod mesh;
+pub mod nodes;
 pub mod python;
 pub mod run;
 pub mod scene;
 pub mod stage2;
+pub mod stage3;

@@ -3,9 +3,13 @@
 //! deformable body as an unstructured mesh with displacement, velocity and cell
 //! stress, `deformable.pvd`), `final.json`.
 
+use crate::body::FeBody;
 use crate::mesh::cell_stress;
-use crate::scene::FeScene2;
+use crate::scene::{FeScene2, FeScene3};
+use nscdd::engine::{Diverged, StepReport};
+use nscdd::output::vtk::VtkWriter;
 use nscdd::registry::Writer2;
+use nscdd::scene::OutputSettings;
 use std::fmt::Write as _;
 use std::io::Write;
 use std::path::Path;
@@ -25,9 +29,76 @@ fn io(dir: &Path, what: &str) -> impl Fn(std::io::Error) -> String {
     move |e| format!("cannot write {w} in {d}: {e}")
 }
 
+/// What the run loop needs of a scene with deformable bodies (2D or 3D).
+pub trait FeRunnable {
+    fn step(&mut self) -> Result<StepReport, Diverged>;
+    fn fe_bodies(&self) -> &[FeBody];
+    fn fe_contacts(&self) -> usize;
+    fn output(&self) -> &OutputSettings;
+    /// (step, t, steps to run).
+    fn clock(&self) -> (u64, f64, u64);
+    fn rigid_kinetic(&self) -> f64;
+    fn write_rigid(&self, vtk: &mut VtkWriter, dir: &Path, frame: u32) -> std::io::Result<()>;
+    fn final_json(&self) -> String;
+}
+
+impl FeRunnable for FeScene2 {
+    fn step(&mut self) -> Result<StepReport, Diverged> {
+        FeScene2::step(self)
+    }
+    fn fe_bodies(&self) -> &[FeBody] {
+        &self.fe.bodies
+    }
+    fn fe_contacts(&self) -> usize {
+        self.fe.contacts.len()
+    }
+    fn output(&self) -> &OutputSettings {
+        &self.output
+    }
+    fn clock(&self) -> (u64, f64, u64) {
+        (self.world.step, self.world.t, self.world.time.steps)
+    }
+    fn rigid_kinetic(&self) -> f64 {
+        self.world.energies().0
+    }
+    fn write_rigid(&self, vtk: &mut VtkWriter, dir: &Path, frame: u32) -> std::io::Result<()> {
+        vtk.write(&self.world, dir, frame)
+    }
+    fn final_json(&self) -> String {
+        nscdd::output::final_json(&self.world)
+    }
+}
+
+impl FeRunnable for FeScene3 {
+    fn step(&mut self) -> Result<StepReport, Diverged> {
+        FeScene3::step(self)
+    }
+    fn fe_bodies(&self) -> &[FeBody] {
+        &self.fe.bodies
+    }
+    fn fe_contacts(&self) -> usize {
+        self.fe.contacts.len()
+    }
+    fn output(&self) -> &OutputSettings {
+        &self.output
+    }
+    fn clock(&self) -> (u64, f64, u64) {
+        (self.world.step, self.world.t, self.world.time.steps)
+    }
+    fn rigid_kinetic(&self) -> f64 {
+        self.world.energies().0
+    }
+    fn write_rigid(&self, vtk: &mut VtkWriter, dir: &Path, frame: u32) -> std::io::Result<()> {
+        nscdd::output::out3::write_vtk3(vtk, &self.world, dir, frame)
+    }
+    fn final_json(&self) -> String {
+        nscdd::output::out3::final_json3(&self.world)
+    }
+}
+
 /// Runs the scene to its end, writing in `dir`. Errors: an unwritable output, or a
 /// diverging step (the step and body named; what was written is kept).
-pub fn run(s: &mut FeScene2, dir: &Path, mut progress: impl FnMut(u64, u64)) -> Result<FeSummary, String> {
+pub fn run<S: FeRunnable>(s: &mut S, dir: &Path, mut progress: impl FnMut(u64, u64)) -> Result<FeSummary, String> {
     std::fs::create_dir_all(dir).map_err(io(dir, "the output directory"))?;
     let mut hist = std::io::BufWriter::new(std::fs::File::create(dir.join("history.csv")).map_err(io(dir, "history.csv"))?);
     writeln!(
@@ -35,26 +106,26 @@ pub fn run(s: &mut FeScene2, dir: &Path, mut progress: impl FnMut(u64, u64)) -> 
         "step,t,sweeps,converged,residual,contacts,deformable_contacts,kinetic_rigid,kinetic_deformable,elastic,load_potential_deformable"
     )
     .map_err(io(dir, "history.csv"))?;
-    let mut vtk = nscdd::output::vtk::VtkWriter::default();
+    let mut vtk = VtkWriter::default();
     let mut frames: Vec<(f64, u32)> = vec![];
-    let every = s.output.every.max(1);
+    let every = s.output().every.max(1);
     let t0 = std::time::Instant::now();
     let mut sum = FeSummary::default();
-    let write_frame = |s: &FeScene2, vtk: &mut nscdd::output::vtk::VtkWriter, frames: &mut Vec<(f64, u32)>| -> Result<(), String> {
-        if !s.output.vtk {
+    let write_frame = |s: &S, vtk: &mut VtkWriter, frames: &mut Vec<(f64, u32)>| -> Result<(), String> {
+        if !s.output().vtk {
             return Ok(());
         }
         let f = frames.len() as u32;
-        vtk.write(&s.world, dir, f).map_err(io(dir, "VTK frames"))?;
-        for (bi, b) in s.fe.bodies.iter().enumerate() {
+        s.write_rigid(vtk, dir, f).map_err(io(dir, "VTK frames"))?;
+        for (bi, b) in s.fe_bodies().iter().enumerate() {
             let name = format!("deformable{bi}_{f:05}.vtu");
             std::fs::write(dir.join(&name), vtu(b)).map_err(io(dir, &name))?;
         }
-        frames.push((s.world.t, f));
+        frames.push((s.clock().1, f));
         Ok(())
     };
     write_frame(s, &mut vtk, &mut frames)?;
-    let n = s.world.time.steps;
+    let n = s.clock().2;
     for _ in 0..n {
         let rep = match s.step() {
             Ok(r) => r,
@@ -68,57 +139,58 @@ pub fn run(s: &mut FeScene2, dir: &Path, mut progress: impl FnMut(u64, u64)) -> 
         if !rep.solve.converged {
             sum.unconverged_steps += 1;
         }
-        let (ek, _) = s.world.energies();
-        let ekf: f64 = s.fe.bodies.iter().map(|b| b.kinetic_energy()).sum();
-        let el: f64 = s.fe.bodies.iter().map(|b| b.elastic_energy()).sum();
-        let lp: f64 = s.fe.bodies.iter().map(|b| b.load_potential()).sum();
+        let ek = s.rigid_kinetic();
+        let ekf: f64 = s.fe_bodies().iter().map(|b| b.kinetic_energy()).sum();
+        let el: f64 = s.fe_bodies().iter().map(|b| b.elastic_energy()).sum();
+        let lp: f64 = s.fe_bodies().iter().map(|b| b.load_potential()).sum();
+        let (step, t, _) = s.clock();
         writeln!(
             hist,
             "{},{:.9e},{},{},{:.3e},{},{},{:.9e},{:.9e},{:.9e},{:.9e}",
-            s.world.step,
-            s.world.t,
+            step,
+            t,
             rep.solve.sweeps,
             rep.solve.converged as u8,
             rep.solve.residual,
             rep.contacts,
-            s.fe.contacts.len(),
+            s.fe_contacts(),
             ek,
             ekf,
             el,
             lp
         )
         .map_err(io(dir, "history.csv"))?;
-        if s.world.step % every == 0 {
+        if step % every == 0 {
             write_frame(s, &mut vtk, &mut frames)?;
         }
-        progress(s.world.step, n);
+        progress(step, n);
     }
     hist.flush().map_err(io(dir, "history.csv"))?;
     vtk.finish(dir).map_err(io(dir, "VTK series"))?;
-    if s.output.vtk {
+    if s.output().vtk {
         let mut pvd = String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n");
         for (t, f) in &frames {
-            for bi in 0..s.fe.bodies.len() {
+            for bi in 0..s.fe_bodies().len() {
                 let _ = writeln!(pvd, "<DataSet timestep=\"{t}\" part=\"{bi}\" file=\"deformable{bi}_{f:05}.vtu\"/>");
             }
         }
         pvd.push_str("</Collection>\n</VTKFile>\n");
         std::fs::write(dir.join("deformable.pvd"), pvd).map_err(io(dir, "deformable.pvd"))?;
     }
-    let fe: Vec<serde_json::Value> =
-        s.fe.bodies
-            .iter()
-            .map(|b| {
-                serde_json::json!({
-                    "name": b.name, "nodes": b.mesh.n_nodes(), "cells": b.mesh.n_cells(),
-                    "elastic": b.elastic, "scikit_fem": b.skfem_version,
-                    "max_displacement": b.u.iter().fold(0.0f64, |m, x| m.max(x.abs())),
-                    "kinetic_energy": b.kinetic_energy(), "elastic_energy": b.elastic_energy(),
-                    "displacement": b.u,
-                })
+    let fe: Vec<serde_json::Value> = s
+        .fe_bodies()
+        .iter()
+        .map(|b| {
+            serde_json::json!({
+                "name": b.name, "nodes": b.mesh.n_nodes(), "cells": b.mesh.n_cells(),
+                "elastic": b.elastic, "scikit_fem": b.skfem_version,
+                "max_displacement": b.u.iter().fold(0.0f64, |m, x| m.max(x.abs())),
+                "kinetic_energy": b.kinetic_energy(), "elastic_energy": b.elastic_energy(),
+                "displacement": b.u,
             })
-            .collect();
-    let mut fin: serde_json::Value = serde_json::from_str(&nscdd::output::final_json(&s.world)).unwrap_or_default();
+        })
+        .collect();
+    let mut fin: serde_json::Value = serde_json::from_str(&s.final_json()).unwrap_or_default();
     if let Some(o) = fin.as_object_mut() {
         o.insert("deformable".into(), serde_json::Value::Array(fe));
     }

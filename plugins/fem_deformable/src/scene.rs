@@ -1,4 +1,5 @@
-//! `[[deformable]]` entries of a 2D scene file and the scene that holds them.
+//! `[[deformable]]` entries of a scene file and the scenes that hold them
+//! ([`FeScene2`], [`FeScene3`]; the file's `dimension` chooses).
 //!
 //! ```toml
 //! [[deformable]]
@@ -14,16 +15,27 @@
 //! # or  mesh = { disk = { centre = [0.0, 1.0], radius = 0.1, refine = 4 } }
 //! # or  mesh = { file = "block.msh" }       (anything meshio reads; relative to the scene)
 //! ```
+//!
+//! In 3D (`dimension = 3`): `velocity` has 3 numbers, there is no `plane`, the
+//! sides are `bottom`/`top` (z), `left`/`right` (x), `front`/`back` (y), and the
+//! generated mesh is a box of tetrahedra:
+//!
+//! ```toml
+//! mesh = { box = { origin = [0.0, 0.0, 0.0], size = [1.0, 1.0, 0.5], cells = [8, 8, 4] } }
+//! ```
 
 use crate::body::{Elastic, FeBody};
 use crate::mesh::Mesh;
 use crate::python;
 use crate::stage2::Deformables2;
+use crate::stage3::Deformables3;
 use nscdd::error::InputError;
 use nscdd::registry::Registry;
 use nscdd::scene::locate::{locate, path_string, Seg};
 use nscdd::scene::{OutputSettings, Scene};
+use nscdd::world::Material;
 use nscdd::world::World2;
+use nscdd::world3::World3;
 use serde::Deserialize;
 use std::path::Path;
 
@@ -34,8 +46,8 @@ pub struct DeformableSpec {
     pub material: String,
     pub young: f64,
     pub poisson: f64,
-    #[serde(default = "strain")]
-    pub plane: String,
+    /// 2D only: `strain` (default) or `stress`.
+    pub plane: Option<String>,
     #[serde(default)]
     pub rayleigh: [f64; 2],
     #[serde(default)]
@@ -44,14 +56,12 @@ pub struct DeformableSpec {
     pub fix: Vec<String>,
     pub mesh: MeshSpec,
 }
-fn strain() -> String {
-    "strain".into()
-}
 
 #[derive(Deserialize, Debug, Clone)]
 #[serde(deny_unknown_fields, rename_all = "lowercase")]
 pub enum MeshSpec {
     Rectangle { origin: [f64; 2], size: [f64; 2], cells: [i64; 2] },
+    Box { origin: [f64; 3], size: [f64; 3], cells: [i64; 3] },
     Disk { centre: [f64; 2], radius: f64, refine: i64 },
     File(String),
 }
@@ -95,6 +105,41 @@ pub fn load_str(text: &str, file: &str, dir: &Path, registry: &Registry) -> Resu
         output,
         decomposition,
     } = scene;
+    let bodies = bodies_from(
+        entries,
+        text,
+        file,
+        dir,
+        &world.materials,
+        2,
+        &world.gravity,
+        world.time.h,
+        world.time.theta,
+    )?;
+    let fe = Deformables2::new(bodies, world.alert);
+    let by_model = crate::coupled::ByModel::from_config(decomposition.as_ref());
+    Ok(FeScene2 {
+        world,
+        fe,
+        output,
+        by_model,
+    })
+}
+
+/// Builds the deformable bodies of a scene's `[[deformable]]` entries, factored
+/// for the scene's h and θ.
+#[allow(clippy::too_many_arguments)]
+fn bodies_from(
+    entries: Vec<toml::Table>,
+    text: &str,
+    file: &str,
+    dir: &Path,
+    materials: &[Material],
+    dim: usize,
+    gravity: &[f64],
+    h: f64,
+    theta: f64,
+) -> Result<Vec<FeBody>, InputError> {
     let mut bodies = Vec::new();
     for (i, e) in entries.into_iter().enumerate() {
         let base = vec![Seg::Key("deformable".into()), Seg::Index(i)];
@@ -111,32 +156,86 @@ pub fn load_str(text: &str, file: &str, dir: &Path, registry: &Registry) -> Resu
             let key = msg.split('`').nth(1).filter(|k| !k.contains(' ')).unwrap_or("");
             err(text, file, &at(key), msg.clone())
         })?;
-        bodies.push(build(&spec, &world, dir).map_err(|(k, m)| err(text, file, &at(k), m))?);
+        let mut b = build(&spec, materials, dim, dir).map_err(|(k, m)| err(text, file, &at(k), m))?;
+        b.set_gravity(gravity);
+        b.factorize(h, theta).map_err(|m| err(text, file, &at(""), m))?;
+        bodies.push(b);
     }
-    let alert = world.alert;
-    let mut fe = Deformables2::new(bodies, alert);
-    for b in &mut fe.bodies {
-        b.set_gravity(&world.gravity);
-        b.factorize(world.time.h, world.time.theta)
-            .map_err(|m| err(text, file, &[Seg::Key("deformable".into())], m))?;
+    Ok(bodies)
+}
+
+/// A 3D scene with deformable bodies: the rigid world and the deformable stage.
+pub struct FeScene3 {
+    pub world: World3,
+    pub fe: Deformables3,
+    pub output: OutputSettings,
+}
+
+/// Loads a 3D scene (`dimension = 3`) that may hold `[[deformable]]` entries.
+/// Subdomains by model are 2D only for now: asking for them is an input error.
+pub fn load3_str(text: &str, file: &str, dir: &Path, registry: &Registry) -> Result<FeScene3, InputError> {
+    let (scene, entries) = nscdd::scene::load3::load_str_with(text, file, registry, true)?;
+    if scene.decomposition.is_some() {
+        return Err(err(
+            text,
+            file,
+            &[Seg::Key("decomposition".into())],
+            "3D scenes with deformable bodies run in one domain for now (subdomains by model are 2D); remove [decomposition]",
+        ));
     }
-    let by_model = crate::coupled::ByModel::from_config(decomposition.as_ref());
-    Ok(FeScene2 {
+    let world = scene.world;
+    let bodies = bodies_from(
+        entries,
+        text,
+        file,
+        dir,
+        &world.materials,
+        3,
+        &world.gravity,
+        world.time.h,
+        world.time.theta,
+    )?;
+    let fe = Deformables3::new(bodies, world.alert);
+    Ok(FeScene3 {
         world,
         fe,
-        output,
-        by_model,
+        output: scene.output,
     })
 }
 
+/// A scene with deformable bodies of either dimension.
+pub enum FeScene {
+    D2(FeScene2),
+    D3(FeScene3),
+}
+
+/// Loads a scene file with deformable bodies of either dimension (its
+/// `dimension` key).
+pub fn load_any(path: &Path, registry: &Registry) -> Result<FeScene, InputError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| InputError {
+        file: file.clone(),
+        line: None,
+        key: String::new(),
+        message: format!("cannot read the file: {e}"),
+    })?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let dim = toml::from_str::<toml::Table>(&text)
+        .ok()
+        .and_then(|t| t.get("dimension").and_then(|d| d.as_integer()));
+    match dim {
+        Some(3) => load3_str(&text, &file, dir, registry).map(FeScene::D3),
+        _ => load_str(&text, &file, dir, registry).map(FeScene::D2),
+    }
+}
+
 /// Builds one deformable body of a spec; errors name the key.
-pub fn build(s: &DeformableSpec, w: &World2, dir: &Path) -> Result<FeBody, (&'static str, String)> {
-    let mat = w
-        .materials
+pub fn build(s: &DeformableSpec, materials: &[Material], dim: usize, dir: &Path) -> Result<FeBody, (&'static str, String)> {
+    let mat = materials
         .iter()
         .position(|m| m.name == s.material)
         .ok_or(("material", format!("unknown material `{}`", s.material)))?;
-    let density = w.materials[mat].density;
+    let density = materials[mat].density;
     if !(s.young > 0.0 && s.young.is_finite()) {
         return Err(("young", format!("must be > 0, got {}", s.young)));
     }
@@ -146,12 +245,23 @@ pub fn build(s: &DeformableSpec, w: &World2, dir: &Path) -> Result<FeBody, (&'st
     if !s.rayleigh.iter().all(|x| *x >= 0.0 && x.is_finite()) {
         return Err(("rayleigh", "α and β must be ≥ 0".into()));
     }
-    let plane_stress = match s.plane.as_str() {
-        "strain" => false,
-        "stress" => true,
-        o => return Err(("plane", format!("`{o}`: `strain` or `stress`"))),
+    let plane_stress = match (dim, s.plane.as_deref()) {
+        (2, None | Some("strain")) | (3, None) => false,
+        (2, Some("stress")) => true,
+        (2, Some(o)) => return Err(("plane", format!("`{o}`: `strain` or `stress`"))),
+        _ => return Err(("plane", "`plane` (strain or stress) is for 2D scenes only".into())),
     };
     let raw = match &s.mesh {
+        MeshSpec::Rectangle { .. } | MeshSpec::Disk { .. } if dim == 3 => {
+            return Err(("mesh", "rectangles and disks are 2D meshes; in 3D use `box` or `file`".into()))
+        }
+        MeshSpec::Box { .. } if dim == 2 => return Err(("mesh", "a box is a 3D mesh; in 2D use `rectangle`, `disk` or `file`".into())),
+        MeshSpec::Box { origin, size, cells } => {
+            if !size.iter().all(|&x| x > 0.0) || cells.iter().any(|&c| c < 1) {
+                return Err(("mesh", "a box needs a positive size and at least 1 cell per side".into()));
+            }
+            python::cuboid(*origin, *size, [cells[0] as usize, cells[1] as usize, cells[2] as usize])
+        }
         MeshSpec::Rectangle { origin, size, cells } => {
             if !(size[0] > 0.0 && size[1] > 0.0) || cells.iter().any(|&c| c < 1) {
                 return Err(("mesh", "a rectangle needs a positive size and at least 1 cell per side".into()));
@@ -169,7 +279,7 @@ pub fn build(s: &DeformableSpec, w: &World2, dir: &Path) -> Result<FeBody, (&'st
             if !p.exists() {
                 return Err(("mesh", format!("mesh file {} not found", p.display())));
             }
-            python::read(&p, 2)
+            python::read(&p, dim)
         }
     }
     .map_err(|e| ("mesh", e.0))?;
@@ -183,7 +293,7 @@ pub fn build(s: &DeformableSpec, w: &World2, dir: &Path) -> Result<FeBody, (&'st
     };
     let a = python::assemble(
         &crate::python::RawMesh {
-            dim: 2,
+            dim,
             points: mesh.x0.clone(),
             cells: mesh.cells.clone(),
         },
@@ -196,43 +306,47 @@ pub fn build(s: &DeformableSpec, w: &World2, dir: &Path) -> Result<FeBody, (&'st
     let mut body = FeBody::new(s.name.clone(), mesh, el, mat as u16, &a.m, &a.k, a.skfem_version).map_err(|m| ("mesh", m))?;
     let fix: Vec<u32> = fixed_nodes(&body.mesh, &s.fix).map_err(|m| ("fix", m))?;
     body.fix_nodes(&fix);
-    match s.velocity.as_slice() {
-        [] => {}
-        [vx, vy] => {
-            for k in 0..body.mesh.n_nodes() {
-                if !body.fixed[2 * k] {
-                    body.v[2 * k] = *vx;
-                    body.v[2 * k + 1] = *vy;
+    match s.velocity.len() {
+        0 => {}
+        n if n == dim => {
+            for (i, v) in body.v.iter_mut().enumerate() {
+                if !body.fixed[i] {
+                    *v = s.velocity[i % dim];
                 }
             }
         }
-        _ => return Err(("velocity", "2 numbers in 2D".into())),
+        _ => return Err(("velocity", format!("{dim} numbers in {dim}D"))),
     }
     Ok(body)
 }
 
-/// Nodes on the named sides (`bottom`, `top`, `left`, `right`) of the mesh's box.
+/// Nodes on the named sides of the mesh's box: `bottom`, `top` (the last axis:
+/// y in 2D, z in 3D), `left`, `right` (x) and, in 3D, `front`, `back` (y).
 pub fn fixed_nodes(m: &Mesh, sides: &[String]) -> Result<Vec<u32>, String> {
-    let n = m.n_nodes();
-    let mut lo = [f64::INFINITY; 2];
-    let mut hi = [f64::NEG_INFINITY; 2];
+    let (n, dim) = (m.n_nodes(), m.dim);
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
     for k in 0..n {
-        for d in 0..2 {
-            lo[d] = lo[d].min(m.x0[2 * k + d]);
-            hi[d] = hi[d].max(m.x0[2 * k + d]);
+        for d in 0..dim {
+            lo[d] = lo[d].min(m.x0[dim * k + d]);
+            hi[d] = hi[d].max(m.x0[dim * k + d]);
         }
     }
-    let tol = 1e-9 * (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    let tol = 1e-9 * (0..dim).map(|d| hi[d] - lo[d]).fold(0.0, f64::max);
+    let up = dim - 1;
     let mut out = vec![];
     for s in sides {
         let (d, v) = match s.as_str() {
-            "bottom" => (1, lo[1]),
-            "top" => (1, hi[1]),
+            "bottom" => (up, lo[up]),
+            "top" => (up, hi[up]),
             "left" => (0, lo[0]),
             "right" => (0, hi[0]),
+            "front" if dim == 3 => (1, lo[1]),
+            "back" if dim == 3 => (1, hi[1]),
+            o if dim == 3 => return Err(format!("unknown side `{o}`: bottom, top, left, right, front or back")),
             o => return Err(format!("unknown side `{o}`: bottom, top, left or right")),
         };
-        out.extend((0..n as u32).filter(|&k| (m.x0[2 * k as usize + d] - v).abs() <= tol));
+        out.extend((0..n as u32).filter(|&k| (m.x0[dim * k as usize + d] - v).abs() <= tol));
     }
     out.sort_unstable();
     out.dedup();
@@ -254,6 +368,22 @@ impl FeScene2 {
                 self.world.step_with(&mut c)?
             }
         };
+        if let Some(e) = self.fe.error.take() {
+            return Err(nscdd::engine::Diverged {
+                step: self.world.step,
+                body: 0,
+                message: e,
+            });
+        }
+        self.fe.update(self.world.time.h, self.world.time.theta, self.world.step)?;
+        Ok(rep)
+    }
+}
+
+impl FeScene3 {
+    /// One time step of the rigid bodies and the deformable bodies (one domain).
+    pub fn step(&mut self) -> Result<nscdd::engine::StepReport, nscdd::engine::Diverged> {
+        let rep = self.world.step_with(&mut self.fe)?;
         if let Some(e) = self.fe.error.take() {
             return Err(nscdd::engine::Diverged {
                 step: self.world.step,

@@ -11,6 +11,7 @@
 
 use crate::body::FeBody;
 use crate::contact2::*;
+pub use crate::nodes::fill_set;
 use nscdd::engine::{ContactStage, Diverged};
 use nscdd::law::target_velocity;
 use nscdd::norms::{natural_map_sq, Norms, Sums};
@@ -229,22 +230,16 @@ impl Deformables2 {
         let c = &self.contacts;
         for a in 0..c.len() {
             let p = global(c.n[a], c.r[a]);
-            let add = |s: &FeSide, sign: f64, sets: &[NodeSet], f: &mut Vec<Vec<f64>>, bodies: &[FeBody]| {
+            let mut add = |s: &FeSide, sign: f64| {
                 let b = s.body as usize;
                 if f[b].is_empty() {
-                    f[b] = vec![0.0; bodies[b].n_dofs()];
+                    f[b] = vec![0.0; self.bodies[b].n_dofs()];
                 }
-                for q in 0..2 {
-                    if s.w[q] != 0.0 {
-                        let node = sets[b].nodes[s.k[q] as usize] as usize;
-                        f[b][2 * node] += sign * s.w[q] * p[0];
-                        f[b][2 * node + 1] += sign * s.w[q] * p[1];
-                    }
-                }
+                self.sets[b].add_side_force(s, p, sign, &mut f[b]);
             };
-            add(&c.cand[a], 1.0, &self.sets, &mut f, &self.bodies);
+            add(&c.cand[a], 1.0);
             if let Anta::Fe(s) = &c.anta[a] {
-                add(s, -1.0, &self.sets, &mut f, &self.bodies);
+                add(s, -1.0);
             }
         }
         for (b, fb) in self.bodies.iter_mut().zip(f) {
@@ -260,28 +255,9 @@ impl Deformables2 {
         }
     }
 
-    /// u⁺ = u⁻ + h((1 − θ)V⁻ + θV⁺); the divergence check names the body and node.
+    /// u⁺ = u⁻ + h((1 − θ)V⁻ + θV⁺) ([`update_bodies`]).
     pub fn update(&mut self, h: f64, theta: f64, step: u64) -> Result<(), Diverged> {
-        for (bi, b) in self.bodies.iter_mut().enumerate() {
-            for i in 0..b.u.len() {
-                b.u[i] += h * ((1.0 - theta) * b.v_begin[i] + theta * b.v[i]);
-            }
-            if let Some(i) = (0..b.u.len()).find(|&i| !(b.u[i].is_finite() && b.v[i].is_finite())) {
-                let d = b.dim();
-                let name = b.name.as_deref().map(|n| format!(" (`{n}`)")).unwrap_or_default();
-                return Err(Diverged {
-                    step,
-                    body: bi as u32,
-                    message: format!(
-                        "deformable body {bi}{name} has a non-finite state at node {} (displacement {}, velocity {})",
-                        i / d,
-                        b.u[i],
-                        b.v[i]
-                    ),
-                });
-            }
-        }
-        Ok(())
+        update_bodies(&mut self.bodies, h, theta, step)
     }
 
     /// Natural-map residual ‖F(r)‖/‖q‖ of the whole step's problem: the world's
@@ -313,6 +289,31 @@ impl Deformables2 {
     }
 }
 
+/// u⁺ = u⁻ + h((1 − θ)V⁻ + θV⁺) of every deformable body; the divergence check
+/// names the body and node.
+pub fn update_bodies(bodies: &mut [FeBody], h: f64, theta: f64, step: u64) -> Result<(), Diverged> {
+    for (bi, b) in bodies.iter_mut().enumerate() {
+        for i in 0..b.u.len() {
+            b.u[i] += h * ((1.0 - theta) * b.v_begin[i] + theta * b.v[i]);
+        }
+        if let Some(i) = (0..b.u.len()).find(|&i| !(b.u[i].is_finite() && b.v[i].is_finite())) {
+            let d = b.dim();
+            let name = b.name.as_deref().map(|n| format!(" (`{n}`)")).unwrap_or_default();
+            return Err(Diverged {
+                step,
+                body: bi as u32,
+                message: format!(
+                    "deformable body {bi}{name} has a non-finite state at node {} (displacement {}, velocity {})",
+                    i / d,
+                    b.u[i],
+                    b.v[i]
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// The law's target ū for a node contact. An open contact (g > 0) may close
 /// exactly its gap within the step, ū = −(g + h(1 − θ)u⁻_n)/(hθ), even when the
 /// free motion predicts a penetration: the framework's Moreau form would then
@@ -324,34 +325,6 @@ pub fn node_target(gap: f64, un_begin: f64, un_free: f64, h: f64, theta: f64, e:
         -(gap + h * (1.0 - theta) * un_begin) / (h * theta)
     } else {
         target_velocity(gap, un_begin, un_free, h, theta, e)
-    }
-}
-
-/// Fills a node set: velocities from the free velocity, G from M̂⁻¹ columns
-/// (scaled by `scale`).
-pub fn fill_set(set: &mut NodeSet, body: &mut FeBody, nodes: &[u32], scale: f64) {
-    let n = nodes.len();
-    let nd = body.n_dofs();
-    set.nodes.clear();
-    set.nodes.extend_from_slice(nodes);
-    set.v.clear();
-    set.v.extend(
-        nodes
-            .iter()
-            .map(|&k| [body.v_free[2 * k as usize], body.v_free[2 * k as usize + 1]]),
-    );
-    set.g.clear();
-    set.g.resize(4 * n * n, 0.0);
-    for (l, &nl) in nodes.iter().enumerate() {
-        let col = body.column(nl);
-        for d in 0..2 {
-            let cd = &col[d * nd..(d + 1) * nd];
-            for (k, &nk) in nodes.iter().enumerate() {
-                for c in 0..2 {
-                    set.g[(2 * k + c) * 2 * n + 2 * l + d] = scale * cd[2 * nk as usize + c];
-                }
-            }
-        }
     }
 }
 

@@ -2,8 +2,8 @@
 
 use nscdd::params::{array, only_keys, positive};
 use nscdd::registry::ParamError;
-use nscdd::registry3::{Aabb3, Glyph3, MassProps3, ShapeStore3};
-use nscdd::rigid3d::bodies::rotate;
+use nscdd::registry3::{Aabb3, FaceContact3, Glyph3, MassProps3, PointContact3, ShapeStore3};
+use nscdd::rigid3d::bodies::{rotate, rotate_inv};
 use std::any::Any;
 use std::f64::consts::PI;
 
@@ -36,6 +36,42 @@ impl ShapeStore3 for Spheres {
         Self::KIND
     }
     store_basics!(|s: &Self| s.radius.len());
+    /// Gap |p − c| − r along the radius through p.
+    fn point_contact(&self, s: u32, x: [f64; 3], _q: [f64; 4], p: [f64; 3]) -> Option<PointContact3> {
+        let r = self.radius[s as usize];
+        let d = [p[0] - x[0], p[1] - x[1], p[2] - x[2]];
+        let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        if l == 0.0 {
+            return None;
+        }
+        let n = [d[0] / l, d[1] / l, d[2] / l];
+        Some(PointContact3 {
+            gap: l - r,
+            normal: n,
+            point: [x[0] + r * n[0], x[1] + r * n[1], x[2] + r * n[2]],
+        })
+    }
+    fn meets_faces(&self) -> bool {
+        true
+    }
+    /// The triangle's closest point to the centre c: gap |q − c| − r.
+    fn face_contact(&self, s: u32, x: [f64; 3], _q: [f64; 4], tri: &[[f64; 3]; 3]) -> Option<FaceContact3> {
+        let r = self.radius[s as usize];
+        let bary = closest_on_triangle(x, tri);
+        let q: [f64; 3] = std::array::from_fn(|c| bary[0] * tri[0][c] + bary[1] * tri[1][c] + bary[2] * tri[2][c]);
+        let d = [q[0] - x[0], q[1] - x[1], q[2] - x[2]];
+        let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        if l == 0.0 {
+            return None;
+        }
+        let n = [d[0] / l, d[1] / l, d[2] / l];
+        Some(FaceContact3 {
+            gap: l - r,
+            normal: n,
+            point: [x[0] + r * n[0], x[1] + r * n[1], x[2] + r * n[2]],
+            bary,
+        })
+    }
     fn push_params(&mut self, p: &toml::Table) -> Result<u32, ParamError> {
         only_keys(p, &["radius"])?;
         self.radius.push(positive(p, "radius", None)?);
@@ -89,6 +125,16 @@ impl ShapeStore3 for Planes {
         Self::KIND
     }
     store_basics!(|s: &Self| s.display.len());
+    /// Signed distance to the plane through x with normal q·e_z.
+    fn point_contact(&self, _s: u32, x: [f64; 3], q: [f64; 4], p: [f64; 3]) -> Option<PointContact3> {
+        let n = rotate(q, [0.0, 0.0, 1.0]);
+        let gap = (p[0] - x[0]) * n[0] + (p[1] - x[1]) * n[1] + (p[2] - x[2]) * n[2];
+        Some(PointContact3 {
+            gap,
+            normal: n,
+            point: [p[0] - gap * n[0], p[1] - gap * n[1], p[2] - gap * n[2]],
+        })
+    }
     fn push_params(&mut self, p: &toml::Table) -> Result<u32, ParamError> {
         only_keys(p, &["display_size"])?;
         self.display.push(positive(p, "display_size", Some(1.0))?);
@@ -160,6 +206,35 @@ impl ShapeStore3 for Boxes {
         Self::KIND
     }
     store_basics!(|s: &Self| s.half.len());
+    /// Outside: the distance to the closest surface point. Inside: the face of
+    /// least penetration (its outward normal, gap minus the depth).
+    fn point_contact(&self, s: u32, x: [f64; 3], q: [f64; 4], p: [f64; 3]) -> Option<PointContact3> {
+        let h = self.half[s as usize];
+        let pl = rotate_inv(q, [p[0] - x[0], p[1] - x[1], p[2] - x[2]]);
+        let c = [pl[0].clamp(-h[0], h[0]), pl[1].clamp(-h[1], h[1]), pl[2].clamp(-h[2], h[2])];
+        let d = [pl[0] - c[0], pl[1] - c[1], pl[2] - c[2]];
+        let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        let (gap, nl, cl) = if l > 0.0 {
+            (l, [d[0] / l, d[1] / l, d[2] / l], c)
+        } else {
+            let k = (0..3)
+                .min_by(|&a, &b| (h[a] - pl[a].abs()).total_cmp(&(h[b] - pl[b].abs())))
+                .unwrap_or(2);
+            let sgn = if pl[k] >= 0.0 { 1.0 } else { -1.0 };
+            let mut n = [0.0; 3];
+            n[k] = sgn;
+            let mut cp = pl;
+            cp[k] = sgn * h[k];
+            (pl[k].abs() - h[k], n, cp)
+        };
+        let n = rotate(q, nl);
+        let cw = rotate(q, cl);
+        Some(PointContact3 {
+            gap,
+            normal: n,
+            point: [x[0] + cw[0], x[1] + cw[1], x[2] + cw[2]],
+        })
+    }
     fn push_params(&mut self, p: &toml::Table) -> Result<u32, ParamError> {
         only_keys(p, &["half_extents"])?;
         let h = array::<3>(p, "half_extents", None)?;
@@ -221,5 +296,67 @@ impl ShapeStore3 for Boxes {
     }
     fn is_grain(&self) -> bool {
         false
+    }
+}
+
+/// Barycentric weights of the point of triangle (a, b, c) closest to p (by the
+/// Voronoi regions of its vertices, edges and face).
+pub fn closest_on_triangle(p: [f64; 3], t: &[[f64; 3]; 3]) -> [f64; 3] {
+    let sub = |u: [f64; 3], v: [f64; 3]| [u[0] - v[0], u[1] - v[1], u[2] - v[2]];
+    let dot = |u: [f64; 3], v: [f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+    let (a, b, c) = (t[0], t[1], t[2]);
+    let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
+    let (d1, d2) = (dot(ab, ap), dot(ac, ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return [1.0, 0.0, 0.0];
+    }
+    let bp = sub(p, b);
+    let (d3, d4) = (dot(ab, bp), dot(ac, bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return [0.0, 1.0, 0.0];
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return [1.0 - v, v, 0.0];
+    }
+    let cp = sub(p, c);
+    let (d5, d6) = (dot(ab, cp), dot(ac, cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return [0.0, 0.0, 1.0];
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return [1.0 - w, 0.0, w];
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return [0.0, 1.0 - w, w];
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let (v, w) = (vb * denom, vc * denom);
+    [1.0 - v - w, v, w]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn closest_point_regions() {
+        let t = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let f = closest_on_triangle([0.2, 0.2, 1.0], &t);
+        assert!((f[0] - 0.6).abs() < 1e-15 && (f[1] - 0.2).abs() < 1e-15 && (f[2] - 0.2).abs() < 1e-15);
+        assert_eq!(closest_on_triangle([-1.0, -1.0, 0.5], &t), [1.0, 0.0, 0.0]);
+        assert_eq!(closest_on_triangle([2.0, -0.1, 0.0], &t), [0.0, 1.0, 0.0]);
+        let e = closest_on_triangle([0.5, -1.0, 0.3], &t);
+        assert!((e[0] - 0.5).abs() < 1e-15 && (e[1] - 0.5).abs() < 1e-15 && e[2] == 0.0);
+        let h = closest_on_triangle([1.0, 1.0, 0.0], &t);
+        assert!(h[0].abs() < 1e-15 && (h[1] - 0.5).abs() < 1e-15 && (h[2] - 0.5).abs() < 1e-15);
+        let s = Spheres { radius: vec![0.5] };
+        let fc = s.face_contact(0, [0.25, 0.25, 0.4], [1.0, 0.0, 0.0, 0.0], &t).unwrap();
+        assert!((fc.gap + 0.1).abs() < 1e-15 && fc.normal == [0.0, 0.0, -1.0]);
     }
 }

@@ -1,0 +1,375 @@
+//! 3D contacts of deformable bodies: boundary nodes against rigid shapes
+//! (node-to-surface through [`nscdd::registry3::ShapeStore3::point_contact`]:
+//! spheres, planes, boxes) and against the boundary triangles of other deformable
+//! bodies (node-to-face).
+//!
+//! A contact α has a candidate side on a deformable body, one boundary node or
+//! (against rigid kinds that meet faces, [`nscdd::registry3::ShapeStore3::meets_faces`]:
+//! spheres) the closest point of a boundary triangle, and an antagonist side: a
+//! rigid body j with the lever arm d = p − x_j of the contact point, or a point
+//! of a boundary triangle (corners a, b, c with barycentric weights) of another
+//! deformable body. A sphere smaller than the mesh (radius below the longest
+//! boundary edge) meets the body at one point, the closest point of its surface,
+//! so that it cannot pass between nodes; larger spheres, planes and boxes meet
+//! the boundary nodes (the pressure spreads over the nodes in contact). Several
+//! face points per small sphere (one per face in a dent) were tried: faces
+//! sharing nodes make a near-singular set of W_αα that NLGS converges on very
+//! slowly (thousands of sweeps for one sphere). The frame is the framework's
+//! B = [n t1 t2] ([`nscdd::rigid3d::contacts::tangents`]), n from the antagonist
+//! to the candidate. The local velocity is u = B (Σ_k w_k v_k)_cand − B v_p,j with
+//! v_p,j = v_j + ω_j × d (rigid) or Σ_k w_k v_k (deformable), and
+//! W_αα = B (Σ_kl w_k w_l G_kl)_cand Bᵀ + (rigid: Bᵀ K_j B, K_j = m⁻¹ + [d]×ᵀ I⁻¹ [d]×;
+//! deformable: the same sum over the face). Node-to-face is one-sided: the nodes
+//! of the body of lower index against the faces of the other (give the finer
+//! mesh the lower index).
+
+use crate::body::FeBody;
+use crate::nodes::{FeSide, NodeSet};
+use nscdd::rigid2d::contacts::Target;
+use nscdd::rigid3d::bodies::cross;
+use nscdd::rigid3d::contacts::{point_velocity, Block3, Frame3};
+use nscdd::rigid3d::coulomb::{self, Sym3};
+use nscdd::rigid3d::Contacts3;
+use nscdd::world3::World3;
+
+pub type FeSide3 = FeSide<3>;
+pub type NodeSet3 = NodeSet<3>;
+pub type Basis = [[f64; 3]; 3];
+
+/// The antagonist of a 3D contact.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Anta3 {
+    /// A rigid body of the world and the lever arm d = p − x_j.
+    Rigid {
+        body: u32,
+        d: [f64; 3],
+    },
+    Fe(FeSide3),
+}
+
+/// Identity of a contact between steps (warm start): deformable body, node,
+/// antagonist (rigid body id, or `1 << 31 | deformable body`), feature (face).
+pub type FeKey = (u32, u32, u32, u32);
+
+/// The contacts of deformable bodies of one step, one `Vec` per field.
+#[derive(Clone, Debug, Default)]
+pub struct FeContacts3 {
+    pub cand: Vec<FeSide3>,
+    pub anta: Vec<Anta3>,
+    pub basis: Vec<Basis>,
+    pub block: Vec<Block3>,
+    pub target: Vec<Target>,
+    pub r: Vec<[f64; 3]>,
+    pub u_free: Vec<[f64; 3]>,
+    pub gap: Vec<f64>,
+    pub point: Vec<[f64; 3]>,
+    pub key: Vec<FeKey>,
+}
+
+impl FeContacts3 {
+    pub fn len(&self) -> usize {
+        self.cand.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.cand.is_empty()
+    }
+    pub fn clear(&mut self) {
+        self.cand.clear();
+        self.anta.clear();
+        self.basis.clear();
+        self.block.clear();
+        self.target.clear();
+        self.r.clear();
+        self.u_free.clear();
+        self.gap.clear();
+        self.point.clear();
+        self.key.clear();
+    }
+}
+
+/// B v (local components of a global vector).
+#[inline(always)]
+pub fn local(b: &Basis, v: [f64; 3]) -> [f64; 3] {
+    b.map(|row| row[0] * v[0] + row[1] * v[1] + row[2] * v[2])
+}
+/// Bᵀ r (global vector of local components).
+#[inline(always)]
+pub fn global(b: &Basis, r: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|c| b[0][c] * r[0] + b[1][c] * r[1] + b[2][c] * r[2])
+}
+
+/// B G Bᵀ of a global 3×3 block, as the symmetric [w00, w01, w02, w11, w12, w22].
+pub fn project(b: &Basis, g: &[[f64; 3]; 3]) -> Sym3 {
+    let e = |p: usize, q: usize| {
+        let mut s = 0.0;
+        for i in 0..3 {
+            for j in 0..3 {
+                s += b[p][i] * g[i][j] * b[q][j];
+            }
+        }
+        s
+    };
+    [e(0, 0), e(0, 1), e(0, 2), e(1, 1), e(1, 2), e(2, 2)]
+}
+
+/// H_jᵀ V_j of a rigid antagonist: B (v_j + ω_j × d).
+#[inline(always)]
+pub fn rigid_local(b: &Basis, d: [f64; 3], v: &[f64; 6]) -> [f64; 3] {
+    local(b, point_velocity(v, d))
+}
+
+/// V_j −= M̂_j⁻¹ H_j Δr of a rigid antagonist.
+#[inline(always)]
+pub fn rigid_apply(b: &Basis, d: [f64; 3], dr: [f64; 3], v: &mut [f64; 6], inv_m: [f64; 3], inv_i: &Sym3) {
+    let p = global(b, dr);
+    let w = coulomb::mul(inv_i, cross(d, p));
+    for k in 0..3 {
+        v[k] -= inv_m[k] * p[k];
+        v[3 + k] -= w[k];
+    }
+}
+
+/// B K_j Bᵀ of a rigid antagonist (the framework's Delassus block with nothing as
+/// the candidate).
+pub fn rigid_delassus(b: &Basis, d: [f64; 3], inv_m: [f64; 3], inv_i: &Sym3) -> Sym3 {
+    let f = Frame3 {
+        basis: *b,
+        d_i: [0.0; 3],
+        d_j: d,
+    };
+    Contacts3::delassus(&f, [0.0; 3], &[0.0; 6], inv_m, inv_i)
+}
+
+/// A contact found by detection, before the node sets exist.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RawFe3 {
+    pub body: u32,
+    pub cand: RawCand3,
+    pub anta: RawAnta3,
+    pub n: [f64; 3],
+    pub gap: f64,
+    pub point: [f64; 3],
+}
+
+/// The candidate side found by detection.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RawCand3 {
+    Node(u32),
+    /// The closest point of a boundary face (index, corners, weights).
+    Face {
+        face: u32,
+        nodes: [u32; 3],
+        w: [f64; 3],
+    },
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RawAnta3 {
+    Rigid(u32),
+    /// A boundary triangle of a deformable body: its index, corners, weights.
+    Face {
+        body: u32,
+        face: u32,
+        nodes: [u32; 3],
+        w: [f64; 3],
+    },
+}
+
+type Bounds = ([f64; 3], [f64; 3]);
+
+fn bounds(b: &FeBody) -> Bounds {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for &k in &b.mesh.boundary {
+        let p = b.position(k as usize);
+        for c in 0..3 {
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
+        }
+    }
+    (lo, hi)
+}
+
+/// The longest boundary edge of a body (reference configuration).
+fn edge_length(b: &FeBody) -> f64 {
+    let m = &b.mesh;
+    let mut l2 = 0.0f64;
+    for f in 0..m.n_facets() {
+        let v = m.facet(f);
+        for (a, c) in [(0, 1), (1, 2), (2, 0)] {
+            let (pa, pc) = (m.node(v[a] as usize), m.node(v[c] as usize));
+            l2 = l2.max((0..3).map(|k| (pa[k] - pc[k]).powi(2)).sum());
+        }
+    }
+    l2.sqrt()
+}
+
+fn inside(p: [f64; 3], b: &Bounds, margin: f64) -> bool {
+    (0..3).all(|c| p[c] >= b.0[c] - margin && p[c] <= b.1[c] + margin)
+}
+
+fn overlap(a: &Bounds, b: &Bounds, margin: f64) -> bool {
+    (0..3).all(|c| a.0[c] <= b.1[c] + margin && b.0[c] <= a.1[c] + margin)
+}
+
+/// Finds node contacts of every deformable body with the rigid bodies of `w`
+/// and with the boundary faces of the other deformable bodies, within `alert`.
+/// Cost: boundary nodes × rigid bodies whose box meets the body's box, and
+/// boundary nodes × faces for each pair of deformable bodies whose boxes meet.
+pub fn detect(w: &World3, fe: &[FeBody], alert: f64, out: &mut Vec<RawFe3>) {
+    out.clear();
+    let boxes: Vec<Bounds> = fe.iter().map(bounds).collect();
+    let spacing: Vec<f64> = fe.iter().map(edge_length).collect();
+    for (fb, body) in fe.iter().enumerate() {
+        let bb = boxes[fb];
+        for rb in 0..w.bodies.len() {
+            let s = w.bodies.shape[rb];
+            let store = &w.shapes[s.kind as usize];
+            let (x, q) = (w.bodies.pos[rb], w.bodies.quat[rb]);
+            let a = store.aabb(s.index, x, q);
+            let ab = (a.min, a.max);
+            if !overlap(&ab, &bb, alert) || w.law(body.material, w.bodies.material[rb]).is_none() {
+                continue;
+            }
+            if store.meets_faces() && store.size(s.index) < spacing[fb] {
+                // one contact at the surface's closest point: several points of
+                // neighbouring faces sharing nodes make a near-singular W_αα set
+                // that NLGS converges on very slowly
+                let mut best: Option<RawFe3> = None;
+                for f in 0..body.mesh.n_facets() {
+                    let nodes = body.mesh.facet(f);
+                    let tri = [0, 1, 2].map(|c| body.position(nodes[c] as usize));
+                    let fb3 = (
+                        std::array::from_fn(|c| tri[0][c].min(tri[1][c]).min(tri[2][c])),
+                        std::array::from_fn(|c| tri[0][c].max(tri[1][c]).max(tri[2][c])),
+                    );
+                    if !overlap(&fb3, &ab, alert) {
+                        continue;
+                    }
+                    let Some(fc) = store.face_contact(s.index, x, q, &tri) else {
+                        continue;
+                    };
+                    if fc.gap > alert {
+                        continue;
+                    }
+                    let rc = RawFe3 {
+                        body: fb as u32,
+                        cand: RawCand3::Face {
+                            face: f as u32,
+                            nodes: [nodes[0], nodes[1], nodes[2]],
+                            w: fc.bary,
+                        },
+                        anta: RawAnta3::Rigid(rb as u32),
+                        // from the antagonist (the rigid shape) to the candidate
+                        n: fc.normal,
+                        gap: fc.gap,
+                        point: fc.point,
+                    };
+                    if best.is_none_or(|b| fc.gap < b.gap) {
+                        best = Some(rc);
+                    }
+                }
+                out.extend(best);
+                continue;
+            }
+            for &k in &body.mesh.boundary {
+                let p = body.position(k as usize);
+                if !inside(p, &ab, alert) {
+                    continue;
+                }
+                if let Some(pc) = store.point_contact(s.index, x, q, p) {
+                    if pc.gap <= alert {
+                        out.push(RawFe3 {
+                            body: fb as u32,
+                            cand: RawCand3::Node(k),
+                            anta: RawAnta3::Rigid(rb as u32),
+                            n: pc.normal,
+                            gap: pc.gap,
+                            point: pc.point,
+                        });
+                    }
+                }
+            }
+        }
+        for (ob, other) in fe.iter().enumerate().skip(fb + 1) {
+            let o = boxes[ob];
+            if !overlap(&o, &bb, alert) || w.law(body.material, other.material).is_none() {
+                continue;
+            }
+            for &k in &body.mesh.boundary {
+                let p = body.position(k as usize);
+                if !inside(p, &o, alert) {
+                    continue;
+                }
+                if let Some((face, nodes, wts, n, gap, q)) = nearest_face(other, p, alert) {
+                    out.push(RawFe3 {
+                        body: fb as u32,
+                        cand: RawCand3::Node(k),
+                        anta: RawAnta3::Face {
+                            body: ob as u32,
+                            face,
+                            nodes,
+                            w: wts,
+                        },
+                        n,
+                        gap,
+                        point: q,
+                    });
+                }
+            }
+        }
+    }
+}
+
+type FaceHit = (u32, [u32; 3], [f64; 3], [f64; 3], f64, [f64; 3]);
+
+/// The boundary triangle of `b` closest to p with p projecting inside it, within
+/// (−edge length, alert]: (face, corners, barycentric weights, outward normal,
+/// gap, projected point).
+fn nearest_face(b: &FeBody, p: [f64; 3], alert: f64) -> Option<FaceHit> {
+    let mut best: Option<FaceHit> = None;
+    for s in 0..b.mesh.n_facets() {
+        let f = b.mesh.facet(s);
+        let (pa, pb, pc) = (b.position(f[0] as usize), b.position(f[1] as usize), b.position(f[2] as usize));
+        let e1 = sub(pb, pa);
+        let e2 = sub(pc, pa);
+        let nn = cross(e1, e2);
+        let area2 = dot(nn, nn).sqrt();
+        if area2 == 0.0 {
+            continue;
+        }
+        let n = nn.map(|x| x / area2);
+        let ap = sub(p, pa);
+        let gap = dot(ap, n);
+        let size = dot(e1, e1).sqrt().max(dot(e2, e2).sqrt());
+        if gap > alert || gap < -size {
+            continue;
+        }
+        // barycentric coordinates of the projection
+        let (d11, d12, d22) = (dot(e1, e1), dot(e1, e2), dot(e2, e2));
+        let (d1p, d2p) = (dot(e1, ap), dot(e2, ap));
+        let det = d11 * d22 - d12 * d12;
+        let xi = (d22 * d1p - d12 * d2p) / det;
+        let eta = (d11 * d2p - d12 * d1p) / det;
+        let tol = -1e-12;
+        if xi < tol || eta < tol || xi + eta > 1.0 - tol {
+            continue;
+        }
+        if best.is_none_or(|bst| gap.abs() < bst.4.abs()) {
+            let q = [
+                pa[0] + xi * e1[0] + eta * e2[0],
+                pa[1] + xi * e1[1] + eta * e2[1],
+                pa[2] + xi * e1[2] + eta * e2[2],
+            ];
+            best = Some((s as u32, [f[0], f[1], f[2]], [1.0 - xi - eta, xi, eta], n, gap, q));
+        }
+    }
+    best
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}

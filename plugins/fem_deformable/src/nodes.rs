@@ -1,0 +1,158 @@
+//! The nodes of a deformable body touched by a step's contacts, in any dimension D.
+//!
+//! A contact side on a deformable body is a point of its boundary written with
+//! D node weights ([`FeSide`]): one node (weights (1, 0, …)) for a candidate node,
+//! the ends of a segment (2D) or the corners of a triangle (3D) for an antagonist
+//! facet. Its velocity is Σ_k w_k v_k and an impulse P applied to it adds w_k P
+//! to node k.
+//!
+//! The velocities of the nodes in contact are tracked through the dense block G
+//! of M̂⁻¹ among them ([`NodeSet`]): an impulse P at node k changes every contact
+//! node l of the same body by G_lk P, so one NLGS update costs O(n_c) and never
+//! solves with M̂. G is filled from columns of M̂⁻¹ ([`crate::body::FeBody::column`],
+//! cached while a node stays in contact).
+
+use crate::body::FeBody;
+
+/// One side made of deformable-body nodes: body (index among the deformable
+/// bodies), indices of the nodes in that body's [`NodeSet`], weights.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FeSide<const D: usize> {
+    pub body: u32,
+    pub k: [u32; D],
+    pub w: [f64; D],
+}
+
+impl<const D: usize> FeSide<D> {
+    /// The side of a single node (set index k).
+    pub fn node(body: u32, k: u32) -> Self {
+        let mut w = [0.0; D];
+        w[0] = 1.0;
+        FeSide { body, k: [k; D], w }
+    }
+}
+
+/// Nodes of one body in contact, their current velocities and G
+/// (`g[(D k + c) · D n + D l + d]` = entry (c, d) of the block G_kl), scaled by the
+/// multiplicity of a copy when the body is shared by subdomains.
+#[derive(Clone, Debug, Default)]
+pub struct NodeSet<const D: usize> {
+    pub nodes: Vec<u32>,
+    pub v: Vec<[f64; D]>,
+    pub g: Vec<f64>,
+}
+
+impl<const D: usize> NodeSet<D> {
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+    /// G_kl.
+    #[inline(always)]
+    pub fn block(&self, k: usize, l: usize) -> [[f64; D]; D] {
+        let nd = D * self.nodes.len();
+        let mut b = [[0.0; D]; D];
+        for (c, row) in b.iter_mut().enumerate() {
+            let r0 = (D * k + c) * nd + D * l;
+            row.copy_from_slice(&self.g[r0..r0 + D]);
+        }
+        b
+    }
+    /// v_l += G_lk p for every node l of the set (G symmetric: row k is read).
+    #[inline(always)]
+    pub fn apply(&mut self, k: usize, p: [f64; D]) {
+        let nd = D * self.nodes.len();
+        for (d, &pd) in p.iter().enumerate() {
+            if pd == 0.0 {
+                continue;
+            }
+            let row = &self.g[(D * k + d) * nd..(D * k + d + 1) * nd];
+            for (l, v) in self.v.iter_mut().enumerate() {
+                for c in 0..D {
+                    v[c] += row[D * l + c] * pd;
+                }
+            }
+        }
+    }
+    /// The velocity of a side: Σ w_k v_k.
+    #[inline(always)]
+    pub fn side_velocity(&self, s: &FeSide<D>) -> [f64; D] {
+        let mut u = [0.0; D];
+        for q in 0..D {
+            if s.w[q] != 0.0 {
+                let v = self.v[s.k[q] as usize];
+                for c in 0..D {
+                    u[c] += s.w[q] * v[c];
+                }
+            }
+        }
+        u
+    }
+    /// Applies the impulse p (global frame) to a side.
+    #[inline(always)]
+    pub fn apply_side(&mut self, s: &FeSide<D>, p: [f64; D]) {
+        for q in 0..D {
+            if s.w[q] != 0.0 {
+                self.apply(s.k[q] as usize, p.map(|x| s.w[q] * x));
+            }
+        }
+    }
+    /// Σ_kl w_k w_l G_kl: the side's share of the Delassus block (global frame).
+    pub fn side_block(&self, s: &FeSide<D>) -> [[f64; D]; D] {
+        let mut g = [[0.0; D]; D];
+        for p in 0..D {
+            for q in 0..D {
+                let ww = s.w[p] * s.w[q];
+                if ww != 0.0 {
+                    let b = self.block(s.k[p] as usize, s.k[q] as usize);
+                    for c in 0..D {
+                        for d in 0..D {
+                            g[c][d] += ww * b[c][d];
+                        }
+                    }
+                }
+            }
+        }
+        g
+    }
+    /// Adds `sign · w_k p` to the nodal force vector `f` (node-major dofs) of the
+    /// body this set belongs to.
+    pub fn add_side_force(&self, s: &FeSide<D>, p: [f64; D], sign: f64, f: &mut [f64]) {
+        for q in 0..D {
+            if s.w[q] != 0.0 {
+                let node = self.nodes[s.k[q] as usize] as usize;
+                for c in 0..D {
+                    f[D * node + c] += sign * s.w[q] * p[c];
+                }
+            }
+        }
+    }
+}
+
+/// Fills a node set: velocities from the free velocity, G from M̂⁻¹ columns
+/// (scaled by `scale`).
+pub fn fill_set<const D: usize>(set: &mut NodeSet<D>, body: &mut FeBody, nodes: &[u32], scale: f64) {
+    debug_assert_eq!(body.dim(), D);
+    let n = nodes.len();
+    let nd = body.n_dofs();
+    set.nodes.clear();
+    set.nodes.extend_from_slice(nodes);
+    set.v.clear();
+    set.v
+        .extend(nodes.iter().map(|&k| std::array::from_fn(|c| body.v_free[D * k as usize + c])));
+    set.g.clear();
+    set.g.resize(D * D * n * n, 0.0);
+    for (l, &nl) in nodes.iter().enumerate() {
+        let col = body.column(nl);
+        for d in 0..D {
+            let cd = &col[d * nd..(d + 1) * nd];
+            for (k, &nk) in nodes.iter().enumerate() {
+                for c in 0..D {
+                    set.g[(D * k + c) * D * n + D * l + d] = scale * cd[D * nk as usize + c];
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,396 @@
+//! The deformable bodies of a 3D world as a contact stage of its time step: the
+//! 3D counterpart of [`crate::stage2`], with the same steps (free velocities and
+//! detection after the rigid free velocity; node sets, G blocks, W_αα, targets
+//! and warm start after the rigid contact set; one NLGS sweep over the rigid
+//! contacts (the framework's, unchanged) then over the deformable ones, sums
+//! merged; V⁺ by one solve per body touched; u⁺ by [`crate::stage2::update_bodies`]).
+//! The local problem of a contact is the framework's 3D Coulomb solver
+//! ([`nscdd::rigid3d::coulomb`]).
+
+use crate::body::FeBody;
+use crate::contact3::*;
+use crate::nodes::fill_set;
+use crate::stage2::{node_target, update_bodies, FeTimes};
+use nscdd::engine::{ContactStage, Diverged};
+use nscdd::norms::{natural_map_sq, Norms, Sums};
+use nscdd::rigid2d::contacts::Target;
+use nscdd::rigid3d::contacts::{tangents, Block3};
+use nscdd::rigid3d::coulomb::{self, Sym3};
+use nscdd::rigid3d::nlgs;
+use nscdd::solver::SolveReport;
+use nscdd::world3::World3;
+use std::time::Instant;
+
+/// The deformable bodies of a 3D scene and their contacts.
+#[derive(Default)]
+pub struct Deformables3 {
+    pub bodies: Vec<FeBody>,
+    pub contacts: FeContacts3,
+    pub sets: Vec<NodeSet3>,
+    pub alert: f64,
+    pub times: FeTimes,
+    raw: Vec<RawFe3>,
+    prev: Vec<(FeKey, [f64; 3])>,
+    /// A failure inside the step (a refactorization), reported after it.
+    pub error: Option<String>,
+}
+
+/// The rigid bodies' M̂⁻¹ as the sweep reads them.
+#[derive(Clone, Copy)]
+pub struct RigidInv<'a> {
+    pub m: &'a [[f64; 3]],
+    pub i: &'a [Sym3],
+}
+
+impl Deformables3 {
+    pub fn new(bodies: Vec<FeBody>, alert: f64) -> Self {
+        let n = bodies.len();
+        Deformables3 {
+            bodies,
+            sets: vec![NodeSet3::default(); n],
+            alert,
+            ..Default::default()
+        }
+    }
+
+    /// Free velocities (factoring M̂ first if h or θ changed) and detection.
+    pub fn begin_step(&mut self, w: &World3) -> Result<(), String> {
+        let (h, theta) = (w.time.h, w.time.theta);
+        self.times = FeTimes::default();
+        let t0 = Instant::now();
+        for b in &mut self.bodies {
+            b.factorize(h, theta)?;
+        }
+        let t1 = Instant::now();
+        for b in &mut self.bodies {
+            b.free_velocity(h, theta);
+        }
+        let t2 = Instant::now();
+        detect(w, &self.bodies, self.alert, &mut self.raw);
+        let t3 = Instant::now();
+        self.times.factor = (t1 - t0).as_secs_f64();
+        self.times.free = (t2 - t1).as_secs_f64();
+        self.times.detect = (t3 - t2).as_secs_f64();
+        Ok(())
+    }
+
+    /// Builds the node sets, their G blocks and the contacts (frames, W_αα, ū, warm
+    /// start), from the raw contacts of [`Self::begin_step`].
+    pub fn build(&mut self, w: &mut World3) {
+        let t0 = Instant::now();
+        let solves0: u64 = self.bodies.iter().map(|b| b.solves).sum();
+        let mut nodes: Vec<Vec<u32>> = vec![vec![]; self.bodies.len()];
+        for rc in &self.raw {
+            match rc.cand {
+                RawCand3::Node(k) => nodes[rc.body as usize].push(k),
+                RawCand3::Face { nodes: f, .. } => nodes[rc.body as usize].extend(f),
+            }
+            if let RawAnta3::Face { body, nodes: f, .. } = rc.anta {
+                nodes[body as usize].extend(f);
+            }
+        }
+        for (bi, ns) in nodes.iter_mut().enumerate() {
+            ns.sort_unstable();
+            ns.dedup();
+            let body = &mut self.bodies[bi];
+            body.retain_columns(ns);
+            fill_set(&mut self.sets[bi], body, ns, 1.0);
+        }
+        let (h, theta) = (w.time.h, w.time.theta);
+        self.prev.clear();
+        self.prev
+            .extend(self.contacts.key.iter().copied().zip(self.contacts.r.iter().copied()));
+        self.prev.sort_unstable_by_key(|x| x.0);
+        let c = &mut self.contacts;
+        c.clear();
+        let v_begin = w.velocity_begin();
+        let vb3 = |b: &FeBody, k: u32| -> [f64; 3] { std::array::from_fn(|q| b.v_begin[3 * k as usize + q]) };
+        for rc in &self.raw {
+            let bi = rc.body as usize;
+            let set = &self.sets[bi];
+            let body = &self.bodies[bi];
+            let (cand, vbi, cand_key) = match rc.cand {
+                RawCand3::Node(node) => {
+                    let k = set.nodes.binary_search(&node).unwrap() as u32;
+                    (FeSide3::node(rc.body, k), vb3(body, node), node)
+                }
+                RawCand3::Face { face, nodes: f, w: wts } => {
+                    let k = f.map(|x| set.nodes.binary_search(&x).unwrap() as u32);
+                    let mut v = [0.0; 3];
+                    for (q, &node) in f.iter().enumerate() {
+                        let vn = vb3(body, node);
+                        for c in 0..3 {
+                            v[c] += wts[q] * vn[c];
+                        }
+                    }
+                    (FeSide3 { body: rc.body, k, w: wts }, v, 1 << 31 | face)
+                }
+            };
+            let (t1, t2) = tangents(rc.n);
+            let basis: Basis = [rc.n, t1, t2];
+            let ub_i = local(&basis, vbi);
+            let uf_i = local(&basis, set.side_velocity(&cand));
+            let mut wb = project(&basis, &set.side_block(&cand));
+            let (anta, ub_j, uf_j, mat_j, key_j, feature) = match rc.anta {
+                RawAnta3::Rigid(j) => {
+                    let ju = j as usize;
+                    let x = w.bodies.pos[ju];
+                    let d = [rc.point[0] - x[0], rc.point[1] - x[1], rc.point[2] - x[2]];
+                    let wr = rigid_delassus(&basis, d, w.bodies.inv_m[ju], &w.bodies.inv_i[ju]);
+                    for q in 0..6 {
+                        wb[q] += wr[q];
+                    }
+                    (
+                        Anta3::Rigid { body: j, d },
+                        rigid_local(&basis, d, &v_begin[ju]),
+                        rigid_local(&basis, d, &w.bodies.vel[ju]),
+                        w.bodies.material[ju],
+                        j,
+                        0,
+                    )
+                }
+                RawAnta3::Face {
+                    body: ob,
+                    face,
+                    nodes: f,
+                    w: wts,
+                } => {
+                    let os = &self.sets[ob as usize];
+                    let kk = f.map(|x| os.nodes.binary_search(&x).unwrap() as u32);
+                    let side = FeSide3 { body: ob, k: kk, w: wts };
+                    let wo = project(&basis, &os.side_block(&side));
+                    for q in 0..6 {
+                        wb[q] += wo[q];
+                    }
+                    let other = &self.bodies[ob as usize];
+                    let mut vbeg = [0.0; 3];
+                    for (q, &node) in f.iter().enumerate() {
+                        let v = vb3(other, node);
+                        for c in 0..3 {
+                            vbeg[c] += wts[q] * v[c];
+                        }
+                    }
+                    (
+                        Anta3::Fe(side),
+                        local(&basis, vbeg),
+                        local(&basis, os.side_velocity(&side)),
+                        other.material,
+                        1 << 31 | ob,
+                        face,
+                    )
+                }
+            };
+            if !(wb[0] > 0.0) {
+                continue;
+            }
+            let Some(law) = w.law(body.material, mat_j) else { continue };
+            let u_begin: [f64; 3] = std::array::from_fn(|q| ub_i[q] - ub_j[q]);
+            let u_free: [f64; 3] = std::array::from_fn(|q| uf_i[q] - uf_j[q]);
+            let key = (rc.body, cand_key, key_j, feature);
+            let r = match self.prev.binary_search_by_key(&key, |x| x.0) {
+                Ok(p) => self.prev[p].1,
+                Err(_) => [0.0; 3],
+            };
+            c.cand.push(cand);
+            c.anta.push(anta);
+            c.basis.push(basis);
+            c.block.push(Block3 {
+                w: wb,
+                pre: coulomb::precompute(&wb),
+            });
+            c.target.push(Target {
+                u_target: node_target(rc.gap, u_begin[0], u_free[0], h, theta, law.e),
+                mu: law.mu,
+            });
+            c.r.push(r);
+            c.u_free.push(u_free);
+            c.gap.push(rc.gap);
+            c.point.push(rc.point);
+            c.key.push(key);
+        }
+        let inv = RigidInv {
+            m: &w.bodies.inv_m,
+            i: &w.bodies.inv_i,
+        };
+        for a in 0..c.len() {
+            let r = c.r[a];
+            if r != [0.0; 3] {
+                apply(&mut self.sets, &mut w.bodies.vel, inv, c.cand[a], c.anta[a], &c.basis[a], r);
+            }
+        }
+        let solves1: u64 = self.bodies.iter().map(|b| b.solves).sum();
+        self.times.solves = solves1.saturating_sub(solves0);
+        self.times.columns = t0.elapsed().as_secs_f64();
+    }
+
+    /// V⁺ of the deformable bodies from their free velocity and the impulses.
+    pub fn finish_velocities(&mut self) {
+        let mut f: Vec<Vec<f64>> = self.bodies.iter().map(|_| Vec::new()).collect();
+        let c = &self.contacts;
+        for a in 0..c.len() {
+            let p = global(&c.basis[a], c.r[a]);
+            let mut add = |s: &FeSide3, sign: f64| {
+                let b = s.body as usize;
+                if f[b].is_empty() {
+                    f[b] = vec![0.0; self.bodies[b].n_dofs()];
+                }
+                self.sets[b].add_side_force(s, p, sign, &mut f[b]);
+            };
+            add(&c.cand[a], 1.0);
+            if let Anta3::Fe(s) = &c.anta[a] {
+                add(s, -1.0);
+            }
+        }
+        for (b, mut fb) in self.bodies.iter_mut().zip(f) {
+            let mut v = b.v_free.clone();
+            if !fb.is_empty() {
+                b.solve_in_place(&mut fb);
+                for (vi, d) in v.iter_mut().zip(&fb) {
+                    *vi += d;
+                }
+            }
+            b.v = v;
+        }
+    }
+
+    /// u⁺ = u⁻ + h((1 − θ)V⁻ + θV⁺).
+    pub fn update(&mut self, h: f64, theta: f64, step: u64) -> Result<(), Diverged> {
+        update_bodies(&mut self.bodies, h, theta, step)
+    }
+
+    /// Natural-map residual ‖F(r)‖/‖q‖ of the whole step's problem (rigid and
+    /// deformable contacts).
+    pub fn residual(&self, w: &World3) -> f64 {
+        let (f1, q1) = nlgs::residual_parts(&w.contacts, &w.bodies.vel);
+        let (f2, q2) = self.residual_parts(&w.bodies.vel);
+        let (f, q) = (f1 + f2, q1 + q2);
+        if q == 0.0 {
+            f.sqrt()
+        } else {
+            (f / q).sqrt()
+        }
+    }
+
+    /// (‖F(r)‖², ‖q‖²) of the deformable contacts.
+    pub fn residual_parts(&self, vel: &[[f64; 6]]) -> (f64, f64) {
+        let c = &self.contacts;
+        let (mut f2, mut q2) = (0.0, 0.0);
+        for a in 0..c.len() {
+            let t = c.target[a];
+            let mut u = local_velocity(&self.sets, vel, c.cand[a], c.anta[a], &c.basis[a]);
+            u[0] -= t.u_target;
+            f2 += natural_map_sq(&c.r[a], &u, t.mu);
+            let q = [c.u_free[a][0] - t.u_target, c.u_free[a][1], c.u_free[a][2]];
+            q2 += q[0] * q[0] + q[1] * q[1] + q[2] * q[2];
+        }
+        (f2, q2)
+    }
+}
+
+/// u_α of a deformable contact from the current velocities.
+#[inline(always)]
+pub fn local_velocity(sets: &[NodeSet3], vel: &[[f64; 6]], cand: FeSide3, anta: Anta3, b: &Basis) -> [f64; 3] {
+    let ui = local(b, sets[cand.body as usize].side_velocity(&cand));
+    let uj = match anta {
+        Anta3::Rigid { body, d } => rigid_local(b, d, &vel[body as usize]),
+        Anta3::Fe(s) => local(b, sets[s.body as usize].side_velocity(&s)),
+    };
+    [ui[0] - uj[0], ui[1] - uj[1], ui[2] - uj[2]]
+}
+
+/// Applies the impulse increment Δr of a deformable contact to both sides.
+#[inline(always)]
+pub fn apply(sets: &mut [NodeSet3], vel: &mut [[f64; 6]], inv: RigidInv<'_>, cand: FeSide3, anta: Anta3, b: &Basis, dr: [f64; 3]) {
+    let p = global(b, dr);
+    sets[cand.body as usize].apply_side(&cand, p);
+    match anta {
+        Anta3::Rigid { body, d } => {
+            let j = body as usize;
+            rigid_apply(b, d, dr, &mut vel[j], inv.m[j], &inv.i[j])
+        }
+        Anta3::Fe(s) => sets[s.body as usize].apply_side(&s, p.map(|x| -x)),
+    }
+}
+
+/// One NLGS sweep over the deformable contacts (storage order), as the rigid
+/// sweep: u0 = u − W_αα r, local solve, relaxation, update of both sides.
+pub fn sweep(c: &mut FeContacts3, sets: &mut [NodeSet3], vel: &mut [[f64; 6]], inv: RigidInv<'_>, omega: f64, mut sums: Option<&mut Sums>) {
+    for a in 0..c.len() {
+        let (cand, anta, b) = (c.cand[a], c.anta[a], c.basis[a]);
+        let u = local_velocity(sets, vel, cand, anta, &b);
+        let r = c.r[a];
+        let blk = c.block[a];
+        let wr_old = coulomb::mul(&blk.w, r);
+        let u0 = [u[0] - wr_old[0], u[1] - wr_old[1], u[2] - wr_old[2]];
+        let t = c.target[a];
+        let mut rn = coulomb::solve_pre_warm(&blk.w, &blk.pre, u0, t.u_target, t.mu, r);
+        if omega != 1.0 {
+            for k in 0..3 {
+                rn[k] = omega * rn[k] + (1.0 - omega) * r[k];
+            }
+        }
+        let dr = [rn[0] - r[0], rn[1] - r[1], rn[2] - r[2]];
+        if let Some(s) = sums.as_deref_mut() {
+            let wr = coulomb::mul(&blk.w, rn);
+            let du = [wr[0] - wr_old[0], wr[1] - wr_old[1], wr[2] - wr_old[2]];
+            s.add(&r, &rn, &du, &wr_old, &wr);
+        }
+        if dr != [0.0; 3] {
+            c.r[a] = rn;
+            apply(sets, vel, inv, cand, anta, &b, dr);
+        }
+    }
+}
+
+impl ContactStage<World3> for Deformables3 {
+    fn after_free_velocity(&mut self, w: &World3) {
+        if let Err(e) = self.begin_step(w) {
+            self.error = Some(e);
+        }
+    }
+    fn prepare(&mut self, w: &mut World3) {
+        self.build(w);
+    }
+    fn solve(&mut self, w: &mut World3) -> SolveReport {
+        let t0 = Instant::now();
+        let s = w.solver.clone();
+        let order: Vec<u32> = <nscdd::dd::Rigid3 as nscdd::dd::Family>::order(w).to_vec();
+        let mut report = SolveReport::default();
+        if w.contacts.is_empty() && self.contacts.is_empty() {
+            report.converged = true;
+        } else {
+            let k = s.check_every.max(1);
+            while report.sweeps < s.max_sweeps {
+                report.sweeps += 1;
+                let check = report.sweeps % k == 0 || report.sweeps == s.max_sweeps;
+                let mut sums = Sums::default();
+                let mut sm = check.then_some(&mut sums);
+                let b = &mut w.bodies;
+                nlgs::sweep(
+                    &mut w.contacts,
+                    &mut b.vel,
+                    &b.inv_m,
+                    &b.inv_i,
+                    &order,
+                    s.relaxation,
+                    sm.as_deref_mut(),
+                );
+                let inv = RigidInv { m: &b.inv_m, i: &b.inv_i };
+                sweep(&mut self.contacts, &mut self.sets, &mut b.vel, inv, s.relaxation, sm);
+                if check {
+                    report.norms = Norms::from_sums(&sums, s.tolerance);
+                    if report.norms.converged(s.norm) {
+                        report.converged = true;
+                        break;
+                    }
+                }
+            }
+        }
+        report.residual = self.residual(w);
+        let t1 = Instant::now();
+        self.finish_velocities();
+        self.times.nlgs = (t1 - t0).as_secs_f64();
+        self.times.update = t1.elapsed().as_secs_f64();
+        report
+    }
+}
