@@ -275,6 +275,39 @@ impl FeBody {
         &self.columns[&node]
     }
 
+    /// Solves the columns of the nodes of `nodes` not cached yet in one solve with
+    /// many right-hand sides (the factor is traversed once for all of them: several
+    /// times faster per column than one by one on 3D meshes).
+    pub fn ensure_columns(&mut self, nodes: &[u32]) {
+        let missing: Vec<u32> = nodes.iter().copied().filter(|k| !self.columns.contains_key(k)).collect();
+        let (d, n) = (self.dim(), self.n_dofs());
+        // in blocks, to bound the memory of the dense right-hand side
+        for chunk in missing.chunks(64) {
+            let mut m = Mat::<f64>::zeros(n, d * chunk.len());
+            for (j, &node) in chunk.iter().enumerate() {
+                for c in 0..d {
+                    let r = d * node as usize + c;
+                    if !self.fixed[r] {
+                        m[(r, d * j + c)] = 1.0;
+                    }
+                }
+            }
+            let llt = self.factor.as_ref().expect("M̂ is factored before any solve");
+            llt.solve_in_place(m.as_mut());
+            for (j, &node) in chunk.iter().enumerate() {
+                let mut out = vec![0.0; d * n];
+                for c in 0..d {
+                    let col = m.col(d * j + c);
+                    for (r, x) in out[c * n..(c + 1) * n].iter_mut().enumerate() {
+                        *x = if self.fixed[r] { 0.0 } else { col[r] };
+                    }
+                }
+                self.columns.insert(node, out);
+            }
+            self.solves += (d * chunk.len()) as u64;
+        }
+    }
+
     /// Keeps the cached columns of `keep` only (memory bound between steps).
     pub fn retain_columns(&mut self, keep: &[u32]) {
         self.columns.retain(|k, _| keep.binary_search(k).is_ok());

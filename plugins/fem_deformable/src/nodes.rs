@@ -135,6 +135,7 @@ impl<const D: usize> NodeSet<D> {
 /// (scaled by `scale`).
 pub fn fill_set<const D: usize>(set: &mut NodeSet<D>, body: &mut FeBody, nodes: &[u32], scale: f64) {
     debug_assert_eq!(body.dim(), D);
+    body.ensure_columns(nodes);
     let n = nodes.len();
     let nd = body.n_dofs();
     set.nodes.clear();
