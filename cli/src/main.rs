@@ -230,6 +230,7 @@ fn main() -> ExitCode {
     };
     let mut reg = nscdd_rigid_disks::registry();
     reg.add_plugin(&nscdd_spheres::SpheresPlugin);
+    reg.add_plugin(&nscdd_polyhedra::PolyhedraPlugin);
     #[cfg(feature = "fem")]
     match &cli.cmd {
         Cmd::Check { scene } if fem::has_deformable(scene) => return fem::check(scene, &reg),

@@ -84,6 +84,14 @@ pub trait ShapeStore3: Any + Send + Sync {
     /// of the shape's surface. Kinds that implement it meet deformable bodies by
     /// their faces instead of by the bodies' nodes (round grains smaller than the
     /// mesh would otherwise pass between nodes).
+    /// Where the shape's principal frame (centroid, principal axes) lies in the frame
+    /// its parameters were given in, as (centroid, unit quaternion): a body placed at
+    /// (x, q) in that frame is stored at x + q·c with orientation q ⊗ q_c, so that
+    /// its position is its centre of mass. Identity for shapes described in their
+    /// principal frame.
+    fn principal_frame(&self, _s: u32) -> ([f64; 3], [f64; 4]) {
+        ([0.0; 3], [1.0, 0.0, 0.0, 0.0])
+    }
     /// Whether this kind implements [`Self::face_contact`].
     fn meets_faces(&self) -> bool {
         false

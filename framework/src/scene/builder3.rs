@@ -72,20 +72,20 @@ impl<'r> SceneBuilder3<'r> {
     /// Adds a body whose shape is `shape` (already in its store); mass and inertia
     /// from the shape and the material's density; orientation as a rotation vector.
     pub fn add_body(&mut self, shape: ShapeRef, material: u16, pos: [f64; 3], rotation: [f64; 3], vel: [f64; 6]) -> u32 {
-        let mp = self.shapes[shape.kind as usize].mass_properties(shape.index, self.materials[material as usize].density);
+        let store = &self.shapes[shape.kind as usize];
+        let mp = store.mass_properties(shape.index, self.materials[material as usize].density);
+        let (c, qc) = store.principal_frame(shape.index);
+        let mut q = from_rotation_vector(rotation);
+        let mut pos = pos;
+        if (c, qc) != ([0.0; 3], [1.0, 0.0, 0.0, 0.0]) {
+            let dc = crate::rigid3d::bodies::rotate(q, c);
+            pos = [pos[0] + dc[0], pos[1] + dc[1], pos[2] + dc[2]];
+            q = crate::rigid3d::bodies::normalize(crate::rigid3d::bodies::quat_mul(q, qc));
+        }
         self.names.push(None);
         self.fixed.push(false);
         self.origins.push(self.origin);
-        self.bodies.push(
-            pos,
-            from_rotation_vector(rotation),
-            vel,
-            mp.mass,
-            mp.inertia,
-            mp.volume,
-            shape,
-            material,
-        )
+        self.bodies.push(pos, q, vel, mp.mass, mp.inertia, mp.volume, shape, material)
     }
 
     /// Makes a body immovable.

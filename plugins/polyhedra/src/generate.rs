@@ -1,0 +1,138 @@
+//! Masonry generators: a running-bond brick wall and a semicircular arch of
+//! radial voussoirs on two fixed supports.
+
+use crate::shapes::Polyhedra;
+use nscdd::params::{array, count, only_keys, positive};
+use nscdd::registry::ParamError;
+use nscdd::registry3::Generator3;
+use nscdd::rigid2d::bodies::ShapeRef;
+use nscdd::scene::builder3::SceneBuilder3;
+
+/// The 8 corners of a box [lo, hi].
+pub fn box_points(lo: [f64; 3], hi: [f64; 3]) -> Vec<[f64; 3]> {
+    let mut v = vec![];
+    for x in [lo[0], hi[0]] {
+        for y in [lo[1], hi[1]] {
+            for z in [lo[2], hi[2]] {
+                v.push([x, y, z]);
+            }
+        }
+    }
+    v
+}
+
+/// Adds a polyhedron body from world points (its pose: centroid, principal axes).
+pub fn add_points(out: &mut SceneBuilder3<'_>, points: &[[f64; 3]], material: u16, fixed: bool) -> Result<u32, ParamError> {
+    let kind = out.kind(Polyhedra::KIND).expect("the plugin registers polyhedra");
+    let index = out
+        .store_mut::<Polyhedra>(kind)
+        .expect("polyhedron store")
+        .push_points(points)
+        .map_err(|m| ParamError::new("kind", m))?;
+    let b = out.add_body(ShapeRef { kind, index }, material, [0.0; 3], [0.0; 3], [0.0; 6]);
+    if fixed {
+        out.set_fixed(b);
+    }
+    Ok(b)
+}
+
+/// `brick_wall`: `courses` courses of `bricks` bricks of size `brick` = [L, W, H]
+/// (x, y, z) in running bond (odd courses start and end with a half brick), from
+/// `origin` (the wall's lower front-left corner); `base_material` adds a fixed
+/// base slab under it (2L wider than the wall, H thick).
+pub struct BrickWall;
+
+impl Generator3 for BrickWall {
+    fn generate(&self, p: &toml::Table, out: &mut SceneBuilder3<'_>) -> Result<(), ParamError> {
+        only_keys(p, &["kind", "material", "brick", "courses", "bricks", "origin", "base_material"])?;
+        let material = out.material_param(p, "material")?;
+        let [l, w, h] = array::<3>(p, "brick", None)?;
+        if ![l, w, h].iter().all(|x| *x > 0.0 && x.is_finite()) {
+            return Err(ParamError::new("brick", "3 positive sizes [L, W, H]"));
+        }
+        let (courses, n) = (count(p, "courses", None)?, count(p, "bricks", None)?);
+        let o = array::<3>(p, "origin", Some([0.0; 3]))?;
+        if p.contains_key("base_material") {
+            let bm = out.material_param(p, "base_material")?;
+            let lo = [o[0] - l, o[1] - l, o[2] - h];
+            let hi = [o[0] + (n as f64 + 1.0) * l, o[1] + w + l, o[2]];
+            add_points(out, &box_points(lo, hi), bm, true)?;
+        }
+        for c in 0..courses {
+            let z0 = o[2] + c as f64 * h;
+            let mut cuts = vec![0.0];
+            if c % 2 == 1 {
+                cuts.push(0.5 * l);
+                for k in 1..n {
+                    cuts.push((k as f64 + 0.5) * l);
+                }
+            } else {
+                for k in 1..n {
+                    cuts.push(k as f64 * l);
+                }
+            }
+            cuts.push(n as f64 * l);
+            for s in cuts.windows(2) {
+                let lo = [o[0] + s[0], o[1], z0];
+                let hi = [o[0] + s[1], o[1] + w, z0 + h];
+                add_points(out, &box_points(lo, hi), material, false)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `arch`: a semicircular arch of `voussoirs` radial voussoirs of mean radius
+/// `radius`, thickness `thickness` (t/R is the thickness ratio) and `depth`
+/// (along y), centred on `origin` (the springing line at z = origin z), on two
+/// fixed supports of `support_material` (blocks under the springers).
+pub struct Arch;
+
+impl Generator3 for Arch {
+    fn generate(&self, p: &toml::Table, out: &mut SceneBuilder3<'_>) -> Result<(), ParamError> {
+        only_keys(
+            p,
+            &[
+                "kind",
+                "material",
+                "support_material",
+                "radius",
+                "thickness",
+                "depth",
+                "voussoirs",
+                "origin",
+            ],
+        )?;
+        let material = out.material_param(p, "material")?;
+        let sm = out.material_param(p, "support_material")?;
+        let r = positive(p, "radius", None)?;
+        let t = positive(p, "thickness", None)?;
+        if t >= 2.0 * r {
+            return Err(ParamError::new("thickness", "must be below twice the radius"));
+        }
+        let d = positive(p, "depth", Some(t))?;
+        let n = count(p, "voussoirs", None)?;
+        let o = array::<3>(p, "origin", Some([0.0; 3]))?;
+        let (ri, re) = (r - 0.5 * t, r + 0.5 * t);
+        for k in 0..n {
+            let mut pts = vec![];
+            for a in [k as f64, k as f64 + 1.0].map(|x| std::f64::consts::PI * x / n as f64) {
+                for rr in [ri, re] {
+                    for y in [o[1], o[1] + d] {
+                        pts.push([o[0] + rr * a.cos(), y, o[2] + rr * a.sin()]);
+                    }
+                }
+            }
+            add_points(out, &pts, material, false)?;
+        }
+        for side in [-1.0, 1.0] {
+            let (x0, x1) = if side > 0.0 {
+                (o[0] + ri - t, o[0] + re + t)
+            } else {
+                (o[0] - re - t, o[0] - ri + t)
+            };
+            add_points(out, &box_points([x0, o[1] - t, o[2] - t], [x1, o[1] + d + t, o[2]]), sm, true)?;
+        }
+        Ok(())
+    }
+}

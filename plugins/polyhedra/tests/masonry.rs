@@ -1,0 +1,177 @@
+//! Masonry validation: stacks carry the exact weights, face–face contacts keep
+//! their points under small rotations, a block on an incline fails at
+//! α* = arctan(min(μ, b/h)) by the right mechanism, arches stand or collapse.
+use nscdd::scene::load3::{load_str, Scene3};
+use nscdd::world3::World3;
+
+fn world(text: &str) -> World3 {
+    match load_str(text, "test.toml", &nscdd_polyhedra::registry()) {
+        Ok(Scene3 { world, .. }) => world,
+        Err(e) => panic!("{e}"),
+    }
+}
+
+fn brick(name: &str, lo: [f64; 3], hi: [f64; 3], rot: [f64; 3]) -> String {
+    // vertices about the centre; the body placed at the centre, turned by `rot`
+    let c = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
+    let v: Vec<String> = nscdd_polyhedra::generate::box_points(lo, hi)
+        .iter()
+        .map(|p| format!("[{}, {}, {}]", p[0] - c[0], p[1] - c[1], p[2] - c[2]))
+        .collect();
+    format!(
+        "[[bodies]]\nname = \"{name}\"\nshape = \"polyhedron\"\nmaterial = \"stone\"\nposition = [{}, {}, {}]\nrotation = [{}, {}, {}]\nvertices = [{}]\n",
+        c[0],
+        c[1],
+        c[2],
+        rot[0],
+        rot[1],
+        rot[2],
+        v.join(", ")
+    )
+}
+
+fn head(mu: f64, h: f64, steps: usize, floor_rot: [f64; 3]) -> String {
+    format!(
+        r#"dimension = 3
+gravity = [0.0, 0.0, -9.81]
+[time]
+step = {h}
+theta = 0.5
+steps = {steps}
+[solver]
+tolerance = 1e-6
+max_sweeps = 20000
+[detection]
+alert = 0.002
+[[materials]]
+name = "stone"
+density = 2000.0
+[[materials]]
+name = "ground"
+density = 2000.0
+[[laws]]
+materials = ["stone", "stone"]
+friction = {mu}
+[[laws]]
+materials = ["stone", "ground"]
+friction = {mu}
+[[laws]]
+materials = ["ground", "ground"]
+law = "none"
+[[bodies]]
+name = "floor"
+shape = "plane"
+material = "ground"
+position = [0.0, 0.0, 0.0]
+rotation = [{}, {}, {}]
+fixed = true
+"#,
+        floor_rot[0], floor_rot[1], floor_rot[2]
+    )
+}
+
+/// Normal impulse / h carried between body a (candidate or antagonist) and b.
+fn carried(w: &World3, a: u32, b: u32) -> (f64, usize) {
+    let c = &w.contacts;
+    let mut f = 0.0;
+    let mut n = 0;
+    for k in 0..c.len() {
+        let [i, j] = c.bodies[k];
+        if (i, j) == (a, b) || (i, j) == (b, a) {
+            f += c.r[k][0] / w.time.h;
+            n += 1;
+        }
+    }
+    (f, n)
+}
+
+#[test]
+fn stack_of_bricks_carries_the_exact_weights() {
+    let (l, wd, ht) = (0.2, 0.1, 0.05);
+    let mut text = head(0.5, 1e-3, 1, [0.0; 3]);
+    for k in 0..3 {
+        let z = k as f64 * ht;
+        // the middle brick turned by 0.01 rad about z: the face contacts keep 4 points
+        let rot = if k == 1 { [0.0, 0.0, 0.01] } else { [0.0; 3] };
+        text += &brick(&format!("b{k}"), [0.0, 0.0, z], [l, wd, z + ht], rot);
+    }
+    let mut w = world(&text);
+    let weight = 2000.0 * l * wd * ht * 9.81;
+    for _ in 0..200 {
+        assert!(w.step().unwrap().solve.converged);
+    }
+    for (lower, upper, above) in [(0u32, 1u32, 3.0), (1, 2, 2.0), (2, 3, 1.0)] {
+        let (f, n) = carried(&w, lower, upper);
+        println!(
+            "interface {lower}-{upper}: {n} points carry {f:.6} N (exact {:.6} N)",
+            above * weight
+        );
+        // the corners of the overlap polygon: 4 for aligned rectangles, 8 where
+        // the brick turned about its centre cuts every corner of the other's
+        let want = if lower == 0 { 4 } else { 8 };
+        assert_eq!(n, want, "the face–face contact has the overlap polygon's corners");
+        assert!((f - above * weight).abs() < 1e-6 * above * weight, "{f} vs {}", above * weight);
+    }
+    // distinct contact points
+    let c = &w.contacts;
+    for a in 0..c.len() {
+        for b in a + 1..c.len() {
+            let d: f64 = (0..3).map(|k| (c.point[a][k] - c.point[b][k]).powi(2)).sum::<f64>().sqrt();
+            assert!(d > 1e-6, "contacts {a} and {b} at the same point");
+        }
+    }
+    for b in 1..4 {
+        let v = w.bodies.vel[b];
+        assert!(v.iter().all(|x| x.abs() < 1e-9), "body {b} moves: {v:?}");
+    }
+}
+
+/// A block b × h on a plane inclined by α about y. Returns (slide along the
+/// slope, rotation angle) after 0.6 s.
+fn incline(b: f64, h: f64, mu: f64, alpha_deg: f64) -> (f64, f64) {
+    let a = alpha_deg.to_radians();
+    let mut text = head(mu, 1e-3, 1, [0.0, a, 0.0]);
+    // the block turned by α about y, its base centre on the plane at the origin:
+    // centre R·(0, 0, h/2), R e_z = (sin α, 0, cos α)
+    let c = [0.5 * h * a.sin(), 0.0, 0.5 * h * a.cos()];
+    text += &brick(
+        "block",
+        [c[0] - 0.5 * b, -0.1, c[2] - 0.5 * h],
+        [c[0] + 0.5 * b, 0.1, c[2] + 0.5 * h],
+        [0.0, a, 0.0],
+    );
+    let mut w = world(&text);
+    let (x0, q0) = (w.bodies.pos[1], w.bodies.quat[1]);
+    for _ in 0..600 {
+        w.step().unwrap();
+    }
+    let x = w.bodies.pos[1];
+    let d = ((x[0] - x0[0]).powi(2) + (x[2] - x0[2]).powi(2)).sqrt();
+    let q = w.bodies.quat[1];
+    let dot = (q[0] * q0[0] + q[1] * q0[1] + q[2] * q0[2] + q[3] * q0[3]).abs().min(1.0);
+    (d, 2.0 * dot.acos())
+}
+
+#[test]
+fn block_on_incline_fails_at_arctan_min_mu_b_over_h() {
+    // sliding governs: μ = 0.4 < b/h = 1
+    let star = 0.4f64.atan().to_degrees();
+    let (d, r) = incline(0.2, 0.2, 0.4, star - 1.0);
+    println!("sliding case, α* − 1°: slide {d:.2e} m, rotation {r:.2e}");
+    assert!(d < 1e-4 && r < 1e-3);
+    let (d, r) = incline(0.2, 0.2, 0.4, star + 1.0);
+    println!("sliding case, α* + 1°: slide {d:.2e} m, rotation {r:.2e}");
+    assert!(r < 1e-2, "slides without turning");
+    let a = (star + 1.0).to_radians();
+    let exact = 0.5 * 9.81 * (a.sin() - 0.4 * a.cos()) * 0.6f64.powi(2);
+    println!("slide {d:.5} m, ½ g (sin α − μ cos α) t² = {exact:.5} m");
+    assert!((d - exact).abs() < 0.02 * exact);
+    // overturning governs: b/h = 0.25 < μ = 0.8
+    let star = 0.25f64.atan().to_degrees();
+    let (d, r) = incline(0.05, 0.2, 0.8, star - 1.0);
+    println!("overturning case, α* − 1°: displacement {d:.2e} m, rotation {r:.2e}");
+    assert!(d < 1e-4 && r < 1e-3);
+    let (d, r) = incline(0.05, 0.2, 0.8, star + 1.0);
+    println!("overturning case, α* + 1°: displacement {d:.2e} m, rotation {r:.2e}");
+    assert!(r > 0.1, "overturns");
+}
