@@ -175,3 +175,56 @@ fn block_on_incline_fails_at_arctan_min_mu_b_over_h() {
     println!("overturning case, α* + 1°: displacement {d:.2e} m, rotation {r:.2e}");
     assert!(r > 0.1, "overturns");
 }
+
+/// Largest displacement of the voussoirs of an arch of thickness ratio t/R after
+/// `steps` steps of 1 ms.
+fn arch(t_over_r: f64, steps: usize) -> f64 {
+    let text = format!(
+        r#"dimension = 3
+gravity = [0.0, 0.0, -9.81]
+[time]
+step = 1e-3
+theta = 0.5
+steps = {steps}
+[solver]
+tolerance = 1e-5
+max_sweeps = 5000
+[detection]
+alert = 0.002
+[[materials]]
+name = "stone"
+density = 2000.0
+[[laws]]
+materials = ["stone", "stone"]
+friction = 1.0
+[[generate]]
+kind = "arch"
+material = "stone"
+support_material = "stone"
+radius = 1.0
+thickness = {t_over_r}
+depth = 0.2
+voussoirs = 24
+"#
+    );
+    let mut w = world(&text);
+    let x0 = w.bodies.pos.clone();
+    for _ in 0..steps {
+        w.step().unwrap();
+    }
+    (0..w.bodies.len())
+        .map(|b| (0..3).map(|k| (w.bodies.pos[b][k] - x0[b][k]).powi(2)).sum::<f64>().sqrt())
+        .fold(0.0, f64::max)
+}
+
+/// A semicircular arch of radial voussoirs (μ = 1: no sliding) stands at
+/// t/R = 0.12 and collapses at t/R = 0.09 (the minimum for radial joints is
+/// t/R ≈ 0.1075).
+#[test]
+fn arch_stands_at_012_and_collapses_at_009() {
+    let stand = arch(0.12, 800);
+    let fall = arch(0.09, 800);
+    println!("largest voussoir displacement after 0.8 s: t/R = 0.12: {stand:.3e} m, t/R = 0.09: {fall:.3e} m");
+    assert!(stand < 1e-3, "t/R = 0.12 should stand: {stand}");
+    assert!(fall > 2e-2, "t/R = 0.09 should collapse: {fall}");
+}
