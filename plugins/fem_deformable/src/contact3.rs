@@ -190,20 +190,6 @@ fn bounds(b: &FeBody) -> Bounds {
     (lo, hi)
 }
 
-/// The longest boundary edge of a body (reference configuration).
-fn edge_length(b: &FeBody) -> f64 {
-    let m = &b.mesh;
-    let mut l2 = 0.0f64;
-    for f in 0..m.n_facets() {
-        let v = m.facet(f);
-        for (a, c) in [(0, 1), (1, 2), (2, 0)] {
-            let (pa, pc) = (m.node(v[a] as usize), m.node(v[c] as usize));
-            l2 = l2.max((0..3).map(|k| (pa[k] - pc[k]).powi(2)).sum());
-        }
-    }
-    l2.sqrt()
-}
-
 fn inside(p: [f64; 3], b: &Bounds, margin: f64) -> bool {
     (0..3).all(|c| p[c] >= b.0[c] - margin && p[c] <= b.1[c] + margin)
 }
@@ -219,7 +205,6 @@ fn overlap(a: &Bounds, b: &Bounds, margin: f64) -> bool {
 pub fn detect(w: &World3, fe: &[FeBody], alert: f64, out: &mut Vec<RawFe3>) {
     out.clear();
     let boxes: Vec<Bounds> = fe.iter().map(bounds).collect();
-    let spacing: Vec<f64> = fe.iter().map(edge_length).collect();
     for (fb, body) in fe.iter().enumerate() {
         let bb = boxes[fb];
         for rb in 0..w.bodies.len() {
@@ -231,7 +216,7 @@ pub fn detect(w: &World3, fe: &[FeBody], alert: f64, out: &mut Vec<RawFe3>) {
             if !overlap(&ab, &bb, alert) || w.law(body.material, w.bodies.material[rb]).is_none() {
                 continue;
             }
-            if store.meets_faces() && store.size(s.index) < spacing[fb] {
+            if store.meets_faces() && store.size(s.index) < body.mesh.longest_boundary_edge {
                 // one contact at the surface's closest point: several points of
                 // neighbouring faces sharing nodes make a near-singular W_αα set
                 // that NLGS converges on very slowly

@@ -15,6 +15,9 @@ pub struct Mesh {
     pub facets: Vec<u32>,
     /// Nodes on the boundary (sorted).
     pub boundary: Vec<u32>,
+    /// The longest edge of the boundary facets (reference configuration): the
+    /// mesh size a rigid grain is compared with in contact detection.
+    pub longest_boundary_edge: f64,
 }
 
 /// A mesh that cannot be used (message for the user).
@@ -65,8 +68,10 @@ impl Mesh {
             cells,
             facets: vec![],
             boundary: vec![],
+            longest_boundary_edge: 0.0,
         };
         m.find_boundary();
+        m.longest_boundary_edge = m.longest_edge();
         Ok(m)
     }
 
@@ -127,6 +132,18 @@ impl Mesh {
         } else {
             f.to_vec()
         }
+    }
+
+    fn longest_edge(&self) -> f64 {
+        let mut l2 = 0.0f64;
+        for f in 0..self.n_facets() {
+            let v = self.facet(f);
+            for a in 0..v.len() {
+                let (pa, pc) = (self.node(v[a] as usize), self.node(v[(a + 1) % v.len()] as usize));
+                l2 = l2.max(pa.iter().zip(pc).map(|(x, y)| (x - y).powi(2)).sum());
+            }
+        }
+        l2.sqrt()
     }
 
     /// Facets (boundary segments in 2D, triangles in 3D).

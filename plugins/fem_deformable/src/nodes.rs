@@ -157,3 +157,33 @@ pub fn fill_set<const D: usize>(set: &mut NodeSet<D>, body: &mut FeBody, nodes: 
         }
     }
 }
+
+/// V⁺ = V_free + M̂⁻¹ Σ_α H_α r_α for every body: the impulses are (candidate
+/// side, deformable antagonist side if any, global impulse P on the candidate);
+/// one solve per body touched.
+pub fn velocities_after<const D: usize>(
+    bodies: &mut [FeBody],
+    sets: &[NodeSet<D>],
+    impulses: impl Iterator<Item = (FeSide<D>, Option<FeSide<D>>, [f64; D])>,
+) {
+    let mut f: Vec<Vec<f64>> = vec![Vec::new(); bodies.len()];
+    for (cand, anta, p) in impulses {
+        for (s, sign) in std::iter::once((cand, 1.0)).chain(anta.map(|s| (s, -1.0))) {
+            let b = s.body as usize;
+            if f[b].is_empty() {
+                f[b] = vec![0.0; bodies[b].n_dofs()];
+            }
+            sets[b].add_side_force(&s, p, sign, &mut f[b]);
+        }
+    }
+    for (b, mut dv) in bodies.iter_mut().zip(f) {
+        let mut v = b.v_free.clone();
+        if !dv.is_empty() {
+            b.solve_in_place(&mut dv);
+            for (vi, d) in v.iter_mut().zip(&dv) {
+                *vi += d;
+            }
+        }
+        b.v = v;
+    }
+}

@@ -67,22 +67,10 @@ impl Deformables2 {
 
     /// Free velocities (factoring M̂ first if h or θ changed) and detection.
     pub fn begin_step(&mut self, w: &World2) -> Result<(), String> {
-        let (h, theta) = (w.time.h, w.time.theta);
-        self.times = FeTimes::default();
-        let t0 = Instant::now();
-        for b in &mut self.bodies {
-            b.factorize(h, theta)?;
-        }
-        let t1 = Instant::now();
-        for b in &mut self.bodies {
-            b.free_velocity(h, theta);
-        }
-        let t2 = Instant::now();
+        self.times = free_velocities(&mut self.bodies, w.time.h, w.time.theta)?;
+        let t = Instant::now();
         detect(w, &self.bodies, self.alert, &mut self.raw);
-        let t3 = Instant::now();
-        self.times.factor = (t1 - t0).as_secs_f64();
-        self.times.free = (t2 - t1).as_secs_f64();
-        self.times.detect = (t3 - t2).as_secs_f64();
+        self.times.detect = t.elapsed().as_secs_f64();
         Ok(())
     }
 
@@ -226,33 +214,15 @@ impl Deformables2 {
 
     /// V⁺ of the deformable bodies from their free velocity and the impulses.
     pub fn finish_velocities(&mut self) {
-        let mut f: Vec<Vec<f64>> = self.bodies.iter().map(|_| Vec::new()).collect();
         let c = &self.contacts;
-        for a in 0..c.len() {
-            let p = global(c.n[a], c.r[a]);
-            let mut add = |s: &FeSide, sign: f64| {
-                let b = s.body as usize;
-                if f[b].is_empty() {
-                    f[b] = vec![0.0; self.bodies[b].n_dofs()];
-                }
-                self.sets[b].add_side_force(s, p, sign, &mut f[b]);
+        let impulses = (0..c.len()).map(|a| {
+            let anta = match c.anta[a] {
+                Anta::Fe(s) => Some(s),
+                Anta::Rigid { .. } => None,
             };
-            add(&c.cand[a], 1.0);
-            if let Anta::Fe(s) = &c.anta[a] {
-                add(s, -1.0);
-            }
-        }
-        for (b, fb) in self.bodies.iter_mut().zip(f) {
-            let mut v = b.v_free.clone();
-            if !fb.is_empty() {
-                let mut dv = fb;
-                b.solve_in_place(&mut dv);
-                for (vi, d) in v.iter_mut().zip(&dv) {
-                    *vi += d;
-                }
-            }
-            b.v = v;
-        }
+            (c.cand[a], anta, global(c.n[a], c.r[a]))
+        });
+        crate::nodes::velocities_after(&mut self.bodies, &self.sets, impulses);
     }
 
     /// u⁺ = u⁻ + h((1 − θ)V⁻ + θV⁺) ([`update_bodies`]).
@@ -287,6 +257,24 @@ impl Deformables2 {
         }
         (f2, q2)
     }
+}
+
+/// Factors M̂ of every body if h or θ changed, then its free velocity; the
+/// times of both stages.
+pub fn free_velocities(bodies: &mut [FeBody], h: f64, theta: f64) -> Result<FeTimes, String> {
+    let t0 = Instant::now();
+    for b in bodies.iter_mut() {
+        b.factorize(h, theta)?;
+    }
+    let t1 = Instant::now();
+    for b in bodies.iter_mut() {
+        b.free_velocity(h, theta);
+    }
+    Ok(FeTimes {
+        factor: (t1 - t0).as_secs_f64(),
+        free: t1.elapsed().as_secs_f64(),
+        ..Default::default()
+    })
 }
 
 /// u⁺ = u⁻ + h((1 − θ)V⁻ + θV⁺) of every deformable body; the divergence check

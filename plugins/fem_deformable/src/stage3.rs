@@ -10,7 +10,7 @@
 use crate::body::FeBody;
 use crate::contact3::*;
 use crate::nodes::fill_set;
-use crate::stage2::{node_target, update_bodies, FeTimes};
+use crate::stage2::{free_velocities, node_target, update_bodies, FeTimes};
 use nscdd::engine::{ContactStage, Diverged};
 use nscdd::norms::{natural_map_sq, Norms, Sums};
 use nscdd::rigid2d::contacts::Target;
@@ -55,22 +55,10 @@ impl Deformables3 {
 
     /// Free velocities (factoring M̂ first if h or θ changed) and detection.
     pub fn begin_step(&mut self, w: &World3) -> Result<(), String> {
-        let (h, theta) = (w.time.h, w.time.theta);
-        self.times = FeTimes::default();
-        let t0 = Instant::now();
-        for b in &mut self.bodies {
-            b.factorize(h, theta)?;
-        }
-        let t1 = Instant::now();
-        for b in &mut self.bodies {
-            b.free_velocity(h, theta);
-        }
-        let t2 = Instant::now();
+        self.times = free_velocities(&mut self.bodies, w.time.h, w.time.theta)?;
+        let t = Instant::now();
         detect(w, &self.bodies, self.alert, &mut self.raw);
-        let t3 = Instant::now();
-        self.times.factor = (t1 - t0).as_secs_f64();
-        self.times.free = (t2 - t1).as_secs_f64();
-        self.times.detect = (t3 - t2).as_secs_f64();
+        self.times.detect = t.elapsed().as_secs_f64();
         Ok(())
     }
 
@@ -225,32 +213,15 @@ impl Deformables3 {
 
     /// V⁺ of the deformable bodies from their free velocity and the impulses.
     pub fn finish_velocities(&mut self) {
-        let mut f: Vec<Vec<f64>> = self.bodies.iter().map(|_| Vec::new()).collect();
         let c = &self.contacts;
-        for a in 0..c.len() {
-            let p = global(&c.basis[a], c.r[a]);
-            let mut add = |s: &FeSide3, sign: f64| {
-                let b = s.body as usize;
-                if f[b].is_empty() {
-                    f[b] = vec![0.0; self.bodies[b].n_dofs()];
-                }
-                self.sets[b].add_side_force(s, p, sign, &mut f[b]);
+        let impulses = (0..c.len()).map(|a| {
+            let anta = match c.anta[a] {
+                Anta3::Fe(s) => Some(s),
+                Anta3::Rigid { .. } => None,
             };
-            add(&c.cand[a], 1.0);
-            if let Anta3::Fe(s) = &c.anta[a] {
-                add(s, -1.0);
-            }
-        }
-        for (b, mut fb) in self.bodies.iter_mut().zip(f) {
-            let mut v = b.v_free.clone();
-            if !fb.is_empty() {
-                b.solve_in_place(&mut fb);
-                for (vi, d) in v.iter_mut().zip(&fb) {
-                    *vi += d;
-                }
-            }
-            b.v = v;
-        }
+            (c.cand[a], anta, global(&c.basis[a], c.r[a]))
+        });
+        crate::nodes::velocities_after(&mut self.bodies, &self.sets, impulses);
     }
 
     /// u⁺ = u⁻ + h((1 − θ)V⁻ + θV⁺).

@@ -146,7 +146,7 @@ fn closest_segments(p1: [f64; 3], q1: [f64; 3], p2: [f64; 3], q2: [f64; 3]) -> (
 }
 
 /// Contacts between polyhedron i (candidate) and polyhedron j (antagonist), both
-/// at their poses; `wi`, `wj` are scratch vertex buffers.
+/// at their poses.
 #[allow(clippy::too_many_arguments)]
 pub fn poly_poly(
     pi: &Poly,
@@ -160,16 +160,9 @@ pub fn poly_poly(
     alert: f64,
     out: &mut Vec<RawContact3>,
 ) {
-    let place = |p: &Poly, x: [f64; 3], q: [f64; 4]| -> Vec<[f64; 3]> {
-        p.vertices
-            .iter()
-            .map(|v| {
-                let r = rotate(q, *v);
-                [x[0] + r[0], x[1] + r[1], x[2] + r[2]]
-            })
-            .collect()
-    };
-    let (wi, wj) = (place(pi, xi, qi), place(pj, xj, qj));
+    let (mut wi, mut wj) = (vec![], vec![]);
+    pi.world_vertices(xi, qi, &mut wi);
+    pj.world_vertices(xj, qj, &mut wj);
     // faces of j separating i's vertices, faces of i separating j's
     let (sj, fj) = best_face(pj, &wj, qj, &wi);
     if sj > alert {
@@ -262,14 +255,13 @@ impl PairDetector3 for PolyPlane {
     fn detect(&self, ctx: &DetectCtx3<'_>, pairs: &[[u32; 2]], out: &mut Vec<RawContact3>) {
         let sa = polys(ctx, true);
         let b = ctx.bodies;
+        let mut wv = vec![];
         for &[i, j] in pairs {
             let (iu, ju) = (i as usize, j as usize);
-            let p = &sa.shapes[b.shape[iu].index as usize];
+            sa.world_vertices(b.shape[iu].index, b.pos[iu], b.quat[iu], &mut wv);
             let n = rotate(b.quat[ju], [0.0, 0.0, 1.0]);
             let xp = b.pos[ju];
-            for (k, v) in p.vertices.iter().enumerate() {
-                let r = rotate(b.quat[iu], *v);
-                let x = [b.pos[iu][0] + r[0], b.pos[iu][1] + r[1], b.pos[iu][2] + r[2]];
+            for (k, &x) in wv.iter().enumerate() {
                 let gap = dot(n, sub(x, xp));
                 if gap <= ctx.alert {
                     out.push(RawContact3 {

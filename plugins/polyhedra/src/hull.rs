@@ -231,8 +231,6 @@ mod tests {
         let (i, _) = principal(&second);
         let mut i = i.to_vec();
         i.sort_by(f64::total_cmp);
-        let exact = [(4.0 + 1.0) / 12.0 - 0.0, 0.0, 0.0];
-        let _ = exact;
         let mut want = vec![(1.0 + 0.25) / 12.0, (4.0 + 0.25) / 12.0, (4.0 + 1.0) / 12.0];
         want.sort_by(f64::total_cmp);
         for k in 0..3 {

@@ -2,7 +2,7 @@
 //! the origin, principal axes along the body axes), with its faces, outward
 //! normals and edges for detection.
 
-use crate::hull::{cross, dot, hull, moments, norm, principal, quat_of, sub, Hull};
+use crate::hull::{hull, moments, norm, principal, quat_of, sub, Hull};
 use nscdd::params::only_keys;
 use nscdd::registry::ParamError;
 use nscdd::registry3::{Aabb3, Glyph3, MassProps3, ShapeStore3};
@@ -25,6 +25,15 @@ pub struct Poly {
 }
 
 impl Poly {
+    /// World coordinates of the vertices at a pose.
+    pub fn world_vertices(&self, x: [f64; 3], q: [f64; 4], out: &mut Vec<[f64; 3]>) {
+        out.clear();
+        out.extend(self.vertices.iter().map(|v| {
+            let r = rotate(q, *v);
+            [x[0] + r[0], x[1] + r[1], x[2] + r[2]]
+        }));
+    }
+
     /// A polyhedron from the hull of `points` given in any frame; also returns
     /// the principal frame in that frame (centroid, quaternion).
     pub fn from_points(points: &[[f64; 3]]) -> Result<(Poly, [f64; 3], [f64; 4]), String> {
@@ -93,11 +102,7 @@ impl Polyhedra {
 
     /// World coordinates of the vertices of shape s at a pose.
     pub fn world_vertices(&self, s: u32, x: [f64; 3], q: [f64; 4], out: &mut Vec<[f64; 3]>) {
-        out.clear();
-        out.extend(self.shapes[s as usize].vertices.iter().map(|v| {
-            let r = rotate(q, *v);
-            [x[0] + r[0], x[1] + r[1], x[2] + r[2]]
-        }));
+        self.shapes[s as usize].world_vertices(x, q, out);
     }
 }
 
@@ -185,9 +190,4 @@ pub fn world_face(p: &Poly, wv: &[[f64; 3]], q: [f64; 4], f: usize, out: &mut Ve
 pub fn unit(a: [f64; 3]) -> Option<[f64; 3]> {
     let l = norm(a);
     (l > 1e-300).then(|| a.map(|x| x / l))
-}
-
-/// Whether a face normal and its polygon agree (counter-clockwise around n).
-pub fn ccw(poly: &[[f64; 3]], n: [f64; 3]) -> bool {
-    dot(cross(sub(poly[1], poly[0]), sub(poly[2], poly[1])), n) > 0.0
 }
