@@ -406,6 +406,13 @@ fn main() -> ExitCode {
                             return ExitCode::from(1);
                         }
                     }
+                    let bonded = s.world.contacts.joint.iter().filter(|j| j.bonded()).count();
+                    if bonded > 0 {
+                        eprintln!(
+                            "error: {bonded} contacts are intact mortar joints (law `mohr_coulomb`): a frictional-contact problem (FCLIB) cannot express their cohesion"
+                        );
+                        return ExitCode::from(2);
+                    }
                     nscdd::fc::problem_from_world3(&s.world)
                 }
             };

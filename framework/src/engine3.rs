@@ -21,6 +21,7 @@ use crate::rigid2d::contacts::{ContactKey, Target};
 use crate::rigid2d::nlgs::make_order;
 use crate::rigid3d::bodies::{cross, from_rotation_vector, normalize, quat_mul, ALL_FREE};
 use crate::rigid3d::contacts::{local_velocity, tangents, Block3, Frame3};
+use crate::rigid3d::joint::{self, Joint};
 use crate::rigid3d::{coulomb, nlgs, Contacts3};
 use crate::solver::SolveReport;
 use crate::world3::World3;
@@ -55,6 +56,7 @@ impl World3 {
         stage.prepare(self);
         let t2 = Instant::now();
         rep.solve = stage.solve(self);
+        update_joints(self);
         let t3 = Instant::now();
         update_positions(self)?;
         let t4 = Instant::now();
@@ -186,7 +188,9 @@ pub fn build_contacts(w: &mut World3) {
     let (h, theta) = (w.time.h, w.time.theta);
     let s = &mut w.scratch;
     s.prev_keys.clear();
-    s.prev_keys.extend(w.contacts.key.iter().copied().zip(w.contacts.r.iter().copied()));
+    let old = &w.contacts;
+    s.prev_keys
+        .extend((0..old.len()).map(|a| (old.key[a], old.r[a], old.joint[a].bonded())));
     s.prev_keys.sort_unstable_by_key(|x| x.0);
     let c = &mut s.next;
     c.clear();
@@ -216,9 +220,15 @@ pub fn build_contacts(w: &mut World3) {
             j: rc.j,
             feature: rc.feature,
         };
-        let r = match s.prev_keys.binary_search_by_key(&key, |x| x.0) {
-            Ok(p) => s.prev_keys[p].1,
-            Err(_) => [0.0; 3],
+        let (r, bonded) = match s.prev_keys.binary_search_by_key(&key, |x| x.0) {
+            Ok(p) => (s.prev_keys[p].1, s.prev_keys[p].2),
+            // bonds are made at the first step only
+            Err(_) => ([0.0; 3], w.step == 0 && rc.gap <= law.bond_gap),
+        };
+        let joint = if bonded && law.is_cohesive() && rc.area > 0.0 {
+            Joint::of(&law, rc.area, h)
+        } else {
+            Joint::default()
         };
         c.bodies.push([rc.i, rc.j]);
         c.frame.push(frame);
@@ -235,6 +245,7 @@ pub fn build_contacts(w: &mut World3) {
         c.gap.push(rc.gap);
         c.point.push(rc.point);
         c.key.push(key);
+        c.joint.push(joint);
     }
     std::mem::swap(&mut w.contacts, &mut s.next);
     let c = &w.contacts;
@@ -250,6 +261,29 @@ pub fn build_contacts(w: &mut World3) {
                 &w.bodies.inv_m,
                 &w.bodies.inv_i,
             );
+        }
+    }
+}
+
+/// Failure of bonded joints on the converged impulses: a joint whose strength is
+/// exceeded loses its bond for good (`rigid3d::joint`). "Exceeded" means by more
+/// than 100 × the solver tolerance (at most 2 %): the impulses of a converged NLGS
+/// are accurate to a few tolerances, and a smaller overload makes the joint slip,
+/// so its slip velocity, hence the excess, grows until it fails a few steps later.
+pub fn update_joints(w: &mut World3) {
+    let tol = (100.0 * w.solver.tolerance).clamp(1e-9, 0.02);
+    let c = &mut w.contacts;
+    for a in 0..c.len() {
+        let jt = c.joint[a];
+        if !jt.bonded() {
+            continue;
+        }
+        let u = c.local_velocity(a, &w.bodies.vel);
+        let wr = coulomb::mul(&c.block[a].w, c.r[a]);
+        let u0 = [u[0] - wr[0], u[1] - wr[1], u[2] - wr[2]];
+        let t = c.target[a];
+        if !joint::holds(&c.block[a].pre, u0, t.u_target, t.mu, &jt, tol) {
+            c.joint[a] = Joint::default();
         }
     }
 }

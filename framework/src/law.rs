@@ -17,8 +17,12 @@
 //! the friction coefficient μ (see `rigid2d::coulomb`).
 //!
 //! Laws are chosen per pair of materials. Built-in law kinds: `coulomb` (keys
-//! `friction`, `restitution`) and `frictionless` (key `restitution`), which takes the
-//! cheaper μ = 0 path of the local solver.
+//! `friction`, `restitution`), `frictionless` (key `restitution`), which takes the
+//! cheaper μ = 0 path of the local solver, and `mohr_coulomb` (keys `friction`,
+//! `cohesion`, `tensile_strength`, `bond_gap`): a mortar joint between 3D rigid
+//! bodies that carries tension up to `tensile_strength` and shear up to
+//! `cohesion + μ σ_n` (stresses, Pa) until it fails, then acts as `coulomb` with
+//! e = 0 for ever (see `rigid3d::joint`).
 
 use crate::params::{number, only_keys};
 use crate::registry::{ParamError, Registry};
@@ -30,6 +34,33 @@ pub struct ContactLaw {
     pub mu: f64,
     /// Newton restitution coefficient e ∈ [0, 1].
     pub e: f64,
+    /// Cohesion c of a bonded joint (Pa; 0: no joint).
+    #[serde(default)]
+    pub cohesion: f64,
+    /// Tensile strength σ_t of a bonded joint (Pa).
+    #[serde(default)]
+    pub tensile: f64,
+    /// Contacts closer than this at the first step are bonded (m).
+    #[serde(default)]
+    pub bond_gap: f64,
+}
+
+impl ContactLaw {
+    /// A Signorini–Coulomb law with friction μ and restitution e.
+    pub fn coulomb(mu: f64, e: f64) -> ContactLaw {
+        ContactLaw {
+            mu,
+            e,
+            cohesion: 0.0,
+            tensile: 0.0,
+            bond_gap: 0.0,
+        }
+    }
+
+    /// Whether contacts of this law can be bonded joints (`mohr_coulomb`).
+    pub fn is_cohesive(&self) -> bool {
+        self.cohesion > 0.0 || self.tensile > 0.0
+    }
 }
 
 /// A law kind: its name and its parameter parser.
@@ -67,14 +98,52 @@ fn parse_coulomb(t: &toml::Table) -> Result<ContactLaw, ParamError> {
     if mu < 0.0 {
         return Err(ParamError::new("friction", format!("μ must be ≥ 0, got {mu}")));
     }
-    Ok(ContactLaw { mu, e: restitution(t)? })
+    Ok(ContactLaw::coulomb(mu, restitution(t)?))
 }
 
 fn parse_frictionless(t: &toml::Table) -> Result<ContactLaw, ParamError> {
     only_keys(t, &["restitution"])?;
+    Ok(ContactLaw::coulomb(0.0, restitution(t)?))
+}
+
+fn parse_mohr_coulomb(t: &toml::Table) -> Result<ContactLaw, ParamError> {
+    only_keys(t, &["friction", "cohesion", "tensile_strength", "bond_gap"])?;
+    let mu = number(t, "friction", None)?;
+    if mu <= 0.0 {
+        return Err(ParamError::new(
+            "friction",
+            format!("a mortar joint needs μ > 0 (its shear strength is c + μ σ_n), got {mu}"),
+        ));
+    }
+    let cohesion = number(t, "cohesion", None)?;
+    if cohesion < 0.0 {
+        return Err(ParamError::new("cohesion", format!("must be ≥ 0 (Pa), got {cohesion}")));
+    }
+    // the tension cut-off cannot lie beyond the apex c/μ of the Mohr–Coulomb cone
+    let apex = cohesion / mu;
+    let tensile = number(t, "tensile_strength", Some(apex))?;
+    if !(0.0..=apex * (1.0 + 1e-12)).contains(&tensile) {
+        return Err(ParamError::new(
+            "tensile_strength",
+            format!("must lie in [0, cohesion/friction = {apex}] (Pa), got {tensile}"),
+        ));
+    }
+    if cohesion == 0.0 && tensile == 0.0 {
+        return Err(ParamError::new(
+            "cohesion",
+            "a mortar joint needs cohesion > 0; use `coulomb` for dry joints",
+        ));
+    }
+    let bond_gap = number(t, "bond_gap", Some(1e-6))?;
+    if bond_gap < 0.0 {
+        return Err(ParamError::new("bond_gap", format!("must be ≥ 0 (m), got {bond_gap}")));
+    }
     Ok(ContactLaw {
-        mu: 0.0,
-        e: restitution(t)?,
+        mu,
+        e: 0.0,
+        cohesion,
+        tensile: tensile.min(apex),
+        bond_gap,
     })
 }
 
@@ -86,6 +155,10 @@ pub(crate) fn register_builtin(r: &mut Registry) {
     r.add_law(LawDef {
         name: "frictionless",
         parse: parse_frictionless,
+    });
+    r.add_law(LawDef {
+        name: "mohr_coulomb",
+        parse: parse_mohr_coulomb,
     });
 }
 

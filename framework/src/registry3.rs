@@ -135,6 +135,9 @@ pub struct RawContact3 {
     pub normal: [f64; 3],
     /// Signed distance (negative: interpenetration).
     pub gap: f64,
+    /// Area of contact this point stands for (m²; 0 for point contacts): what
+    /// bonded joints scale their strengths with.
+    pub area: f64,
 }
 
 /// What a 3D narrow phase sees.

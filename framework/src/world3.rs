@@ -59,7 +59,8 @@ pub(crate) struct Scratch3 {
     pub raw: Vec<RawContact3>,
     pub v_begin: Vec<[f64; 6]>,
     pub order: Vec<u32>,
-    pub prev_keys: Vec<(ContactKey, [f64; 3])>,
+    /// The last step's contacts: key, impulse, bonded.
+    pub prev_keys: Vec<(ContactKey, [f64; 3], bool)>,
     pub next: Contacts3,
 }
 

@@ -160,6 +160,9 @@ struct ContactOut {
     /// The impulse in world axes (N·s).
     impulse: [f64; 3],
     gap: f64,
+    /// An intact bonded joint (law `mohr_coulomb`).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    bonded: bool,
 }
 
 #[derive(Serialize)]
@@ -203,6 +206,7 @@ pub fn final_json3(w: &World3) -> String {
             r: c.r[a],
             impulse: c.world_impulse(a),
             gap: c.gap[a],
+            bonded: c.joint[a].bonded(),
         })
         .collect();
     let mut s = serde_json::to_string_pretty(&FinalOut {

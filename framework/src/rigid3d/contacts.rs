@@ -16,6 +16,7 @@
 
 use super::bodies::{cross, dot};
 use super::coulomb::{Pre3, Sym3};
+use super::joint::Joint;
 use crate::rigid2d::contacts::{ContactKey, Target};
 use serde::{Deserialize, Serialize};
 
@@ -49,6 +50,8 @@ pub struct Contacts3 {
     pub gap: Vec<f64>,
     pub point: Vec<[f64; 3]>,
     pub key: Vec<ContactKey>,
+    /// Strengths of bonded joints (zero for other contacts).
+    pub joint: Vec<Joint>,
 }
 
 /// The tangent vectors (t1, t2) completing a unit normal n, chosen continuously in n
@@ -186,6 +189,7 @@ impl Contacts3 {
         self.gap.reserve(n);
         self.point.reserve(n);
         self.key.reserve(n);
+        self.joint.reserve(n);
     }
 
     /// Appends contact `a` of `other` with its bodies renamed (i, j).
@@ -199,6 +203,7 @@ impl Contacts3 {
         self.gap.push(other.gap[a]);
         self.point.push(other.point[a]);
         self.key.push(other.key[a]);
+        self.joint.push(other.joint[a]);
     }
 
     pub fn clear(&mut self) {
@@ -211,6 +216,7 @@ impl Contacts3 {
         self.gap.clear();
         self.point.clear();
         self.key.clear();
+        self.joint.clear();
     }
 
     /// The Delassus block W_αα = Bᵀ (K_i + K_j) B.

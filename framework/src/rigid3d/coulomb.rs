@@ -297,7 +297,7 @@ pub fn solve_pre_warm(w: &Sym3, pre: &Pre3, u0: [f64; 3], u_target: f64, mu: f64
 /// Minimiser of `½ xᵀ A x + b·x` on the disk `|x| ≤ rad`, A = [[a, c], [c, d]] SPD,
 /// when the unconstrained minimiser lies outside the disk: `x = −(A + λI)⁻¹ b` with
 /// `|x(λ)| = rad`. `None` if A is not positive definite.
-fn disk_min(a: f64, c: f64, d: f64, b: [f64; 2], rad: f64) -> Option<[f64; 2]> {
+pub(crate) fn disk_min(a: f64, c: f64, d: f64, b: [f64; 2], rad: f64) -> Option<[f64; 2]> {
     let bn = (b[0] * b[0] + b[1] * b[1]).sqrt();
     if rad <= 0.0 || bn == 0.0 {
         return Some([0.0, 0.0]);

@@ -5,6 +5,7 @@
 
 use super::contacts::{apply_with, local_velocity, Contacts3, InvMass3, InvMassOf, Split};
 use super::coulomb::{self, Sym3};
+use super::joint;
 use crate::norms::{natural_map_sq, Norms, Sums};
 use crate::solver::{SolveReport, SolverSettings};
 
@@ -49,7 +50,12 @@ fn sweep_with<M: InvMassOf + ?Sized>(
         let wr_old = coulomb::mul(&blk.w, r);
         let u0 = [u[0] - wr_old[0], u[1] - wr_old[1], u[2] - wr_old[2]];
         let t = c.target[a];
-        let mut rn = coulomb::solve_pre_warm(&blk.w, &blk.pre, u0, t.u_target, t.mu, r);
+        let jt = c.joint[a];
+        let mut rn = if jt.bonded() {
+            joint::solve(&blk.w, &blk.pre, u0, t.u_target, t.mu, &jt, r)
+        } else {
+            coulomb::solve_pre_warm(&blk.w, &blk.pre, u0, t.u_target, t.mu, r)
+        };
         if omega != 1.0 {
             for k in 0..3 {
                 rn[k] = omega * rn[k] + (1.0 - omega) * r[k];
@@ -129,7 +135,12 @@ pub fn residual_parts(c: &Contacts3, vel: &[[f64; 6]]) -> (f64, f64) {
         let t = c.target[a];
         let mut u = c.local_velocity(a, vel);
         u[0] -= t.u_target;
-        f2 += natural_map_sq(&c.r[a], &u, t.mu);
+        let jt = c.joint[a];
+        f2 += if jt.bonded() {
+            joint::natural_map_sq(c.r[a], u, t.mu, &jt)
+        } else {
+            natural_map_sq(&c.r[a], &u, t.mu)
+        };
         let q = [c.u_free[a][0] - t.u_target, c.u_free[a][1], c.u_free[a][2]];
         q2 += q[0] * q[0] + q[1] * q[1] + q[2] * q[2];
     }

@@ -56,7 +56,7 @@ pub fn load_str_with(text: &str, file: &str, registry: &Registry, deformable: bo
     validate_solver(&cx, &sf.solver)?;
     let mats = materials(&cx, &sf)?;
     let nm = mats.len();
-    let (laws, declared) = laws(&cx, &sf, registry, nm, &mats)?;
+    let (laws, declared) = laws(&cx, &sf, registry, nm, &mats, 3)?;
     let mut b = SceneBuilder3::new(registry, mats);
     let mut drives = vec![];
     add_bodies(&cx, &sf, &mut b, &mut drives)?;

@@ -347,7 +347,7 @@ fn load_parsed(cx: &Ctx, sf: SceneFile, registry: &Registry) -> Result<Scene, In
         return Err(cx.err(&[], "the scene has no bodies"));
     }
     let nm = b.materials.len();
-    let (laws, declared) = laws(&cx, &sf, registry, nm, &b.materials)?;
+    let (laws, declared) = laws(&cx, &sf, registry, nm, &b.materials, 2)?;
     // every pair of materials that can touch needs a law; every pair of kinds a detector
     let info: Vec<BodyInfo> = (0..b.bodies.len())
         .map(|i| BodyInfo {
@@ -553,6 +553,7 @@ pub(crate) fn laws<B>(
     registry: &Registry,
     nm: usize,
     materials: &[Material],
+    dimension: u8,
 ) -> Result<(Vec<Option<crate::law::ContactLaw>>, Vec<bool>), InputError> {
     let mut table = vec![None; nm * nm];
     let mut declared = vec![false; nm * nm];
@@ -580,6 +581,12 @@ pub(crate) fn laws<B>(
                 None
             }
         };
+        if dimension == 2 && law.is_some_and(|x| x.is_cohesive()) {
+            return Err(cx.err(
+                &at(&base, &[k("law")]),
+                format!("`{}` bonds 3D rigid bodies (joints of faces); a 2D scene cannot use it", l.law),
+            ));
+        }
         let (a, c) = (ids[0] as usize, ids[1] as usize);
         if declared[a * nm + c] {
             return Err(cx.err(&at(&base, &[k("materials")]), "a law for this pair of materials is already given"));

@@ -1,5 +1,5 @@
 //! Restart of a 3D world from its saved state (`final.json` / `checkpoint.json` of a
-//! 3D run): positions, quaternions, velocities, the contacts' keys and impulses, the
+//! 3D run): positions, quaternions, velocities, the contacts' keys, impulses and bonds, the
 //! step, the time and the box height. The same rules as in 2D
 //! ([`super::restart`]): the scene that wrote the state, the same step h; a
 //! continued one-domain run is bitwise the uninterrupted one.
@@ -8,6 +8,7 @@ use super::restart::StateChecks;
 use crate::error::InputError;
 use crate::rigid2d::contacts::ContactKey;
 use crate::rigid3d::contacts::Frame3;
+use crate::rigid3d::joint::Joint;
 use crate::rigid3d::Contacts3;
 use crate::world3::World3;
 use serde::Deserialize;
@@ -30,6 +31,8 @@ struct SavedContact {
     normal: [f64; 3],
     r: [f64; 3],
     gap: f64,
+    #[serde(default)]
+    bonded: bool,
 }
 
 #[derive(Deserialize)]
@@ -103,6 +106,7 @@ pub fn restart3_str(w: &mut World3, text: &str, file: &str) -> Result<(), InputE
         c.gap.push(sc.gap);
         c.point.push(sc.point);
         c.key.push(ContactKey { i, j, feature: sc.feature });
+        c.joint.push(if sc.bonded { Joint::RESTORED } else { Joint::default() });
     }
     let b = &mut w.bodies;
     for (k, sb) in saved.bodies.iter().enumerate() {

@@ -104,6 +104,8 @@ fn face_contacts(
             pts.push(*x);
         }
     }
+    // the overlap polygon's area, shared by its corners
+    let area = polygon_area(&pts, n) / pts.len() as f64;
     for (k, x) in pts.iter().enumerate() {
         let gap = dot(sub(*x, reference[0]), n);
         if gap <= alert {
@@ -116,9 +118,20 @@ fn face_contacts(
                 point,
                 normal,
                 gap,
+                area,
             });
         }
     }
+}
+
+/// Area of a planar convex polygon (vertices in order) of unit normal n.
+pub(crate) fn polygon_area(p: &[[f64; 3]], n: [f64; 3]) -> f64 {
+    let m = p.len();
+    let mut s = 0.0;
+    for k in 1..m.saturating_sub(1) {
+        s += dot(cross(sub(p[k], p[0]), sub(p[k + 1], p[0])), n);
+    }
+    0.5 * s.abs()
 }
 
 /// Closest points of segments [p1, q1] and [p2, q2]: (on the first, on the second).
@@ -229,6 +242,7 @@ pub fn poly_poly(
             point: [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2])],
             normal: ax,
             gap: s,
+            area: 0.0,
         });
     }
 }
@@ -248,7 +262,9 @@ impl PairDetector3 for PolyPoly {
     }
 }
 
-/// Polyhedron–plane: each vertex within alert of the plane (normal: the plane's z axis).
+/// Polyhedron–plane: each vertex within alert of the plane (normal: the plane's z
+/// axis). When the face most anti-parallel to the plane lies on it (all its
+/// vertices within alert), its vertices share its area.
 pub struct PolyPlane;
 
 impl PairDetector3 for PolyPlane {
@@ -261,9 +277,22 @@ impl PairDetector3 for PolyPlane {
             sa.world_vertices(b.shape[iu].index, b.pos[iu], b.quat[iu], &mut wv);
             let n = rotate(b.quat[ju], [0.0, 0.0, 1.0]);
             let xp = b.pos[ju];
+            let p = &sa.shapes[b.shape[iu].index as usize];
+            let q = b.quat[iu];
+            let f = (0..p.faces.len())
+                .min_by(|&x, &y| dot(rotate(q, p.normals[x]), n).total_cmp(&dot(rotate(q, p.normals[y]), n)))
+                .expect("a polyhedron has faces");
+            let flush = p.faces[f].iter().all(|&v| dot(n, sub(wv[v as usize], xp)) <= ctx.alert);
+            let share = if flush {
+                let pts: Vec<[f64; 3]> = p.faces[f].iter().map(|&v| wv[v as usize]).collect();
+                polygon_area(&pts, n) / pts.len() as f64
+            } else {
+                0.0
+            };
             for (k, &x) in wv.iter().enumerate() {
                 let gap = dot(n, sub(x, xp));
                 if gap <= ctx.alert {
+                    let area = if flush && p.faces[f].contains(&(k as u32)) { share } else { 0.0 };
                     out.push(RawContact3 {
                         i,
                         j,
@@ -271,6 +300,7 @@ impl PairDetector3 for PolyPlane {
                         point: [x[0] - 0.5 * gap * n[0], x[1] - 0.5 * gap * n[1], x[2] - 0.5 * gap * n[2]],
                         normal: n,
                         gap,
+                        area,
                     });
                 }
             }
@@ -332,6 +362,7 @@ impl PairDetector3 for PolySphere {
                 point: [q[0] - 0.5 * gap * n[0], q[1] - 0.5 * gap * n[1], q[2] - 0.5 * gap * n[2]],
                 normal: n,
                 gap,
+                area: 0.0,
             });
         }
     }

@@ -39,6 +39,7 @@ impl PairDetector3 for SphereSphere {
                 point: [xj[0] + s * n[0], xj[1] + s * n[1], xj[2] + s * n[2]],
                 normal: n,
                 gap,
+                area: 0.0,
             });
         }
     }
@@ -68,6 +69,7 @@ impl PairDetector3 for SpherePlane {
                 point: [xs[0] - s * n[0], xs[1] - s * n[1], xs[2] - s * n[2]],
                 normal: n,
                 gap,
+                area: 0.0,
             });
         }
     }
@@ -119,6 +121,7 @@ impl PairDetector3 for SphereBox {
                 point: [xs[0] - s * n[0], xs[1] - s * n[1], xs[2] - s * n[2]],
                 normal: n,
                 gap,
+                area: 0.0,
             });
         }
     }
