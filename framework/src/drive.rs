@@ -109,6 +109,19 @@ pub struct Phase {
     pub until: Option<f64>,
 }
 
+impl Phase {
+    /// A phase imposing the velocity `v(t)` until `until` (for ever if `None`).
+    pub fn velocity(v: TimeFn, until: Option<f64>) -> Phase {
+        Phase {
+            velocity: Some(v),
+            force: None,
+            pressure: None,
+            servo: None,
+            until,
+        }
+    }
+}
+
 /// A servo-controlled wall (as DEM codes drive stress-controlled walls): at each step
 /// the wall moves into the sample at `v = clamp(gain × (σ_target − σ_wall),
 /// −max_velocity, max_velocity)`, σ_wall being the stress the grains exerted on it

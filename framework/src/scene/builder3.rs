@@ -2,12 +2,14 @@
 //! and by plugins' 3D generators.
 
 use super::builder::Origin;
+use crate::drive::DofDrive;
 use crate::registry::{ParamError, Registry};
 use crate::registry3::ShapeStore3;
 use crate::rigid2d::bodies::ShapeRef;
 use crate::rigid3d::bodies::from_rotation_vector;
 use crate::rigid3d::Bodies3;
 use crate::world::Material;
+use crate::world3::BodyDrive3;
 use std::collections::BTreeMap;
 
 /// 3D bodies under construction, with the shape stores of the kinds they use.
@@ -21,6 +23,7 @@ pub struct SceneBuilder3<'r> {
     pub(crate) materials: Vec<Material>,
     pub(crate) origins: Vec<Origin>,
     pub(crate) origin: Origin,
+    pub(crate) drives: Vec<BodyDrive3>,
 }
 
 impl<'r> SceneBuilder3<'r> {
@@ -35,6 +38,7 @@ impl<'r> SceneBuilder3<'r> {
             materials,
             origins: vec![],
             origin: Origin::Body(0),
+            drives: vec![],
         }
     }
 
@@ -101,6 +105,18 @@ impl<'r> SceneBuilder3<'r> {
 
     pub fn position(&self, b: u32) -> [f64; 3] {
         self.bodies.pos[b as usize]
+    }
+
+    /// Drives the degrees of freedom of a body (x, y, z, rx, ry, rz; `None`: free).
+    /// A generator that drives a body by velocity sets its initial velocity to
+    /// the drive's value at t = 0 ([`Self::set_velocity`]).
+    pub fn drive(&mut self, b: u32, dof: [Option<DofDrive>; 6]) {
+        self.drives.push(BodyDrive3 { body: b, dof });
+    }
+
+    /// Sets a body's initial velocity (v, ω in world axes).
+    pub fn set_velocity(&mut self, b: u32, vel: [f64; 6]) {
+        self.bodies.vel[b as usize] = vel;
     }
 
     /// Sets a body's name (for outputs and `[output] box3`).

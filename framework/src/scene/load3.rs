@@ -76,6 +76,7 @@ pub fn load_str_with(text: &str, file: &str, registry: &Registry, deformable: bo
         gen.generate(&spec.params, &mut b)
             .map_err(|e: ParamError| cx.err(&at(&base, &[k(&e.key)]), e.msg))?;
     }
+    drives.append(&mut b.drives);
     if b.bodies.is_empty() {
         return Err(cx.err(&[], "the scene has no bodies"));
     }

@@ -1,8 +1,9 @@
-//! Masonry generators: a running-bond brick wall and a semicircular arch of
-//! radial voussoirs on two fixed supports.
+//! Masonry generators: a running-bond brick wall, a semicircular arch of radial
+//! voussoirs on two fixed supports, and a tilting table.
 
 use crate::shapes::Polyhedra;
-use nscdd::params::{array, count, only_keys, positive};
+use nscdd::drive::{DofDrive, Phase, Shape, TimeFn};
+use nscdd::params::{array, count, number, only_keys, positive};
 use nscdd::registry::ParamError;
 use nscdd::registry3::Generator3;
 use nscdd::rigid2d::bodies::ShapeRef;
@@ -133,6 +134,73 @@ impl Generator3 for Arch {
             };
             add_points(out, &box_points([x0, o[1] - t, o[2] - t], [x1, o[1] + d + t, o[2]]), sm, true)?;
         }
+        Ok(())
+    }
+}
+
+/// `tilting_table`: a slab of `size` = [Lx, Ly, Lz] whose top face is centred on
+/// `origin` at t = 0, turned from t = `start` at the constant rate `rate` (rad/s)
+/// about a hinge along y in its top face, at x = origin x + `hinge` (default
+/// −Lx/2: the edge), the side x > 0 rising, until the tilt reaches `max_angle` (degrees; drives act at
+/// step ends, so the tilt stops within rate × h of it); then it stays.
+///
+/// Every degree of freedom is driven by velocity: ω_y = −rate, and the centroid
+/// c = H + R_y(−θ) d₀ (H on the hinge, d₀ = c(0) − H, θ = rate (t − start)) moves
+/// on its circle with `v = rate ρ (−sin(θ + β), 0, cos(θ + β))`, ρ = |d₀|,
+/// β = atan2(d₀z, d₀x): sine drives, so the hinge stays in place.
+pub struct TiltingTable;
+
+impl Generator3 for TiltingTable {
+    fn generate(&self, p: &toml::Table, out: &mut SceneBuilder3<'_>) -> Result<(), ParamError> {
+        only_keys(p, &["kind", "material", "size", "origin", "hinge", "rate", "max_angle", "start"])?;
+        let material = out.material_param(p, "material")?;
+        let [lx, ly, lz] = array::<3>(p, "size", None)?;
+        if ![lx, ly, lz].iter().all(|x| *x > 0.0) {
+            return Err(ParamError::new("size", "3 positive sizes [Lx, Ly, Lz]"));
+        }
+        let o = array::<3>(p, "origin", Some([0.0; 3]))?;
+        let hinge = number(p, "hinge", Some(-0.5 * lx))?;
+        if hinge.abs() > 0.5 * lx {
+            return Err(ParamError::new(
+                "hinge",
+                format!("must lie on the table, in [−Lx/2, Lx/2] = ±{}", 0.5 * lx),
+            ));
+        }
+        let rate = positive(p, "rate", None)?;
+        let max_angle = positive(p, "max_angle", None)?;
+        if max_angle >= 90.0 {
+            return Err(ParamError::new("max_angle", format!("must be below 90 degrees, got {max_angle}")));
+        }
+        let start = number(p, "start", Some(0.0))?;
+        if start < 0.0 {
+            return Err(ParamError::new("start", format!("must be ≥ 0 (s), got {start}")));
+        }
+        let lo = [o[0] - 0.5 * lx, o[1] - 0.5 * ly, o[2] - lz];
+        let hi = [o[0] + 0.5 * lx, o[1] + 0.5 * ly, o[2]];
+        let b = add_points(out, &box_points(lo, hi), material, false)?;
+        out.set_name(b, "table");
+        let d0 = [-hinge, -0.5 * lz];
+        let (rho, beta) = ((d0[0] * d0[0] + d0[1] * d0[1]).sqrt(), d0[1].atan2(d0[0]));
+        let stop = start + max_angle.to_radians() / rate;
+        let phased = |f: TimeFn| {
+            let mut ph = vec![];
+            if start > 0.0 {
+                ph.push(Phase::velocity(TimeFn::Constant(0.0), Some(start)));
+            }
+            ph.push(Phase::velocity(f, Some(stop)));
+            ph.push(Phase::velocity(TimeFn::Constant(0.0), None));
+            Some(DofDrive::Phases(ph))
+        };
+        let freq = rate / (2.0 * std::f64::consts::PI);
+        let ph0 = beta - rate * start;
+        let vx = TimeFn::Shaped(Shape::Sine([-rate * rho, freq, ph0, 0.0]));
+        let vz = TimeFn::Shaped(Shape::Sine([rate * rho, freq, ph0 + 0.5 * std::f64::consts::PI, 0.0]));
+        let wy = TimeFn::Constant(-rate);
+        let hold = || Some(DofDrive::One(Phase::velocity(TimeFn::Constant(0.0), None)));
+        if start == 0.0 {
+            out.set_velocity(b, [vx.eval(0.0), 0.0, vz.eval(0.0), 0.0, -rate, 0.0]);
+        }
+        out.drive(b, [phased(vx), hold(), phased(vz), hold(), phased(wy), hold()]);
         Ok(())
     }
 }

@@ -43,6 +43,7 @@ impl Plugin for PolyhedraPlugin {
         reg.add_detector3(Polyhedra::KIND, nscdd_spheres::shapes::Spheres::KIND, Arc::new(detect::PolySphere));
         reg.add_generator3("brick_wall", Box::new(generate::BrickWall));
         reg.add_generator3("arch", Box::new(generate::Arch));
+        reg.add_generator3("tilting_table", Box::new(generate::TiltingTable));
     }
 }
 

@@ -176,6 +176,66 @@ fn block_on_incline_fails_at_arctan_min_mu_b_over_h() {
     assert!(r > 0.1, "overturns");
 }
 
+/// A block b × h standing on the hinge of a tilting table (a 1 m table turned about
+/// the middle of its top face) turned at 0.02 rad/s up to `alpha_deg`, then held
+/// for 1 s. The table stops abruptly: the block's centre, h/2 above the hinge, gets
+/// a jolt ω h/2 ≤ 2 mm/s, which a block 1° from failure absorbs by slipping
+/// v²/(2 g (μ cos α − sin α)) ≈ 1e-5 m. Returns (displacement, rotation) of the
+/// block relative to the table.
+fn tilting(b: f64, h: f64, mu: f64, alpha_deg: f64) -> (f64, f64) {
+    // the scene head without its floor
+    let head = head(mu, 2e-3, 1, [0.0; 3]);
+    let mut text = head[..head.find("[[bodies]]").unwrap()].to_string();
+    text += &format!(
+        "[[generate]]\nkind = \"tilting_table\"\nmaterial = \"ground\"\nsize = [1.0, 0.6, 0.1]\nhinge = 0.0\nrate = 0.02\nmax_angle = {alpha_deg}\n"
+    );
+    text += &brick("block", [-0.5 * b, -0.1, 0.0], [0.5 * b, 0.1, h], [0.0; 3]);
+    let mut w = world(&text);
+    // body 0: the block, body 1: the generated table
+    let rel = |w: &World3| {
+        let (qt, qb) = (w.bodies.quat[1], w.bodies.quat[0]);
+        let d = [0, 1, 2].map(|k| w.bodies.pos[0][k] - w.bodies.pos[1][k]);
+        // the block's pose in the table's frame: Rₜᵀ (x_b − x_t), qₜ⁻¹ q_b
+        let qi = [qt[0], -qt[1], -qt[2], -qt[3]];
+        (nscdd::rigid3d::bodies::rotate(qi, d), nscdd::rigid3d::bodies::quat_mul(qi, qb))
+    };
+    let (x0, q0) = rel(&w);
+    let qt0 = w.bodies.quat[1];
+    let steps = ((alpha_deg.to_radians() / 0.02 + 1.0) / 2e-3).round() as usize;
+    for _ in 0..steps {
+        w.step().unwrap();
+    }
+    // the table's rotation since t = 0 (its principal frame need not be the world's)
+    let qt = nscdd::rigid3d::bodies::quat_mul(w.bodies.quat[1], [qt0[0], -qt0[1], -qt0[2], -qt0[3]]);
+    let tilt = 2.0 * qt[0].abs().min(1.0).acos();
+    // drives act at step ends: the tilt stops within rate × h of max_angle
+    assert!((tilt - alpha_deg.to_radians()).abs() <= 0.02 * 2e-3, "table at {tilt} rad");
+    let (x, q) = rel(&w);
+    let d = [0, 1, 2].map(|k| x[k] - x0[k]);
+    let dot = (q[0] * q0[0] + q[1] * q0[1] + q[2] * q0[2] + q[3] * q0[3]).abs().min(1.0);
+    ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt(), 2.0 * dot.acos())
+}
+
+#[test]
+fn block_on_tilting_table_fails_at_arctan_min_mu_b_over_h() {
+    // sliding governs: μ = 0.5 < b/h = 2
+    let star = 0.5f64.atan().to_degrees();
+    let (d, r) = tilting(0.2, 0.1, 0.5, star - 1.0);
+    println!("table, sliding case, α* − 1°: {d:.2e} m, {r:.2e} rad");
+    assert!(d < 1e-4 && r < 1e-3);
+    let (d, r) = tilting(0.2, 0.1, 0.5, star + 1.0);
+    println!("table, sliding case, α* + 1°: {d:.2e} m, {r:.2e} rad");
+    assert!(d > 0.02 && r < 1e-2, "slides without turning");
+    // overturning governs: b/h = 0.5 < μ = 0.8
+    let star = 0.5f64.atan().to_degrees();
+    let (d, r) = tilting(0.1, 0.2, 0.8, star - 1.0);
+    println!("table, overturning case, α* − 1°: {d:.2e} m, {r:.2e} rad");
+    assert!(d < 1e-4 && r < 1e-3);
+    let (_, r) = tilting(0.1, 0.2, 0.8, star + 1.0);
+    println!("table, overturning case, α* + 1°: {r:.2e} rad");
+    assert!(r > 0.2, "overturns");
+}
+
 /// Largest displacement of the voussoirs of an arch of thickness ratio t/R after
 /// `steps` steps of 1 ms.
 fn arch(t_over_r: f64, steps: usize) -> f64 {
