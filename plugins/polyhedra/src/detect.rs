@@ -104,9 +104,13 @@ fn face_contacts(
             pts.push(*x);
         }
     }
-    // the overlap polygon's area, shared by its corners
-    let area = polygon_area(&pts, n) / pts.len() as f64;
+    // the overlap polygon's area, shared by the points kept
+    let keep = reduce4(&pts, n, reference[0]);
+    let area = polygon_area(&pts, n) / keep.iter().filter(|&&x| x).count() as f64;
     for (k, x) in pts.iter().enumerate() {
+        if !keep[k] {
+            continue;
+        }
         let gap = dot(sub(*x, reference[0]), n);
         if gap <= alert {
             let point = [x[0] - 0.5 * gap * n[0], x[1] - 0.5 * gap * n[1], x[2] - 0.5 * gap * n[2]];
@@ -122,6 +126,31 @@ fn face_contacts(
             });
         }
     }
+}
+
+/// At most 4 corners of an overlap polygon (n: reference normal, p: a point of the
+/// reference plane): the deepest, the farthest from it, then on each side of the
+/// line through these two the corner farthest from it. They span the polygon but
+/// for slivers at cut corners, so the contact keeps its support and its moments
+/// without the redundant points that slow NLGS down (8 corners for bricks turned
+/// about their common normal).
+fn reduce4(pts: &[[f64; 3]], n: [f64; 3], p: [f64; 3]) -> Vec<bool> {
+    let m = pts.len();
+    let mut keep = vec![m <= 4; m];
+    if m <= 4 {
+        return keep;
+    }
+    let depth = |k: usize| dot(sub(pts[k], p), n);
+    let a = (0..m).min_by(|&x, &y| depth(x).total_cmp(&depth(y))).unwrap();
+    let far = |k: usize| norm(sub(pts[k], pts[a]));
+    let b = (0..m).max_by(|&x, &y| far(x).total_cmp(&far(y))).unwrap();
+    let side = |k: usize| dot(cross(sub(pts[b], pts[a]), sub(pts[k], pts[a])), n);
+    let c = (0..m).max_by(|&x, &y| side(x).total_cmp(&side(y))).unwrap();
+    let d = (0..m).min_by(|&x, &y| side(x).total_cmp(&side(y))).unwrap();
+    for k in [a, b, c, d] {
+        keep[k] = true;
+    }
+    keep
 }
 
 /// Area of a planar convex polygon (vertices in order) of unit normal n.
