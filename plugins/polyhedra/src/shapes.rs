@@ -17,6 +17,8 @@ pub struct Poly {
     pub normals: Vec<[f64; 3]>,
     /// Unique edges (vertex pairs).
     pub edges: Vec<[u32; 2]>,
+    /// The two faces that meet at each edge.
+    pub edge_faces: Vec<[u32; 2]>,
     pub volume: f64,
     /// Principal moments of inertia per unit density.
     pub inertia: [f64; 3],
@@ -51,15 +53,22 @@ impl Poly {
             .iter()
             .map(|n| [0, 1, 2].map(|k| r[0][k] * n[0] + r[1][k] * n[1] + r[2][k] * n[2]))
             .collect();
-        let mut edges = vec![];
-        for f in &h.faces {
+        let (mut edges, mut edge_faces): (Vec<[u32; 2]>, Vec<[u32; 2]>) = (vec![], vec![]);
+        for (fi, f) in h.faces.iter().enumerate() {
             for q in 0..f.len() {
                 let (a, b) = (f[q], f[(q + 1) % f.len()]);
                 let e = [a.min(b), a.max(b)];
-                if !edges.contains(&e) {
-                    edges.push(e);
+                match edges.iter().position(|x| *x == e) {
+                    Some(k) => edge_faces[k] = [edge_faces[k][0], fi as u32],
+                    None => {
+                        edges.push(e);
+                        edge_faces.push([fi as u32, u32::MAX]);
+                    }
                 }
             }
+        }
+        if edge_faces.iter().any(|f| f[1] == u32::MAX) {
+            return Err("the hull is not closed (an edge with one face)".into());
         }
         let radius = vertices.iter().map(|v| norm(*v)).fold(0.0, f64::max);
         let Hull { faces, .. } = h;
@@ -69,6 +78,7 @@ impl Poly {
                 faces,
                 normals,
                 edges,
+                edge_faces,
                 volume,
                 inertia,
                 radius,
