@@ -183,15 +183,48 @@ pub fn free_velocity(w: &mut World3) {
     }
 }
 
+/// The last step's contact that a new contact continues: the one with its key, or
+/// else the nearest one of the same pair of bodies within the alert distance
+/// (multi-point contacts renumber their points when their polygons change a
+/// little: the impulse and the bond follow the point). `p`: where the key would be
+/// inserted in the sorted `prev`.
+fn continued(prev: &[PrevContact], p: usize, key: ContactKey, point: [f64; 3], alert: f64) -> Option<usize> {
+    let same = |k: usize| prev[k].key.i == key.i && prev[k].key.j == key.j;
+    let (mut lo, mut hi) = (p, p);
+    while lo > 0 && same(lo - 1) {
+        lo -= 1;
+    }
+    while hi < prev.len() && same(hi) {
+        hi += 1;
+    }
+    let d2 = |k: usize| (0..3).map(|c| (prev[k].point[c] - point[c]).powi(2)).sum::<f64>();
+    (lo..hi)
+        .filter(|&k| d2(k) <= alert * alert)
+        .min_by(|&a, &b| d2(a).total_cmp(&d2(b)))
+}
+
+/// A contact of the last step, as the next step's warm start and bonds read it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PrevContact {
+    pub key: ContactKey,
+    pub r: [f64; 3],
+    pub bonded: bool,
+    pub point: [f64; 3],
+}
+
 /// This step's contact set: frames, W_αα, ū and the warm start, applied at once.
 pub fn build_contacts(w: &mut World3) {
     let (h, theta) = (w.time.h, w.time.theta);
     let s = &mut w.scratch;
     s.prev_keys.clear();
     let old = &w.contacts;
-    s.prev_keys
-        .extend((0..old.len()).map(|a| (old.key[a], old.r[a], old.joint[a].bonded())));
-    s.prev_keys.sort_unstable_by_key(|x| x.0);
+    s.prev_keys.extend((0..old.len()).map(|a| PrevContact {
+        key: old.key[a],
+        r: old.r[a],
+        bonded: old.joint[a].bonded(),
+        point: old.point[a],
+    }));
+    s.prev_keys.sort_unstable_by_key(|x| x.key);
     let c = &mut s.next;
     c.clear();
     let b = &w.bodies;
@@ -220,10 +253,14 @@ pub fn build_contacts(w: &mut World3) {
             j: rc.j,
             feature: rc.feature,
         };
-        let (r, bonded) = match s.prev_keys.binary_search_by_key(&key, |x| x.0) {
-            Ok(p) => (s.prev_keys[p].1, s.prev_keys[p].2),
+        let prev = match s.prev_keys.binary_search_by_key(&key, |x| x.key) {
+            Ok(p) => Some(p),
+            Err(p) => continued(&s.prev_keys, p, key, rc.point, w.alert),
+        };
+        let (r, bonded) = match prev {
+            Some(p) => (s.prev_keys[p].r, s.prev_keys[p].bonded),
             // bonds are made at the first step only
-            Err(_) => ([0.0; 3], w.step == 0 && rc.gap <= law.bond_gap),
+            None => ([0.0; 3], w.step == 0 && rc.gap <= law.bond_gap),
         };
         let joint = if bonded && law.is_cohesive() && rc.area > 0.0 {
             Joint::of(&law, rc.area, h)

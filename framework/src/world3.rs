@@ -5,7 +5,6 @@ use crate::detect3::{Detector3, DetectorTable3};
 use crate::drive::DofDrive;
 use crate::law::ContactLaw;
 use crate::registry3::{RawContact3, ShapeStore3};
-use crate::rigid2d::contacts::ContactKey;
 use crate::rigid3d::{Bodies3, Contacts3};
 use crate::solver::SolverSettings;
 use crate::world::{Material, TimeSettings};
@@ -59,8 +58,7 @@ pub(crate) struct Scratch3 {
     pub raw: Vec<RawContact3>,
     pub v_begin: Vec<[f64; 6]>,
     pub order: Vec<u32>,
-    /// The last step's contacts: key, impulse, bonded.
-    pub prev_keys: Vec<(ContactKey, [f64; 3], bool)>,
+    pub prev_keys: Vec<crate::engine3::PrevContact>,
     pub next: Contacts3,
 }
 
