@@ -2,8 +2,12 @@
 //! VTK frames (`vtk/bodies_*.vtp`: one point per body with `id`, `radius`,
 //! `velocity`, `angular_velocity` (vectors), `material`; `vtk/walls_*.vtp`: planes
 //! and boxes as polygons; `vtk/contacts_*.vtp`: a line per contact with `r_n`,
-//! `r_t` = |r_t|, `f_n`, `gap`), with the series `bodies.pvd`, `walls.pvd`,
-//! `contacts.pvd`.
+//! `r_t` = |r_t|, `f_n`, `gap`; `vtk/points_*.vtp`: a vertex per contact point
+//! with the contact force on the candidate body as the vector `force` (impulse / h,
+//! world axes), `f_n`, `gap` and `bonded` (1 for an intact mortar joint)), with the
+//! series `bodies.pvd`, `walls.pvd`, `contacts.pvd`, `points.pvd`. Polyhedra and
+//! other faceted shapes are drawn as their faces in `walls_*.vtp` (cell `id`: the
+//! body).
 
 use super::history::{solver_fields, SOLVER_COLUMNS};
 use super::vtk::{cells, export, piece, VtkWriter};
@@ -303,8 +307,34 @@ pub fn write_vtk3(v: &mut VtkWriter, w: &World3, dir: &Path, frame: u32) -> std:
         piece(cpts, None, lines, None, vec![], cell),
         &vdir.join(format!("contacts_{frame:06}.vtp")),
     )?;
+    // contact points with their forces
+    let (mut ppts, mut force, mut pfn, mut pgap, mut bonded) = (vec![], vec![], vec![], vec![], vec![]);
+    for a in 0..m {
+        ppts.extend_from_slice(&c.point[a]);
+        force.extend(c.world_impulse(a).map(|x| x / w.time.h));
+        pfn.push(c.r[a][0] / w.time.h);
+        pgap.push(c.gap[a]);
+        bonded.push(c.joint[a].bonded() as u8 as f64);
+    }
+    let point = vec![
+        Attribute::vectors("force").with_data(force),
+        Attribute::scalars("f_n", 1).with_data(pfn),
+        Attribute::scalars("gap", 1).with_data(pgap),
+        Attribute::scalars("bonded", 1).with_data(bonded),
+    ];
+    export(
+        piece(
+            ppts,
+            cells((0..m as u64).collect(), (1..=m as u64).collect()),
+            None,
+            None,
+            point,
+            vec![],
+        ),
+        &vdir.join(format!("points_{frame:06}.vtp")),
+    )?;
     v.frames.push((w.t, frame));
-    for name in ["bodies", "walls", "contacts"] {
+    for name in ["bodies", "walls", "contacts", "points"] {
         v.write_pvd(dir, name)?;
     }
     Ok(())

@@ -287,3 +287,70 @@ fn arch_stands_at_012_and_collapses_at_009() {
     assert!(stand < 1e-3, "t/R = 0.12 should stand: {stand}");
     assert!(fall > 2e-2, "t/R = 0.09 should collapse: {fall}");
 }
+
+#[test]
+fn stack_exports_a_frictional_contact_problem_that_solve_fc_solves() {
+    let (l, wd, ht) = (0.2, 0.1, 0.05);
+    let mut text = head(0.5, 1e-3, 1, [0.0; 3]);
+    for k in 0..3 {
+        let z = k as f64 * ht;
+        let rot = if k == 1 { [0.0, 0.0, 0.01] } else { [0.0; 3] };
+        text += &brick(&format!("b{k}"), [0.0, 0.0, z], [l, wd, z + ht], rot);
+    }
+    let mut w = world(&text);
+    for _ in 0..20 {
+        w.step().unwrap();
+    }
+    let p = nscdd::fc::problem_from_world3(&w);
+    assert_eq!((p.dim, p.nc), (3, 12), "3 interfaces of 4 points");
+    // the engine's impulses solve the exported problem (to the engine's tolerance)
+    let r_world: Vec<f64> = w.contacts.r.iter().flatten().copied().collect();
+    let res_world = p.natural_residual(&r_world);
+    let sol = p.solve(&nscdd::fc::FcOptions {
+        tol: 1e-6,
+        max_sweeps: 100_000,
+        check_every: 1,
+        norm: nscdd::fc::FcNorm::Natural,
+    });
+    println!(
+        "world r: residual {res_world:.1e}; solve-fc: {} sweeps, residual {:.1e}",
+        sol.sweeps, sol.residual
+    );
+    // (NLGS converges slowly on the redundant 4-point faces in this norm)
+    assert!(sol.converged && sol.residual < 1e-6);
+    assert!(res_world < 1e-5, "{res_world}");
+    // the velocities (unique, unlike the impulses of 4-point faces) agree
+    let u_world = p.velocity(&r_world);
+    let du = u_world.iter().zip(&sol.u).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    assert!(du < 1e-6, "local velocities differ by {du}");
+}
+
+#[test]
+fn outputs_draw_the_blocks_and_their_contact_points() {
+    let (l, wd, ht) = (0.2, 0.1, 0.05);
+    let mut text = head(0.5, 1e-3, 20, [0.0; 3]);
+    text += "[output]\nevery = 10\n";
+    for k in 0..3 {
+        let z = k as f64 * ht;
+        text += &brick(&format!("b{k}"), [0.0, 0.0, z], [l, wd, z + ht], [0.0; 3]);
+    }
+    let mut s = load_str(&text, "stack.toml", &nscdd_polyhedra::registry()).unwrap();
+    let dir = std::env::temp_dir().join(format!("nscdd-poly-out-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    nscdd::run3::run3(&mut s, &dir, |_, _| {}).unwrap();
+    for f in ["points.pvd", "walls.pvd", "vtk/points_000002.vtp", "vtk/walls_000002.vtp"] {
+        assert!(dir.join(f).exists(), "{f}");
+    }
+    let points = std::fs::read_to_string(dir.join("vtk/points_000002.vtp")).unwrap();
+    assert!(points.contains("NumberOfPoints=\"12\""), "12 contact points");
+    for name in ["\"force\"", "\"f_n\"", "\"bonded\""] {
+        assert!(points.contains(name), "{name}");
+    }
+    // each brick drawn as its 6 faces (the plane as one more polygon)
+    let walls = std::fs::read_to_string(dir.join("vtk/walls_000002.vtp")).unwrap();
+    assert!(walls.contains("NumberOfPolys=\"19\""), "{}", &walls[..300]);
+    let fin: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("final.json")).unwrap()).unwrap();
+    assert_eq!(fin["bodies"][1]["kind"], "polyhedron");
+    assert_eq!(fin["contacts"].as_array().unwrap().len(), 12);
+    let _ = std::fs::remove_dir_all(&dir);
+}
