@@ -235,9 +235,10 @@ fn block_on_tilting_table_fails_at_arctan_min_mu_b_over_h() {
     assert!(r > 0.2, "overturns");
 }
 
-/// Largest displacement of the voussoirs of an arch of thickness ratio t/R after
-/// `steps` steps of 1 ms.
-fn arch(t_over_r: f64, steps: usize) -> f64 {
+/// An arch of 24 radial voussoirs of thickness ratio t/R (R = 1 m), μ = 1: bodies
+/// 0..24 the voussoirs from the right springing (angle 0) to the left, 24 the left
+/// support, 25 the right one.
+fn arch_world(t_over_r: f64) -> World3 {
     let text = format!(
         r#"dimension = 3
 gravity = [0.0, 0.0, -9.81]
@@ -264,16 +265,90 @@ radius = 1.0
 thickness = {t_over_r}
 depth = 0.2
 voussoirs = 24
-"#
+"#,
+        steps = 1
     );
-    let mut w = world(&text);
+    world(&text)
+}
+
+fn largest_displacement(w: &World3, x0: &[[f64; 3]]) -> f64 {
+    (0..w.bodies.len())
+        .map(|b| (0..3).map(|k| (w.bodies.pos[b][k] - x0[b][k]).powi(2)).sum::<f64>().sqrt())
+        .fold(0.0, f64::max)
+}
+
+/// Largest displacement of the voussoirs of an arch of thickness ratio t/R after
+/// `steps` steps of 1 ms.
+fn arch(t_over_r: f64, steps: usize) -> f64 {
+    let mut w = arch_world(t_over_r);
     let x0 = w.bodies.pos.clone();
     for _ in 0..steps {
         w.step().unwrap();
     }
-    (0..w.bodies.len())
-        .map(|b| (0..3).map(|k| (w.bodies.pos[b][k] - x0[b][k]).powi(2)).sum::<f64>().sqrt())
-        .fold(0.0, f64::max)
+    largest_displacement(&w, &x0)
+}
+
+/// Relative rotations (about y) at the 25 joints of the arch, from the right
+/// springing: joint k lies between voussoirs k − 1 and k, at π k / 24.
+fn joint_rotations(w: &World3, q0: &[[f64; 4]]) -> Vec<f64> {
+    use nscdd::rigid3d::bodies::{quat_mul, to_rotation_vector};
+    let theta = |b: usize| {
+        let q = q0[b];
+        to_rotation_vector(quat_mul(w.bodies.quat[b], [q[0], -q[1], -q[2], -q[3]]))[1]
+    };
+    let turn = |k: usize| if k == 0 || k == 25 { 0.0 } else { theta(k - 1) };
+    (0..25).map(|k| turn(k + 1) - turn(k)).collect()
+}
+
+#[test]
+fn collapsing_arch_forms_five_hinges() {
+    // t/R = 0.09, below the minimum 0.1075 of radial joints: follow the collapse
+    // until a voussoir has moved 5 mm, while the segments are still rigid blocks
+    let mut w = arch_world(0.09);
+    let (x0, q0) = (w.bodies.pos.clone(), w.bodies.quat.clone());
+    while largest_displacement(&w, &x0) < 5e-3 {
+        w.step().unwrap();
+        assert!(w.step < 2000, "the arch does not collapse");
+    }
+    let rot = joint_rotations(&w, &q0);
+    let max = rot.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    // a hinge: a run of adjacent joints turning the same way (the discrete joints
+    // share a hinge that falls between them), at its rotation-weighted position
+    let mut hinges: Vec<(f64, f64)> = vec![]; // (position in joints, rotation)
+    let mut k = 0;
+    while k < 25 {
+        if rot[k].abs() <= 0.1 * max {
+            k += 1;
+            continue;
+        }
+        let (mut sum, mut moment) = (0.0, 0.0);
+        let sign = rot[k].signum();
+        while k < 25 && rot[k].abs() > 0.1 * max && rot[k].signum() == sign {
+            sum += rot[k];
+            moment += rot[k] * k as f64;
+            k += 1;
+        }
+        hinges.push((moment / sum, sum));
+    }
+    let deg = |x: f64| 180.0 * x / 24.0;
+    println!(
+        "t = {:.3} s: hinges at {:?} degrees from the right springing, rotations {:?}",
+        w.t,
+        hinges.iter().map(|h| deg(h.0)).collect::<Vec<_>>(),
+        hinges.iter().map(|h| h.1).collect::<Vec<_>>()
+    );
+    assert_eq!(hinges.len(), 5, "a five-hinge mechanism: {rot:?}");
+    // symmetric; at the springings, at the crown, and at the haunches 45°–65° from
+    // the crown (Heyman: 54.5° at the minimum thickness of radial joints)
+    assert!((deg(hinges[2].0) - 90.0).abs() < 1e-6, "crown hinge at {}", deg(hinges[2].0));
+    assert!((hinges[0].0 + hinges[4].0 - 24.0).abs() < 1e-3 && (hinges[1].0 + hinges[3].0 - 24.0).abs() < 1e-3);
+    assert!(hinges[0].0 < 1.0, "springing hinge at {}°", deg(hinges[0].0));
+    let haunch = 90.0 - deg(hinges[1].0);
+    assert!((45.0..=65.0).contains(&haunch), "haunch hinge {haunch}° from the crown");
+    // alternating senses: intrados and extrados hinges alternate along the arch
+    for k in 0..4 {
+        assert!(hinges[k].1 * hinges[k + 1].1 < 0.0, "senses {hinges:?}");
+    }
 }
 
 /// A semicircular arch of radial voussoirs (μ = 1: no sliding) stands at
