@@ -73,17 +73,14 @@ pub trait ShapeStore3: Any + Send + Sync {
     }
     /// A point p (world frame) against this shape's surface at a pose (a boundary
     /// node of a deformable body): the signed distance (the gap), the unit outward
-    /// normal at the closest surface point, and that point. `None`: this kind does
-    /// not meet points.
-    fn point_contact(&self, _s: u32, _pos: [f64; 3], _quat: [f64; 4], _p: [f64; 3]) -> Option<PointContact3> {
+    /// normal at the closest surface point, and that point. `hint` is the outward
+    /// normal of the deformable body's surface at the node (zero if unknown): where
+    /// several faces of the shape are at the same distance (a node on an edge of
+    /// a block resting on it), the one facing the node's surface is meant. `None`:
+    /// this kind does not meet points.
+    fn point_contact(&self, _s: u32, _pos: [f64; 3], _quat: [f64; 4], _p: [f64; 3], _hint: [f64; 3]) -> Option<PointContact3> {
         None
     }
-    /// A triangle (world frame, a boundary face of a deformable body) against this
-    /// shape at a pose: the closest point of the triangle (barycentric weights),
-    /// the gap, the unit normal from the shape towards the triangle and the point
-    /// of the shape's surface. Kinds that implement it meet deformable bodies by
-    /// their faces instead of by the bodies' nodes (round grains smaller than the
-    /// mesh would otherwise pass between nodes).
     /// Where the shape's principal frame (centroid, principal axes) lies in the frame
     /// its parameters were given in, as (centroid, unit quaternion): a body placed at
     /// (x, q) in that frame is stored at x + q·c with orientation q ⊗ q_c, so that
@@ -96,6 +93,12 @@ pub trait ShapeStore3: Any + Send + Sync {
     fn meets_faces(&self) -> bool {
         false
     }
+    /// A triangle (world frame, a boundary face of a deformable body) against this
+    /// shape at a pose: the closest point of the triangle (barycentric weights),
+    /// the gap, the unit normal from the shape towards the triangle and the point
+    /// of the shape's surface. Kinds that implement it meet deformable bodies by
+    /// their faces instead of by the bodies' nodes (round grains smaller than the
+    /// mesh would otherwise pass between nodes).
     fn face_contact(&self, _s: u32, _pos: [f64; 3], _quat: [f64; 4], _tri: &[[f64; 3]; 3]) -> Option<FaceContact3> {
         None
     }

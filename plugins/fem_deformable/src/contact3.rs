@@ -262,7 +262,7 @@ pub fn detect(w: &World3, fe: &[FeBody], alert: f64, out: &mut Vec<RawFe3>) {
                 if !inside(p, &ab, alert) {
                     continue;
                 }
-                if let Some(pc) = store.point_contact(s.index, x, q, p) {
+                if let Some(pc) = store.point_contact(s.index, x, q, p, body.mesh.node_normal[k as usize]) {
                     if pc.gap <= alert {
                         out.push(RawFe3 {
                             body: fb as u32,

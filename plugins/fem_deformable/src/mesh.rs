@@ -18,6 +18,9 @@ pub struct Mesh {
     /// The longest edge of the boundary facets (reference configuration): the
     /// mesh size a rigid grain is compared with in contact detection.
     pub longest_boundary_edge: f64,
+    /// 3D: the outward unit normal of the boundary at each node (area-weighted
+    /// mean of its facets', reference configuration; zero inside and in 2D).
+    pub node_normal: Vec<[f64; 3]>,
 }
 
 /// A mesh that cannot be used (message for the user).
@@ -69,9 +72,11 @@ impl Mesh {
             facets: vec![],
             boundary: vec![],
             longest_boundary_edge: 0.0,
+            node_normal: vec![],
         };
         m.find_boundary();
         m.longest_boundary_edge = m.longest_edge();
+        m.node_normal = m.node_normals();
         Ok(m)
     }
 
@@ -132,6 +137,31 @@ impl Mesh {
         } else {
             f.to_vec()
         }
+    }
+
+    fn node_normals(&self) -> Vec<[f64; 3]> {
+        let mut n = vec![[0.0; 3]; self.n_nodes()];
+        if self.dim != 3 {
+            return n;
+        }
+        let p = |k: u32| [self.x0[3 * k as usize], self.x0[3 * k as usize + 1], self.x0[3 * k as usize + 2]];
+        for f in 0..self.n_facets() {
+            let v = self.facet(f);
+            let a = p(v[0]);
+            let c = cross(sub(p(v[1]), a), sub(p(v[2]), a));
+            for &k in v {
+                for d in 0..3 {
+                    n[k as usize][d] += c[d];
+                }
+            }
+        }
+        for x in &mut n {
+            let l = dot(*x, *x).sqrt();
+            if l > 0.0 {
+                *x = x.map(|c| c / l);
+            }
+        }
+        n
     }
 
     fn longest_edge(&self) -> f64 {

@@ -372,6 +372,43 @@ impl PairDetector3 for PolyPlane {
     }
 }
 
+/// The point of a polyhedron's surface (world vertices `wv`, orientation q) closest
+/// to the point c, the unit outward normal there and the signed distance of c
+/// (negative inside: then the face of least penetration; among faces within
+/// 1e-9 of the size of it, the one most opposed to `hint`, e.g. the surface normal
+/// of a node on an edge). `None` when c lies outside on the surface (no normal).
+pub fn closest_surface(p: &Poly, wv: &[[f64; 3]], q: [f64; 4], c: [f64; 3], hint: [f64; 3]) -> Option<([f64; 3], [f64; 3], f64)> {
+    let mut depth = f64::NEG_INFINITY;
+    let side = |f: usize| dot(rotate(q, p.normals[f]), sub(c, wv[p.faces[f][0] as usize]));
+    for f in 0..p.faces.len() {
+        depth = depth.max(side(f));
+    }
+    let tol = 1e-9 * p.radius;
+    if depth <= tol {
+        let f = (0..p.faces.len())
+            .filter(|&f| side(f) >= depth - tol)
+            .min_by(|&a, &b| dot(rotate(q, p.normals[a]), hint).total_cmp(&dot(rotate(q, p.normals[b]), hint)))
+            .expect("the deepest face");
+        let (n, s) = (rotate(q, p.normals[f]), side(f));
+        let x = [c[0] - s * n[0], c[1] - s * n[1], c[2] - s * n[2]];
+        return Some((x, n, s));
+    }
+    let mut best = (f64::INFINITY, [0.0; 3]);
+    for f in &p.faces {
+        for t in 1..f.len() - 1 {
+            let tri = [wv[f[0] as usize], wv[f[t] as usize], wv[f[t + 1] as usize]];
+            let w = closest_on_triangle(c, &tri);
+            let x = [0, 1, 2].map(|k| w[0] * tri[0][k] + w[1] * tri[1][k] + w[2] * tri[2][k]);
+            let d = norm(sub(x, c));
+            if d < best.0 {
+                best = (d, x);
+            }
+        }
+    }
+    let n = unit(sub(c, best.1))?;
+    Some((best.1, n, best.0))
+}
+
 /// Polyhedron (candidate) – sphere (antagonist).
 pub struct PolySphere;
 
@@ -387,35 +424,11 @@ impl PairDetector3 for PolySphere {
             let r = ss.radius[b.shape[ju].index as usize];
             let c = b.pos[ju];
             sa.world_vertices(b.shape[iu].index, b.pos[iu], b.quat[iu], &mut wv);
-            // inside: the face of least penetration
-            let mut depth = (f64::NEG_INFINITY, 0);
-            for f in 0..p.faces.len() {
-                let n = rotate(b.quat[iu], p.normals[f]);
-                let s = dot(n, sub(c, wv[p.faces[f][0] as usize]));
-                if s > depth.0 {
-                    depth = (s, f);
-                }
-            }
-            let (q, n, gap) = if depth.0 <= 0.0 {
-                let n = rotate(b.quat[iu], p.normals[depth.1]);
-                let q = [c[0] - depth.0 * n[0], c[1] - depth.0 * n[1], c[2] - depth.0 * n[2]];
-                (q, n.map(|x| -x), depth.0 - r)
-            } else {
-                let mut best = (f64::INFINITY, [0.0; 3]);
-                for f in &p.faces {
-                    for t in 1..f.len() - 1 {
-                        let tri = [wv[f[0] as usize], wv[f[t] as usize], wv[f[t + 1] as usize]];
-                        let w = closest_on_triangle(c, &tri);
-                        let q = [0, 1, 2].map(|k| w[0] * tri[0][k] + w[1] * tri[1][k] + w[2] * tri[2][k]);
-                        let d = norm(sub(q, c));
-                        if d < best.0 {
-                            best = (d, q);
-                        }
-                    }
-                }
-                let Some(n) = unit(sub(best.1, c)) else { continue };
-                (best.1, n, best.0 - r)
+            let Some((q, outward, d)) = closest_surface(p, &wv, b.quat[iu], c, [0.0; 3]) else {
+                continue;
             };
+            // the normal from the sphere (antagonist) to the polyhedron
+            let (n, gap) = (outward.map(|x| -x), d - r);
             if gap > ctx.alert {
                 continue;
             }

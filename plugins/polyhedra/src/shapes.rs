@@ -5,7 +5,7 @@
 use crate::hull::{hull, moments, norm, principal, quat_of, sub, Hull};
 use nscdd::params::only_keys;
 use nscdd::registry::ParamError;
-use nscdd::registry3::{Aabb3, Glyph3, MassProps3, ShapeStore3};
+use nscdd::registry3::{Aabb3, Glyph3, MassProps3, PointContact3, ShapeStore3};
 use nscdd::rigid3d::bodies::rotate;
 use std::any::Any;
 
@@ -186,6 +186,19 @@ impl ShapeStore3 for Polyhedra {
     }
     fn principal_frame(&self, s: u32) -> ([f64; 3], [f64; 4]) {
         self.frames[s as usize]
+    }
+    /// A boundary node of a deformable body against the block: the closest point
+    /// of the block's surface (a block resting on a soil mesh finer than itself
+    /// meets the mesh's nodes under it).
+    fn point_contact(&self, s: u32, x: [f64; 3], q: [f64; 4], p: [f64; 3], hint: [f64; 3]) -> Option<PointContact3> {
+        let poly = &self.shapes[s as usize];
+        let mut wv = [[0.0; 3]; 64];
+        for (k, v) in poly.vertices.iter().enumerate() {
+            let r = rotate(q, *v);
+            wv[k] = [x[0] + r[0], x[1] + r[1], x[2] + r[2]];
+        }
+        let (point, normal, gap) = crate::detect::closest_surface(poly, &wv[..poly.vertices.len()], q, p, hint)?;
+        Some(PointContact3 { gap, normal, point })
     }
 }
 

@@ -37,7 +37,7 @@ impl ShapeStore3 for Spheres {
     }
     store_basics!(|s: &Self| s.radius.len());
     /// Gap |p − c| − r along the radius through p.
-    fn point_contact(&self, s: u32, x: [f64; 3], _q: [f64; 4], p: [f64; 3]) -> Option<PointContact3> {
+    fn point_contact(&self, s: u32, x: [f64; 3], _q: [f64; 4], p: [f64; 3], _hint: [f64; 3]) -> Option<PointContact3> {
         let r = self.radius[s as usize];
         let d = [p[0] - x[0], p[1] - x[1], p[2] - x[2]];
         let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
@@ -126,7 +126,7 @@ impl ShapeStore3 for Planes {
     }
     store_basics!(|s: &Self| s.display.len());
     /// Signed distance to the plane through x with normal q·e_z.
-    fn point_contact(&self, _s: u32, x: [f64; 3], q: [f64; 4], p: [f64; 3]) -> Option<PointContact3> {
+    fn point_contact(&self, _s: u32, x: [f64; 3], q: [f64; 4], p: [f64; 3], _hint: [f64; 3]) -> Option<PointContact3> {
         let n = rotate(q, [0.0, 0.0, 1.0]);
         let gap = (p[0] - x[0]) * n[0] + (p[1] - x[1]) * n[1] + (p[2] - x[2]) * n[2];
         Some(PointContact3 {
@@ -206,21 +206,29 @@ impl ShapeStore3 for Boxes {
         Self::KIND
     }
     store_basics!(|s: &Self| s.half.len());
-    /// Outside: the distance to the closest surface point. Inside: the face of
-    /// least penetration (its outward normal, gap minus the depth).
-    fn point_contact(&self, s: u32, x: [f64; 3], q: [f64; 4], p: [f64; 3]) -> Option<PointContact3> {
+    /// Outside: the distance to the closest surface point. Inside or on the
+    /// surface: the face of least penetration (its outward normal, gap minus the
+    /// depth), among faces within 1e-9 of it the one facing `hint`.
+    fn point_contact(&self, s: u32, x: [f64; 3], q: [f64; 4], p: [f64; 3], hint: [f64; 3]) -> Option<PointContact3> {
         let h = self.half[s as usize];
         let pl = rotate_inv(q, [p[0] - x[0], p[1] - x[1], p[2] - x[2]]);
+        let hl = rotate_inv(q, hint);
         let c = [pl[0].clamp(-h[0], h[0]), pl[1].clamp(-h[1], h[1]), pl[2].clamp(-h[2], h[2])];
         let d = [pl[0] - c[0], pl[1] - c[1], pl[2] - c[2]];
         let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
         let (gap, nl, cl) = if l > 0.0 {
             (l, [d[0] / l, d[1] / l, d[2] / l], c)
         } else {
+            let depth = |a: usize| h[a] - pl[a].abs();
+            let sign = |a: usize| if pl[a] >= 0.0 { 1.0 } else { -1.0 };
+            let least = (0..3).map(depth).fold(f64::INFINITY, f64::min);
+            let tol = 1e-9 * h.iter().fold(0.0f64, |m, x| m.max(*x));
+            // ties (a point on an edge): the face most opposed to the hint
             let k = (0..3)
-                .min_by(|&a, &b| (h[a] - pl[a].abs()).total_cmp(&(h[b] - pl[b].abs())))
+                .filter(|&a| depth(a) <= least + tol)
+                .min_by(|&a, &b| (sign(a) * hl[a]).total_cmp(&(sign(b) * hl[b])))
                 .unwrap_or(2);
-            let sgn = if pl[k] >= 0.0 { 1.0 } else { -1.0 };
+            let sgn = sign(k);
             let mut n = [0.0; 3];
             n[k] = sgn;
             let mut cp = pl;
