@@ -40,6 +40,14 @@ pub fn count(t: &toml::Table, key: &str, default: Option<u64>) -> Result<u64, Pa
     }
 }
 
+/// A boolean.
+pub fn boolean(t: &toml::Table, key: &str, default: Option<bool>) -> Result<bool, ParamError> {
+    match t.get(key) {
+        None => default.ok_or_else(|| ParamError::new(key, "missing key")),
+        Some(v) => v.as_bool().ok_or_else(|| ParamError::new(key, "must be true or false")),
+    }
+}
+
 /// A string.
 pub fn string<'a>(t: &'a toml::Table, key: &str, default: Option<&'a str>) -> Result<&'a str, ParamError> {
     match t.get(key) {

@@ -3,7 +3,7 @@
 
 use crate::shapes::Polyhedra;
 use nscdd::drive::{DofDrive, Phase, Shape, TimeFn};
-use nscdd::params::{array, count, number, only_keys, positive};
+use nscdd::params::{array, boolean, count, number, only_keys, positive};
 use nscdd::registry::ParamError;
 use nscdd::registry3::Generator3;
 use nscdd::rigid2d::bodies::ShapeRef;
@@ -86,7 +86,8 @@ impl Generator3 for BrickWall {
 /// `arch`: a semicircular arch of `voussoirs` radial voussoirs of mean radius
 /// `radius`, thickness `thickness` (t/R is the thickness ratio) and `depth`
 /// (along y), centred on `origin` (the springing line at z = origin z), on two
-/// fixed supports of `support_material` (blocks under the springers).
+/// fixed supports of `support_material` (blocks under the springers), or, with
+/// `supports = false`, on whatever the scene puts there (piers).
 pub struct Arch;
 
 impl Generator3 for Arch {
@@ -102,10 +103,11 @@ impl Generator3 for Arch {
                 "depth",
                 "voussoirs",
                 "origin",
+                "supports",
             ],
         )?;
         let material = out.material_param(p, "material")?;
-        let sm = out.material_param(p, "support_material")?;
+        let supports = boolean(p, "supports", Some(true))?;
         let r = positive(p, "radius", None)?;
         let t = positive(p, "thickness", None)?;
         if t >= 2.0 * r {
@@ -126,6 +128,10 @@ impl Generator3 for Arch {
             }
             add_points(out, &pts, material, false)?;
         }
+        if !supports {
+            return Ok(());
+        }
+        let sm = out.material_param(p, "support_material")?;
         for side in [-1.0, 1.0] {
             let (x0, x1) = if side > 0.0 {
                 (o[0] + ri - t, o[0] + re + t)
