@@ -70,6 +70,19 @@ fixed = true
     )
 }
 
+/// Three 0.2 × 0.1 × 0.05 m bricks stacked on the floor (μ = 0.5, h = 1 ms), the
+/// middle one turned by `turn` about z; `extra` is added to the scene head.
+fn stack(steps: usize, turn: f64, extra: &str) -> String {
+    let (l, wd, ht) = (0.2, 0.1, 0.05);
+    let mut text = head(0.5, 1e-3, steps, [0.0; 3]) + extra;
+    for k in 0..3 {
+        let z = k as f64 * ht;
+        let rot = if k == 1 { [0.0, 0.0, turn] } else { [0.0; 3] };
+        text += &brick(&format!("b{k}"), [0.0, 0.0, z], [l, wd, z + ht], rot);
+    }
+    text
+}
+
 /// Normal impulse / h carried between body a (candidate or antagonist) and b.
 fn carried(w: &World3, a: u32, b: u32) -> (f64, usize) {
     let c = &w.contacts;
@@ -88,14 +101,8 @@ fn carried(w: &World3, a: u32, b: u32) -> (f64, usize) {
 #[test]
 fn stack_of_bricks_carries_the_exact_weights() {
     let (l, wd, ht) = (0.2, 0.1, 0.05);
-    let mut text = head(0.5, 1e-3, 1, [0.0; 3]);
-    for k in 0..3 {
-        let z = k as f64 * ht;
-        // the middle brick turned by 0.01 rad about z: the face contacts keep 4 points
-        let rot = if k == 1 { [0.0, 0.0, 0.01] } else { [0.0; 3] };
-        text += &brick(&format!("b{k}"), [0.0, 0.0, z], [l, wd, z + ht], rot);
-    }
-    let mut w = world(&text);
+    // the middle brick turned by 0.01 rad about z: the face contacts keep 4 points
+    let mut w = world(&stack(1, 0.01, ""));
     let weight = 2000.0 * l * wd * ht * 9.81;
     for _ in 0..200 {
         assert!(w.step().unwrap().solve.converged);
@@ -365,14 +372,7 @@ fn arch_stands_at_012_and_collapses_at_009() {
 
 #[test]
 fn stack_exports_a_frictional_contact_problem_that_solve_fc_solves() {
-    let (l, wd, ht) = (0.2, 0.1, 0.05);
-    let mut text = head(0.5, 1e-3, 1, [0.0; 3]);
-    for k in 0..3 {
-        let z = k as f64 * ht;
-        let rot = if k == 1 { [0.0, 0.0, 0.01] } else { [0.0; 3] };
-        text += &brick(&format!("b{k}"), [0.0, 0.0, z], [l, wd, z + ht], rot);
-    }
-    let mut w = world(&text);
+    let mut w = world(&stack(1, 0.01, ""));
     for _ in 0..20 {
         w.step().unwrap();
     }
@@ -402,13 +402,7 @@ fn stack_exports_a_frictional_contact_problem_that_solve_fc_solves() {
 
 #[test]
 fn outputs_draw_the_blocks_and_their_contact_points() {
-    let (l, wd, ht) = (0.2, 0.1, 0.05);
-    let mut text = head(0.5, 1e-3, 20, [0.0; 3]);
-    text += "[output]\nevery = 10\n";
-    for k in 0..3 {
-        let z = k as f64 * ht;
-        text += &brick(&format!("b{k}"), [0.0, 0.0, z], [l, wd, z + ht], [0.0; 3]);
-    }
+    let text = stack(20, 0.0, "[output]\nevery = 10\n");
     let mut s = load_str(&text, "stack.toml", &nscdd_polyhedra::registry()).unwrap();
     let dir = std::env::temp_dir().join(format!("nscdd-poly-out-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
