@@ -423,3 +423,61 @@ fn outputs_draw_the_blocks_and_their_contact_points() {
     assert_eq!(fin["contacts"].as_array().unwrap().len(), 12);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn spheres_rest_on_a_block_face_and_edge() {
+    // a fixed 0.4 m cube; a ball on its top face, another on its top edge (x = 0.2),
+    // leaning on it from outside: the first rests, the edge holds the second's
+    // normal along the line from the edge to its centre
+    let r = 0.05;
+    let mut text = head(0.5, 1e-3, 1, [0.0; 3]);
+    text += "[output]\nevery = 0\n";
+    let v: Vec<String> = nscdd_polyhedra::generate::box_points([-0.2, -0.2, -0.2], [0.2, 0.2, 0.2])
+        .iter()
+        .map(|p| format!("[{}, {}, {}]", p[0], p[1], p[2]))
+        .collect();
+    text += &format!(
+        "[[bodies]]\nname = \"cube\"\nshape = \"polyhedron\"\nmaterial = \"ground\"\nposition = [0.0, 0.0, 0.6]\nfixed = true\nvertices = [{}]\n",
+        v.join(", ")
+    );
+    text += &format!(
+        "[[bodies]]\nname = \"top\"\nshape = \"sphere\"\nmaterial = \"stone\"\nradius = {r}\nposition = [0.0, 0.0, {}]\n",
+        0.8 + r
+    );
+    // on the edge at 45°: centre at (0.2, 0, 0.8) + r (1, 0, 1)/√2
+    let c = r / 2f64.sqrt();
+    text += &format!(
+        "[[bodies]]\nname = \"edge\"\nshape = \"sphere\"\nmaterial = \"stone\"\nradius = {r}\nposition = [{}, 0.0, {}]\n",
+        0.2 + c,
+        0.8 + c
+    );
+    let mut w = world(&text);
+    w.step().unwrap();
+    let c_top = (0..w.contacts.len()).find(|&a| w.contacts.bodies[a].contains(&2)).unwrap();
+    let c_edge = (0..w.contacts.len()).find(|&a| w.contacts.bodies[a].contains(&3)).unwrap();
+    // the normals: vertical on the face, diagonal on the edge
+    let n_top = w.contacts.frame[c_top].basis[0];
+    let n_edge = w.contacts.frame[c_edge].basis[0];
+    let s = 0.5f64.sqrt();
+    assert!((n_top[2].abs() - 1.0).abs() < 1e-12, "{n_top:?}");
+    assert!(
+        (n_edge[0].abs() - s).abs() < 1e-9 && (n_edge[2].abs() - s).abs() < 1e-9,
+        "{n_edge:?}"
+    );
+    assert!(w.contacts.gap[c_top].abs() < 1e-12 && w.contacts.gap[c_edge].abs() < 1e-12);
+    for _ in 0..100 {
+        w.step().unwrap();
+    }
+    // the ball on the face is at rest and carries its weight to the cube
+    let m = w.bodies.mass[2];
+    assert!((w.bodies.pos[2][2] - (0.8 + r)).abs() < 1e-9);
+    assert!((w.reaction[2][2] / 1e-3 - m * 9.81).abs() < 1e-6 * m * 9.81);
+    // the ball on the edge rolls off outwards (x grows), never into the cube
+    assert!(w.bodies.pos[3][0] > 0.2 + c);
+    let (d, _) = {
+        let p = w.bodies.pos[3];
+        let q = [p[0].clamp(-0.2, 0.2), p[1].clamp(-0.2, 0.2), p[2].clamp(0.4, 0.8)];
+        (((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt(), q)
+    };
+    assert!(d > r - 1e-6, "ball centre {d} from the cube");
+}
