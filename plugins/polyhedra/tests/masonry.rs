@@ -481,3 +481,42 @@ fn spheres_rest_on_a_block_face_and_edge() {
     };
     assert!(d > r - 1e-6, "ball centre {d} from the cube");
 }
+
+#[test]
+fn generator_input_errors_name_the_key() {
+    let head = head(0.5, 1e-3, 1, [0.0; 3]);
+    for (gen, key) in [
+        (
+            "kind = \"tilting_table\"\nmaterial = \"ground\"\nsize = [1.0, 0.6, 0.1]\nrate = 0.1\nmax_angle = 95.0",
+            "max_angle",
+        ),
+        (
+            "kind = \"tilting_table\"\nmaterial = \"ground\"\nsize = [1.0, 0.6, 0.1]\nrate = 0.1\nmax_angle = 30.0\nhinge = 0.8",
+            "hinge",
+        ),
+        (
+            "kind = \"tilting_table\"\nmaterial = \"ground\"\nsize = [1.0, 0.6, 0.1]\nrate = -0.1\nmax_angle = 30.0",
+            "rate",
+        ),
+        (
+            "kind = \"tilting_table\"\nmaterial = \"ground\"\nsize = [1.0, 0.6, 0.1]\nrate = 0.1\nmax_angle = 30.0\nstart = -1.0",
+            "start",
+        ),
+        (
+            "kind = \"arch\"\nmaterial = \"stone\"\nradius = 1.0\nthickness = 0.1\nvoussoirs = 8\nsupports = \"no\"",
+            "supports",
+        ),
+        (
+            "kind = \"arch\"\nmaterial = \"stone\"\nradius = 1.0\nthickness = 0.1\nvoussoirs = 8",
+            "support_material",
+        ),
+        (
+            "kind = \"brick_wall\"\nmaterial = \"stone\"\nbrick = [0.2, 0.0, 0.05]\ncourses = 2\nbricks = 2",
+            "brick",
+        ),
+    ] {
+        let text = format!("{head}[[generate]]\n{gen}\n");
+        let e = load_str(&text, "t.toml", &nscdd_polyhedra::registry()).err().expect(gen);
+        assert!(e.key.ends_with(key) && e.line.is_some(), "{gen}: {e}");
+    }
+}
