@@ -197,10 +197,14 @@ fn continued(prev: &[PrevContact], p: usize, key: ContactKey, point: [f64; 3], a
     while hi < prev.len() && same(hi) {
         hi += 1;
     }
-    let d2 = |k: usize| (0..3).map(|c| (prev[k].point[c] - point[c]).powi(2)).sum::<f64>();
+    let d2 = |k: usize| dist2(prev[k].point, point);
     (lo..hi)
         .filter(|&k| d2(k) <= alert * alert)
         .min_by(|&a, &b| d2(a).total_cmp(&d2(b)))
+}
+
+fn dist2(a: [f64; 3], b: [f64; 3]) -> f64 {
+    (0..3).map(|c| (a[c] - b[c]).powi(2)).sum()
 }
 
 /// A contact of the last step, as the next step's warm start and bonds read it.
@@ -253,14 +257,22 @@ pub fn build_contacts(w: &mut World3) {
             j: rc.j,
             feature: rc.feature,
         };
-        let prev = match s.prev_keys.binary_search_by_key(&key, |x| x.key) {
-            Ok(p) => Some(p),
-            Err(p) => continued(&s.prev_keys, p, key, rc.point, w.alert),
+        // the same key at the same place, else the nearest point of the pair; a
+        // key that now names another corner of a polygon, farther than alert, still
+        // gives its warm start but never its bond
+        let (exact, at) = match s.prev_keys.binary_search_by_key(&key, |x| x.key) {
+            Ok(p) => (Some(p), p),
+            Err(p) => (None, p),
         };
-        let (r, bonded) = match prev {
-            Some(p) => (s.prev_keys[p].r, s.prev_keys[p].bonded),
+        let near = match exact {
+            Some(p) if dist2(s.prev_keys[p].point, rc.point) <= w.alert * w.alert => Some(p),
+            _ => continued(&s.prev_keys, at, key, rc.point, w.alert),
+        };
+        let r = near.or(exact).map_or([0.0; 3], |p| s.prev_keys[p].r);
+        let bonded = match near {
+            Some(p) => s.prev_keys[p].bonded,
             // bonds are made at the first step only
-            None => ([0.0; 3], w.step == 0 && rc.gap <= law.bond_gap),
+            None => w.step == 0 && rc.gap <= law.bond_gap,
         };
         let joint = if bonded && law.is_cohesive() && rc.area > 0.0 {
             Joint::of(&law, rc.area, h)
@@ -319,7 +331,7 @@ pub fn update_joints(w: &mut World3) {
         let wr = coulomb::mul(&c.block[a].w, c.r[a]);
         let u0 = [u[0] - wr[0], u[1] - wr[1], u[2] - wr[2]];
         let t = c.target[a];
-        if !joint::holds(&c.block[a].pre, u0, t.u_target, t.mu, &jt, tol) {
+        if !joint::holds(&c.block[a].w, &c.block[a].pre, c.r[a], u0, t.u_target, t.mu, &jt, tol) {
             c.joint[a] = Joint::default();
         }
     }

@@ -121,6 +121,12 @@ fn parse_mohr_coulomb(t: &toml::Table) -> Result<ContactLaw, ParamError> {
     }
     // the tension cut-off cannot lie beyond the apex c/μ of the Mohr–Coulomb cone
     let apex = cohesion / mu;
+    if !apex.is_finite() {
+        return Err(ParamError::new(
+            "friction",
+            format!("too small for cohesion {cohesion}: c/μ overflows"),
+        ));
+    }
     let tensile = number(t, "tensile_strength", Some(apex))?;
     if !(0.0..=apex * (1.0 + 1e-12)).contains(&tensile) {
         return Err(ParamError::new(

@@ -30,7 +30,9 @@
 //! while its sticking impulse lies in K_c (the strength is not exhausted); once it
 //! does not, the contact loses its bond for good and obeys `coulomb` with e = 0.
 //! New contacts are never bonded: only contacts within `bond_gap` at the first step
-//! are, and a bond survives only under the same contact key.
+//! are, and a bond survives only on the same contact point (the same key at the
+//! same place, or the nearest point of the same pair within the alert distance
+//! when a polygon's corners are renumbered: `engine3::build_contacts`).
 
 use super::coulomb::{self, disk_min, Pre3, Sym3};
 use crate::law::ContactLaw;
@@ -58,9 +60,11 @@ impl Joint {
 
     /// The strengths of a bonded contact of tributary area `area` over a step h.
     pub fn of(law: &ContactLaw, area: f64, h: f64) -> Joint {
+        let shift = law.cohesion * area * h / law.mu;
         Joint {
-            shift: law.cohesion * area * h / law.mu,
-            tension: law.tensile * area * h,
+            shift,
+            // T ≤ s also after round-off (the default σ_t is c/μ)
+            tension: (law.tensile * area * h).min(shift),
         }
     }
 
@@ -150,11 +154,19 @@ fn fallback(w: &Sym3, u0: [f64; 3], u_target: f64, mu: f64, j: &Joint) -> [f64; 
 /// Whether an intact joint still holds at the end of the step: its sticking
 /// impulse for `u0 = u − W r` lies in K_c, up to `tol` relative to its strength
 /// (the solver's tolerance: an NLGS converged to it leaves residual velocities that
-/// would otherwise read as a strength exceeded by that much).
-pub fn holds(pre: &Pre3, u0: [f64; 3], u_target: f64, mu: f64, j: &Joint, tol: f64) -> bool {
+/// would otherwise read as a strength exceeded by that much). A singular W has no
+/// sticking impulse: the joint holds while the contact does not move,
+/// |u − ū e_n| ≤ tol |u0 − ū e_n| with u = W r + u0.
+#[allow(clippy::too_many_arguments)]
+pub fn holds(w: &Sym3, pre: &Pre3, r: [f64; 3], u0: [f64; 3], u_target: f64, mu: f64, j: &Joint, tol: f64) -> bool {
     match stick(pre, u0, u_target) {
-        Some(r) => admissible(r, mu, j, tol),
-        None => true,
+        Some(rs) => admissible(rs, mu, j, tol),
+        None => {
+            let wr = coulomb::mul(w, r);
+            let len = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            let moved = len([wr[0] + u0[0] - u_target, wr[1] + u0[1], wr[2] + u0[2]]);
+            moved <= tol * len([u0[0] - u_target, u0[1], u0[2]])
+        }
     }
 }
 
@@ -232,12 +244,12 @@ mod tests {
         let w: Sym3 = [2.0, 0.0, 0.0, 3.0, 0.0, 3.0];
         let pre = precompute(&w);
         let j = Joint { shift: 1.0, tension: 0.4 };
-        assert!(holds(&pre, [0.4, 0.0, 0.0], 0.0, 0.5, &j, 1e-9));
-        assert!(holds(&pre, [0.0, 0.0, 0.0], 0.0, 0.5, &j, 1e-9));
-        assert!(!holds(&pre, [2.0, 0.0, 0.0], 0.0, 0.5, &j, 1e-9));
-        assert!(!holds(&pre, [-1.0, 3.0, 0.0], 0.0, 0.5, &j, 1e-9));
+        assert!(holds(&w, &pre, [0.0; 3], [0.4, 0.0, 0.0], 0.0, 0.5, &j, 1e-9));
+        assert!(holds(&w, &pre, [0.0; 3], [0.0, 0.0, 0.0], 0.0, 0.5, &j, 1e-9));
+        assert!(!holds(&w, &pre, [0.0; 3], [2.0, 0.0, 0.0], 0.0, 0.5, &j, 1e-9));
+        assert!(!holds(&w, &pre, [0.0; 3], [-1.0, 3.0, 0.0], 0.0, 0.5, &j, 1e-9));
         // an unbonded contact at rest under zero load holds trivially
-        assert!(holds(&pre, [0.0; 3], 0.0, 0.5, &Joint::RESTORED, 1e-9));
+        assert!(holds(&w, &pre, [0.0; 3], [0.0; 3], 0.0, 0.5, &Joint::RESTORED, 1e-9));
         assert!(project([-5.0, 0.0, 0.0], 0.5, &j) == [-0.4, 0.0, 0.0]);
     }
 }
