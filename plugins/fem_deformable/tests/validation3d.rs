@@ -233,10 +233,12 @@ mesh = {{ box = {{ origin = [0.0, 0.0, 0.0], size = [1.0, 1.0, 0.4], cells = [3,
 /// one (meets the nodes) rests on the node under its lowest point (a sphere off
 /// a node would roll into the hollow between nodes: it cuts the facets, sag
 /// ≈ d²/2R for nodes at d from its lowest point); the block carries both weights.
-#[test]
-fn spheres_rest_on_a_deformable_block() {
+/// The scene head of the rigid-on-deformable tests: gravity, the floor, h = 0.01 s
+/// (θ = 1, 60 steps), tolerance 1e-7, a material `stone` (2 500 kg/m³) with μ = 0.5
+/// on the deformable `solid` and no friction on the floor.
+fn stone_head() -> String {
     let g = 9.81;
-    let text = format!(
+    format!(
         r#"gravity = [0.0, 0.0, -{g}]
 {HEAD}
 [time]
@@ -260,7 +262,15 @@ friction = 0.5
 [[laws]]
 materials = ["ground", "stone"]
 law = "frictionless"
-[[laws]]
+"#
+    )
+}
+
+#[test]
+fn spheres_rest_on_a_deformable_block() {
+    let g = 9.81;
+    let text = format!(
+        r#"{}[[laws]]
 materials = ["stone", "stone"]
 friction = 0.3
 [[bodies]]
@@ -281,7 +291,8 @@ young = 1e8
 poisson = 0.3
 fix = ["bottom"]
 mesh = {{ box = {{ origin = [0.0, 0.0, 0.0], size = [2.0, 1.0, 0.3], cells = [8, 4, 2] }} }}
-"#
+"#,
+        stone_head()
     );
     let mut s = scene(&text);
     for _ in 0..60 {
@@ -331,30 +342,7 @@ fn a_masonry_block_rests_level_on_a_deformable_block() {
         .map(|p| format!("[{}, {}, {}]", p[0], p[1], p[2]))
         .collect();
     let text = format!(
-        r#"gravity = [0.0, 0.0, -{g}]
-{HEAD}
-[time]
-step = 0.01
-theta = 1.0
-steps = 60
-[solver]
-tolerance = 1e-7
-max_sweeps = 20000
-[detection]
-alert = 0.02
-[[materials]]
-name = "stone"
-density = 2500.0
-[[laws]]
-materials = ["solid", "ground"]
-law = "frictionless"
-[[laws]]
-materials = ["solid", "stone"]
-friction = 0.5
-[[laws]]
-materials = ["ground", "stone"]
-law = "frictionless"
-[[bodies]]
+        r#"{}[[bodies]]
 name = "block"
 shape = "polyhedron"
 material = "stone"
@@ -367,6 +355,7 @@ poisson = 0.3
 fix = ["bottom"]
 mesh = {{ box = {{ origin = [0.0, 0.0, 0.0], size = [1.0, 1.0, 0.3], cells = [10, 10, 3] }} }}
 "#,
+        stone_head(),
         v.join(", ")
     );
     let mut s = scene(&text);
