@@ -50,51 +50,5 @@ mesh = { rectangle = { origin = [0.0, 0.0], size = [2.0, 0.5], cells = [140, 70]
     reg.add_plugin(&nscdd_rigid_disks::RigidDisks);
     let t0 = Instant::now();
     let mut s = nscdd_fem_deformable::scene::load_str(text, "bench2d", std::path::Path::new("."), &reg).unwrap();
-    let load = t0.elapsed().as_secs_f64();
-    let b = &s.fe.bodies[0];
-    println!(
-        "nodes {}, dofs {}, nnz(M̂) {}, load (Python start, mesh, scikit-fem assembly, symbolic + numeric Cholesky) {load:.3} s",
-        b.mesh.n_nodes(),
-        b.n_dofs(),
-        b.nnz()
-    );
-    let t = Instant::now();
-    s.fe.bodies[0].factorize(2e-3, 0.5).unwrap();
-    println!("numeric refactorization (h changed) {:.4} s", t.elapsed().as_secs_f64());
-    s.fe.bodies[0].factorize(1e-3, 0.5).unwrap();
-    let mut acc = nscdd_fem_deformable::stage2::FeTimes::default();
-    let (mut contacts, mut sweeps, mut total) = (0, 0, 0.0);
-    for k in 0..steps {
-        let t = Instant::now();
-        let rep = s.step().unwrap();
-        let dt = t.elapsed().as_secs_f64();
-        let f = s.fe.times;
-        if k == 0 {
-            println!("first step {dt:.4} s: columns {:.4} s ({} solves)", f.columns, f.solves);
-            continue;
-        }
-        total += dt;
-        acc.free += f.free;
-        acc.detect += f.detect;
-        acc.columns += f.columns;
-        acc.nlgs += f.nlgs;
-        acc.update += f.update;
-        acc.solves += f.solves;
-        contacts += s.fe.contacts.len();
-        sweeps += rep.solve.sweeps as usize;
-    }
-    let n = (steps - 1).max(1) as f64;
-    println!(
-        "per step (mean of {} steps after the first): total {:.4} s | free velocity {:.4} | detection {:.4} | columns + G {:.4} ({:.1} solves) | NLGS {:.4} ({:.0} sweeps) | V⁺ {:.4} | {:.0} deformable contacts",
-        steps - 1,
-        total / n,
-        acc.free / n,
-        acc.detect / n,
-        acc.columns / n,
-        acc.solves as f64 / n,
-        acc.nlgs / n,
-        sweeps as f64 / n,
-        acc.update / n,
-        contacts as f64 / n
-    );
+    nscdd_fem_deformable::bench::bench(&mut s, steps, t0.elapsed().as_secs_f64());
 }

@@ -1,4 +1,5 @@
 //! # Deformable bodies: linear elastic finite elements, coupled to rigid bodies
+pub mod bench;
 pub mod body;
 pub mod contact2;
 pub mod contact3;

@@ -33,7 +33,10 @@ fn io(dir: &Path, what: &str) -> impl Fn(std::io::Error) -> String {
 pub trait FeRunnable {
     fn step(&mut self) -> Result<StepReport, Diverged>;
     fn fe_bodies(&self) -> &[FeBody];
+    fn fe_bodies_mut(&mut self) -> &mut [FeBody];
     fn fe_contacts(&self) -> usize;
+    /// Time spent in the deformable stages during the last step.
+    fn fe_times(&self) -> crate::stage2::FeTimes;
     fn output(&self) -> &OutputSettings;
     /// (step, t, steps to run).
     fn clock(&self) -> (u64, f64, u64);
@@ -48,6 +51,12 @@ impl FeRunnable for FeScene2 {
     }
     fn fe_bodies(&self) -> &[FeBody] {
         &self.fe.bodies
+    }
+    fn fe_bodies_mut(&mut self) -> &mut [FeBody] {
+        &mut self.fe.bodies
+    }
+    fn fe_times(&self) -> crate::stage2::FeTimes {
+        self.fe.times
     }
     fn fe_contacts(&self) -> usize {
         self.fe.contacts.len()
@@ -75,6 +84,12 @@ impl FeRunnable for FeScene3 {
     }
     fn fe_bodies(&self) -> &[FeBody] {
         &self.fe.bodies
+    }
+    fn fe_bodies_mut(&mut self) -> &mut [FeBody] {
+        &mut self.fe.bodies
+    }
+    fn fe_times(&self) -> crate::stage2::FeTimes {
+        self.fe.times
     }
     fn fe_contacts(&self) -> usize {
         self.fe.contacts.len()
