@@ -15,7 +15,9 @@
 //! l of the same body by G_lk P. The Delassus block of α is
 //! W_αα = Σ_kl w_k w_l Fᵀ G_kl F (+ the rigid side's Hᵀ M̂⁻¹ H).
 
-use nscdd::rigid2d::contacts::{Block2, Target};
+use crate::nodes::FeContacts;
+pub use crate::nodes::FeKey;
+use nscdd::rigid2d::contacts::Block2;
 use nscdd::world::World2;
 
 /// A 2D side: one node, or the two ends of a segment.
@@ -34,58 +36,8 @@ pub enum Anta {
     Fe(FeSide),
 }
 
-/// Identity of a contact between steps (warm start): deformable body, node,
-/// antagonist (rigid body id, or `1 << 31 | deformable body`), feature (segment).
-pub type FeKey = (u32, u32, u32, u32);
-
-/// The contacts of deformable bodies of one step, one `Vec` per field.
-#[derive(Clone, Debug, Default)]
-pub struct FeContacts2 {
-    pub cand: Vec<FeSide>,
-    pub anta: Vec<Anta>,
-    pub n: Vec<[f64; 2]>,
-    pub block: Vec<Block2>,
-    pub target: Vec<Target>,
-    pub r: Vec<[f64; 2]>,
-    pub u_free: Vec<[f64; 2]>,
-    pub gap: Vec<f64>,
-    pub point: Vec<[f64; 2]>,
-    pub key: Vec<FeKey>,
-}
-
-impl FeContacts2 {
-    pub fn len(&self) -> usize {
-        self.cand.len()
-    }
-    pub fn is_empty(&self) -> bool {
-        self.cand.is_empty()
-    }
-    pub fn clear(&mut self) {
-        self.cand.clear();
-        self.anta.clear();
-        self.n.clear();
-        self.block.clear();
-        self.target.clear();
-        self.r.clear();
-        self.u_free.clear();
-        self.gap.clear();
-        self.point.clear();
-        self.key.clear();
-    }
-    /// Appends contact `a` of `src` with its sides renamed.
-    pub fn push_from(&mut self, src: &FeContacts2, a: usize, cand: FeSide, anta: Anta) {
-        self.cand.push(cand);
-        self.anta.push(anta);
-        self.n.push(src.n[a]);
-        self.block.push(src.block[a]);
-        self.target.push(src.target[a]);
-        self.r.push(src.r[a]);
-        self.u_free.push(src.u_free[a]);
-        self.gap.push(src.gap[a]);
-        self.point.push(src.point[a]);
-        self.key.push(src.key[a]);
-    }
-}
+/// The 2D contacts of deformable bodies of one step; the frame is the normal n.
+pub type FeContacts2 = FeContacts<FeSide, Anta, [f64; 2], Block2, 2>;
 
 impl NodeSet {
     /// Fᵀ (Σ_kl w_k w_l G_kl) F for a side, as [W_nn, W_nt, W_tt].

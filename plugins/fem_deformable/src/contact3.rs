@@ -24,8 +24,8 @@
 //! mesh the lower index).
 
 use crate::body::FeBody;
-use crate::nodes::{FeSide, NodeSet};
-use nscdd::rigid2d::contacts::Target;
+pub use crate::nodes::FeKey;
+use crate::nodes::{FeContacts, FeSide, NodeSet};
 use nscdd::rigid3d::bodies::cross;
 use nscdd::rigid3d::contacts::{point_velocity, Block3, Frame3};
 use nscdd::rigid3d::coulomb::{self, Sym3};
@@ -47,45 +47,9 @@ pub enum Anta3 {
     Fe(FeSide3),
 }
 
-/// Identity of a contact between steps (warm start): deformable body, node,
-/// antagonist (rigid body id, or `1 << 31 | deformable body`), feature (face).
-pub type FeKey = (u32, u32, u32, u32);
-
-/// The contacts of deformable bodies of one step, one `Vec` per field.
-#[derive(Clone, Debug, Default)]
-pub struct FeContacts3 {
-    pub cand: Vec<FeSide3>,
-    pub anta: Vec<Anta3>,
-    pub basis: Vec<Basis>,
-    pub block: Vec<Block3>,
-    pub target: Vec<Target>,
-    pub r: Vec<[f64; 3]>,
-    pub u_free: Vec<[f64; 3]>,
-    pub gap: Vec<f64>,
-    pub point: Vec<[f64; 3]>,
-    pub key: Vec<FeKey>,
-}
-
-impl FeContacts3 {
-    pub fn len(&self) -> usize {
-        self.cand.len()
-    }
-    pub fn is_empty(&self) -> bool {
-        self.cand.is_empty()
-    }
-    pub fn clear(&mut self) {
-        self.cand.clear();
-        self.anta.clear();
-        self.basis.clear();
-        self.block.clear();
-        self.target.clear();
-        self.r.clear();
-        self.u_free.clear();
-        self.gap.clear();
-        self.point.clear();
-        self.key.clear();
-    }
-}
+/// The 3D contacts of deformable bodies of one step; the frame is the basis
+/// B = [n t1 t2].
+pub type FeContacts3 = FeContacts<FeSide3, Anta3, Basis, Block3, 3>;
 
 /// B v (local components of a global vector).
 #[inline(always)]

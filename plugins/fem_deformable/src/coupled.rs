@@ -267,7 +267,7 @@ impl Coupled<'_> {
                 if let Anta::Rigid { body, arm } = c.anta[a] {
                     let r = c.r[a];
                     let b = body as usize;
-                    rigid_apply(c.n[a], arm, [-r[0], -r[1]], &mut vfree[b], w.bodies.inv_mass[b]);
+                    rigid_apply(c.frame[a], arm, [-r[0], -r[1]], &mut vfree[b], w.bodies.inv_mass[b]);
                 }
             }
         }
@@ -275,7 +275,7 @@ impl Coupled<'_> {
             sd.vel = sd.rigid.iter().map(|&b| vfree[b as usize]).collect();
             <nscdd::dd::Rigid2 as nscdd::dd::Family>::copy_delassus(&mut sd.contacts, &sd.inv);
             for a in 0..sd.fec.len() {
-                let (cand, anta, n) = (sd.fec.cand[a], sd.fec.anta[a], sd.fec.n[a]);
+                let (cand, anta, n) = (sd.fec.cand[a], sd.fec.anta[a], sd.fec.frame[a]);
                 let mut wb = sd.sets[cand.body as usize].delassus(&cand, n);
                 let wo = match anta {
                     Anta::Rigid { body, arm } => rigid_delassus(n, arm, sd.inv[body as usize]),
@@ -299,7 +299,15 @@ impl Coupled<'_> {
             for a in 0..sd.fec.len() {
                 let r = sd.fec.r[a];
                 if r != [0.0, 0.0] {
-                    stage2::apply(&mut sd.sets, &mut sd.vel, &sd.inv, sd.fec.cand[a], sd.fec.anta[a], sd.fec.n[a], r);
+                    stage2::apply(
+                        &mut sd.sets,
+                        &mut sd.vel,
+                        &sd.inv,
+                        sd.fec.cand[a],
+                        sd.fec.anta[a],
+                        sd.fec.frame[a],
+                        r,
+                    );
                 }
             }
         }
@@ -362,7 +370,7 @@ fn glue(subs: &mut [Sub], ifr: &[(u32, Iface)], iff: &[(u32, Iface)], w: &World2
             let sd = &subs[e as usize];
             let mut f = sd.fgam[l as usize].clone();
             for a in 0..sd.fec.len() {
-                let p = global(sd.fec.n[a], sd.fec.r[a]);
+                let p = global(sd.fec.frame[a], sd.fec.r[a]);
                 let mut add = |s: &FeSide, sign: f64| {
                     if s.body == l {
                         for q in 0..2 {

@@ -187,3 +187,75 @@ pub fn velocities_after<const D: usize>(
         b.v = v;
     }
 }
+
+/// Identity of a contact between steps (warm start): deformable body, node,
+/// antagonist (rigid body id, or `1 << 31 | deformable body`), feature (segment or
+/// face).
+pub type FeKey = (u32, u32, u32, u32);
+
+/// The contacts of deformable bodies of one step, one `Vec` per field (2D and 3D:
+/// sides C and A, frame F, W_αα block B, D components).
+#[derive(Clone, Debug)]
+pub struct FeContacts<C, A, F, B, const D: usize> {
+    pub cand: Vec<C>,
+    pub anta: Vec<A>,
+    pub frame: Vec<F>,
+    pub block: Vec<B>,
+    pub target: Vec<nscdd::rigid2d::contacts::Target>,
+    pub r: Vec<[f64; D]>,
+    pub u_free: Vec<[f64; D]>,
+    pub gap: Vec<f64>,
+    pub point: Vec<[f64; D]>,
+    pub key: Vec<FeKey>,
+}
+
+impl<C, A, F, B, const D: usize> Default for FeContacts<C, A, F, B, D> {
+    fn default() -> Self {
+        FeContacts {
+            cand: vec![],
+            anta: vec![],
+            frame: vec![],
+            block: vec![],
+            target: vec![],
+            r: vec![],
+            u_free: vec![],
+            gap: vec![],
+            point: vec![],
+            key: vec![],
+        }
+    }
+}
+
+impl<C, A, F: Copy, B: Copy, const D: usize> FeContacts<C, A, F, B, D> {
+    pub fn len(&self) -> usize {
+        self.cand.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.cand.is_empty()
+    }
+    pub fn clear(&mut self) {
+        self.cand.clear();
+        self.anta.clear();
+        self.frame.clear();
+        self.block.clear();
+        self.target.clear();
+        self.r.clear();
+        self.u_free.clear();
+        self.gap.clear();
+        self.point.clear();
+        self.key.clear();
+    }
+    /// Appends contact `a` of `src` with its sides renamed.
+    pub fn push_from(&mut self, src: &Self, a: usize, cand: C, anta: A) {
+        self.cand.push(cand);
+        self.anta.push(anta);
+        self.frame.push(src.frame[a]);
+        self.block.push(src.block[a]);
+        self.target.push(src.target[a]);
+        self.r.push(src.r[a]);
+        self.u_free.push(src.u_free[a]);
+        self.gap.push(src.gap[a]);
+        self.point.push(src.point[a]);
+        self.key.push(src.key[a]);
+    }
+}

@@ -177,7 +177,7 @@ impl Deformables2 {
             };
             c.cand.push(cand);
             c.anta.push(anta);
-            c.n.push(n);
+            c.frame.push(n);
             c.block.push(Block2 {
                 w: wb,
                 pre: coulomb::precompute(wb, law.mu),
@@ -202,7 +202,7 @@ impl Deformables2 {
                     &w.bodies.inv_mass,
                     c.cand[a],
                     c.anta[a],
-                    c.n[a],
+                    c.frame[a],
                     r,
                 );
             }
@@ -220,7 +220,7 @@ impl Deformables2 {
                 Anta::Fe(s) => Some(s),
                 Anta::Rigid { .. } => None,
             };
-            (c.cand[a], anta, global(c.n[a], c.r[a]))
+            (c.cand[a], anta, global(c.frame[a], c.r[a]))
         });
         crate::nodes::velocities_after(&mut self.bodies, &self.sets, impulses);
     }
@@ -249,7 +249,7 @@ impl Deformables2 {
         let (mut f2, mut q2) = (0.0, 0.0);
         for a in 0..c.len() {
             let t = c.target[a];
-            let mut u = local_velocity(&self.sets, vel, c.cand[a], c.anta[a], c.n[a]);
+            let mut u = local_velocity(&self.sets, vel, c.cand[a], c.anta[a], c.frame[a]);
             u[0] -= t.u_target;
             f2 += natural_map_sq(&c.r[a], &u, t.mu);
             let q = [c.u_free[a][0] - t.u_target, c.u_free[a][1]];
@@ -342,7 +342,7 @@ pub fn apply(sets: &mut [NodeSet], vel: &mut [[f64; 3]], inv: &[[f64; 3]], cand:
 /// sweep: u0 = u − W_αα r, local solve, relaxation, update of both sides.
 pub fn sweep(c: &mut FeContacts2, sets: &mut [NodeSet], vel: &mut [[f64; 3]], inv: &[[f64; 3]], omega: f64, mut sums: Option<&mut Sums>) {
     for a in 0..c.len() {
-        let (cand, anta, n) = (c.cand[a], c.anta[a], c.n[a]);
+        let (cand, anta, n) = (c.cand[a], c.anta[a], c.frame[a]);
         let u = local_velocity(sets, vel, cand, anta, n);
         let r = c.r[a];
         let Block2 { w, pre } = c.block[a];

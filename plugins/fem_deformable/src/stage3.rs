@@ -181,7 +181,7 @@ impl Deformables3 {
             };
             c.cand.push(cand);
             c.anta.push(anta);
-            c.basis.push(basis);
+            c.frame.push(basis);
             c.block.push(Block3 {
                 w: wb,
                 pre: coulomb::precompute(&wb),
@@ -203,7 +203,7 @@ impl Deformables3 {
         for a in 0..c.len() {
             let r = c.r[a];
             if r != [0.0; 3] {
-                apply(&mut self.sets, &mut w.bodies.vel, inv, c.cand[a], c.anta[a], &c.basis[a], r);
+                apply(&mut self.sets, &mut w.bodies.vel, inv, c.cand[a], c.anta[a], &c.frame[a], r);
             }
         }
         let solves1: u64 = self.bodies.iter().map(|b| b.solves).sum();
@@ -219,7 +219,7 @@ impl Deformables3 {
                 Anta3::Fe(s) => Some(s),
                 Anta3::Rigid { .. } => None,
             };
-            (c.cand[a], anta, global(&c.basis[a], c.r[a]))
+            (c.cand[a], anta, global(&c.frame[a], c.r[a]))
         });
         crate::nodes::velocities_after(&mut self.bodies, &self.sets, impulses);
     }
@@ -248,7 +248,7 @@ impl Deformables3 {
         let (mut f2, mut q2) = (0.0, 0.0);
         for a in 0..c.len() {
             let t = c.target[a];
-            let mut u = local_velocity(&self.sets, vel, c.cand[a], c.anta[a], &c.basis[a]);
+            let mut u = local_velocity(&self.sets, vel, c.cand[a], c.anta[a], &c.frame[a]);
             u[0] -= t.u_target;
             f2 += natural_map_sq(&c.r[a], &u, t.mu);
             let q = [c.u_free[a][0] - t.u_target, c.u_free[a][1], c.u_free[a][2]];
@@ -287,7 +287,7 @@ pub fn apply(sets: &mut [NodeSet3], vel: &mut [[f64; 6]], inv: RigidInv<'_>, can
 /// sweep: u0 = u − W_αα r, local solve, relaxation, update of both sides.
 pub fn sweep(c: &mut FeContacts3, sets: &mut [NodeSet3], vel: &mut [[f64; 6]], inv: RigidInv<'_>, omega: f64, mut sums: Option<&mut Sums>) {
     for a in 0..c.len() {
-        let (cand, anta, b) = (c.cand[a], c.anta[a], c.basis[a]);
+        let (cand, anta, b) = (c.cand[a], c.anta[a], c.frame[a]);
         let u = local_velocity(sets, vel, cand, anta, &b);
         let r = c.r[a];
         let blk = c.block[a];
