@@ -162,15 +162,86 @@ fn overlap(a: &Bounds, b: &Bounds, margin: f64) -> bool {
     (0..3).all(|c| a.0[c] <= b.1[c] + margin && b.0[c] <= a.1[c] + margin)
 }
 
+/// The boundary facets and nodes of one deformable body binned in a uniform grid
+/// over its box (cells of about two boundary edges, at most 64 per axis), so that
+/// a rigid body meets only the facets and nodes near it.
+struct SurfaceGrid {
+    lo: [f64; 3],
+    cell: [f64; 3],
+    dims: [usize; 3],
+    facets: Vec<Vec<u32>>,
+    nodes: Vec<Vec<u32>>,
+}
+
+impl SurfaceGrid {
+    fn new(body: &FeBody, bb: &Bounds) -> Self {
+        let target = 2.0 * body.mesh.longest_boundary_edge;
+        let mut dims = [1usize; 3];
+        let mut cell = [1.0; 3];
+        for c in 0..3 {
+            let ext = bb.1[c] - bb.0[c];
+            dims[c] = if target > 0.0 { ((ext / target).ceil() as usize).clamp(1, 64) } else { 1 };
+            cell[c] = if ext > 0.0 { ext / dims[c] as f64 } else { 1.0 };
+        }
+        let n = dims[0] * dims[1] * dims[2];
+        let mut g = SurfaceGrid {
+            lo: bb.0,
+            cell,
+            dims,
+            facets: vec![vec![]; n],
+            nodes: vec![vec![]; n],
+        };
+        for f in 0..body.mesh.n_facets() {
+            let v = body.mesh.facet(f);
+            let p = [0, 1, 2].map(|c| body.position(v[c] as usize));
+            let lo = std::array::from_fn(|c| p[0][c].min(p[1][c]).min(p[2][c]));
+            let hi = std::array::from_fn(|c| p[0][c].max(p[1][c]).max(p[2][c]));
+            g.each_cell(&(lo, hi), 0.0, |i, g| g.facets[i].push(f as u32));
+        }
+        for &k in &body.mesh.boundary {
+            let p = body.position(k as usize);
+            g.each_cell(&(p, p), 0.0, |i, g| g.nodes[i].push(k));
+        }
+        g
+    }
+
+    /// Calls `f` with every cell that the box `b`, grown by `margin`, meets.
+    fn each_cell(&mut self, b: &Bounds, margin: f64, mut f: impl FnMut(usize, &mut Self)) {
+        let idx = |x: f64, c: usize, s: &Self| (((x - s.lo[c]) / s.cell[c]).floor().max(0.0) as usize).min(s.dims[c] - 1);
+        let lo: [usize; 3] = std::array::from_fn(|c| idx(b.0[c] - margin, c, self));
+        let hi: [usize; 3] = std::array::from_fn(|c| idx(b.1[c] + margin, c, self));
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                for x in lo[0]..=hi[0] {
+                    f(x + self.dims[0] * (y + self.dims[1] * z), self);
+                }
+            }
+        }
+    }
+
+    /// The facets (`faces`) or boundary nodes near the box `b` grown by `margin`,
+    /// in increasing order (the order of a full scan), in `out`.
+    fn near(&mut self, b: &Bounds, margin: f64, faces: bool, out: &mut Vec<u32>) {
+        out.clear();
+        self.each_cell(b, margin, |i, g| out.extend_from_slice(if faces { &g.facets[i] } else { &g.nodes[i] }));
+        out.sort_unstable();
+        out.dedup();
+    }
+}
+
 /// Finds node contacts of every deformable body with the rigid bodies of `w`
 /// and with the boundary faces of the other deformable bodies, within `alert`.
-/// Cost: boundary nodes × rigid bodies whose box meets the body's box, and
-/// boundary nodes × faces for each pair of deformable bodies whose boxes meet.
+/// Cost: against rigid bodies, the boundary nodes and facets in the grid cells
+/// (about two boundary edges wide) that each rigid body's box meets, after a grid
+/// built once per body and step; boundary nodes × faces for each pair of
+/// deformable bodies whose boxes meet.
 pub fn detect(w: &World3, fe: &[FeBody], alert: f64, out: &mut Vec<RawFe3>) {
     out.clear();
     let boxes: Vec<Bounds> = fe.iter().map(bounds).collect();
+    let mut near: Vec<u32> = vec![];
     for (fb, body) in fe.iter().enumerate() {
         let bb = boxes[fb];
+        let mut grid: Option<SurfaceGrid> = None;
         for rb in 0..w.bodies.len() {
             let s = w.bodies.shape[rb];
             let store = &w.shapes[s.kind as usize];
@@ -180,12 +251,15 @@ pub fn detect(w: &World3, fe: &[FeBody], alert: f64, out: &mut Vec<RawFe3>) {
             if !overlap(&ab, &bb, alert) || w.law(body.material, w.bodies.material[rb]).is_none() {
                 continue;
             }
+            let grid = grid.get_or_insert_with(|| SurfaceGrid::new(body, &bb));
             if store.meets_faces() && store.size(s.index) < body.mesh.longest_boundary_edge {
                 // one contact at the surface's closest point: several points of
                 // neighbouring faces sharing nodes make a near-singular W_αα set
                 // that NLGS converges on very slowly
                 let mut best: Option<RawFe3> = None;
-                for f in 0..body.mesh.n_facets() {
+                grid.near(&ab, alert, true, &mut near);
+                for &f in &near {
+                    let f = f as usize;
                     let nodes = body.mesh.facet(f);
                     let tri = [0, 1, 2].map(|c| body.position(nodes[c] as usize));
                     let fb3 = (
@@ -221,7 +295,8 @@ pub fn detect(w: &World3, fe: &[FeBody], alert: f64, out: &mut Vec<RawFe3>) {
                 out.extend(best);
                 continue;
             }
-            for &k in &body.mesh.boundary {
+            grid.near(&ab, alert, false, &mut near);
+            for &k in &near {
                 let p = body.position(k as usize);
                 if !inside(p, &ab, alert) {
                     continue;
