@@ -180,7 +180,11 @@ impl SurfaceGrid {
         let mut cell = [1.0; 3];
         for c in 0..3 {
             let ext = bb.1[c] - bb.0[c];
-            dims[c] = if target > 0.0 { ((ext / target).ceil() as usize).clamp(1, 64) } else { 1 };
+            dims[c] = if target > 0.0 {
+                ((ext / target).ceil() as usize).clamp(1, 64)
+            } else {
+                1
+            };
             cell[c] = if ext > 0.0 { ext / dims[c] as f64 } else { 1.0 };
         }
         let n = dims[0] * dims[1] * dims[2];
@@ -223,7 +227,9 @@ impl SurfaceGrid {
     /// in increasing order (the order of a full scan), in `out`.
     fn near(&mut self, b: &Bounds, margin: f64, faces: bool, out: &mut Vec<u32>) {
         out.clear();
-        self.each_cell(b, margin, |i, g| out.extend_from_slice(if faces { &g.facets[i] } else { &g.nodes[i] }));
+        self.each_cell(b, margin, |i, g| {
+            out.extend_from_slice(if faces { &g.facets[i] } else { &g.nodes[i] })
+        });
         out.sort_unstable();
         out.dedup();
     }

@@ -125,6 +125,19 @@ fn face_contacts(sc: &mut PolyScratch, n: [f64; 3], alert: f64, i: u32, j: u32, 
             pts.push(*x);
         }
     }
+    // clipping along an edge that lies on a side plane (the equal faces of a
+    // joint) can put a point anywhere on that edge: drop points on a straight line
+    // between their neighbours, they are no corners
+    let mut k = 0;
+    while pts.len() > 3 && k < pts.len() {
+        let m = pts.len();
+        let (p0, p1, p2) = (pts[(k + m - 1) % m], pts[k], pts[(k + 1) % m]);
+        if norm(cross(sub(p1, p0), sub(p2, p1))) <= 1e-9 * scale * scale {
+            pts.remove(k);
+        } else {
+            k += 1;
+        }
+    }
     // the corners within alert, at most 4 of them kept; they share the overlap
     // polygon's area
     let gap = |x: &[f64; 3]| dot(sub(*x, reference[0]), n);
