@@ -1,6 +1,6 @@
 //! Contact solver settings and the per-step report, shared by every dimension.
 
-use crate::norms::{Criterion, Norms};
+use crate::norms::{Criterion, Norms, Sums};
 use serde::{Deserialize, Serialize};
 
 /// Order in which an NLGS sweep visits the contacts.
@@ -43,6 +43,32 @@ impl Default for SolverSettings {
             ordering: Ordering::Stored,
             seed: 0,
         }
+    }
+}
+
+impl SolverSettings {
+    /// The NLGS loop: `sweep` does one sweep over the contacts, accumulating the
+    /// check sums when it gets them (every `check_every` sweeps and at the last
+    /// one); the loop stops when the criterion holds or after `max_sweeps`. The
+    /// residual is left to the caller.
+    pub fn run_sweeps(&self, mut sweep: impl FnMut(Option<&mut Sums>)) -> SolveReport {
+        let mut report = SolveReport::default();
+        let k = self.check_every.max(1);
+        while report.sweeps < self.max_sweeps {
+            report.sweeps += 1;
+            if report.sweeps % k == 0 || report.sweeps == self.max_sweeps {
+                let mut sums = Sums::default();
+                sweep(Some(&mut sums));
+                report.norms = Norms::from_sums(&sums, self.tolerance);
+                if report.norms.converged(self.norm) {
+                    report.converged = true;
+                    break;
+                }
+            } else {
+                sweep(None);
+            }
+        }
+        report
     }
 }
 

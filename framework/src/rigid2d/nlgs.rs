@@ -10,7 +10,7 @@
 
 use super::contacts::{apply, local_velocity, Block2, Contacts2, Frame2, Target};
 use super::coulomb;
-use crate::norms::{natural_map_sq, Norms, Sums};
+use crate::norms::{natural_map_sq, Sums};
 use crate::solver::{Ordering, SolveReport, SolverSettings};
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
@@ -121,27 +121,13 @@ fn visit<const CHECK: bool, const RELAX: bool>(
 
 /// Runs sweeps until the criterion holds or `max_sweeps` is reached.
 pub fn solve(c: &mut Contacts2, vel: &mut [[f64; 3]], inv_mass: &[[f64; 3]], order: &[u32], s: &SolverSettings) -> SolveReport {
-    let mut report = SolveReport::default();
     if c.is_empty() {
-        report.converged = true;
-        return report;
+        return SolveReport {
+            converged: true,
+            ..Default::default()
+        };
     }
-    let k = s.check_every.max(1);
-    while report.sweeps < s.max_sweeps {
-        report.sweeps += 1;
-        let check = report.sweeps % k == 0 || report.sweeps == s.max_sweeps;
-        if check {
-            let mut sums = Sums::default();
-            sweep(c, vel, inv_mass, order, s.relaxation, Some(&mut sums));
-            report.norms = Norms::from_sums(&sums, s.tolerance);
-            if report.norms.converged(s.norm) {
-                report.converged = true;
-                break;
-            }
-        } else {
-            sweep(c, vel, inv_mass, order, s.relaxation, None);
-        }
-    }
+    let mut report = s.run_sweeps(|sums| sweep(c, vel, inv_mass, order, s.relaxation, sums));
     report.residual = residual(c, vel);
     report
 }

@@ -6,7 +6,7 @@
 use super::contacts::{apply_with, local_velocity, Contacts3, InvMass3, InvMassOf, Split};
 use super::coulomb::{self, Sym3};
 use super::joint;
-use crate::norms::{natural_map_sq, Norms, Sums};
+use crate::norms::{natural_map_sq, Sums};
 use crate::solver::{SolveReport, SolverSettings};
 
 /// One sweep; accumulates the check sums when `sums` is given. An empty `order`
@@ -93,27 +93,13 @@ pub fn solve(
     order: &[u32],
     s: &SolverSettings,
 ) -> SolveReport {
-    let mut report = SolveReport::default();
     if c.is_empty() {
-        report.converged = true;
-        return report;
+        return SolveReport {
+            converged: true,
+            ..Default::default()
+        };
     }
-    let k = s.check_every.max(1);
-    while report.sweeps < s.max_sweeps {
-        report.sweeps += 1;
-        let check = report.sweeps % k == 0 || report.sweeps == s.max_sweeps;
-        if check {
-            let mut sums = Sums::default();
-            sweep(c, vel, inv_m, inv_i, order, s.relaxation, Some(&mut sums));
-            report.norms = Norms::from_sums(&sums, s.tolerance);
-            if report.norms.converged(s.norm) {
-                report.converged = true;
-                break;
-            }
-        } else {
-            sweep(c, vel, inv_m, inv_i, order, s.relaxation, None);
-        }
-    }
+    let mut report = s.run_sweeps(|sums| sweep(c, vel, inv_m, inv_i, order, s.relaxation, sums));
     report.residual = residual(c, vel);
     report
 }

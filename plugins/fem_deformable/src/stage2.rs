@@ -14,7 +14,7 @@ use crate::contact2::*;
 pub use crate::nodes::fill_set;
 use nscdd::engine::{ContactStage, Diverged};
 use nscdd::law::target_velocity;
-use nscdd::norms::{natural_map_sq, Norms, Sums};
+use nscdd::norms::{natural_map_sq, Sums};
 use nscdd::rigid2d::contacts::{Block2, Target};
 use nscdd::rigid2d::{coulomb, nlgs};
 use nscdd::solver::SolveReport;
@@ -380,16 +380,13 @@ impl ContactStage<World2> for Deformables2 {
         let t0 = Instant::now();
         let s = w.solver.clone();
         let order: Vec<u32> = <nscdd::dd::Rigid2 as nscdd::dd::Family>::order(w).to_vec();
-        let mut report = SolveReport::default();
-        if w.contacts.is_empty() && self.contacts.is_empty() {
-            report.converged = true;
+        let mut report = if w.contacts.is_empty() && self.contacts.is_empty() {
+            SolveReport {
+                converged: true,
+                ..Default::default()
+            }
         } else {
-            let k = s.check_every.max(1);
-            while report.sweeps < s.max_sweeps {
-                report.sweeps += 1;
-                let check = report.sweeps % k == 0 || report.sweeps == s.max_sweeps;
-                let mut sums = Sums::default();
-                let mut sm = check.then_some(&mut sums);
+            s.run_sweeps(|mut sm| {
                 nlgs::sweep(
                     &mut w.contacts,
                     &mut w.bodies.vel,
@@ -406,15 +403,8 @@ impl ContactStage<World2> for Deformables2 {
                     s.relaxation,
                     sm,
                 );
-                if check {
-                    report.norms = Norms::from_sums(&sums, s.tolerance);
-                    if report.norms.converged(s.norm) {
-                        report.converged = true;
-                        break;
-                    }
-                }
-            }
-        }
+            })
+        };
         report.residual = self.residual(w);
         let t1 = Instant::now();
         self.finish_velocities();

@@ -12,7 +12,7 @@ use crate::contact3::*;
 use crate::nodes::fill_set;
 use crate::stage2::{free_velocities, node_target, update_bodies, FeTimes};
 use nscdd::engine::{ContactStage, Diverged};
-use nscdd::norms::{natural_map_sq, Norms, Sums};
+use nscdd::norms::{natural_map_sq, Sums};
 use nscdd::rigid2d::contacts::Target;
 use nscdd::rigid3d::contacts::{tangents, Block3};
 use nscdd::rigid3d::coulomb::{self, Sym3};
@@ -326,16 +326,13 @@ impl ContactStage<World3> for Deformables3 {
         let t0 = Instant::now();
         let s = w.solver.clone();
         let order: Vec<u32> = <nscdd::dd::Rigid3 as nscdd::dd::Family>::order(w).to_vec();
-        let mut report = SolveReport::default();
-        if w.contacts.is_empty() && self.contacts.is_empty() {
-            report.converged = true;
+        let mut report = if w.contacts.is_empty() && self.contacts.is_empty() {
+            SolveReport {
+                converged: true,
+                ..Default::default()
+            }
         } else {
-            let k = s.check_every.max(1);
-            while report.sweeps < s.max_sweeps {
-                report.sweeps += 1;
-                let check = report.sweeps % k == 0 || report.sweeps == s.max_sweeps;
-                let mut sums = Sums::default();
-                let mut sm = check.then_some(&mut sums);
+            s.run_sweeps(|mut sm| {
                 let b = &mut w.bodies;
                 nlgs::sweep(
                     &mut w.contacts,
@@ -348,15 +345,8 @@ impl ContactStage<World3> for Deformables3 {
                 );
                 let inv = RigidInv { m: &b.inv_m, i: &b.inv_i };
                 sweep(&mut self.contacts, &mut self.sets, &mut b.vel, inv, s.relaxation, sm);
-                if check {
-                    report.norms = Norms::from_sums(&sums, s.tolerance);
-                    if report.norms.converged(s.norm) {
-                        report.converged = true;
-                        break;
-                    }
-                }
-            }
-        }
+            })
+        };
         report.residual = self.residual(w);
         let t1 = Instant::now();
         self.finish_velocities();
