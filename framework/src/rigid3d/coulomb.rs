@@ -476,22 +476,36 @@ fn slide_general<B: Block3>(w: &B, s0: f64, u0t: [f64; 2], mu: f64) -> Option<[f
 
 /// Projected fixed point on the local problem, for degenerate blocks.
 fn fallback<B: Block3>(w: &B, u0: [f64; 3], u_target: f64, mu: f64) -> [f64; 3] {
-    // ρ = 1 / (Gershgorin bound of λ_max)
+    projected_fixed_point(w, u0, u_target, mu, 2000, 0.0, |z| project_cone(&z, mu))
+}
+
+/// `r ← project(r − ρ (W r + u0 − ū e_n + μ|u_t| e_n))` from r = 0 with
+/// ρ = 1 / (Gershgorin bound of λ_max), at most `iters` times, until the change is
+/// below 1e-15 (|r|₁ + `floor`). `project` is the projection on the admissible
+/// set (the Coulomb cone, or a joint's cut cone in [`super::joint`]).
+pub(crate) fn projected_fixed_point<B: Block3>(
+    w: &B,
+    u0: [f64; 3],
+    u_target: f64,
+    mu: f64,
+    iters: usize,
+    floor: f64,
+    project: impl Fn([f64; 3]) -> [f64; 3],
+) -> [f64; 3] {
     let lmax = w.lmax();
     if !(lmax > 0.0) {
         return [0.0; 3];
     }
     let rho = 1.0 / lmax;
     let mut r = [0.0; 3];
-    for _ in 0..2000 {
+    for _ in 0..iters {
         let wr = w.mul(r);
         let u = [wr[0] + u0[0] - u_target, wr[1] + u0[1], wr[2] + u0[2]];
         let ut = (u[1] * u[1] + u[2] * u[2]).sqrt();
-        let z = [r[0] - rho * (u[0] + mu * ut), r[1] - rho * u[1], r[2] - rho * u[2]];
-        let p = project_cone(&z, mu);
+        let p = project([r[0] - rho * (u[0] + mu * ut), r[1] - rho * u[1], r[2] - rho * u[2]]);
         let d = (p[0] - r[0]).abs() + (p[1] - r[1]).abs() + (p[2] - r[2]).abs();
         r = p;
-        if d <= 1e-15 * (r[0].abs() + r[1].abs() + r[2].abs()) {
+        if d <= 1e-15 * (r[0].abs() + r[1].abs() + r[2].abs() + floor) {
             break;
         }
     }

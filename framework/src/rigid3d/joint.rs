@@ -124,31 +124,8 @@ pub fn solve(w: &Sym3, pre: &Pre3, u0: [f64; 3], u_target: f64, mu: f64, j: &Joi
             return [rn, rt[0], rt[1]];
         }
     }
-    fallback(w, u0, u_target, mu, j)
-}
-
-/// Projected fixed point `r ← P_Kc(r − ρ (W r + u0 − ū e_n + μ|u_t| e_n))`.
-fn fallback(w: &Sym3, u0: [f64; 3], u_target: f64, mu: f64, j: &Joint) -> [f64; 3] {
-    let lmax = (w[0].abs() + w[1].abs() + w[2].abs())
-        .max(w[1].abs() + w[3].abs() + w[4].abs())
-        .max(w[2].abs() + w[4].abs() + w[5].abs());
-    if !(lmax > 0.0) {
-        return [0.0; 3];
-    }
-    let rho = 1.0 / lmax;
-    let mut r = [0.0; 3];
-    for _ in 0..4000 {
-        let wr = coulomb::mul(w, r);
-        let u = [wr[0] + u0[0] - u_target, wr[1] + u0[1], wr[2] + u0[2]];
-        let ut = (u[1] * u[1] + u[2] * u[2]).sqrt();
-        let p = project([r[0] - rho * (u[0] + mu * ut), r[1] - rho * u[1], r[2] - rho * u[2]], mu, j);
-        let d = (p[0] - r[0]).abs() + (p[1] - r[1]).abs() + (p[2] - r[2]).abs();
-        r = p;
-        if d <= 1e-15 * (r[0].abs() + r[1].abs() + r[2].abs() + j.shift) {
-            break;
-        }
-    }
-    r
+    // the rim of the cut, degenerate blocks: the projected fixed point on K_c
+    coulomb::projected_fixed_point(w, u0, u_target, mu, 4000, j.shift, |z| project(z, mu, j))
 }
 
 /// Whether an intact joint still holds at the end of the step: its sticking
