@@ -8,7 +8,7 @@
 //!   blocks, NLGS, update, output), from the example scene's settings.
 
 use nscdd::registry::Registry;
-use nscdd::rigid2d::nlgs;
+use nscdd::solver::nlgs;
 use std::time::Instant;
 
 fn lattice_scene(n: usize) -> String {

@@ -4,7 +4,7 @@
 //! the contacts carry load), timing plain sweeps of the solver's hot loop.
 
 use nscdd::registry::Registry;
-use nscdd::rigid3d::nlgs;
+use nscdd::solver::nlgs;
 use std::time::Instant;
 
 fn lattice3(n: usize) -> String {
@@ -60,7 +60,7 @@ pub fn nlgs3(reg: &Registry, n: usize, sweeps: usize) {
     let mut vel = w.bodies.vel.clone();
     let t = Instant::now();
     for _ in 0..sweeps {
-        nlgs::sweep(c, &mut vel, &w.bodies.inv_m, &w.bodies.inv_i, &[], 1.0, None);
+        nlgs::sweep(c, &mut vel, &w.bodies.inv_mass, &[], 1.0, None);
     }
     let dt = t.elapsed().as_secs_f64();
     let updates = (c.len() * sweeps) as f64;

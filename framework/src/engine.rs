@@ -14,10 +14,11 @@
 //! (frames, Delassus blocks W_αα, law targets ū and warm start), NLGS
 //! ([`crate::rigid2d::nlgs`]) and [`update_positions`].
 
+use crate::dim::{Dim, D2};
 use crate::drive::Imposed;
 use crate::law::target_velocity;
-use crate::rigid2d::contacts::{Block2, ContactKey, Frame2, Target};
-use crate::rigid2d::{nlgs, Contacts2};
+use crate::model::{ContactKey, Target};
+use crate::solver::nlgs;
 use crate::solver::SolveReport;
 use crate::world::World2;
 use std::time::Instant;
@@ -150,16 +151,6 @@ pub fn free_velocity(w: &mut World2) {
     }
 }
 
-/// Local velocity of a raw frame from explicit body velocities.
-#[inline]
-fn local(n: [f64; 2], ai: [f64; 2], aj: [f64; 2], vi: [f64; 3], vj: [f64; 3]) -> [f64; 2] {
-    let dv = [vi[0] - vj[0], vi[1] - vj[1]];
-    [
-        n[0] * dv[0] + n[1] * dv[1] + ai[0] * vi[2] - aj[0] * vj[2],
-        -n[1] * dv[0] + n[0] * dv[1] + ai[1] * vi[2] - aj[1] * vj[2],
-    ]
-}
-
 /// Builds this step's contact set from the raw contacts: lever arms, W_αα, ū, and
 /// the impulses of persisting contacts (warm start), which are applied at once to
 /// the free velocities.
@@ -174,23 +165,16 @@ pub fn build_contacts(w: &mut World2) {
     let b = &w.bodies;
     for rc in &s.raw {
         let (i, j) = (rc.i as usize, rc.j as usize);
-        let n = rc.normal;
-        let t = [-n[1], n[0]];
-        let arm = |x: [f64; 2]| {
-            let d = [rc.point[0] - x[0], rc.point[1] - x[1]];
-            [d[0] * n[1] - d[1] * n[0], d[0] * t[1] - d[1] * t[0]]
-        };
-        let (ai, aj) = (arm(b.pos[i]), arm(b.pos[j]));
-        let frame = Frame2 { n, arm_i: ai, arm_j: aj };
-        let wb = Contacts2::delassus(&frame, b.inv_mass[i], b.inv_mass[j]);
+        let frame = D2::frame(&rc.point, &rc.normal, &b.pos[i], &b.pos[j]);
+        let wb = D2::delassus(&frame, &b.inv_mass[i], &b.inv_mass[j]);
         if !(wb[0] > 0.0) {
             continue;
         }
         let Some(law) = w.laws[b.material[i] as usize * w.materials.len() + b.material[j] as usize] else {
             continue;
         };
-        let u_begin = local(n, ai, aj, s.v_begin[i], s.v_begin[j]);
-        let u_free = local(n, ai, aj, b.vel[i], b.vel[j]);
+        let u_begin = D2::local_velocity(&frame, &s.v_begin[i], &s.v_begin[j]);
+        let u_free = D2::local_velocity(&frame, &b.vel[i], &b.vel[j]);
         let key = ContactKey {
             i: rc.i,
             j: rc.j,
@@ -202,10 +186,7 @@ pub fn build_contacts(w: &mut World2) {
         };
         c.bodies.push([rc.i, rc.j]);
         c.frame.push(frame);
-        c.block.push(Block2 {
-            w: wb,
-            pre: crate::rigid2d::coulomb::precompute(wb, law.mu),
-        });
+        c.block.push(D2::block(wb, law.mu));
         c.target.push(Target {
             u_target: target_velocity(rc.gap, u_begin[0], u_free[0], h, theta, law.e),
             mu: law.mu,
@@ -215,14 +196,10 @@ pub fn build_contacts(w: &mut World2) {
         c.gap.push(rc.gap);
         c.point.push(rc.point);
         c.key.push(key);
+        c.joint.push(Default::default());
     }
     std::mem::swap(&mut w.contacts, &mut s.next);
-    let c = &w.contacts;
-    for a in 0..c.len() {
-        if c.r[a] != [0.0, 0.0] {
-            c.apply(a, c.r[a], &mut w.bodies.vel, &w.bodies.inv_mass);
-        }
-    }
+    w.contacts.apply_all(&mut w.bodies.vel, &w.bodies.inv_mass);
 }
 
 /// q⁺ = q⁻ + h((1 − θ)V⁻ + θV⁺); the per-body reactions; the divergence check.
@@ -255,18 +232,13 @@ pub fn update_positions(w: &mut World2) -> Result<(), Diverged> {
     w.reaction.clear();
     w.reaction.resize(w.bodies.len(), [0.0; 3]);
     for a in 0..c.len() {
-        let (Frame2 { n, arm_i: ai, arm_j: aj }, r) = (c.frame[a], c.r[a]);
-        let p = [r[0] * n[0] - r[1] * n[1], r[0] * n[1] + r[1] * n[0]];
         let [i, j] = c.bodies[a];
-        let (i, j) = (i as usize, j as usize);
-        let ri = &mut w.reaction[i];
-        ri[0] += p[0];
-        ri[1] += p[1];
-        ri[2] += ai[0] * r[0] + ai[1] * r[1];
-        let rj = &mut w.reaction[j];
-        rj[0] -= p[0];
-        rj[1] -= p[1];
-        rj[2] -= aj[0] * r[0] + aj[1] * r[1];
+        let (f, r) = (&c.frame[a], &c.r[a]);
+        let (pi, pj) = (D2::reaction_i(f, r), D2::reaction_j(f, r));
+        for k in 0..3 {
+            w.reaction[i as usize][k] += pi[k];
+            w.reaction[j as usize][k] -= pj[k];
+        }
     }
     w.step += 1;
     w.t = w.step as f64 * h;

@@ -14,15 +14,16 @@
 //! whatever the step. Degrees of freedom driven by velocity take V⁺ = v(t_i+1) and
 //! are removed from M̂⁻¹ (rotations: the world inertia restricted to the free axes).
 
+use crate::dim::coulomb3 as coulomb;
+use crate::dim::joint::Joint;
+use crate::dim::{Dim, Vector, D3};
 use crate::drive::Imposed;
 use crate::engine::{ContactStage, Diverged, Nlgs, StageTimes, StepReport};
 use crate::law::target_velocity;
-use crate::rigid2d::contacts::{ContactKey, Target};
-use crate::rigid2d::nlgs::make_order;
+use crate::model::{ContactKey, Target};
 use crate::rigid3d::bodies::{cross, from_rotation_vector, normalize, quat_mul, ALL_FREE};
-use crate::rigid3d::contacts::{local_velocity, tangents, Block3, Frame3};
-use crate::rigid3d::joint::{self, Joint};
-use crate::rigid3d::{coulomb, nlgs, Contacts3};
+use crate::solver::nlgs::{self, make_order};
+
 use crate::solver::SolveReport;
 use crate::world3::World3;
 use std::time::Instant;
@@ -30,7 +31,7 @@ use std::time::Instant;
 impl ContactStage<World3> for Nlgs {
     fn solve(&mut self, w: &mut World3) -> SolveReport {
         let b = &mut w.bodies;
-        nlgs::solve(&mut w.contacts, &mut b.vel, &b.inv_m, &b.inv_i, &w.scratch.order, &w.solver)
+        nlgs::solve(&mut w.contacts, &mut b.vel, &b.inv_mass, &w.scratch.order, &w.solver)
     }
 }
 
@@ -107,7 +108,7 @@ pub fn free_velocity(w: &mut World3) {
         if b.free[k] == 0 {
             continue;
         }
-        let (im, ii) = (b.inv_m[k], b.inv_i[k]);
+        let (im, ii) = (b.inv_mass[k].m, b.inv_mass[k].i);
         let m = b.mass[k];
         let iw = if isotropic(b.inertia[k]) { [0.0; 6] } else { b.world_inertia(k) };
         let v = &mut b.vel[k];
@@ -171,7 +172,7 @@ pub fn free_velocity(w: &mut World3) {
                             // an imposed moment about a world axis, through I_w⁻¹
                             let mut tq = [0.0; 3];
                             tq[dof - 3] = h * f;
-                            let dw = coulomb::mul(&b.inv_i[k], tq);
+                            let dw = coulomb::mul(&b.inv_mass[k].i, tq);
                             for a in 0..3 {
                                 b.vel[k][3 + a] += dw[a];
                             }
@@ -235,23 +236,16 @@ pub fn build_contacts(w: &mut World3) {
     let nm = w.materials.len();
     for rc in &s.raw {
         let (i, j) = (rc.i as usize, rc.j as usize);
-        let n = rc.normal;
-        let (t1, t2) = tangents(n);
-        let arm = |x: [f64; 3]| [rc.point[0] - x[0], rc.point[1] - x[1], rc.point[2] - x[2]];
-        let frame = Frame3 {
-            basis: [n, t1, t2],
-            d_i: arm(b.pos[i]),
-            d_j: arm(b.pos[j]),
-        };
-        let wb = Contacts3::delassus(&frame, b.inv_m[i], &b.inv_i[i], b.inv_m[j], &b.inv_i[j]);
+        let frame = D3::frame(&rc.point, &rc.normal, &b.pos[i], &b.pos[j]);
+        let wb = D3::delassus(&frame, &b.inv_mass[i], &b.inv_mass[j]);
         if !(wb[0] > 0.0) {
             continue;
         }
         let Some(law) = w.laws[b.material[i] as usize * nm + b.material[j] as usize] else {
             continue;
         };
-        let u_begin = local_velocity(&frame, &s.v_begin[i], &s.v_begin[j]);
-        let u_free = local_velocity(&frame, &b.vel[i], &b.vel[j]);
+        let u_begin = D3::local_velocity(&frame, &s.v_begin[i], &s.v_begin[j]);
+        let u_free = D3::local_velocity(&frame, &b.vel[i], &b.vel[j]);
         let key = ContactKey {
             i: rc.i,
             j: rc.j,
@@ -275,16 +269,13 @@ pub fn build_contacts(w: &mut World3) {
             None => w.step == 0 && rc.gap <= law.bond_gap,
         };
         let joint = if bonded && law.is_cohesive() && rc.area > 0.0 {
-            Joint::of(&law, rc.area, h)
+            Joint::of(law.cohesion, law.tensile, law.mu, rc.area, h)
         } else {
             Joint::default()
         };
         c.bodies.push([rc.i, rc.j]);
         c.frame.push(frame);
-        c.block.push(Block3 {
-            w: wb,
-            pre: coulomb::precompute(&wb),
-        });
+        c.block.push(D3::block(wb, law.mu));
         c.target.push(Target {
             u_target: target_velocity(rc.gap, u_begin[0], u_free[0], h, theta, law.e),
             mu: law.mu,
@@ -297,21 +288,7 @@ pub fn build_contacts(w: &mut World3) {
         c.joint.push(joint);
     }
     std::mem::swap(&mut w.contacts, &mut s.next);
-    let c = &w.contacts;
-    for a in 0..c.len() {
-        if c.r[a] != [0.0; 3] {
-            let [i, j] = c.bodies[a];
-            crate::rigid3d::contacts::apply(
-                &c.frame[a],
-                c.r[a],
-                i as usize,
-                j as usize,
-                &mut w.bodies.vel,
-                &w.bodies.inv_m,
-                &w.bodies.inv_i,
-            );
-        }
-    }
+    w.contacts.apply_all(&mut w.bodies.vel, &w.bodies.inv_mass);
 }
 
 /// Failure of bonded joints on the converged impulses: a joint whose strength is
@@ -328,10 +305,10 @@ pub fn update_joints(w: &mut World3) {
             continue;
         }
         let u = c.local_velocity(a, &w.bodies.vel);
-        let wr = coulomb::mul(&c.block[a].w, c.r[a]);
-        let u0 = [u[0] - wr[0], u[1] - wr[1], u[2] - wr[2]];
+        let wr = D3::w_mul(&c.block[a], &c.r[a]);
+        let u0 = u.sub(&wr);
         let t = c.target[a];
-        if !joint::holds(&c.block[a].w, &c.block[a].pre, c.r[a], u0, t.u_target, t.mu, &jt, tol) {
+        if !D3::joint_holds(&c.block[a], &c.r[a], &u0, t.u_target, t.mu, &jt, tol) {
             c.joint[a] = Joint::default();
         }
     }
@@ -368,15 +345,12 @@ pub fn update_positions(w: &mut World3) -> Result<(), Diverged> {
     w.reaction.clear();
     w.reaction.resize(w.bodies.len(), [0.0; 6]);
     for a in 0..c.len() {
-        let p = c.world_impulse(a);
         let [i, j] = c.bodies[a];
-        let f = c.frame[a];
-        let (mi, mj) = (cross(f.d_i, p), cross(f.d_j, p));
-        for k in 0..3 {
-            w.reaction[i as usize][k] += p[k];
-            w.reaction[i as usize][3 + k] += mi[k];
-            w.reaction[j as usize][k] -= p[k];
-            w.reaction[j as usize][3 + k] -= mj[k];
+        let (f, r) = (&c.frame[a], &c.r[a]);
+        let (pi, pj) = (D3::reaction_i(f, r), D3::reaction_j(f, r));
+        for k in 0..6 {
+            w.reaction[i as usize][k] += pi[k];
+            w.reaction[j as usize][k] -= pj[k];
         }
     }
     w.step += 1;

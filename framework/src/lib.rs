@@ -23,12 +23,14 @@
 pub mod dd;
 pub mod detect;
 pub mod detect3;
+pub mod dim;
 pub mod drive;
 pub mod engine;
 pub mod engine3;
 pub mod error;
 pub mod fc;
 pub mod law;
+pub mod model;
 pub mod norms;
 pub mod output;
 pub mod params;

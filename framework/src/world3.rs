@@ -238,7 +238,7 @@ impl World3 {
             let m = b.mass[k];
             let iw = b.world_inertia(k);
             let w = [v[3], v[4], v[5]];
-            let iwv = crate::rigid3d::coulomb::mul(&iw, w);
+            let iwv = crate::dim::coulomb3::mul(&iw, w);
             ek += 0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) + 0.5 * (w[0] * iwv[0] + w[1] * iwv[1] + w[2] * iwv[2]);
             let x = b.pos[k];
             ep -= m * (self.gravity[0] * x[0] + self.gravity[1] * x[1] + self.gravity[2] * x[2]);

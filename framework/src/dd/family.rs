@@ -6,10 +6,11 @@
 //! contact set, the copies' M̂_E⁻¹ and the operations of DESIGN.md §3: one NLGS sweep,
 //! M̂_E⁻¹ applied to an impulse, M̂_E applied to a velocity increment (the gluing).
 
+use crate::dim::{Dim, D2, D3};
 use crate::engine::{Diverged, StepReport};
+use crate::model::{ContactKey, Contacts};
 use crate::norms::Sums;
-use crate::rigid2d::contacts::ContactKey;
-use crate::rigid3d::coulomb as c3;
+use crate::solver::nlgs;
 
 /// A body family as NSCDD sees it (see the module docs).
 pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'static {
@@ -69,270 +70,116 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     fn step_with(w: &mut Self::World, stage: &mut super::NscddOf<Self>) -> Result<StepReport, Diverged>;
 }
 
-/// 2D rigid bodies ([`crate::rigid2d`], [`crate::world::World2`]).
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Rigid2;
+/// The NSCDD family of the rigid bodies of one dimension `$d` in the world `$world`:
+/// every operation is the dimension's ([`Dim`]) or the generic contact set's and
+/// NLGS's.
+macro_rules! rigid_family {
+    ($(#[$doc:meta])* $name:ident, $d:ty, $world:ty, $space:expr) => {
+        $(#[$doc])*
+        #[derive(Clone, Copy, Debug, Default)]
+        pub struct $name;
 
-impl Family for Rigid2 {
-    type V = [f64; 3];
-    type InvMass = [f64; 3];
-    type Contacts = crate::rigid2d::Contacts2;
-    type World = crate::world::World2;
-    const SPACE: usize = 2;
+        impl Family for $name {
+            type V = <$d as Dim>::Twist;
+            type InvMass = <$d as Dim>::InvMass;
+            type Contacts = Contacts<$d>;
+            type World = $world;
+            const SPACE: usize = $space;
 
-    fn len(c: &Self::Contacts) -> usize {
-        c.len()
-    }
-    fn reserve(c: &mut Self::Contacts, n: usize) {
-        c.reserve(n);
-    }
-    fn push_contact(dst: &mut Self::Contacts, src: &Self::Contacts, a: usize, li: u32, lj: u32) {
-        dst.push_from(src, a, li, lj);
-    }
-    fn bodies(c: &Self::Contacts, a: usize) -> [u32; 2] {
-        c.bodies[a]
-    }
-    fn key(c: &Self::Contacts, a: usize) -> ContactKey {
-        c.key[a]
-    }
-    fn point(c: &Self::Contacts, a: usize) -> [f64; 3] {
-        [c.point[a][0], c.point[a][1], 0.0]
-    }
-    fn copy_r(dst: &mut Self::Contacts, ga: usize, src: &Self::Contacts, la: usize) {
-        dst.r[ga] = src.r[la];
-    }
-    fn r(c: &Self::Contacts, a: usize) -> &[f64] {
-        &c.r[a]
-    }
-    fn r_mut(c: &mut Self::Contacts, a: usize) -> &mut [f64] {
-        &mut c.r[a]
-    }
-    fn copy_delassus(c: &mut Self::Contacts, inv: &[Self::InvMass]) {
-        for a in 0..c.len() {
-            let [i, j] = c.bodies[a];
-            let w = crate::rigid2d::Contacts2::delassus(&c.frame[a], inv[i as usize], inv[j as usize]);
-            c.block[a] = crate::rigid2d::contacts::Block2 {
-                w,
-                pre: crate::rigid2d::coulomb::precompute(w, c.target[a].mu),
-            };
-        }
-    }
-    fn warm_start(c: &Self::Contacts, vel: &mut [Self::V], inv: &[Self::InvMass]) {
-        for a in 0..c.len() {
-            if c.r[a] != [0.0, 0.0] {
-                c.apply(a, c.r[a], vel, inv);
+            fn len(c: &Self::Contacts) -> usize {
+                c.len()
+            }
+            fn reserve(c: &mut Self::Contacts, n: usize) {
+                c.reserve(n);
+            }
+            fn push_contact(dst: &mut Self::Contacts, src: &Self::Contacts, a: usize, li: u32, lj: u32) {
+                dst.push_from(src, a, li, lj);
+            }
+            fn bodies(c: &Self::Contacts, a: usize) -> [u32; 2] {
+                c.bodies[a]
+            }
+            fn key(c: &Self::Contacts, a: usize) -> ContactKey {
+                c.key[a]
+            }
+            fn point(c: &Self::Contacts, a: usize) -> [f64; 3] {
+                let mut p = [0.0; 3];
+                p[..<$d as Dim>::N].copy_from_slice(c.point[a].as_ref());
+                p
+            }
+            fn copy_r(dst: &mut Self::Contacts, ga: usize, src: &Self::Contacts, la: usize) {
+                dst.r[ga] = src.r[la];
+            }
+            fn r(c: &Self::Contacts, a: usize) -> &[f64] {
+                c.r[a].as_ref()
+            }
+            fn r_mut(c: &mut Self::Contacts, a: usize) -> &mut [f64] {
+                c.r[a].as_mut()
+            }
+            fn copy_delassus(c: &mut Self::Contacts, inv: &[Self::InvMass]) {
+                c.refresh_delassus(inv);
+            }
+            fn warm_start(c: &Self::Contacts, vel: &mut [Self::V], inv: &[Self::InvMass]) {
+                c.apply_all(vel, inv);
+            }
+            fn sweep(c: &mut Self::Contacts, vel: &mut [Self::V], inv: &[Self::InvMass], order: &[u32], omega: f64, sums: Option<&mut Sums>) {
+                nlgs::sweep(c, vel, inv, order, omega, sums);
+            }
+            fn scale_inv(im: Self::InvMass, m: f64) -> Self::InvMass {
+                <$d as Dim>::scale_inv(&im, m)
+            }
+            fn apply_impulse(v: &mut Self::V, im: &Self::InvMass, f: &Self::V) {
+                <$d as Dim>::apply_inv(v, im, f);
+            }
+            fn glue(v: &mut Self::V, f: &mut Self::V, im: &Self::InvMass, dv: &Self::V) {
+                <$d as Dim>::glue(v, f, im, dv);
+            }
+            fn n_bodies(w: &Self::World) -> usize {
+                w.bodies.len()
+            }
+            fn movable(w: &Self::World, g: usize) -> bool {
+                w.bodies.movable(g)
+            }
+            fn inv_mass(w: &Self::World, g: usize) -> Self::InvMass {
+                w.bodies.inv_mass[g]
+            }
+            fn rho2(w: &Self::World, g: usize) -> f64 {
+                w.bodies.rho2(g)
+            }
+            fn contacts(w: &Self::World) -> &Self::Contacts {
+                &w.contacts
+            }
+            fn contacts_mut(w: &mut Self::World) -> &mut Self::Contacts {
+                &mut w.contacts
+            }
+            fn vel(w: &Self::World) -> &[Self::V] {
+                &w.bodies.vel
+            }
+            fn vel_mut(w: &mut Self::World) -> &mut [Self::V] {
+                &mut w.bodies.vel
+            }
+            fn order(w: &Self::World) -> &[u32] {
+                &w.scratch.order
+            }
+            fn residual(w: &Self::World) -> f64 {
+                nlgs::residual(&w.contacts, &w.bodies.vel)
+            }
+            fn solver(w: &Self::World) -> &crate::solver::SolverSettings {
+                &w.solver
+            }
+            fn step_with(w: &mut Self::World, stage: &mut super::NscddOf<Self>) -> Result<StepReport, Diverged> {
+                w.step_with(stage)
             }
         }
-    }
-    fn sweep(c: &mut Self::Contacts, vel: &mut [Self::V], inv: &[Self::InvMass], order: &[u32], omega: f64, sums: Option<&mut Sums>) {
-        crate::rigid2d::nlgs::sweep(c, vel, inv, order, omega, sums);
-    }
-    fn scale_inv(im: Self::InvMass, m: f64) -> Self::InvMass {
-        [im[0] * m, im[1] * m, im[2] * m]
-    }
-    fn apply_impulse(v: &mut Self::V, im: &Self::InvMass, f: &Self::V) {
-        for d in 0..3 {
-            v[d] += im[d] * f[d];
-        }
-    }
-    fn glue(v: &mut Self::V, f: &mut Self::V, im: &Self::InvMass, dv: &Self::V) {
-        for d in 0..3 {
-            if im[d] != 0.0 {
-                v[d] += dv[d];
-                f[d] += dv[d] / im[d];
-            }
-        }
-    }
-    fn n_bodies(w: &Self::World) -> usize {
-        w.bodies.len()
-    }
-    fn movable(w: &Self::World, g: usize) -> bool {
-        w.bodies.movable(g)
-    }
-    fn inv_mass(w: &Self::World, g: usize) -> Self::InvMass {
-        w.bodies.inv_mass[g]
-    }
-    fn rho2(w: &Self::World, g: usize) -> f64 {
-        let ms = w.bodies.mass[g];
-        if ms[0] > 0.0 && ms[0].is_finite() && ms[2].is_finite() {
-            ms[2] / ms[0]
-        } else {
-            0.0
-        }
-    }
-    fn contacts(w: &Self::World) -> &Self::Contacts {
-        &w.contacts
-    }
-    fn contacts_mut(w: &mut Self::World) -> &mut Self::Contacts {
-        &mut w.contacts
-    }
-    fn vel(w: &Self::World) -> &[Self::V] {
-        &w.bodies.vel
-    }
-    fn vel_mut(w: &mut Self::World) -> &mut [Self::V] {
-        &mut w.bodies.vel
-    }
-    fn order(w: &Self::World) -> &[u32] {
-        &w.scratch.order
-    }
-    fn residual(w: &Self::World) -> f64 {
-        crate::rigid2d::nlgs::residual(&w.contacts, &w.bodies.vel)
-    }
-    fn solver(w: &Self::World) -> &crate::solver::SolverSettings {
-        &w.solver
-    }
-    fn step_with(w: &mut Self::World, stage: &mut super::NscddOf<Self>) -> Result<StepReport, Diverged> {
-        w.step_with(stage)
-    }
+    };
 }
 
-pub use crate::rigid3d::contacts::InvMass3;
+rigid_family!(
+    /// 2D rigid bodies ([`crate::rigid2d`], [`crate::world::World2`]).
+    Rigid2, D2, crate::world::World2, 2
+);
+rigid_family!(
+    /// 3D rigid bodies ([`crate::rigid3d`], [`crate::world3::World3`]).
+    Rigid3, D3, crate::world3::World3, 3
+);
 
-/// 3D rigid bodies ([`crate::rigid3d`], [`crate::world3::World3`]).
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Rigid3;
-
-impl Family for Rigid3 {
-    type V = [f64; 6];
-    type InvMass = InvMass3;
-    type Contacts = crate::rigid3d::Contacts3;
-    type World = crate::world3::World3;
-    const SPACE: usize = 3;
-
-    fn len(c: &Self::Contacts) -> usize {
-        c.len()
-    }
-    fn reserve(c: &mut Self::Contacts, n: usize) {
-        c.reserve(n);
-    }
-    fn push_contact(dst: &mut Self::Contacts, src: &Self::Contacts, a: usize, li: u32, lj: u32) {
-        dst.push_from(src, a, li, lj);
-    }
-    fn bodies(c: &Self::Contacts, a: usize) -> [u32; 2] {
-        c.bodies[a]
-    }
-    fn key(c: &Self::Contacts, a: usize) -> ContactKey {
-        c.key[a]
-    }
-    fn point(c: &Self::Contacts, a: usize) -> [f64; 3] {
-        c.point[a]
-    }
-    fn copy_r(dst: &mut Self::Contacts, ga: usize, src: &Self::Contacts, la: usize) {
-        dst.r[ga] = src.r[la];
-    }
-    fn r(c: &Self::Contacts, a: usize) -> &[f64] {
-        &c.r[a]
-    }
-    fn r_mut(c: &mut Self::Contacts, a: usize) -> &mut [f64] {
-        &mut c.r[a]
-    }
-    fn copy_delassus(c: &mut Self::Contacts, inv: &[Self::InvMass]) {
-        for a in 0..c.len() {
-            let [i, j] = c.bodies[a];
-            let (bi, bj) = (&inv[i as usize], &inv[j as usize]);
-            let w = crate::rigid3d::Contacts3::delassus(&c.frame[a], bi.m, &bi.i, bj.m, &bj.i);
-            c.block[a] = crate::rigid3d::contacts::Block3 {
-                w,
-                pre: c3::precompute(&w),
-            };
-        }
-    }
-    fn warm_start(c: &Self::Contacts, vel: &mut [Self::V], inv: &[Self::InvMass]) {
-        for a in 0..c.len() {
-            if c.r[a] != [0.0; 3] {
-                let [bi, bj] = c.bodies[a];
-                crate::rigid3d::contacts::apply_with(&c.frame[a], c.r[a], bi as usize, bj as usize, vel, inv);
-            }
-        }
-    }
-    fn sweep(c: &mut Self::Contacts, vel: &mut [Self::V], inv: &[Self::InvMass], order: &[u32], omega: f64, sums: Option<&mut Sums>) {
-        crate::rigid3d::nlgs::sweep_split(c, vel, inv, order, omega, sums);
-    }
-    fn scale_inv(im: Self::InvMass, m: f64) -> Self::InvMass {
-        InvMass3 {
-            m: im.m.map(|x| x * m),
-            i: im.i.map(|x| x * m),
-        }
-    }
-    fn apply_impulse(v: &mut Self::V, im: &Self::InvMass, f: &Self::V) {
-        for d in 0..3 {
-            v[d] += im.m[d] * f[d];
-        }
-        let w = c3::mul(&im.i, [f[3], f[4], f[5]]);
-        for d in 0..3 {
-            v[3 + d] += w[d];
-        }
-    }
-    fn glue(v: &mut Self::V, f: &mut Self::V, im: &Self::InvMass, dv: &Self::V) {
-        for d in 0..3 {
-            if im.m[d] != 0.0 {
-                v[d] += dv[d];
-                f[d] += dv[d] / im.m[d];
-            }
-        }
-        // rotations: M̂_E = (I_E⁻¹)⁻¹ on the free axes
-        match c3::inverse(&im.i) {
-            Some(ie) => {
-                let df = c3::mul(&ie, [dv[3], dv[4], dv[5]]);
-                for d in 0..3 {
-                    v[3 + d] += dv[3 + d];
-                    f[3 + d] += df[d];
-                }
-            }
-            None => {
-                // some rotations driven: the free axes (diagonal of I⁻¹ restricted)
-                let diag = [im.i[0], im.i[3], im.i[5]];
-                for d in 0..3 {
-                    if diag[d] != 0.0 {
-                        v[3 + d] += dv[3 + d];
-                        f[3 + d] += dv[3 + d] / diag[d];
-                    }
-                }
-            }
-        }
-    }
-    fn n_bodies(w: &Self::World) -> usize {
-        w.bodies.len()
-    }
-    fn movable(w: &Self::World, g: usize) -> bool {
-        w.bodies.movable(g)
-    }
-    fn inv_mass(w: &Self::World, g: usize) -> Self::InvMass {
-        InvMass3 {
-            m: w.bodies.inv_m[g],
-            i: w.bodies.inv_i[g],
-        }
-    }
-    fn rho2(w: &Self::World, g: usize) -> f64 {
-        let (m, i) = (w.bodies.mass[g], w.bodies.inertia[g]);
-        if m > 0.0 && m.is_finite() && i.iter().all(|x| x.is_finite()) {
-            (i[0] + i[1] + i[2]) / (3.0 * m)
-        } else {
-            0.0
-        }
-    }
-    fn contacts(w: &Self::World) -> &Self::Contacts {
-        &w.contacts
-    }
-    fn contacts_mut(w: &mut Self::World) -> &mut Self::Contacts {
-        &mut w.contacts
-    }
-    fn vel(w: &Self::World) -> &[Self::V] {
-        &w.bodies.vel
-    }
-    fn vel_mut(w: &mut Self::World) -> &mut [Self::V] {
-        &mut w.bodies.vel
-    }
-    fn order(w: &Self::World) -> &[u32] {
-        &w.scratch.order
-    }
-    fn residual(w: &Self::World) -> f64 {
-        crate::rigid3d::nlgs::residual(&w.contacts, &w.bodies.vel)
-    }
-    fn solver(w: &Self::World) -> &crate::solver::SolverSettings {
-        &w.solver
-    }
-    fn step_with(w: &mut Self::World, stage: &mut super::NscddOf<Self>) -> Result<StepReport, Diverged> {
-        w.step_with(stage)
-    }
-}
+pub use crate::dim::d3::InvMass3;

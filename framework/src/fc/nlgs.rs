@@ -4,13 +4,13 @@
 //! off-diagonal D × D blocks `W_αβ` of row α in compressed rows. A sweep visits the
 //! contacts in storage order: `u0_α = q_α + Σ_{β≠α} W_αβ r_β`, then `r_α` ← the
 //! one-contact solution for `(W_αα, u0_α, μ_α)` (the exact 2D enumeration of
-//! [`crate::rigid2d::coulomb`], or [`crate::rigid3d::coulomb`] whose block data are
+//! [`crate::dim::coulomb2`], or [`crate::dim::coulomb3`] whose block data are
 //! precomputed once).
 
 use super::{q_scale, FcNorm, FcOptions, FcProblem, FcSolution};
+use crate::dim::coulomb2 as c2;
+use crate::dim::coulomb3 as c3;
 use crate::norms::{natural_map_sq, Norms, Sums};
-use crate::rigid2d::coulomb as c2;
-use crate::rigid3d::coulomb as c3;
 use std::time::Instant;
 
 /// W in block form.

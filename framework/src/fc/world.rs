@@ -120,10 +120,10 @@ pub fn problem_from_world3(w: &crate::world3::World3) -> FcProblem {
     while g0 < inc.len() {
         let body = inc[g0].0 as usize;
         let g1 = g0 + inc[g0..].iter().take_while(|x| x.0 as usize == body).count();
-        let (im, ii) = (b.inv_m[body], b.inv_i[body]);
+        let (im, ii) = (b.inv_mass[body].m, b.inv_mass[body].i);
         // M̂⁻¹ h for a row h of Hᵀ
         let minv = |h: &[f64; 6]| -> [f64; 6] {
-            let w = crate::rigid3d::coulomb::mul(&ii, [h[3], h[4], h[5]]);
+            let w = crate::dim::coulomb3::mul(&ii, [h[3], h[4], h[5]]);
             [im[0] * h[0], im[1] * h[1], im[2] * h[2], w[0], w[1], w[2]]
         };
         for x in g0..g1 {

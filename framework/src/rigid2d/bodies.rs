@@ -66,6 +66,17 @@ impl Bodies2 {
         id
     }
 
+    /// ρ² = I/m (0 when undefined): the weight of rotations in the gluing norm
+    /// |V|² = |v|² + ρ² |ω|².
+    pub fn rho2(&self, b: usize) -> f64 {
+        let ms = self.mass[b];
+        if ms[0] > 0.0 && ms[0].is_finite() && ms[2].is_finite() {
+            ms[2] / ms[0]
+        } else {
+            0.0
+        }
+    }
+
     /// Whether contact impulses can move the body at all.
     #[inline]
     pub fn movable(&self, b: usize) -> bool {

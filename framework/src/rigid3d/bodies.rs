@@ -9,11 +9,13 @@
 //! freedom is driven by velocity or fixed) and the symmetric world tensor
 //! `I_w⁻¹` restricted to the free rotational axes ([`Bodies3::refresh_inverse`]).
 
+use crate::dim::coulomb3::Sym3;
+use crate::dim::d3::InvMass3;
+pub use crate::dim::d3::{cross, dot};
 use crate::rigid2d::bodies::ShapeRef;
-use crate::rigid3d::coulomb::Sym3;
 use serde::{Deserialize, Serialize};
 
-/// 3D rigid bodies. `vel`, `inv_m` and `inv_i` are the contact solver's hot fields.
+/// 3D rigid bodies. `vel` and `inv_mass` are the contact solver's hot fields.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct Bodies3 {
     pub pos: Vec<[f64; 3]>,
@@ -24,11 +26,10 @@ pub struct Bodies3 {
     pub mass: Vec<f64>,
     /// Principal moments of inertia (body frame).
     pub inertia: Vec<[f64; 3]>,
-    /// Translational diagonal of M̂⁻¹ (0 on driven or fixed axes).
-    pub inv_m: Vec<[f64; 3]>,
-    /// Rotational block of M̂⁻¹ in the world frame, upper triangle
-    /// [xx, xy, xz, yy, yz, zz], restricted to the free rotational axes.
-    pub inv_i: Vec<Sym3>,
+    /// M̂⁻¹: the translational diagonal (0 on driven or fixed axes) and the
+    /// rotational block in the world frame, upper triangle [xx, xy, xz, yy, yz, zz],
+    /// restricted to the free rotational axes.
+    pub inv_mass: Vec<InvMass3>,
     /// Which of the 6 degrees of freedom are free (bit k: dof k moves under impulses).
     pub free: Vec<u8>,
     pub volume: Vec<f64>,
@@ -65,14 +66,24 @@ impl Bodies3 {
         self.vel.push(vel);
         self.mass.push(mass);
         self.inertia.push(inertia);
-        self.inv_m.push([0.0; 3]);
-        self.inv_i.push([0.0; 6]);
+        self.inv_mass.push(InvMass3::default());
         self.free.push(ALL_FREE);
         self.volume.push(volume);
         self.shape.push(shape);
         self.material.push(material);
         self.refresh_inverse(id as usize);
         id
+    }
+
+    /// ρ² = tr(I)/(3m) (0 when undefined): the weight of rotations in the gluing
+    /// norm |V|² = |v|² + ρ² |ω|².
+    pub fn rho2(&self, b: usize) -> f64 {
+        let (m, i) = (self.mass[b], self.inertia[b]);
+        if m > 0.0 && m.is_finite() && i.iter().all(|x| x.is_finite()) {
+            (i[0] + i[1] + i[2]) / (3.0 * m)
+        } else {
+            0.0
+        }
     }
 
     /// Whether contact impulses can move the body at all.
@@ -96,7 +107,7 @@ impl Bodies3 {
         let f = self.free[b];
         let m = self.mass[b];
         for k in 0..3 {
-            self.inv_m[b][k] = if f & (1 << k) != 0 { 1.0 / m } else { 0.0 };
+            self.inv_mass[b].m[k] = if f & (1 << k) != 0 { 1.0 / m } else { 0.0 };
         }
         // the free rotational axes, without allocating (this runs every step for
         // bodies whose world inertia turns with them)
@@ -128,12 +139,12 @@ impl Bodies3 {
                 out[c][c] = p / det;
             }
             _ => {
-                let inv = crate::rigid3d::coulomb::inverse(&iw).unwrap_or([0.0; 6]);
-                self.inv_i[b] = inv;
+                let inv = crate::dim::coulomb3::inverse(&iw).unwrap_or([0.0; 6]);
+                self.inv_mass[b].i = inv;
                 return;
             }
         }
-        self.inv_i[b] = [out[0][0], out[0][1], out[0][2], out[1][1], out[1][2], out[2][2]];
+        self.inv_mass[b].i = [out[0][0], out[0][1], out[0][2], out[1][1], out[1][2], out[2][2]];
     }
 }
 
@@ -199,16 +210,6 @@ pub fn quat_mul(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
     ]
 }
 
-#[inline(always)]
-pub fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-#[inline(always)]
-pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -240,14 +241,14 @@ mod tests {
             0,
         );
         let iw = b.world_inertia(0);
-        let inv = crate::rigid3d::coulomb::inverse(&iw).unwrap();
+        let inv = crate::dim::coulomb3::inverse(&iw).unwrap();
         for k in 0..6 {
-            assert!((inv[k] - b.inv_i[0][k]).abs() < 1e-14);
+            assert!((inv[k] - b.inv_mass[0].i[k]).abs() < 1e-14);
         }
         // z rotation driven: the xy block inverted alone
         b.free[0] = ALL_FREE & !(1 << 5);
         b.refresh_inverse(0);
-        let ii = b.inv_i[0];
+        let ii = b.inv_mass[0].i;
         assert_eq!((ii[2], ii[4], ii[5]), (0.0, 0.0, 0.0));
         let det = iw[0] * iw[3] - iw[1] * iw[1];
         assert!((ii[0] - iw[3] / det).abs() < 1e-14);

@@ -5,10 +5,10 @@
 //! continued one-domain run is bitwise the uninterrupted one.
 
 use super::restart::StateChecks;
+use crate::dim::joint::Joint;
 use crate::error::InputError;
 use crate::rigid2d::contacts::ContactKey;
 use crate::rigid3d::contacts::Frame3;
-use crate::rigid3d::joint::Joint;
 use crate::rigid3d::Contacts3;
 use crate::world3::World3;
 use serde::Deserialize;

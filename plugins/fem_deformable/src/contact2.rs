@@ -84,7 +84,7 @@ pub fn rigid_delassus(n: [f64; 2], arm: [f64; 2], im: [f64; 3]) -> [f64; 3] {
         arm_i: [0.0; 2],
         arm_j: arm,
     };
-    nscdd::rigid2d::Contacts2::delassus(&f, [0.0; 3], im)
+    nscdd::dim::d2::delassus(&f, [0.0; 3], im)
 }
 
 /// A contact found by detection, before the node sets exist.

@@ -26,10 +26,9 @@
 use crate::body::FeBody;
 pub use crate::nodes::FeKey;
 use crate::nodes::{FeContacts, FeSide, NodeSet};
+use nscdd::dim::coulomb3::{self as coulomb, Sym3};
 use nscdd::rigid3d::bodies::cross;
 use nscdd::rigid3d::contacts::{point_velocity, Block3, Frame3};
-use nscdd::rigid3d::coulomb::{self, Sym3};
-use nscdd::rigid3d::Contacts3;
 use nscdd::world3::World3;
 
 pub type FeSide3 = FeSide<3>;
@@ -101,7 +100,7 @@ pub fn rigid_delassus(b: &Basis, d: [f64; 3], inv_m: [f64; 3], inv_i: &Sym3) -> 
         d_i: [0.0; 3],
         d_j: d,
     };
-    Contacts3::delassus(&f, [0.0; 3], &[0.0; 6], inv_m, inv_i)
+    nscdd::dim::d3::delassus(&f, [0.0; 3], &[0.0; 6], inv_m, inv_i)
 }
 
 /// A contact found by detection, before the node sets exist.

@@ -23,10 +23,11 @@
 
 use crate::contact2::*;
 use crate::stage2::{self, Deformables2};
+use nscdd::dim::coulomb2 as coulomb;
 use nscdd::engine::ContactStage;
 use nscdd::norms::{Norms, Sums};
 use nscdd::rigid2d::contacts::Block2;
-use nscdd::rigid2d::{coulomb, Contacts2};
+use nscdd::rigid2d::Contacts2;
 use nscdd::solver::SolveReport;
 use nscdd::world::World2;
 
@@ -92,7 +93,7 @@ impl ContactStage<World2> for Coupled<'_> {
             for sd in subs.iter_mut() {
                 let mut part = Sums::default();
                 let mut sm = check.then_some(&mut part);
-                nscdd::rigid2d::nlgs::sweep(&mut sd.contacts, &mut sd.vel, &sd.inv, &[], s.relaxation, sm.as_deref_mut());
+                nscdd::solver::nlgs::sweep(&mut sd.contacts, &mut sd.vel, &sd.inv, &[], s.relaxation, sm.as_deref_mut());
                 stage2::sweep(&mut sd.fec, &mut sd.sets, &mut sd.vel, &sd.inv, s.relaxation, sm);
                 sums.merge(&part);
             }
@@ -260,7 +261,7 @@ impl Coupled<'_> {
             let cc = &w.contacts;
             for a in 0..cc.len() {
                 if cc.r[a] != [0.0, 0.0] {
-                    cc.apply(a, [-cc.r[a][0], -cc.r[a][1]], &mut vfree, &w.bodies.inv_mass);
+                    cc.apply(a, &[-cc.r[a][0], -cc.r[a][1]], &mut vfree, &w.bodies.inv_mass);
                 }
             }
             for a in 0..c.len() {
@@ -293,7 +294,7 @@ impl Coupled<'_> {
             for a in 0..sd.contacts.len() {
                 let r = sd.contacts.r[a];
                 if r != [0.0, 0.0] {
-                    sd.contacts.apply(a, r, &mut sd.vel, &sd.inv);
+                    sd.contacts.apply(a, &r, &mut sd.vel, &sd.inv);
                 }
             }
             for a in 0..sd.fec.len() {

@@ -12,11 +12,12 @@
 use crate::body::FeBody;
 use crate::contact2::*;
 pub use crate::nodes::fill_set;
+use nscdd::dim::coulomb2 as coulomb;
 use nscdd::engine::{ContactStage, Diverged};
 use nscdd::law::target_velocity;
 use nscdd::norms::{natural_map_sq, Sums};
 use nscdd::rigid2d::contacts::{Block2, Target};
-use nscdd::rigid2d::{coulomb, nlgs};
+use nscdd::solver::nlgs;
 use nscdd::solver::SolveReport;
 use nscdd::world::World2;
 use std::time::Instant;

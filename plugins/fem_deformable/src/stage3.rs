@@ -5,18 +5,18 @@
 //! contacts (the framework's, unchanged) then over the deformable ones, sums
 //! merged; V⁺ by one solve per body touched; u⁺ by [`crate::stage2::update_bodies`]).
 //! The local problem of a contact is the framework's 3D Coulomb solver
-//! ([`nscdd::rigid3d::coulomb`]).
+//! ([`nscdd::dim::coulomb3`]).
 
 use crate::body::FeBody;
 use crate::contact3::*;
 use crate::nodes::fill_set;
 use crate::stage2::{free_velocities, node_target, update_bodies, FeTimes};
+use nscdd::dim::coulomb3 as coulomb;
 use nscdd::engine::{ContactStage, Diverged};
 use nscdd::norms::{natural_map_sq, Sums};
 use nscdd::rigid2d::contacts::Target;
 use nscdd::rigid3d::contacts::{tangents, Block3};
-use nscdd::rigid3d::coulomb::{self, Sym3};
-use nscdd::rigid3d::nlgs;
+use nscdd::solver::nlgs;
 use nscdd::solver::SolveReport;
 use nscdd::world3::World3;
 use std::time::Instant;
@@ -36,11 +36,7 @@ pub struct Deformables3 {
 }
 
 /// The rigid bodies' M̂⁻¹ as the sweep reads them.
-#[derive(Clone, Copy)]
-pub struct RigidInv<'a> {
-    pub m: &'a [[f64; 3]],
-    pub i: &'a [Sym3],
-}
+pub type RigidInv<'a> = &'a [nscdd::dim::d3::InvMass3];
 
 impl Deformables3 {
     pub fn new(bodies: Vec<FeBody>, alert: f64) -> Self {
@@ -124,7 +120,7 @@ impl Deformables3 {
                     let ju = j as usize;
                     let x = w.bodies.pos[ju];
                     let d = [rc.point[0] - x[0], rc.point[1] - x[1], rc.point[2] - x[2]];
-                    let wr = rigid_delassus(&basis, d, w.bodies.inv_m[ju], &w.bodies.inv_i[ju]);
+                    let wr = rigid_delassus(&basis, d, w.bodies.inv_mass[ju].m, &w.bodies.inv_mass[ju].i);
                     for q in 0..6 {
                         wb[q] += wr[q];
                     }
@@ -196,10 +192,7 @@ impl Deformables3 {
             c.point.push(rc.point);
             c.key.push(key);
         }
-        let inv = RigidInv {
-            m: &w.bodies.inv_m,
-            i: &w.bodies.inv_i,
-        };
+        let inv: RigidInv<'_> = &w.bodies.inv_mass;
         for a in 0..c.len() {
             let r = c.r[a];
             if r != [0.0; 3] {
@@ -277,7 +270,7 @@ pub fn apply(sets: &mut [NodeSet3], vel: &mut [[f64; 6]], inv: RigidInv<'_>, can
     match anta {
         Anta3::Rigid { body, d } => {
             let j = body as usize;
-            rigid_apply(b, d, dr, &mut vel[j], inv.m[j], &inv.i[j])
+            rigid_apply(b, d, dr, &mut vel[j], inv[j].m, &inv[j].i)
         }
         Anta3::Fe(s) => sets[s.body as usize].apply_side(&s, p.map(|x| -x)),
     }
@@ -334,16 +327,8 @@ impl ContactStage<World3> for Deformables3 {
         } else {
             s.run_sweeps(|mut sm| {
                 let b = &mut w.bodies;
-                nlgs::sweep(
-                    &mut w.contacts,
-                    &mut b.vel,
-                    &b.inv_m,
-                    &b.inv_i,
-                    &order,
-                    s.relaxation,
-                    sm.as_deref_mut(),
-                );
-                let inv = RigidInv { m: &b.inv_m, i: &b.inv_i };
+                nlgs::sweep(&mut w.contacts, &mut b.vel, &b.inv_mass, &order, s.relaxation, sm.as_deref_mut());
+                let inv: RigidInv<'_> = &b.inv_mass;
                 sweep(&mut self.contacts, &mut self.sets, &mut b.vel, inv, s.relaxation, sm);
             })
         };

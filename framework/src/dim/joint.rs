@@ -10,7 +10,7 @@
 //!   K_c = { r :  r_n ≥ −T,  |r_t| ≤ C + μ r_n },
 //! ```
 //!
-//! and its law is the Signorini–Coulomb law of [`super::coulomb`] on that set: the
+//! and its law is the Signorini–Coulomb law of [`super::coulomb3`] on that set: the
 //! joint stays closed (u_n = ū) while r_n > −T and may open (u_n ≥ ū) only at
 //! r_n = −T; it sticks (u_t = 0) inside the cone and slides with r_t opposite to u_t
 //! on its mantle. With the apex shift `s = C/μ` and `r̂ = r + s e_n`, the cone part
@@ -34,8 +34,7 @@
 //! same place, or the nearest point of the same pair within the alert distance
 //! when a polygon's corners are renumbered: `engine3::build_contacts`).
 
-use super::coulomb::{self, disk_min, Pre3, Sym3};
-use crate::law::ContactLaw;
+use super::coulomb3::{self as coulomb, disk_min, Pre3, Sym3};
 use crate::norms::project_cone;
 use serde::{Deserialize, Serialize};
 
@@ -58,13 +57,15 @@ impl Joint {
         tension: 0.0,
     };
 
-    /// The strengths of a bonded contact of tributary area `area` over a step h.
-    pub fn of(law: &ContactLaw, area: f64, h: f64) -> Joint {
-        let shift = law.cohesion * area * h / law.mu;
+    /// The strengths of a bonded contact of tributary area `area` over a step h,
+    /// from the law's cohesion c, tensile strength σ_t and friction μ:
+    /// `s = c A h / μ`, `T = min(σ_t A h, s)`.
+    pub fn of(cohesion: f64, tensile: f64, mu: f64, area: f64, h: f64) -> Joint {
+        let shift = cohesion * area * h / mu;
         Joint {
             shift,
             // T ≤ s also after round-off (the default σ_t is c/μ)
-            tension: (law.tensile * area * h).min(shift),
+            tension: (tensile * area * h).min(shift),
         }
     }
 
@@ -158,7 +159,7 @@ pub fn natural_map_sq(r: [f64; 3], u: [f64; 3], mu: f64, j: &Joint) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rigid3d::coulomb::precompute;
+    use crate::dim::coulomb3::precompute;
 
     fn check(w: &Sym3, u0: [f64; 3], mu: f64, j: &Joint) -> [f64; 3] {
         let r = solve(w, &precompute(w), u0, 0.0, mu, j, [0.0; 3]);

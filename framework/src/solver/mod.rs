@@ -1,4 +1,7 @@
-//! Contact solver settings and the per-step report, shared by every dimension.
+//! The contact solver: settings, the per-step report, the one convergence-check loop
+//! ([`SolverSettings::run_sweeps`]) and NLGS ([`nlgs`]), for every dimension.
+
+pub mod nlgs;
 
 use crate::norms::{Criterion, Norms, Sums};
 use serde::{Deserialize, Serialize};

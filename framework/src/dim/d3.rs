@@ -1,0 +1,278 @@
+//! 3D rigid bodies: six degrees of freedom, orientations as unit quaternions.
+//!
+//! A body's twist is `V = (v, ω)` with ω in the world frame; `M̂ = diag(m I₃, I_w)`
+//! with the world inertia `I_w = R diag(I₁, I₂, I₃) Rᵀ`, seen by the solver as
+//! [`InvMass3`] (per-axis translational entries, 0 on driven axes, and `I_w⁻¹`
+//! restricted to the free rotational axes). A contact has the orthonormal frame
+//! `B = [n t1 t2]` (n from j towards i) and the lever arms `d_b = p − x_b`:
+//!
+//! ```text
+//! u_α = Bᵀ ((v_i + ω_i × d_i) − (v_j + ω_j × d_j)),
+//! ```
+//!
+//! an impulse r acts as `P = B r` at p: `Δv_i = m_i⁻¹ P`, `Δω_i = I_i⁻¹ (d_i × P)`
+//! and the opposite on j, and `W_αα = Bᵀ (K_i + K_j) B` with
+//! `K_b = diag(m_b⁻¹) + [d_b]×ᵀ I_b⁻¹ [d_b]×`.
+
+use super::coulomb3::{self as coulomb, Pre3, Sym3};
+use super::joint::{self, Joint};
+use super::Dim;
+use serde::{Deserialize, Serialize};
+
+/// Space.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct D3;
+
+/// The frame of a contact: basis rows n, t1, t2 and the lever arms of both bodies.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[repr(C)]
+pub struct Frame3 {
+    pub basis: [[f64; 3]; 3],
+    pub d_i: [f64; 3],
+    pub d_j: [f64; 3],
+}
+
+/// W_αα and its precomputed data.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[repr(C)]
+pub struct Block3 {
+    pub w: Sym3,
+    pub pre: Pre3,
+}
+
+/// M̂⁻¹ of one 3D rigid body: translational diagonal and rotational block.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct InvMass3 {
+    pub m: [f64; 3],
+    pub i: Sym3,
+}
+
+#[inline(always)]
+pub fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[inline(always)]
+pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+/// The tangent vectors (t1, t2) completing a unit normal n, chosen continuously in n
+/// away from the switch of the helper axis.
+pub fn tangents(n: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    let helper = if n[0].abs() < 0.6 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+    let t = cross(n, helper);
+    let l = dot(t, t).sqrt();
+    let t1 = [t[0] / l, t[1] / l, t[2] / l];
+    (t1, cross(n, t1))
+}
+
+/// Velocity of the point at lever arm d of a body with V = (v, ω).
+#[inline(always)]
+pub fn point_velocity(v: &[f64; 6], d: [f64; 3]) -> [f64; 3] {
+    let w = [v[3], v[4], v[5]];
+    let c = cross(w, d);
+    [v[0] + c[0], v[1] + c[1], v[2] + c[2]]
+}
+
+/// u = Bᵀ (v_p,i − v_p,j).
+#[inline(always)]
+pub fn local_velocity(f: &Frame3, vi: &[f64; 6], vj: &[f64; 6]) -> [f64; 3] {
+    let (a, b) = (point_velocity(vi, f.d_i), point_velocity(vj, f.d_j));
+    let dv = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    [dot(f.basis[0], dv), dot(f.basis[1], dv), dot(f.basis[2], dv)]
+}
+
+/// The world vector B r of a local one.
+#[inline(always)]
+pub fn to_world(b: &[[f64; 3]; 3], r: [f64; 3]) -> [f64; 3] {
+    [
+        b[0][0] * r[0] + b[1][0] * r[1] + b[2][0] * r[2],
+        b[0][1] * r[0] + b[1][1] * r[1] + b[2][1] * r[2],
+        b[0][2] * r[0] + b[1][2] * r[1] + b[2][2] * r[2],
+    ]
+}
+
+/// Adds the velocity change of an impulse `dr` (local) to both bodies.
+#[inline(always)]
+pub fn apply(f: &Frame3, dr: [f64; 3], bi: usize, bj: usize, vel: &mut [[f64; 6]], inv: &[InvMass3]) {
+    let p = to_world(&f.basis, dr);
+    let (ii, ij) = (&inv[bi], &inv[bj]);
+    let (mi, mj) = (ii.m, ij.m);
+    let wi = coulomb::mul(&ii.i, cross(f.d_i, p));
+    let wj = coulomb::mul(&ij.i, cross(f.d_j, p));
+    let vi = &mut vel[bi];
+    for k in 0..3 {
+        vi[k] += mi[k] * p[k];
+        vi[3 + k] += wi[k];
+    }
+    let vj = &mut vel[bj];
+    for k in 0..3 {
+        vj[k] -= mj[k] * p[k];
+        vj[3 + k] -= wj[k];
+    }
+}
+
+/// K_b = diag(m⁻¹) + [d]×ᵀ I⁻¹ [d]× (symmetric, full).
+fn k_matrix(inv_m: [f64; 3], inv_i: &Sym3, d: [f64; 3]) -> [[f64; 3]; 3] {
+    let mut k = [[0.0; 3]; 3];
+    // column c: [d]×ᵀ I⁻¹ (d × e_c) = −d × (I⁻¹ (d × e_c))
+    for c in 0..3 {
+        let mut e = [0.0; 3];
+        e[c] = 1.0;
+        let w = coulomb::mul(inv_i, cross(d, e));
+        let col = cross(w, d);
+        for r in 0..3 {
+            k[r][c] = col[r];
+        }
+        k[c][c] += inv_m[c];
+    }
+    k
+}
+
+/// The Delassus block W_αα = Bᵀ (K_i + K_j) B.
+pub fn delassus(f: &Frame3, mi: [f64; 3], ii: &Sym3, mj: [f64; 3], ij: &Sym3) -> Sym3 {
+    let (ki, kj) = (k_matrix(mi, ii, f.d_i), k_matrix(mj, ij, f.d_j));
+    let b = &f.basis;
+    let e = |a: usize, c: usize| {
+        let mut s = 0.0;
+        for r in 0..3 {
+            for q in 0..3 {
+                s += b[a][r] * (ki[r][q] + kj[r][q]) * b[c][q];
+            }
+        }
+        s
+    };
+    let mut w = [e(0, 0), e(0, 1), e(0, 2), e(1, 1), e(1, 2), e(2, 2)];
+    // round-off below the block's scale: keep the exact sphere structure
+    let scale = w[0].abs().max(w[3].abs()).max(w[5].abs());
+    for x in [1usize, 2, 4] {
+        if w[x].abs() <= 1e-15 * scale {
+            w[x] = 0.0;
+        }
+    }
+    if (w[3] - w[5]).abs() <= 1e-15 * scale {
+        w[5] = w[3];
+    }
+    w
+}
+
+impl Dim for D3 {
+    const N: usize = 3;
+    const DOF: usize = 6;
+    const NAME: &'static str = "3D";
+    type Point = [f64; 3];
+    type Rot = [f64; 4];
+    type Twist = [f64; 6];
+    type Local = [f64; 3];
+    type Frame = Frame3;
+    type W = Sym3;
+    type Block = Block3;
+    type InvMass = InvMass3;
+
+    #[inline]
+    fn frame(p: &[f64; 3], n: &[f64; 3], x_i: &[f64; 3], x_j: &[f64; 3]) -> Frame3 {
+        let (t1, t2) = tangents(*n);
+        let arm = |x: &[f64; 3]| [p[0] - x[0], p[1] - x[1], p[2] - x[2]];
+        Frame3 {
+            basis: [*n, t1, t2],
+            d_i: arm(x_i),
+            d_j: arm(x_j),
+        }
+    }
+    #[inline(always)]
+    fn local_velocity(f: &Frame3, vi: &[f64; 6], vj: &[f64; 6]) -> [f64; 3] {
+        local_velocity(f, vi, vj)
+    }
+    #[inline(always)]
+    fn apply(f: &Frame3, dr: &[f64; 3], i: usize, j: usize, vel: &mut [[f64; 6]], inv: &[InvMass3]) {
+        apply(f, *dr, i, j, vel, inv)
+    }
+    #[inline]
+    fn delassus(f: &Frame3, inv_i: &InvMass3, inv_j: &InvMass3) -> Sym3 {
+        delassus(f, inv_i.m, &inv_i.i, inv_j.m, &inv_j.i)
+    }
+    #[inline(always)]
+    fn w_nn(w: &Sym3) -> f64 {
+        w[0]
+    }
+    #[inline]
+    fn block(w: Sym3, _mu: f64) -> Block3 {
+        Block3 {
+            w,
+            pre: coulomb::precompute(&w),
+        }
+    }
+    #[inline(always)]
+    fn w_mul(b: &Block3, r: &[f64; 3]) -> [f64; 3] {
+        coulomb::mul(&b.w, *r)
+    }
+    #[inline(always)]
+    fn solve(b: &Block3, u0: &[f64; 3], u_target: f64, mu: f64, prev: &[f64; 3]) -> [f64; 3] {
+        coulomb::solve_pre_warm(&b.w, &b.pre, *u0, u_target, mu, *prev)
+    }
+    fn solve_joint(b: &Block3, u0: &[f64; 3], u_target: f64, mu: f64, j: &Joint, prev: &[f64; 3]) -> [f64; 3] {
+        joint::solve(&b.w, &b.pre, *u0, u_target, mu, j, *prev)
+    }
+    fn joint_holds(b: &Block3, r: &[f64; 3], u0: &[f64; 3], u_target: f64, mu: f64, j: &Joint, tol: f64) -> bool {
+        joint::holds(&b.w, &b.pre, *r, *u0, u_target, mu, j, tol)
+    }
+    fn joint_natural_map_sq(r: &[f64; 3], u: &[f64; 3], mu: f64, j: &Joint) -> f64 {
+        joint::natural_map_sq(*r, *u, mu, j)
+    }
+    #[inline]
+    fn reaction_i(f: &Frame3, r: &[f64; 3]) -> [f64; 6] {
+        let p = to_world(&f.basis, *r);
+        let m = cross(f.d_i, p);
+        [p[0], p[1], p[2], m[0], m[1], m[2]]
+    }
+    #[inline]
+    fn reaction_j(f: &Frame3, r: &[f64; 3]) -> [f64; 6] {
+        let p = to_world(&f.basis, *r);
+        let m = cross(f.d_j, p);
+        [p[0], p[1], p[2], m[0], m[1], m[2]]
+    }
+    fn scale_inv(im: &InvMass3, m: f64) -> InvMass3 {
+        InvMass3 {
+            m: im.m.map(|x| x * m),
+            i: im.i.map(|x| x * m),
+        }
+    }
+    fn apply_inv(v: &mut [f64; 6], im: &InvMass3, f: &[f64; 6]) {
+        for d in 0..3 {
+            v[d] += im.m[d] * f[d];
+        }
+        let w = coulomb::mul(&im.i, [f[3], f[4], f[5]]);
+        for d in 0..3 {
+            v[3 + d] += w[d];
+        }
+    }
+    fn glue(v: &mut [f64; 6], f: &mut [f64; 6], im: &InvMass3, dv: &[f64; 6]) {
+        for d in 0..3 {
+            if im.m[d] != 0.0 {
+                v[d] += dv[d];
+                f[d] += dv[d] / im.m[d];
+            }
+        }
+        // rotations: M̂_E = (I_E⁻¹)⁻¹ on the free axes
+        match coulomb::inverse(&im.i) {
+            Some(ie) => {
+                let df = coulomb::mul(&ie, [dv[3], dv[4], dv[5]]);
+                for d in 0..3 {
+                    v[3 + d] += dv[3 + d];
+                    f[3 + d] += df[d];
+                }
+            }
+            None => {
+                // some rotations driven: the free axes (diagonal of I⁻¹ restricted)
+                let diag = [im.i[0], im.i[3], im.i[5]];
+                for d in 0..3 {
+                    if diag[d] != 0.0 {
+                        v[3 + d] += dv[3 + d];
+                        f[3 + d] += dv[3 + d] / diag[d];
+                    }
+                }
+            }
+        }
+    }
+}
