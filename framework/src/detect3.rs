@@ -84,7 +84,7 @@ impl Detector3 {
         self.pairs.clear();
         for b in 0..n {
             let s = bodies.shape[b];
-            self.aabb.push(shapes[s.kind as usize].aabb(s.index, bodies.pos[b], bodies.quat[b]));
+            self.aabb.push(shapes[s.kind as usize].aabb(s.index, bodies.pos[b], bodies.rot[b]));
         }
         let mut ext: Vec<f64> = self.aabb.iter().filter(|a| a.is_bounded()).map(|a| a.extent()).collect();
         let mut cell = 1.0;

@@ -122,18 +122,23 @@ pub fn free_velocity(w: &mut World2) {
     w.scratch.v_begin.extend_from_slice(&b.vel);
     for d in &w.drives {
         let k = d.body as usize;
-        for dof in 0..3 {
-            if let Some(drv) = &d.dof[dof] {
-                b.inv_mass[k][dof] = if drv.is_velocity_at(t_end) { 0.0 } else { 1.0 / b.mass[k][dof] };
+        let mut free = crate::model::all_free::<D2>();
+        for (dof, drv) in d.dof.iter().enumerate() {
+            if drv.as_ref().is_some_and(|x| x.is_velocity_at(t_end)) {
+                free &= !(1 << dof);
             }
+        }
+        if b.free[k] != free {
+            b.free[k] = free;
+            b.refresh_inverse(k);
         }
     }
     let g = w.gravity;
     for k in 0..b.len() {
         let im = b.inv_mass[k];
         let v = &mut b.vel[k];
-        v[0] += h * im[0] * b.mass[k][0] * g[0];
-        v[1] += h * im[1] * b.mass[k][1] * g[1];
+        v[0] += h * im[0] * b.mass[k] * g[0];
+        v[1] += h * im[1] * b.mass[k] * g[1];
     }
     for d in &w.drives {
         let k = d.body as usize;
@@ -143,7 +148,8 @@ pub fn free_velocity(w: &mut World2) {
                 Imposed::Velocity(v) => b.vel[k][dof] = v,
                 _ => {
                     if let Imposed::Force(f) = drv.at(t_theta) {
-                        b.vel[k][dof] += h * f / b.mass[k][dof];
+                        let m = if dof < 2 { b.mass[k] } else { b.inertia[k] };
+                        b.vel[k][dof] += h * f / m;
                     }
                 }
             }
@@ -206,40 +212,18 @@ pub fn build_contacts(w: &mut World2) {
 pub fn update_positions(w: &mut World2) -> Result<(), Diverged> {
     let (h, theta) = (w.time.h, w.time.theta);
     let b = &mut w.bodies;
-    for k in 0..b.len() {
-        let (v0, v1) = (w.scratch.v_begin[k], b.vel[k]);
-        let dq = [
-            h * ((1.0 - theta) * v0[0] + theta * v1[0]),
-            h * ((1.0 - theta) * v0[1] + theta * v1[1]),
-            h * ((1.0 - theta) * v0[2] + theta * v1[2]),
-        ];
-        b.pos[k][0] += dq[0];
-        b.pos[k][1] += dq[1];
-        b.rot[k] += dq[2];
-        if !(b.pos[k].iter().chain(&b.vel[k]).all(|x| x.is_finite()) && b.rot[k].is_finite()) {
-            let label = w.body_label(k);
-            return Err(Diverged {
-                step: w.step + 1,
-                body: k as u32,
-                message: format!(
-                    "{label} has a non-finite state (position {:?}, velocity {:?})",
-                    w.bodies.pos[k], w.bodies.vel[k]
-                ),
-            });
-        }
+    if let Err(k) = crate::step::integrate(b, &w.scratch.v_begin, h, theta) {
+        let label = w.body_label(k);
+        return Err(Diverged {
+            step: w.step + 1,
+            body: k as u32,
+            message: format!(
+                "{label} has a non-finite state (position {:?}, velocity {:?})",
+                w.bodies.pos[k], w.bodies.vel[k]
+            ),
+        });
     }
-    let c = &w.contacts;
-    w.reaction.clear();
-    w.reaction.resize(w.bodies.len(), [0.0; 3]);
-    for a in 0..c.len() {
-        let [i, j] = c.bodies[a];
-        let (f, r) = (&c.frame[a], &c.r[a]);
-        let (pi, pj) = (D2::reaction_i(f, r), D2::reaction_j(f, r));
-        for k in 0..3 {
-            w.reaction[i as usize][k] += pi[k];
-            w.reaction[j as usize][k] -= pj[k];
-        }
-    }
+    crate::step::reactions(&w.contacts, w.bodies.len(), &mut w.reaction);
     w.step += 1;
     w.t = w.step as f64 * h;
     if let (Some(bw), None) = (&w.box_walls, w.box_h0) {

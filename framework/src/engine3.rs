@@ -21,7 +21,7 @@ use crate::drive::Imposed;
 use crate::engine::{ContactStage, Diverged, Nlgs, StageTimes, StepReport};
 use crate::law::target_velocity;
 use crate::model::{ContactKey, Target};
-use crate::rigid3d::bodies::{cross, from_rotation_vector, normalize, quat_mul, ALL_FREE};
+use crate::rigid3d::bodies::{cross, ALL_FREE};
 use crate::solver::nlgs::{self, make_order};
 
 use crate::solver::SolveReport;
@@ -318,41 +318,18 @@ pub fn update_joints(w: &mut World3) {
 pub fn update_positions(w: &mut World3) -> Result<(), Diverged> {
     let (h, theta) = (w.time.h, w.time.theta);
     let b = &mut w.bodies;
-    for k in 0..b.len() {
-        let (v0, v1) = (w.scratch.v_begin[k], b.vel[k]);
-        let vm: [f64; 6] = std::array::from_fn(|a| (1.0 - theta) * v0[a] + theta * v1[a]);
-        for a in 0..3 {
-            b.pos[k][a] += h * vm[a];
-        }
-        let rot = [h * vm[3], h * vm[4], h * vm[5]];
-        if rot != [0.0; 3] {
-            b.quat[k] = normalize(quat_mul(from_rotation_vector(rot), b.quat[k]));
-        }
-        let finite = b.pos[k].iter().chain(&b.vel[k]).chain(&b.quat[k]).all(|x| x.is_finite());
-        if !finite {
-            let label = w.body_label(k);
-            return Err(Diverged {
-                step: w.step + 1,
-                body: k as u32,
-                message: format!(
-                    "{label} has a non-finite state (position {:?}, velocity {:?})",
-                    w.bodies.pos[k], w.bodies.vel[k]
-                ),
-            });
-        }
+    if let Err(k) = crate::step::integrate(b, &w.scratch.v_begin, h, theta) {
+        let label = w.body_label(k);
+        return Err(Diverged {
+            step: w.step + 1,
+            body: k as u32,
+            message: format!(
+                "{label} has a non-finite state (position {:?}, velocity {:?})",
+                w.bodies.pos[k], w.bodies.vel[k]
+            ),
+        });
     }
-    let c = &w.contacts;
-    w.reaction.clear();
-    w.reaction.resize(w.bodies.len(), [0.0; 6]);
-    for a in 0..c.len() {
-        let [i, j] = c.bodies[a];
-        let (f, r) = (&c.frame[a], &c.r[a]);
-        let (pi, pj) = (D3::reaction_i(f, r), D3::reaction_j(f, r));
-        for k in 0..6 {
-            w.reaction[i as usize][k] += pi[k];
-            w.reaction[j as usize][k] -= pj[k];
-        }
-    }
+    crate::step::reactions(&w.contacts, w.bodies.len(), &mut w.reaction);
     w.step += 1;
     w.t = w.step as f64 * h;
     if let (Some(bw), None) = (&w.box_walls, w.box_h0) {

@@ -42,5 +42,6 @@ pub mod run;
 pub mod run3;
 pub mod scene;
 pub mod solver;
+pub mod step;
 pub mod world;
 pub mod world3;

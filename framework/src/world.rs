@@ -121,7 +121,7 @@ impl World2 {
         for b in 0..self.bodies.len() {
             let s = self.bodies.shape[b];
             if self.shapes[s.kind as usize].is_grain() && self.bodies.movable(b) {
-                a += self.bodies.area[b];
+                a += self.bodies.volume[b];
             }
         }
         Some(a / ((x1 - x0) * (y1 - y0)))
@@ -134,9 +134,9 @@ impl World2 {
             if !b.movable(k) {
                 continue;
             }
-            let (v, m, x) = (b.vel[k], b.mass[k], b.pos[k]);
-            ek += 0.5 * (m[0] * v[0] * v[0] + m[1] * v[1] * v[1] + m[2] * v[2] * v[2]);
-            ep -= m[0] * (self.gravity[0] * x[0] + self.gravity[1] * x[1]);
+            let (v, m, i, x) = (b.vel[k], b.mass[k], b.inertia[k], b.pos[k]);
+            ek += 0.5 * (m * v[0] * v[0] + m * v[1] * v[1] + i * v[2] * v[2]);
+            ep -= m * (self.gravity[0] * x[0] + self.gravity[1] * x[1]);
         }
         (ek, ep)
     }

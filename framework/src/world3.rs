@@ -104,7 +104,7 @@ impl World3 {
         let bw = self.box_walls.as_ref()?;
         let bb = |b: u32| {
             let s = self.bodies.shape[b as usize];
-            self.shapes[s.kind as usize].aabb(s.index, self.bodies.pos[b as usize], self.bodies.quat[b as usize])
+            self.shapes[s.kind as usize].aabb(s.index, self.bodies.pos[b as usize], self.bodies.rot[b as usize])
         };
         let w = bw.walls;
         Some([

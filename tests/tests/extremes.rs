@@ -234,10 +234,10 @@ fn heavy(case: &str, ratio: f64, steps: u64, tol: f64, max_sweeps: u32) -> (Figu
     let (s, f) = simulate(case, &text, |_, _| {});
     let w = &s.world;
     let k = index_of(w, "heavy");
-    let m_light = w.bodies.mass[index_of(w, "a")][0];
-    assert!((w.bodies.mass[k][0] / m_light / ratio - 1.0).abs() < 1e-9);
+    let m_light = w.bodies.mass[index_of(w, "a")];
+    assert!((w.bodies.mass[k] / m_light / ratio - 1.0).abs() < 1e-9);
     let sink = 0.01 + 3f64.sqrt() * 0.01 - w.bodies.pos[k][1];
-    let weight = (w.bodies.mass[k][0] + 2.0 * m_light) * G;
+    let weight = (w.bodies.mass[k] + 2.0 * m_light) * G;
     // floor and walls (friction) together carry the weight
     let support: f64 = ["floor", "left", "right"].iter().map(|b| -w.reaction[index_of(w, b)][1]).sum();
     (f, sink, support / w.time.h / weight - 1.0)
@@ -543,7 +543,7 @@ fn column_scene(n: usize, steps: u64, tol: f64, max_sweeps: u32) -> String {
 
 /// Bottom contact force / (n m g) after the last step.
 fn bottom_ratio(w: &World2, n: usize) -> f64 {
-    let m = w.bodies.mass[1][0];
+    let m = w.bodies.mass[1];
     -w.reaction[0][1] / w.time.h / (n as f64 * m * G)
 }
 

@@ -38,7 +38,7 @@ fn run(case: &str, text: &str) -> (Scene3, Figures) {
         assert!(rep.solve.residual.is_finite(), "{case}: non-finite residual at step {}", w.step);
         assert!(w.contacts.r.iter().flatten().all(|x| x.is_finite()), "{case}: non-finite impulse");
         assert!(
-            w.bodies.quat.iter().flatten().all(|x| x.is_finite()),
+            w.bodies.rot.iter().flatten().all(|x| x.is_finite()),
             "{case}: non-finite orientation"
         );
         f.max_residual = f.max_residual.max(rep.solve.residual);

@@ -303,7 +303,7 @@ fn stack_split_1x4_approaches_the_unique_impulses() {
         let mut n = Nscdd::new(dd(1, 4));
         let rb = dd_step(&mut n, &mut b);
         assert!(ra.solve.converged);
-        let m = b.world.bodies.mass[3][0];
+        let m = b.world.bodies.mass[3];
         let c = &b.world.contacts;
         assert_eq!(c.len(), 30);
         // the contact below disk k joins disk k (body k + 3) and the body under it

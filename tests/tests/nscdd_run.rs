@@ -352,7 +352,7 @@ fn momentum(s: &Scene) -> ([f64; 2], f64) {
     let b = &s.world.bodies;
     let (mut p, mut scale) = ([0.0; 2], 0.0);
     for k in 0..b.len() {
-        let m = b.mass[k][0];
+        let m = b.mass[k];
         p[0] += m * b.vel[k][0];
         p[1] += m * b.vel[k][1];
         scale += m * (b.vel[k][0].abs() + b.vel[k][1].abs());

@@ -306,7 +306,7 @@ fn generated(label: &str, toml: &str, steps: usize, at_rest: bool) -> (usize, u3
     // A sample at rest: the floor carries the weight, Σ of the vertical impulses on
     // it ≈ −m g h.
     let b = &w.bodies;
-    let weight_h: f64 = (0..b.len()).filter(|&k| b.movable(k)).map(|k| b.mass[k][0] * 9.81 * w.time.h).sum();
+    let weight_h: f64 = (0..b.len()).filter(|&k| b.movable(k)).map(|k| b.mass[k] * 9.81 * w.time.h).sum();
     let floor = w.names.iter().position(|n| n.as_deref() == Some("floor")).unwrap() as u32;
     let mut on_floor = 0.0;
     for a in 0..nc {

@@ -91,6 +91,35 @@ impl Dim for D2 {
     type W = [f64; 3];
     type Block = Block2;
     type InvMass = [f64; 3];
+    type Inertia = f64;
+
+    fn normalize_rot(r: f64) -> f64 {
+        r
+    }
+    fn inv_mass(mass: f64, inertia: &f64, _rot: &f64, free: u8) -> [f64; 3] {
+        let inv = |k: u8, x: f64| if free & (1 << k) != 0 { 1.0 / x } else { 0.0 };
+        [inv(0, mass), inv(1, mass), inv(2, *inertia)]
+    }
+    fn isotropic(_inertia: &f64) -> bool {
+        true
+    }
+    fn rho2(mass: f64, inertia: &f64) -> f64 {
+        if mass > 0.0 && mass.is_finite() && inertia.is_finite() {
+            inertia / mass
+        } else {
+            0.0
+        }
+    }
+    #[inline]
+    fn integrate(pos: &mut [f64; 2], rot: &mut f64, v0: &[f64; 3], v1: &[f64; 3], h: f64, theta: f64) {
+        let dq: [f64; 3] = std::array::from_fn(|a| h * ((1.0 - theta) * v0[a] + theta * v1[a]));
+        pos[0] += dq[0];
+        pos[1] += dq[1];
+        *rot += dq[2];
+    }
+    fn rot_finite(r: &f64) -> bool {
+        r.is_finite()
+    }
 
     #[inline]
     fn frame(p: &[f64; 2], n: &[f64; 2], x_i: &[f64; 2], x_j: &[f64; 2]) -> Frame2 {

@@ -16,6 +16,7 @@
 
 use super::coulomb3::{self as coulomb, Pre3, Sym3};
 use super::joint::{self, Joint};
+use super::rotation::{self, rotation_matrix};
 use super::Dim;
 use serde::{Deserialize, Serialize};
 
@@ -157,6 +158,59 @@ pub fn delassus(f: &Frame3, mi: [f64; 3], ii: &Sym3, mj: [f64; 3], ij: &Sym3) ->
     w
 }
 
+/// World inertia tensor I_w = R diag(I) Rᵀ (upper triangle) of principal moments
+/// `i` at orientation q.
+pub fn world_inertia(q: &[f64; 4], i: &[f64; 3]) -> Sym3 {
+    let r = rotation_matrix(*q);
+    let e = |a: usize, c: usize| (0..3).map(|k| r[a][k] * i[k] * r[c][k]).sum::<f64>();
+    [e(0, 0), e(0, 1), e(0, 2), e(1, 1), e(1, 2), e(2, 2)]
+}
+
+/// M̂⁻¹ from the mass, orientation and free degrees of freedom: `1/m` on free
+/// axes, `(I_w restricted to the free rotational axes)⁻¹`, padded with zeros.
+pub fn inv_mass(m: f64, inertia: &[f64; 3], q: &[f64; 4], f: u8) -> InvMass3 {
+    let mut out = InvMass3::default();
+    for k in 0..3 {
+        out.m[k] = if f & (1 << k) != 0 { 1.0 / m } else { 0.0 };
+    }
+    // the free rotational axes, without allocating (this runs every step for
+    // bodies whose world inertia turns with them)
+    let (mut rot_free, mut nfree) = ([0usize; 3], 0);
+    for k in 0..3 {
+        if f & (1 << (3 + k)) != 0 {
+            rot_free[nfree] = k;
+            nfree += 1;
+        }
+    }
+    let iw = world_inertia(q, inertia);
+    // entry (a, c) of the symmetric tensor stored as [xx, xy, xz, yy, yz, zz]
+    const IDX: [[usize; 3]; 3] = [[0, 1, 2], [1, 3, 4], [2, 4, 5]];
+    let full = |a: usize, c: usize| iw[IDX[a][c]];
+    let mut r = [[0.0; 3]; 3];
+    match nfree {
+        0 => {}
+        1 => {
+            let a = rot_free[0];
+            r[a][a] = 1.0 / full(a, a);
+        }
+        2 => {
+            let (a, c) = (rot_free[0], rot_free[1]);
+            let (p, q, s) = (full(a, a), full(a, c), full(c, c));
+            let det = p * s - q * q;
+            r[a][a] = s / det;
+            r[a][c] = -q / det;
+            r[c][a] = -q / det;
+            r[c][c] = p / det;
+        }
+        _ => {
+            out.i = coulomb::inverse(&iw).unwrap_or([0.0; 6]);
+            return out;
+        }
+    }
+    out.i = [r[0][0], r[0][1], r[0][2], r[1][1], r[1][2], r[2][2]];
+    out
+}
+
 impl Dim for D3 {
     const N: usize = 3;
     const DOF: usize = 6;
@@ -169,6 +223,38 @@ impl Dim for D3 {
     type W = Sym3;
     type Block = Block3;
     type InvMass = InvMass3;
+    type Inertia = [f64; 3];
+
+    fn normalize_rot(q: [f64; 4]) -> [f64; 4] {
+        rotation::normalize(q)
+    }
+    fn inv_mass(mass: f64, inertia: &[f64; 3], rot: &[f64; 4], free: u8) -> InvMass3 {
+        inv_mass(mass, inertia, rot, free)
+    }
+    fn isotropic(i: &[f64; 3]) -> bool {
+        i[0] == i[1] && i[1] == i[2]
+    }
+    fn rho2(m: f64, i: &[f64; 3]) -> f64 {
+        if m > 0.0 && m.is_finite() && i.iter().all(|x| x.is_finite()) {
+            (i[0] + i[1] + i[2]) / (3.0 * m)
+        } else {
+            0.0
+        }
+    }
+    #[inline]
+    fn integrate(pos: &mut [f64; 3], q: &mut [f64; 4], v0: &[f64; 6], v1: &[f64; 6], h: f64, theta: f64) {
+        let vm: [f64; 6] = std::array::from_fn(|a| (1.0 - theta) * v0[a] + theta * v1[a]);
+        for a in 0..3 {
+            pos[a] += h * vm[a];
+        }
+        let rot = [h * vm[3], h * vm[4], h * vm[5]];
+        if rot != [0.0; 3] {
+            *q = rotation::normalize(rotation::quat_mul(rotation::from_rotation_vector(rot), *q));
+        }
+    }
+    fn rot_finite(q: &[f64; 4]) -> bool {
+        q.iter().all(|x| x.is_finite())
+    }
 
     #[inline]
     fn frame(p: &[f64; 3], n: &[f64; 3], x_i: &[f64; 3], x_j: &[f64; 3]) -> Frame3 {

@@ -37,6 +37,7 @@ pub mod coulomb3;
 pub mod d2;
 pub mod d3;
 pub mod joint;
+pub mod rotation;
 
 pub use d2::D2;
 pub use d3::D3;
@@ -115,6 +116,25 @@ pub trait Dim: Copy + Default + Debug + PartialEq + Send + Sync + 'static {
     type Block: Pod;
     /// M̂⁻¹ of one body as the solver reads it.
     type InvMass: Pod;
+    /// A body's rotational inertia: I about the centre in 2D, the principal
+    /// moments (body frame) in 3D.
+    type Inertia: Pod;
+
+    /// A valid orientation close to `r` (3D: the quaternion normalised).
+    fn normalize_rot(r: Self::Rot) -> Self::Rot;
+    /// M̂⁻¹ of a body of mass m and inertia I at orientation `rot`, restricted to the
+    /// free degrees of freedom (bit k of `free`: dof k moves under impulses).
+    fn inv_mass(mass: f64, inertia: &Self::Inertia, rot: &Self::Rot, free: u8) -> Self::InvMass;
+    /// Whether M̂⁻¹ does not depend on the orientation (2D; isotropic 3D bodies).
+    fn isotropic(inertia: &Self::Inertia) -> bool;
+    /// ρ² = I/m (3D: tr(I)/3m), 0 when undefined: the weight of rotations in the
+    /// gluing norm |V|² = |v|² + ρ² |ω|².
+    fn rho2(mass: f64, inertia: &Self::Inertia) -> f64;
+    /// The θ-method's position update `q⁺ = q⁻ + h((1 − θ)V⁻ + θV⁺)` (3D: the
+    /// rotation increment applied as an exact rotation).
+    fn integrate(pos: &mut Self::Point, rot: &mut Self::Rot, v0: &Self::Twist, v1: &Self::Twist, h: f64, theta: f64);
+    /// Whether an orientation is finite.
+    fn rot_finite(r: &Self::Rot) -> bool;
 
     /// The frame of a contact at `point` with unit normal `normal` (from j to i)
     /// between bodies whose centres are `x_i`, `x_j`.

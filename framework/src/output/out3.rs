@@ -192,8 +192,8 @@ pub fn final_json3(w: &World3) -> String {
                 kind: w.kind_name(k),
                 material: &w.materials[b.material[k] as usize].name,
                 position: b.pos[k],
-                rotation: to_rotation_vector(b.quat[k]),
-                quaternion: b.quat[k],
+                rotation: to_rotation_vector(b.rot[k]),
+                quaternion: b.rot[k],
                 velocity: b.vel[k],
                 fixed: w.fixed[k],
                 shape: w.shapes[s.kind as usize].describe(s.index),
@@ -238,7 +238,7 @@ pub fn write_vtk3(v: &mut VtkWriter, w: &World3, dir: &Path, frame: u32) -> std:
     for k in 0..n {
         let s = b.shape[k];
         let store = &w.shapes[s.kind as usize];
-        let glyph = store.glyph(s.index, b.pos[k], b.quat[k]);
+        let glyph = store.glyph(s.index, b.pos[k], b.rot[k]);
         pts.extend_from_slice(&b.pos[k]);
         vel.extend_from_slice(&b.vel[k][..3]);
         omega.extend_from_slice(&b.vel[k][3..]);

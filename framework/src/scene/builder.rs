@@ -98,7 +98,7 @@ impl<'r> SceneBuilder2<'r> {
 
     /// Makes a body immovable.
     pub fn set_fixed(&mut self, b: u32) {
-        self.bodies.inv_mass[b as usize] = [0.0; 3];
+        self.bodies.set_fixed(b as usize);
     }
 
     pub fn body_count(&self) -> usize {

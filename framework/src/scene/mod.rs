@@ -635,11 +635,11 @@ fn add_bodies(cx: &Ctx, sf: &SceneFile, b: &mut SceneBuilder2, drives: &mut Vec<
             spec.rotation,
             spec.velocity,
         );
-        let mp = b.bodies.mass[id as usize];
-        if !(mp[0] > 0.0 && mp[0].is_finite() && mp[2] > 0.0 && mp[2].is_finite()) {
+        let (m, i) = (b.bodies.mass[id as usize], b.bodies.inertia[id as usize]);
+        if !(m > 0.0 && m.is_finite() && i > 0.0 && i.is_finite()) {
             return Err(cx.err(
                 &p("shape"),
-                format!("the body's mass ({}) and inertia ({}) must be positive and finite", mp[0], mp[2]),
+                format!("the body's mass ({m}) and inertia ({i}) must be positive and finite"),
             ));
         }
         if let Some(name) = &spec.name {

@@ -111,7 +111,7 @@ pub fn restart3_str(w: &mut World3, text: &str, file: &str) -> Result<(), InputE
     let b = &mut w.bodies;
     for (k, sb) in saved.bodies.iter().enumerate() {
         b.pos[k] = sb.position;
-        b.quat[k] = sb.quaternion;
+        b.rot[k] = sb.quaternion;
         b.vel[k] = sb.velocity;
         b.refresh_inverse(k);
     }

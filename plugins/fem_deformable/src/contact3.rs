@@ -250,7 +250,7 @@ pub fn detect(w: &World3, fe: &[FeBody], alert: f64, out: &mut Vec<RawFe3>) {
         for rb in 0..w.bodies.len() {
             let s = w.bodies.shape[rb];
             let store = &w.shapes[s.kind as usize];
-            let (x, q) = (w.bodies.pos[rb], w.bodies.quat[rb]);
+            let (x, q) = (w.bodies.pos[rb], w.bodies.rot[rb]);
             let a = store.aabb(s.index, x, q);
             let ab = (a.min, a.max);
             if !overlap(&ab, &bb, alert) || w.law(body.material, w.bodies.material[rb]).is_none() {

@@ -334,8 +334,8 @@ fn glue(subs: &mut [Sub], ifr: &[(u32, Iface)], iff: &[(u32, Iface)], w: &World2
     let (mut jump2, mut links, mut v2, mut ncopies) = (0.0, 0u64, 0.0, 0u64);
     for (b, copies) in ifr {
         let m = copies.len() as f64;
-        let mass = w.bodies.mass[*b as usize];
-        let rho2 = if mass[0] > 0.0 { mass[2] / mass[0] } else { 0.0 };
+        let (mass, inertia) = (w.bodies.mass[*b as usize], w.bodies.inertia[*b as usize]);
+        let rho2 = if mass > 0.0 { inertia / mass } else { 0.0 };
         let mut mean = [0.0; 3];
         let mut prev: Option<[f64; 3]> = None;
         for &(e, l) in copies {

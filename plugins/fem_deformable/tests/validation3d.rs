@@ -368,7 +368,7 @@ mesh = {{ box = {{ origin = [0.0, 0.0, 0.0], size = [1.0, 1.0, 0.3], cells = [10
     let carried = rigid / 0.01;
     let c = &s.fe.contacts;
     let active = (0..c.len()).filter(|&a| c.r[a][0] > 0.0).count();
-    let q = w.bodies.quat[1];
+    let q = w.bodies.rot[1];
     let tilt = 2.0 * (q[1] * q[1] + q[2] * q[2]).sqrt().min(1.0).asin();
     let settle = 0.4 - w.bodies.pos[1][2];
     println!("block: {active} nodes carry {carried} N of {weight} N, settles {settle:e} m, tilt {tilt:e} rad");

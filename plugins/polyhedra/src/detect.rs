@@ -343,7 +343,7 @@ impl PairDetector3 for PolyPoly {
         for &[i, j] in pairs {
             let (iu, ju) = (i as usize, j as usize);
             let (pi, pj) = (&sa.shapes[b.shape[iu].index as usize], &sb.shapes[b.shape[ju].index as usize]);
-            poly_poly(pi, b.pos[iu], b.quat[iu], pj, b.pos[ju], b.quat[ju], i, j, ctx.alert, &mut sc, out);
+            poly_poly(pi, b.pos[iu], b.rot[iu], pj, b.pos[ju], b.rot[ju], i, j, ctx.alert, &mut sc, out);
         }
     }
 }
@@ -360,11 +360,11 @@ impl PairDetector3 for PolyPlane {
         let mut wv = vec![];
         for &[i, j] in pairs {
             let (iu, ju) = (i as usize, j as usize);
-            sa.world_vertices(b.shape[iu].index, b.pos[iu], b.quat[iu], &mut wv);
-            let n = rotate(b.quat[ju], [0.0, 0.0, 1.0]);
+            sa.world_vertices(b.shape[iu].index, b.pos[iu], b.rot[iu], &mut wv);
+            let n = rotate(b.rot[ju], [0.0, 0.0, 1.0]);
             let xp = b.pos[ju];
             let p = &sa.shapes[b.shape[iu].index as usize];
-            let q = b.quat[iu];
+            let q = b.rot[iu];
             let f = (0..p.faces.len())
                 .min_by(|&x, &y| dot(rotate(q, p.normals[x]), n).total_cmp(&dot(rotate(q, p.normals[y]), n)))
                 .expect("a polyhedron has faces");
@@ -448,8 +448,8 @@ impl PairDetector3 for PolySphere {
             let p = &sa.shapes[b.shape[iu].index as usize];
             let r = ss.radius[b.shape[ju].index as usize];
             let c = b.pos[ju];
-            sa.world_vertices(b.shape[iu].index, b.pos[iu], b.quat[iu], &mut wv);
-            let Some((q, outward, d)) = closest_surface(p, &wv, b.quat[iu], c, [0.0; 3]) else {
+            sa.world_vertices(b.shape[iu].index, b.pos[iu], b.rot[iu], &mut wv);
+            let Some((q, outward, d)) = closest_surface(p, &wv, b.rot[iu], c, [0.0; 3]) else {
                 continue;
             };
             // the normal from the sphere (antagonist) to the polyhedron

@@ -147,13 +147,13 @@ fn incline(b: f64, h: f64, mu: f64, alpha_deg: f64) -> (f64, f64) {
         [0.0, a, 0.0],
     );
     let mut w = world(&text);
-    let (x0, q0) = (w.bodies.pos[1], w.bodies.quat[1]);
+    let (x0, q0) = (w.bodies.pos[1], w.bodies.rot[1]);
     for _ in 0..600 {
         w.step().unwrap();
     }
     let x = w.bodies.pos[1];
     let d = ((x[0] - x0[0]).powi(2) + (x[2] - x0[2]).powi(2)).sqrt();
-    let q = w.bodies.quat[1];
+    let q = w.bodies.rot[1];
     let dot = (q[0] * q0[0] + q[1] * q0[1] + q[2] * q0[2] + q[3] * q0[3]).abs().min(1.0);
     (d, 2.0 * dot.acos())
 }
@@ -199,20 +199,20 @@ fn tilting(b: f64, h: f64, mu: f64, alpha_deg: f64) -> (f64, f64) {
     let mut w = world(&text);
     // body 0: the block, body 1: the generated table
     let rel = |w: &World3| {
-        let (qt, qb) = (w.bodies.quat[1], w.bodies.quat[0]);
+        let (qt, qb) = (w.bodies.rot[1], w.bodies.rot[0]);
         let d = [0, 1, 2].map(|k| w.bodies.pos[0][k] - w.bodies.pos[1][k]);
         // the block's pose in the table's frame: Rₜᵀ (x_b − x_t), qₜ⁻¹ q_b
         let qi = [qt[0], -qt[1], -qt[2], -qt[3]];
         (nscdd::rigid3d::bodies::rotate(qi, d), nscdd::rigid3d::bodies::quat_mul(qi, qb))
     };
     let (x0, q0) = rel(&w);
-    let qt0 = w.bodies.quat[1];
+    let qt0 = w.bodies.rot[1];
     let steps = ((alpha_deg.to_radians() / 0.02 + 1.0) / 2e-3).round() as usize;
     for _ in 0..steps {
         w.step().unwrap();
     }
     // the table's rotation since t = 0 (its principal frame need not be the world's)
-    let qt = nscdd::rigid3d::bodies::quat_mul(w.bodies.quat[1], [qt0[0], -qt0[1], -qt0[2], -qt0[3]]);
+    let qt = nscdd::rigid3d::bodies::quat_mul(w.bodies.rot[1], [qt0[0], -qt0[1], -qt0[2], -qt0[3]]);
     let tilt = 2.0 * qt[0].abs().min(1.0).acos();
     // drives act at step ends: the tilt stops within rate × h of max_angle
     assert!((tilt - alpha_deg.to_radians()).abs() <= 0.02 * 2e-3, "table at {tilt} rad");
@@ -301,7 +301,7 @@ fn joint_rotations(w: &World3, q0: &[[f64; 4]]) -> Vec<f64> {
     use nscdd::rigid3d::bodies::{quat_mul, to_rotation_vector};
     let theta = |b: usize| {
         let q = q0[b];
-        to_rotation_vector(quat_mul(w.bodies.quat[b], [q[0], -q[1], -q[2], -q[3]]))[1]
+        to_rotation_vector(quat_mul(w.bodies.rot[b], [q[0], -q[1], -q[2], -q[3]]))[1]
     };
     let turn = |k: usize| if k == 0 || k == 25 { 0.0 } else { theta(k - 1) };
     (0..25).map(|k| turn(k + 1) - turn(k)).collect()
@@ -312,7 +312,7 @@ fn collapsing_arch_forms_five_hinges() {
     // t/R = 0.09, below the minimum 0.1075 of radial joints: follow the collapse
     // until a voussoir has moved 5 mm, while the segments are still rigid blocks
     let mut w = arch_world(0.09);
-    let (x0, q0) = (w.bodies.pos.clone(), w.bodies.quat.clone());
+    let (x0, q0) = (w.bodies.pos.clone(), w.bodies.rot.clone());
     while largest_displacement(&w, &x0) < 5e-3 {
         w.step().unwrap();
         assert!(w.step < 2000, "the arch does not collapse");

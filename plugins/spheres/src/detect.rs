@@ -56,7 +56,7 @@ impl PairDetector3 for SpherePlane {
         for &[i, j] in pairs {
             let r = sa.radius[b.shape[i as usize].index as usize];
             let (xs, xp) = (b.pos[i as usize], b.pos[j as usize]);
-            let n = rotate(b.quat[j as usize], [0.0, 0.0, 1.0]);
+            let n = rotate(b.rot[j as usize], [0.0, 0.0, 1.0]);
             let gap = dot(n, [xs[0] - xp[0], xs[1] - xp[1], xs[2] - xp[2]]) - r;
             if gap > ctx.alert {
                 continue;
@@ -87,7 +87,7 @@ impl PairDetector3 for SphereBox {
         for &[i, j] in pairs {
             let r = sa.radius[b.shape[i as usize].index as usize];
             let h = bx.half[b.shape[j as usize].index as usize];
-            let (xs, xb, q) = (b.pos[i as usize], b.pos[j as usize], b.quat[j as usize]);
+            let (xs, xb, q) = (b.pos[i as usize], b.pos[j as usize], b.rot[j as usize]);
             let c = rotate_inv(q, [xs[0] - xb[0], xs[1] - xb[1], xs[2] - xb[2]]);
             let cl = [c[0].clamp(-h[0], h[0]), c[1].clamp(-h[1], h[1]), c[2].clamp(-h[2], h[2])];
             let d = [c[0] - cl[0], c[1] - cl[1], c[2] - cl[2]];
