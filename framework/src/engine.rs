@@ -12,7 +12,7 @@
 //! Degrees of freedom driven by velocity take V⁺ = v(t_i+1) and have M̂⁻¹ = 0.
 //! Stages: [`free_velocity`], detection ([`crate::detect`]), [`build_contacts`]
 //! (frames, Delassus blocks W_αα, law targets ū and warm start), NLGS
-//! ([`crate::rigid2d::nlgs`]) and [`update_positions`].
+//! ([`crate::solver::nlgs`]) and [`update_positions`].
 
 use crate::dim::{Dim, D2};
 use crate::drive::Imposed;
@@ -40,19 +40,7 @@ pub struct StepReport {
     pub times: StageTimes,
 }
 
-/// A step produced a non-finite state.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Diverged {
-    pub step: u64,
-    pub body: u32,
-    pub message: String,
-}
-
-impl std::fmt::Display for Diverged {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "the run diverged at step {}: {}", self.step, self.message)
-    }
-}
+pub use crate::step::Diverged;
 
 /// The contact-solve stage of a step of a world `W`, between the construction of
 /// the contact set and the position update: the one-domain NLGS ([`Nlgs`]) or NSCDD
@@ -121,17 +109,7 @@ pub fn free_velocity(w: &mut World2) {
     w.scratch.v_begin.clear();
     w.scratch.v_begin.extend_from_slice(&b.vel);
     for d in &w.drives {
-        let k = d.body as usize;
-        let mut free = crate::model::all_free::<D2>();
-        for (dof, drv) in d.dof.iter().enumerate() {
-            if drv.as_ref().is_some_and(|x| x.is_velocity_at(t_end)) {
-                free &= !(1 << dof);
-            }
-        }
-        if b.free[k] != free {
-            b.free[k] = free;
-            b.refresh_inverse(k);
-        }
+        crate::step::drive_free_dofs(b, d.body as usize, &d.dof, t_end);
     }
     let g = w.gravity;
     for k in 0..b.len() {
@@ -213,15 +191,7 @@ pub fn update_positions(w: &mut World2) -> Result<(), Diverged> {
     let (h, theta) = (w.time.h, w.time.theta);
     let b = &mut w.bodies;
     if let Err(k) = crate::step::integrate(b, &w.scratch.v_begin, h, theta) {
-        let label = w.body_label(k);
-        return Err(Diverged {
-            step: w.step + 1,
-            body: k as u32,
-            message: format!(
-                "{label} has a non-finite state (position {:?}, velocity {:?})",
-                w.bodies.pos[k], w.bodies.vel[k]
-            ),
-        });
+        return Err(Diverged::non_finite(w.step + 1, k, w.body_label(k), &w.bodies));
     }
     crate::step::reactions(&w.contacts, w.bodies.len(), &mut w.reaction);
     w.step += 1;

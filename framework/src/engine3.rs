@@ -4,7 +4,7 @@
 //! ```text
 //! V_free = V⁻ + h M̂⁻¹ F̂        F̂: gravity, imposed forces at t_i + θh, and the
 //!                               gyroscopic torque −ω⁻ × (I_w ω⁻) (zero for spheres)
-//! M̂ (V⁺ − V_free) = H r          r: contact impulses (NLGS, rigid3d::nlgs)
+//! M̂ (V⁺ − V_free) = H r          r: contact impulses (NLGS, solver::nlgs)
 //! x⁺ = x⁻ + h ((1 − θ) v⁻ + θ v⁺)
 //! q⁺ = exp(½ h ω_θ) ⊗ q⁻,       ω_θ = (1 − θ) ω⁻ + θ ω⁺   (world-frame ω)
 //! ```
@@ -21,7 +21,7 @@ use crate::drive::Imposed;
 use crate::engine::{ContactStage, Diverged, Nlgs, StageTimes, StepReport};
 use crate::law::target_velocity;
 use crate::model::{ContactKey, Target};
-use crate::rigid3d::bodies::{cross, ALL_FREE};
+use crate::rigid3d::bodies::cross;
 use crate::solver::nlgs::{self, make_order};
 
 use crate::solver::SolveReport;
@@ -86,17 +86,7 @@ pub fn free_velocity(w: &mut World3) {
     w.scratch.v_begin.extend_from_slice(&b.vel);
     // free degrees of freedom at the end of the step; M̂⁻¹ where it can change
     for d in &w.drives {
-        let k = d.body as usize;
-        let mut free = ALL_FREE;
-        for (dof, drv) in d.dof.iter().enumerate() {
-            if drv.as_ref().is_some_and(|x| x.is_velocity_at(t_end)) {
-                free &= !(1 << dof);
-            }
-        }
-        if b.free[k] != free {
-            b.free[k] = free;
-            b.refresh_inverse(k);
-        }
+        crate::step::drive_free_dofs(b, d.body as usize, &d.dof, t_end);
     }
     for k in 0..b.len() {
         if b.free[k] != 0 && !isotropic(b.inertia[k]) {
@@ -292,7 +282,7 @@ pub fn build_contacts(w: &mut World3) {
 }
 
 /// Failure of bonded joints on the converged impulses: a joint whose strength is
-/// exceeded loses its bond for good (`rigid3d::joint`). "Exceeded" means by more
+/// exceeded loses its bond for good (`dim::joint`). "Exceeded" means by more
 /// than 100 × the solver tolerance (at most 2 %): the impulses of a converged NLGS
 /// are accurate to a few tolerances, and a smaller overload makes the joint slip,
 /// so its slip velocity, hence the excess, grows until it fails a few steps later.
@@ -319,15 +309,7 @@ pub fn update_positions(w: &mut World3) -> Result<(), Diverged> {
     let (h, theta) = (w.time.h, w.time.theta);
     let b = &mut w.bodies;
     if let Err(k) = crate::step::integrate(b, &w.scratch.v_begin, h, theta) {
-        let label = w.body_label(k);
-        return Err(Diverged {
-            step: w.step + 1,
-            body: k as u32,
-            message: format!(
-                "{label} has a non-finite state (position {:?}, velocity {:?})",
-                w.bodies.pos[k], w.bodies.vel[k]
-            ),
-        });
+        return Err(Diverged::non_finite(w.step + 1, k, w.body_label(k), &w.bodies));
     }
     crate::step::reactions(&w.contacts, w.bodies.len(), &mut w.reaction);
     w.step += 1;

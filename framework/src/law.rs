@@ -14,7 +14,7 @@
 //! then obeys the position-level condition of the θ-method, `g⁺ ≥ 0`, i.e.
 //! `u_n⁺ ≥ −(g + h (1 − θ) u_n⁻) / (h θ)`. Both are `u_n ≥ ū ⊥ r_n ≥ 0` with the
 //! target ū computed by [`target_velocity`]; the tangential part is Coulomb's law with
-//! the friction coefficient μ (see `rigid2d::coulomb`).
+//! the friction coefficient μ (see `dim::coulomb2`, `dim::coulomb3`).
 //!
 //! Laws are chosen per pair of materials. Built-in law kinds: `coulomb` (keys
 //! `friction`, `restitution`), `frictionless` (key `restitution`), which takes the
@@ -22,7 +22,7 @@
 //! `cohesion`, `tensile_strength`, `bond_gap`): a mortar joint between 3D rigid
 //! bodies that carries tension up to `tensile_strength` and shear up to
 //! `cohesion + μ σ_n` (stresses, Pa) until it fails, then acts as `coulomb` with
-//! e = 0 for ever (see `rigid3d::joint`).
+//! e = 0 for ever (see `dim::joint`).
 
 use crate::params::{number, only_keys};
 use crate::registry::{ParamError, Registry};

@@ -1,9 +1,10 @@
 //! # nscdd: non-smooth contact dynamics with domain decomposition
 //!
-//! The framework holds what every body family shares: the Moreau–Jean time step
-//! ([`engine`]), contact detection driven by plugins' narrow phases ([`detect`],
+//! The framework holds what every body family shares, written once for 2D and 3D
+//! over the dimension trait [`dim::Dim`]: bodies and contacts ([`model`]), the
+//! Moreau–Jean time step ([`engine`], [`step`]), contact detection driven by plugins' narrow phases ([`detect`],
 //! [`registry`]), contact laws ([`law`]), the NLGS solver and LMGC90's convergence
-//! norms ([`rigid2d::nlgs`], [`norms`]), scene files ([`scene`]), outputs
+//! norms ([`solver::nlgs`], [`norms`]), scene files ([`scene`]), outputs
 //! ([`output`]) and frictional-contact problems in local form ([`fc`]).
 //! It never names a plugin: shapes, detectors and generators come from plugins
 //! through the [`registry::Registry`].

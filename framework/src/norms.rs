@@ -32,7 +32,7 @@
 //!
 //! Sums are plain additions, so the sums of several subdomains reduce to the sums of
 //! the whole problem ([`Sums::merge`]) and the test is the same as for one domain.
-//! The solver-independent measure is [`natural_map_sq`], summed by `rigid2d::nlgs::residual`.
+//! The solver-independent measure is [`natural_map_sq`], summed by `solver::nlgs::residual`.
 
 use serde::{Deserialize, Serialize};
 

@@ -7,7 +7,33 @@
 //! ```
 
 use crate::dim::{Dim, Vector};
-use crate::model::{Bodies, Contacts};
+use crate::drive::DofDrive;
+use crate::model::{all_free, Bodies, Contacts};
+
+/// A step produced a non-finite state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Diverged {
+    pub step: u64,
+    pub body: u32,
+    pub message: String,
+}
+
+impl std::fmt::Display for Diverged {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "the run diverged at step {}: {}", self.step, self.message)
+    }
+}
+
+impl Diverged {
+    /// Body k (labelled `label`) has a non-finite state after step `step`.
+    pub fn non_finite<D: Dim>(step: u64, k: usize, label: String, b: &Bodies<D>) -> Diverged {
+        Diverged {
+            step,
+            body: k as u32,
+            message: format!("{label} has a non-finite state (position {:?}, velocity {:?})", b.pos[k], b.vel[k]),
+        }
+    }
+}
 
 /// The θ-method's position update of every body from V⁻ (`v_begin`) and V⁺ (the
 /// bodies' velocities). Stops at the first body whose state is not finite and
@@ -35,5 +61,21 @@ pub fn reactions<D: Dim>(c: &Contacts<D>, n_bodies: usize, reaction: &mut Vec<D:
             reaction[i as usize][k] += pi[k];
             reaction[j as usize][k] -= pj[k];
         }
+    }
+}
+
+/// The free degrees of freedom of body k at the end of the step (`t_end`): those
+/// not driven by an imposed velocity then (drives `dof`, one per degree of
+/// freedom); M̂⁻¹ is recomputed when they change.
+pub fn drive_free_dofs<D: Dim>(b: &mut Bodies<D>, k: usize, dof: &[Option<DofDrive>], t_end: f64) {
+    let mut free = all_free::<D>();
+    for (d, drv) in dof.iter().enumerate() {
+        if drv.as_ref().is_some_and(|x| x.is_velocity_at(t_end)) {
+            free &= !(1 << d);
+        }
+    }
+    if b.free[k] != free {
+        b.free[k] = free;
+        b.refresh_inverse(k);
     }
 }

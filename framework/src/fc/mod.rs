@@ -18,7 +18,7 @@
 //!
 //! ```text
 //! u0_α = q_α + Σ_{β≠α} W_αβ r_β   (= u_α − W_αα r_α),
-//! r_α  ← the one-contact solution for (W_αα, u0_α, μ_α)   (rigid2d::coulomb, rigid3d::coulomb)
+//! r_α  ← the one-contact solution for (W_αα, u0_α, μ_α)   (dim::coulomb2, dim::coulomb3)
 //! ```
 //!
 //! FCLIB's HDF5 files are read by [`fclib`] (cargo feature `hdf5`).
@@ -27,7 +27,7 @@
 //! `‖F(r)‖ / ‖q‖ < tol` with `F(r) = r − P_K(r − (u + Φ(u)))`, `Φ(u)_α = (μ_α |u_t,α|, 0)`
 //! (divided by 1 when `q = 0`), evaluated every `check_every` sweeps; or
 //! [`FcNorm::Lmgc`], LMGC90's norms accumulated over a check sweep exactly as
-//! [`crate::rigid2d::nlgs`] does (see [`crate::norms`]). The final residual is always
+//! [`crate::solver::nlgs`] does (see [`crate::norms`]). The final residual is always
 //! the natural-map one.
 //!
 //! [`problem_from_world`] writes the local problem of a 2D world's last step: with
