@@ -34,6 +34,8 @@
 
 pub mod coulomb2;
 pub mod coulomb3;
+#[cfg(test)]
+mod coulomb3_tests;
 pub mod d2;
 pub mod d3;
 pub mod joint;
