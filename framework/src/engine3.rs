@@ -72,11 +72,6 @@ impl World3 {
     }
 }
 
-/// Whether body b's inertia is isotropic (then I_w does not depend on orientation).
-fn isotropic(i: [f64; 3]) -> bool {
-    i[0] == i[1] && i[1] == i[2]
-}
-
 /// V_free = V⁻ + h M̂⁻¹ F̂ with the drives applied; keeps V⁻.
 pub fn free_velocity(w: &mut World3) {
     let h = w.time.h;
@@ -89,7 +84,7 @@ pub fn free_velocity(w: &mut World3) {
         crate::step::drive_free_dofs(b, d.body as usize, &d.dof, t_end);
     }
     for k in 0..b.len() {
-        if b.free[k] != 0 && !isotropic(b.inertia[k]) {
+        if b.free[k] != 0 && !D3::isotropic(&b.inertia[k]) {
             b.refresh_inverse(k);
         }
     }
@@ -100,12 +95,16 @@ pub fn free_velocity(w: &mut World3) {
         }
         let (im, ii) = (b.inv_mass[k].m, b.inv_mass[k].i);
         let m = b.mass[k];
-        let iw = if isotropic(b.inertia[k]) { [0.0; 6] } else { b.world_inertia(k) };
+        let iw = if D3::isotropic(&b.inertia[k]) {
+            [0.0; 6]
+        } else {
+            b.world_inertia(k)
+        };
         let v = &mut b.vel[k];
         for a in 0..3 {
             v[a] += h * im[a] * m * g[a];
         }
-        if !isotropic(b.inertia[k]) {
+        if !D3::isotropic(&b.inertia[k]) {
             // gyroscopic torque −ω × (I_w ω), explicit
             let om = [v[3], v[4], v[5]];
             let l = coulomb::mul(&iw, om);
