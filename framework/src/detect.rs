@@ -1,183 +1,127 @@
-//! Contact detection: an O(N) cell-grid broad phase, then the narrow phases that
-//! plugins registered for each pair of shape kinds.
+//! Contact detection, once for 2D and 3D: an O(N) cell-grid broad phase, then the
+//! narrow phases that plugins registered for each pair of shape kinds
+//! ([`crate::shape::PairDetector`]), called once per batch of candidate pairs.
 //!
 //! The grid's cell size is the median body extent plus the alert distance, so that
-//! a polydisperse sample (radii spread 1:100) keeps few bodies per cell. A body is
-//! inserted in every cell its box covers; a pair is reported only by the cell holding
-//! the lower corner of the two boxes' intersection, so each pair appears once. Bodies
-//! whose box spans more than [`LARGE_CELLS`] cells (long walls) and unbounded shapes
-//! (half-planes) are kept aside and tested against every body by box overlap. The
-//! bodies are bucketed by a counting sort over cells: no hashing, deterministic order.
-//! Pairs of two bodies that impulses cannot move are skipped.
+//! a polydisperse sample (radii spread 1:100) keeps few bodies per cell; it grows
+//! until the grid has O(N) cells. A bounded body is entered in every cell its box
+//! covers, extended by the alert distance towards lower coordinates; a pair whose
+//! boxes overlap within the alert distance shares the cell of the lower corner of
+//! the intersection of those extended boxes and is reported there only, so no pair
+//! appears twice. Bodies whose box spans more than [`LARGE_CELLS`] cells (long
+//! walls) and unbounded shapes (half-planes, planes) are kept aside and tested
+//! against every body by box overlap. Bodies are bucketed by a counting sort over
+//! cells (no hashing). A pair is `[i, j]` with i < j; pairs are sorted by kind pair,
+//! then by bodies: the order of the raw contacts depends on the scene only, never
+//! on the grid. Pairs of two bodies that impulses cannot move are skipped.
 
-use crate::registry::{Aabb2, PairDetector2, RawContact2, ShapeStore2};
-use crate::rigid2d::Bodies2;
+use crate::dim::Dim;
+use crate::model::Bodies;
+use crate::shape::{Aabb, DetectCtx, PairDetector, RawContact, ShapeStore};
 use std::sync::Arc;
 
 /// Bodies spanning more cells than this along one axis are tested against all.
 pub const LARGE_CELLS: usize = 8;
 
-/// Detector table resolved at scene load: entry `ka * nk + kb`.
-#[derive(Clone, Default)]
-pub struct DetectorTable {
+/// Detector table resolved at scene load: entry `ka * nk + kb`, with whether the
+/// registered order is (kb, ka).
+pub struct DetectorTable<D: Dim> {
     pub nk: usize,
-    pub table: Vec<Option<(Arc<dyn PairDetector2>, bool)>>,
+    pub table: Vec<Option<(Arc<dyn PairDetector<D>>, bool)>>,
+}
+
+impl<D: Dim> Default for DetectorTable<D> {
+    fn default() -> Self {
+        DetectorTable { nk: 0, table: vec![] }
+    }
+}
+
+impl<D: Dim> Clone for DetectorTable<D> {
+    fn clone(&self) -> Self {
+        DetectorTable {
+            nk: self.nk,
+            table: self.table.clone(),
+        }
+    }
 }
 
 /// Reusable buffers of the detection stage (no allocation once warmed up).
-#[derive(Default)]
-pub struct Detector {
-    aabb: Vec<Aabb2>,
+pub struct Detector<D: Dim> {
+    aabb: Vec<Aabb<D>>,
     small: Vec<u32>,
     large: Vec<u32>,
     cell_start: Vec<u32>,
     cell_items: Vec<u32>,
     entries: Vec<(u32, u32)>,
+    fill: Vec<u32>,
     pairs: Vec<(u32, [u32; 2])>,
     batch: Vec<[u32; 2]>,
 }
 
-impl Detector {
-    /// Candidate pairs whose boxes overlap within `alert`, grouped by kind pair.
-    fn broad_phase(&mut self, bodies: &Bodies2, shapes: &[Box<dyn ShapeStore2>], alert: f64, nk: usize) {
-        let n = bodies.len();
-        self.aabb.clear();
-        self.small.clear();
-        self.large.clear();
-        self.pairs.clear();
-        for b in 0..n {
-            let s = bodies.shape[b];
-            self.aabb.push(shapes[s.kind as usize].aabb(s.index, bodies.pos[b], bodies.rot[b]));
+impl<D: Dim> Default for Detector<D> {
+    fn default() -> Self {
+        Detector {
+            aabb: vec![],
+            small: vec![],
+            large: vec![],
+            cell_start: vec![],
+            cell_items: vec![],
+            entries: vec![],
+            fill: vec![],
+            pairs: vec![],
+            batch: vec![],
         }
-        let mut ext: Vec<f64> = self
-            .aabb
-            .iter()
-            .filter(|a| a.is_bounded())
-            .map(|a| (a.max[0] - a.min[0]).max(a.max[1] - a.min[1]))
-            .collect();
-        let mut cell = 1.0;
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        if !ext.is_empty() {
-            let mid = ext.len() / 2;
-            ext.select_nth_unstable_by(mid, |a, b| a.total_cmp(b));
-            cell = ext[mid] + alert;
-            if !(cell > 0.0) {
-                cell = 1.0;
-            }
-        }
-        for (b, a) in self.aabb.iter().enumerate() {
-            let big = !a.is_bounded() || (a.max[0] - a.min[0]).max(a.max[1] - a.min[1]) > LARGE_CELLS as f64 * cell;
-            if big {
-                self.large.push(b as u32);
-            } else {
-                self.small.push(b as u32);
-                for k in 0..2 {
-                    lo[k] = lo[k].min(a.min[k]);
-                    hi[k] = hi[k].max(a.max[k]);
-                }
-            }
-        }
-        let movable = |b: u32| bodies.movable(b as usize);
-        let kind = |b: u32| bodies.shape[b as usize].kind as u32;
-        let key = |a: u32, b: u32| kind(a) * nk as u32 + kind(b);
-        if !self.small.is_empty() {
-            // keep the number of cells O(N)
-            let span = [(hi[0] - lo[0]).max(cell), (hi[1] - lo[1]).max(cell)];
-            while (span[0] / cell).ceil() * (span[1] / cell).ceil() > 4.0 * self.small.len() as f64 + 16.0 {
-                cell *= 1.5;
-            }
-            let nx = ((span[0] / cell).floor() as usize + 1).max(1);
-            let ny = ((span[1] / cell).floor() as usize + 1).max(1);
-            let cidx = |x: f64, k: usize, m: usize| (((x - lo[k]) / cell).floor().max(0.0) as usize).min(m - 1);
-            self.entries.clear();
-            for &b in &self.small {
-                let a = &self.aabb[b as usize];
-                let (x0, x1) = (cidx(a.min[0] - alert, 0, nx), cidx(a.max[0], 0, nx));
-                let (y0, y1) = (cidx(a.min[1] - alert, 1, ny), cidx(a.max[1], 1, ny));
-                for iy in y0..=y1 {
-                    for ix in x0..=x1 {
-                        self.entries.push(((iy * nx + ix) as u32, b));
-                    }
-                }
-            }
-            // counting sort by cell (stable: bodies stay in id order inside a cell)
-            let ncell = nx * ny;
-            self.cell_start.clear();
-            self.cell_start.resize(ncell + 1, 0);
-            for &(c, _) in &self.entries {
-                self.cell_start[c as usize + 1] += 1;
-            }
-            for c in 0..ncell {
-                self.cell_start[c + 1] += self.cell_start[c];
-            }
-            self.cell_items.clear();
-            self.cell_items.resize(self.entries.len(), 0);
-            let mut fill = self.cell_start.clone();
-            for &(c, b) in &self.entries {
-                self.cell_items[fill[c as usize] as usize] = b;
-                fill[c as usize] += 1;
-            }
-            for c in 0..ncell {
-                let items = &self.cell_items[self.cell_start[c] as usize..self.cell_start[c + 1] as usize];
-                let (cx, cy) = (c % nx, c / nx);
-                for (p, &a) in items.iter().enumerate() {
-                    let ba = &self.aabb[a as usize];
-                    for &b in &items[p + 1..] {
-                        let bb = &self.aabb[b as usize];
-                        if !ba.overlaps(bb, alert) || !(movable(a) || movable(b)) {
-                            continue;
-                        }
-                        // report only in the cell of the lower corner of the overlap
-                        let ox = cidx(ba.min[0].max(bb.min[0]) - alert, 0, nx);
-                        let oy = cidx(ba.min[1].max(bb.min[1]) - alert, 1, ny);
-                        if ox == cx && oy == cy {
-                            self.pairs.push((key(a, b), [a, b]));
-                        }
-                    }
-                }
-            }
-        }
-        for (p, &a) in self.large.iter().enumerate() {
-            let ba = self.aabb[a as usize];
-            for &b in self.small.iter().chain(&self.large[p + 1..]) {
-                if (movable(a) || movable(b)) && ba.overlaps(&self.aabb[b as usize], alert) {
-                    self.pairs.push((key(a, b), [a, b]));
-                }
-            }
-        }
-        // group by kind pair, then by bodies: a deterministic order
-        self.pairs.sort_unstable();
     }
+}
 
+/// The uniform grid over the small bodies' boxes (lower corner `lo`, cell size,
+/// cells per axis; axes past D::N have one cell).
+struct Grid {
+    lo: [f64; 3],
+    cell: f64,
+    dims: [usize; 3],
+}
+
+impl Grid {
+    #[inline]
+    fn index(&self, x: f64, k: usize) -> usize {
+        (((x - self.lo[k]) / self.cell).floor().max(0.0) as usize).min(self.dims[k] - 1)
+    }
+    #[inline]
+    fn flat(&self, c: [usize; 3]) -> usize {
+        (c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]
+    }
+    /// The cell of a point (coordinates past `n` ignored).
+    #[inline]
+    fn cell_of(&self, n: usize, x: impl Fn(usize) -> f64) -> [usize; 3] {
+        std::array::from_fn(|k| if k < n { self.index(x(k), k) } else { 0 })
+    }
+}
+
+impl<D: Dim> Detector<D> {
     /// Runs the broad phase and the narrow phases; fills `out` (cleared first).
     pub fn detect(
         &mut self,
-        bodies: &Bodies2,
-        shapes: &[Box<dyn ShapeStore2>],
-        table: &DetectorTable,
+        bodies: &Bodies<D>,
+        shapes: &[Box<dyn ShapeStore<D>>],
+        table: &DetectorTable<D>,
         alert: f64,
-        out: &mut Vec<RawContact2>,
+        out: &mut Vec<RawContact<D>>,
     ) {
         out.clear();
         let nk = table.nk;
         self.broad_phase(bodies, shapes, alert, nk);
-        let mut k = 0;
-        while k < self.pairs.len() {
-            let key = self.pairs[k].0;
-            let mut e = k;
-            while e < self.pairs.len() && self.pairs[e].0 == key {
-                e += 1;
-            }
-            let (ka, kb) = ((key as usize) / nk, (key as usize) % nk);
+        let mut p = 0;
+        while p < self.pairs.len() {
+            let key = self.pairs[p].0;
+            let q = p + self.pairs[p..].iter().take_while(|x| x.0 == key).count();
+            let (ka, kb) = (key as usize / nk, key as usize % nk);
             if let Some((det, swapped)) = &table.table[key as usize] {
                 self.batch.clear();
-                if *swapped {
-                    self.batch.extend(self.pairs[k..e].iter().map(|(_, [a, b])| [*b, *a]));
-                } else {
-                    self.batch.extend(self.pairs[k..e].iter().map(|(_, p)| *p));
-                }
+                self.batch
+                    .extend(self.pairs[p..q].iter().map(|x| if *swapped { [x.1[1], x.1[0]] } else { x.1 }));
                 let (sa, sb) = if *swapped { (kb, ka) } else { (ka, kb) };
-                let ctx = crate::registry::DetectCtx {
+                let ctx = DetectCtx {
                     a: shapes[sa].as_ref(),
                     b: shapes[sb].as_ref(),
                     bodies,
@@ -185,7 +129,127 @@ impl Detector {
                 };
                 det.detect(&ctx, &self.batch, out);
             }
-            k = e;
+            p = q;
+        }
+    }
+
+    /// Candidate pairs whose boxes overlap within `alert`, sorted by kind pair and
+    /// bodies.
+    fn broad_phase(&mut self, bodies: &Bodies<D>, shapes: &[Box<dyn ShapeStore<D>>], alert: f64, nk: usize) {
+        self.aabb.clear();
+        self.small.clear();
+        self.large.clear();
+        self.pairs.clear();
+        for b in 0..bodies.len() {
+            let s = bodies.shape[b];
+            self.aabb.push(shapes[s.kind as usize].aabb(s.index, bodies.pos[b], bodies.rot[b]));
+        }
+        let mut cell = self.cell_size(alert);
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for (b, a) in self.aabb.iter().enumerate() {
+            if !a.is_bounded() || a.extent() > LARGE_CELLS as f64 * cell {
+                self.large.push(b as u32);
+            } else {
+                self.small.push(b as u32);
+                for k in 0..D::N {
+                    lo[k] = lo[k].min(a.min[k] - alert);
+                    hi[k] = hi[k].max(a.max[k]);
+                }
+            }
+        }
+        let kind = |b: u32| bodies.shape[b as usize].kind as u32;
+        let movable = |b: u32| bodies.movable(b as usize);
+        let key = |a: u32, b: u32| kind(a) * nk as u32 + kind(b);
+        if !self.small.is_empty() {
+            // keep the number of cells O(N)
+            let span: [f64; 3] = std::array::from_fn(|k| if k < D::N { (hi[k] - lo[k]).max(cell) } else { cell });
+            while span.iter().map(|s| (s / cell).ceil()).product::<f64>() > 4.0 * self.small.len() as f64 + 64.0 {
+                cell *= 1.5;
+            }
+            let dims = std::array::from_fn(|k| ((span[k] / cell).floor() as usize + 1).max(1));
+            let grid = Grid { lo, cell, dims };
+            self.bucket(&grid, alert);
+            for c in 0..self.cell_start.len() - 1 {
+                let items = &self.cell_items[self.cell_start[c] as usize..self.cell_start[c + 1] as usize];
+                for (p, &a) in items.iter().enumerate() {
+                    let ba = &self.aabb[a as usize];
+                    for &b in &items[p + 1..] {
+                        let bb = &self.aabb[b as usize];
+                        if !(movable(a) || movable(b)) || !ba.overlaps(bb, alert) {
+                            continue;
+                        }
+                        // the pair's home cell: lower corner of the extended boxes' intersection
+                        let home = grid.cell_of(D::N, |k| ba.min[k].max(bb.min[k]) - alert);
+                        if grid.flat(home) == c {
+                            let (i, j) = if a < b { (a, b) } else { (b, a) };
+                            self.pairs.push((key(i, j), [i, j]));
+                        }
+                    }
+                }
+            }
+        }
+        // large bodies against everything
+        for (p, &a) in self.large.iter().enumerate() {
+            let ba = self.aabb[a as usize];
+            for &b in self.small.iter().chain(&self.large[p + 1..]) {
+                if (movable(a) || movable(b)) && ba.overlaps(&self.aabb[b as usize], alert) {
+                    let (i, j) = if a < b { (a, b) } else { (b, a) };
+                    self.pairs.push((key(i, j), [i, j]));
+                }
+            }
+        }
+        // group by kind pair, then by bodies: a deterministic order
+        self.pairs.sort_unstable();
+    }
+
+    /// Median extent of the bounded boxes plus the alert distance (1 if none).
+    fn cell_size(&self, alert: f64) -> f64 {
+        let mut ext: Vec<f64> = self.aabb.iter().filter(|a| a.is_bounded()).map(|a| a.extent()).collect();
+        if ext.is_empty() {
+            return 1.0;
+        }
+        let mid = ext.len() / 2;
+        ext.select_nth_unstable_by(mid, |a, b| a.total_cmp(b));
+        let cell = ext[mid] + alert;
+        if cell > 0.0 {
+            cell
+        } else {
+            1.0
+        }
+    }
+
+    /// The small bodies in the cells their extended boxes cover, by a counting sort
+    /// over cells (stable: bodies stay in id order inside a cell).
+    fn bucket(&mut self, grid: &Grid, alert: f64) {
+        self.entries.clear();
+        for &b in &self.small {
+            let a = &self.aabb[b as usize];
+            let c0 = grid.cell_of(D::N, |k| a.min[k] - alert);
+            let c1 = grid.cell_of(D::N, |k| a.max[k]);
+            for z in c0[2]..=c1[2] {
+                for y in c0[1]..=c1[1] {
+                    for x in c0[0]..=c1[0] {
+                        self.entries.push((grid.flat([x, y, z]) as u32, b));
+                    }
+                }
+            }
+        }
+        let ncell = grid.dims.iter().product::<usize>();
+        self.cell_start.clear();
+        self.cell_start.resize(ncell + 1, 0);
+        for &(c, _) in &self.entries {
+            self.cell_start[c as usize + 1] += 1;
+        }
+        for c in 0..ncell {
+            self.cell_start[c + 1] += self.cell_start[c];
+        }
+        self.cell_items.clear();
+        self.cell_items.resize(self.entries.len(), 0);
+        self.fill.clear();
+        self.fill.extend_from_slice(&self.cell_start);
+        for &(c, b) in &self.entries {
+            self.cell_items[self.fill[c as usize] as usize] = b;
+            self.fill[c as usize] += 1;
         }
     }
 }

@@ -266,3 +266,12 @@ mod tests {
         assert_eq!(d.at(1.5), Imposed::Velocity(-1.0));
     }
 }
+
+/// The drives of one body, per degree of freedom (2D: x, y, rot; 3D: x, y, z, rx,
+/// ry, rz, rotations about the world axes; the entries past the dimension's
+/// degrees of freedom are `None`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct BodyDrive {
+    pub body: u32,
+    pub dof: [Option<DofDrive>; 6],
+}

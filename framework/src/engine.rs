@@ -1,26 +1,30 @@
-//! One Moreau–Jean time step, one stage per function.
+//! One Moreau–Jean time step, one stage per function, once for 2D and 3D.
 //!
 //! Over [t_i, t_i+1] with step h and θ ∈ [½, 1] (DESIGN.md §2), for rigid bodies
 //! (M̂ = M):
 //!
 //! ```text
-//! V_free = V⁻ + M̂⁻¹ h F̂                 F̂: gravity + imposed forces at t_i + θh
-//! M̂ (V⁺ − V_free) = H r                  r: contact impulses (NLGS)
+//! V_free = V⁻ + h M̂⁻¹ F̂        F̂: gravity, imposed forces at t_i + θh, and in 3D
+//!                               the gyroscopic torque −ω⁻ × (I_w ω⁻) (zero for spheres)
+//! M̂ (V⁺ − V_free) = H r          r: contact impulses (NLGS)
 //! q⁺ = q⁻ + h ((1 − θ) V⁻ + θ V⁺)
 //! ```
 //!
-//! Degrees of freedom driven by velocity take V⁺ = v(t_i+1) and have M̂⁻¹ = 0.
-//! Stages: [`free_velocity`], detection ([`crate::detect`]), [`build_contacts`]
-//! (frames, Delassus blocks W_αα, law targets ū and warm start), NLGS
-//! ([`crate::solver::nlgs`]) and [`update_positions`].
+//! In 3D the orientation update applies the θ-method's increment h ω_θ as an exact
+//! rotation (unit quaternion, renormalised: `Dim::integrate`). Degrees of freedom
+//! driven by velocity take V⁺ = v(t_i+1) and are removed from M̂⁻¹. Stages:
+//! [`free_velocity`], detection ([`crate::detect`]), [`build_contacts`] (frames,
+//! Delassus blocks W_αα, law targets ū, warm start and bonds), NLGS
+//! ([`crate::solver::nlgs`]), [`update_joints`] and [`update_positions`].
 
-use crate::dim::{Dim, D2};
+use crate::dim::joint::Joint;
+use crate::dim::{Dim, Vector};
 use crate::drive::Imposed;
 use crate::law::target_velocity;
 use crate::model::{ContactKey, Target};
 use crate::solver::nlgs;
 use crate::solver::SolveReport;
-use crate::world::World2;
+use crate::world::World;
 use std::time::Instant;
 
 /// Wall-clock seconds spent in each stage of a step.
@@ -60,20 +64,21 @@ pub trait ContactStage<W> {
 /// The one-domain NLGS stage.
 pub struct Nlgs;
 
-impl ContactStage<World2> for Nlgs {
-    fn solve(&mut self, w: &mut World2) -> SolveReport {
+impl<D: Dim> ContactStage<World<D>> for Nlgs {
+    fn solve(&mut self, w: &mut World<D>) -> SolveReport {
         nlgs::solve(&mut w.contacts, &mut w.bodies.vel, &w.bodies.inv_mass, &w.scratch.order, &w.solver)
     }
 }
 
-impl World2 {
+impl<D: Dim> World<D> {
     /// Advances the scene by one step, contacts solved by NLGS.
     pub fn step(&mut self) -> Result<StepReport, Diverged> {
         self.step_with(&mut Nlgs)
     }
 
-    /// Advances the scene by one step with the given contact-solve stage.
-    pub fn step_with(&mut self, stage: &mut impl ContactStage<World2>) -> Result<StepReport, Diverged> {
+    /// Advances the scene by one step with the given contact-solve stage (NLGS or
+    /// NSCDD).
+    pub fn step_with(&mut self, stage: &mut impl ContactStage<World<D>>) -> Result<StepReport, Diverged> {
         let mut rep = StepReport::default();
         let t0 = Instant::now();
         free_velocity(self);
@@ -87,6 +92,7 @@ impl World2 {
         stage.prepare(self);
         let t2 = Instant::now();
         rep.solve = stage.solve(self);
+        update_joints(self);
         let t3 = Instant::now();
         update_positions(self)?;
         let t4 = Instant::now();
@@ -102,32 +108,68 @@ impl World2 {
 }
 
 /// V_free = V⁻ + h M̂⁻¹ F̂, with the drives applied; keeps V⁻ in the scratch.
-pub fn free_velocity(w: &mut World2) {
+pub fn free_velocity<D: Dim>(w: &mut World<D>) {
     let h = w.time.h;
-    let (t_end, t_theta) = (w.t + h, w.t + w.time.theta * h);
+    let t_end = w.t + h;
     let b = &mut w.bodies;
     w.scratch.v_begin.clear();
     w.scratch.v_begin.extend_from_slice(&b.vel);
+    // free degrees of freedom at the end of the step; M̂⁻¹ where it can change
     for d in &w.drives {
-        crate::step::drive_free_dofs(b, d.body as usize, &d.dof, t_end);
+        crate::step::drive_free_dofs(b, d.body as usize, &d.dof[..D::DOF], t_end);
+    }
+    for k in 0..b.len() {
+        if b.free[k] != 0 && !D::isotropic(&b.inertia[k]) {
+            b.refresh_inverse(k);
+        }
     }
     let g = w.gravity;
     for k in 0..b.len() {
-        let im = b.inv_mass[k];
-        let v = &mut b.vel[k];
-        v[0] += h * im[0] * b.mass[k] * g[0];
-        v[1] += h * im[1] * b.mass[k] * g[1];
+        if b.free[k] != 0 {
+            D::free_flight(&mut b.vel[k], b.mass[k], &b.inertia[k], &b.rot[k], &b.inv_mass[k], &g, h);
+        }
     }
+    apply_drives(w);
+}
+
+/// The drives' velocities and forces; pressure and servo drives of box walls act
+/// on the current face of the box sample.
+fn apply_drives<D: Dim>(w: &mut World<D>) {
+    let h = w.time.h;
+    let (t_end, t_theta) = (w.t + h, w.t + w.time.theta * h);
+    let extent = w.box_extent();
+    let (walls, reaction, b) = (w.box_walls.as_ref(), &w.reaction, &mut w.bodies);
+    // wall k of the box is wall k/2's axis, lower side (sign +1) for even k
+    let wall = |k: usize, dof: usize| walls.and_then(|bw| bw.wall_of(k, D::N)).filter(|wl| wl / 2 == dof);
+    let sign = |wl: usize| if wl % 2 == 0 { 1.0 } else { -1.0 };
     for d in &w.drives {
         let k = d.body as usize;
-        for dof in 0..3 {
+        for dof in 0..D::DOF {
             let Some(drv) = &d.dof[dof] else { continue };
             match drv.at(t_end) {
                 Imposed::Velocity(v) => b.vel[k][dof] = v,
+                Imposed::Servo(sigma, gain, vmax) => {
+                    // the stress the grains exerted on the wall over the last step
+                    if let (Some(wl), Some(e)) = (wall(k, dof), &extent) {
+                        let area = World::<D>::box_face(e, dof);
+                        let measured = -sign(wl) * reaction.get(k).map_or(0.0, |r| r[dof]) / (h * area);
+                        b.vel[k][dof] = sign(wl) * (gain * (sigma - measured)).clamp(-vmax, vmax);
+                    }
+                }
                 _ => {
-                    if let Imposed::Force(f) = drv.at(t_theta) {
-                        let m = if dof < 2 { b.mass[k] } else { b.inertia[k] };
-                        b.vel[k][dof] += h * f / m;
+                    let imposed = match drv.at(t_theta) {
+                        Imposed::Pressure(sigma) => match (wall(k, dof), &extent) {
+                            (Some(wl), Some(e)) => Imposed::Force(sign(wl) * sigma * World::<D>::box_face(e, dof)),
+                            _ => Imposed::Free,
+                        },
+                        other => other,
+                    };
+                    if let Imposed::Force(f) = imposed {
+                        if dof < D::N {
+                            b.vel[k][dof] += h * f / b.mass[k];
+                        } else {
+                            D::apply_moment(&mut b.vel[k], &b.inertia[k], &b.inv_mass[k], dof - D::N, h * f);
+                        }
                     }
                 }
             }
@@ -135,42 +177,100 @@ pub fn free_velocity(w: &mut World2) {
     }
 }
 
-/// Builds this step's contact set from the raw contacts: lever arms, W_αα, ū, and
-/// the impulses of persisting contacts (warm start), which are applied at once to
-/// the free velocities.
-pub fn build_contacts(w: &mut World2) {
+/// The last step's contact that a new contact continues: the one with its key, or
+/// else the nearest one of the same pair of bodies within the alert distance
+/// (multi-point contacts renumber their points when their polygons change a
+/// little: the impulse and the bond follow the point). `p`: where the key would be
+/// inserted in the sorted `prev`.
+fn continued<D: Dim>(prev: &[PrevContact<D>], p: usize, key: ContactKey, point: D::Point, alert: f64) -> Option<usize> {
+    let same = |k: usize| prev[k].key.i == key.i && prev[k].key.j == key.j;
+    let (mut lo, mut hi) = (p, p);
+    while lo > 0 && same(lo - 1) {
+        lo -= 1;
+    }
+    while hi < prev.len() && same(hi) {
+        hi += 1;
+    }
+    let d2 = |k: usize| dist2(&prev[k].point, &point);
+    (lo..hi)
+        .filter(|&k| d2(k) <= alert * alert)
+        .min_by(|&a, &b| d2(a).total_cmp(&d2(b)))
+}
+
+fn dist2<P: Vector>(a: &P, b: &P) -> f64 {
+    let d = a.sub(b);
+    d.dot(&d)
+}
+
+/// A contact of the last step, as the next step's warm start and bonds read it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PrevContact<D: Dim> {
+    pub key: ContactKey,
+    pub r: D::Local,
+    pub bonded: bool,
+    pub point: D::Point,
+}
+
+/// This step's contact set from the raw contacts: frames, W_αα, ū, the warm start
+/// (applied at once to the free velocities) and the bonds of mortar joints.
+pub fn build_contacts<D: Dim>(w: &mut World<D>) {
     let (h, theta) = (w.time.h, w.time.theta);
     let s = &mut w.scratch;
     s.prev_keys.clear();
-    s.prev_keys.extend(w.contacts.key.iter().copied().zip(w.contacts.r.iter().copied()));
-    s.prev_keys.sort_unstable_by_key(|x| x.0);
+    let old = &w.contacts;
+    s.prev_keys.extend((0..old.len()).map(|a| PrevContact {
+        key: old.key[a],
+        r: old.r[a],
+        bonded: old.joint[a].bonded(),
+        point: old.point[a],
+    }));
+    s.prev_keys.sort_unstable_by_key(|x| x.key);
     let c = &mut s.next;
     c.clear();
     let b = &w.bodies;
+    let nm = w.materials.len();
     for rc in &s.raw {
         let (i, j) = (rc.i as usize, rc.j as usize);
-        let frame = D2::frame(&rc.point, &rc.normal, &b.pos[i], &b.pos[j]);
-        let wb = D2::delassus(&frame, &b.inv_mass[i], &b.inv_mass[j]);
-        if !(wb[0] > 0.0) {
+        let frame = D::frame(&rc.point, &rc.normal, &b.pos[i], &b.pos[j]);
+        let wb = D::delassus(&frame, &b.inv_mass[i], &b.inv_mass[j]);
+        if !(D::w_nn(&wb) > 0.0) {
             continue;
         }
-        let Some(law) = w.laws[b.material[i] as usize * w.materials.len() + b.material[j] as usize] else {
+        let Some(law) = w.laws[b.material[i] as usize * nm + b.material[j] as usize] else {
             continue;
         };
-        let u_begin = D2::local_velocity(&frame, &s.v_begin[i], &s.v_begin[j]);
-        let u_free = D2::local_velocity(&frame, &b.vel[i], &b.vel[j]);
+        let u_begin = D::local_velocity(&frame, &s.v_begin[i], &s.v_begin[j]);
+        let u_free = D::local_velocity(&frame, &b.vel[i], &b.vel[j]);
         let key = ContactKey {
             i: rc.i,
             j: rc.j,
             feature: rc.feature,
         };
-        let r = match s.prev_keys.binary_search_by_key(&key, |x| x.0) {
-            Ok(p) => s.prev_keys[p].1,
-            Err(_) => [0.0, 0.0],
+        // the same key at the same place, else the nearest point of the pair; a
+        // key that now names another corner of a polygon, farther than alert, still
+        // gives its warm start but never its bond
+        let (exact, at) = match s.prev_keys.binary_search_by_key(&key, |x| x.key) {
+            Ok(p) => (Some(p), p),
+            Err(p) => (None, p),
+        };
+        let near = match exact {
+            Some(p) if dist2(&s.prev_keys[p].point, &rc.point) <= w.alert * w.alert => Some(p),
+            _ => continued(&s.prev_keys, at, key, rc.point, w.alert),
+        };
+        let r = near.or(exact).map_or(D::Local::zero(), |p| s.prev_keys[p].r);
+        let bonded = match near {
+            Some(p) => s.prev_keys[p].bonded,
+            // bonds are made at the first step only
+            None => w.step == 0 && rc.gap <= law.bond_gap,
+        };
+        let joint = if bonded && law.is_cohesive() && rc.area > 0.0 {
+            Joint::of(law.cohesion, law.tensile, law.mu, rc.area, h)
+        } else {
+            Joint::default()
         };
         c.bodies.push([rc.i, rc.j]);
         c.frame.push(frame);
-        c.block.push(D2::block(wb, law.mu));
+        c.block.push(D::block(wb, law.mu));
         c.target.push(Target {
             u_target: target_velocity(rc.gap, u_begin[0], u_free[0], h, theta, law.e),
             mu: law.mu,
@@ -180,14 +280,37 @@ pub fn build_contacts(w: &mut World2) {
         c.gap.push(rc.gap);
         c.point.push(rc.point);
         c.key.push(key);
-        c.joint.push(Default::default());
+        c.joint.push(joint);
     }
     std::mem::swap(&mut w.contacts, &mut s.next);
     w.contacts.apply_all(&mut w.bodies.vel, &w.bodies.inv_mass);
 }
 
+/// Failure of bonded joints on the converged impulses: a joint whose strength is
+/// exceeded loses its bond for good (`dim::joint`). "Exceeded" means by more
+/// than 100 × the solver tolerance (at most 2 %): the impulses of a converged NLGS
+/// are accurate to a few tolerances, and a smaller overload makes the joint slip,
+/// so its slip velocity, hence the excess, grows until it fails a few steps later.
+pub fn update_joints<D: Dim>(w: &mut World<D>) {
+    let tol = (100.0 * w.solver.tolerance).clamp(1e-9, 0.02);
+    let c = &mut w.contacts;
+    for a in 0..c.len() {
+        let jt = c.joint[a];
+        if !jt.bonded() {
+            continue;
+        }
+        let u = c.local_velocity(a, &w.bodies.vel);
+        let wr = D::w_mul(&c.block[a], &c.r[a]);
+        let u0 = u.sub(&wr);
+        let t = c.target[a];
+        if !D::joint_holds(&c.block[a], &c.r[a], &u0, t.u_target, t.mu, &jt, tol) {
+            c.joint[a] = Joint::default();
+        }
+    }
+}
+
 /// q⁺ = q⁻ + h((1 − θ)V⁻ + θV⁺); the per-body reactions; the divergence check.
-pub fn update_positions(w: &mut World2) -> Result<(), Diverged> {
+pub fn update_positions<D: Dim>(w: &mut World<D>) -> Result<(), Diverged> {
     let (h, theta) = (w.time.h, w.time.theta);
     let b = &mut w.bodies;
     if let Err(k) = crate::step::integrate(b, &w.scratch.v_begin, h, theta) {
@@ -198,7 +321,7 @@ pub fn update_positions(w: &mut World2) -> Result<(), Diverged> {
     w.t = w.step as f64 * h;
     if let (Some(bw), None) = (&w.box_walls, w.box_h0) {
         if w.t >= bw.strain_from {
-            w.box_h0 = w.box_extent().map(|e| e[3] - e[2]);
+            w.box_h0 = w.box_extent().map(|e| e.max[D::N - 1] - e.min[D::N - 1]);
         }
     }
     Ok(())

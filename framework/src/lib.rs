@@ -23,11 +23,9 @@
 
 pub mod dd;
 pub mod detect;
-pub mod detect3;
 pub mod dim;
 pub mod drive;
 pub mod engine;
-pub mod engine3;
 pub mod error;
 pub mod fc;
 pub mod law;
@@ -36,12 +34,12 @@ pub mod norms;
 pub mod output;
 pub mod params;
 pub mod registry;
-pub mod registry3;
 pub mod rigid2d;
 pub mod rigid3d;
 pub mod run;
 pub mod run3;
 pub mod scene;
+pub mod shape;
 pub mod solver;
 pub mod step;
 pub mod world;

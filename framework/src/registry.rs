@@ -20,146 +20,17 @@
 //! assert!(reg.plugins().contains(&"nothing"));
 //! ```
 
+use crate::dim::{Dim, D2, D3};
 use crate::law::LawDef;
-use crate::rigid2d::Bodies2;
-use crate::scene::builder::SceneBuilder2;
+use crate::scene::builder::SceneBuilder;
+pub use crate::shape::*;
 use std::any::Any;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-/// Axis-aligned bounding box in 2D.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Aabb2 {
-    pub min: [f64; 2],
-    pub max: [f64; 2],
-}
-
-impl Aabb2 {
-    pub fn overlaps(&self, o: &Aabb2, margin: f64) -> bool {
-        self.min[0] <= o.max[0] + margin
-            && o.min[0] <= self.max[0] + margin
-            && self.min[1] <= o.max[1] + margin
-            && o.min[1] <= self.max[1] + margin
-    }
-    pub fn is_bounded(&self) -> bool {
-        self.min.iter().chain(&self.max).all(|x| x.is_finite())
-    }
-}
-
-/// Mass properties of one shape for a density (2D: per unit depth).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MassProps2 {
-    pub area: f64,
-    pub mass: f64,
-    /// Moment of inertia about the centre of mass.
-    pub inertia: f64,
-}
-
-/// How a shape is drawn in the VTK output.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Glyph2 {
-    /// A particle of this radius at the body's position.
-    Disk(f64),
-    /// A closed polygon (world coordinates).
-    Polygon(Vec<[f64; 2]>),
-    /// A line through two points with a thickness.
-    Segment([f64; 2], [f64; 2], f64),
-}
-
-/// A shape-specific key that failed, with the reason (located in the scene file by
-/// the loader).
-#[derive(Clone, Debug, PartialEq)]
-pub struct ParamError {
-    pub key: String,
-    pub msg: String,
-}
-
-impl ParamError {
-    pub fn new(key: impl Into<String>, msg: impl Into<String>) -> Self {
-        ParamError {
-            key: key.into(),
-            msg: msg.into(),
-        }
-    }
-}
-
-/// The store of all shapes of one kind (struct-of-arrays, owned by a plugin).
-pub trait ShapeStore2: Any + Send + Sync {
-    fn kind(&self) -> &'static str;
-    fn len(&self) -> usize;
-    fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-    fn as_any(&self) -> &dyn Any;
-    fn as_any_mut(&mut self) -> &mut dyn Any;
-    /// Parses one shape from a body's shape-specific keys and stores it.
-    fn push_params(&mut self, params: &toml::Table) -> Result<u32, ParamError>;
-    /// Bounding box of shape `s` at a pose. Unbounded shapes (half-planes) return
-    /// infinite bounds and are tested against every body.
-    fn aabb(&self, s: u32, pos: [f64; 2], rot: f64) -> Aabb2;
-    fn mass_properties(&self, s: u32, density: f64) -> MassProps2;
-    /// A length typical of the shape (radius for a disk), used to size the detection
-    /// grid and the default alert distance.
-    fn size(&self, s: u32) -> f64;
-    fn glyph(&self, s: u32, pos: [f64; 2], rot: f64) -> Glyph2;
-    /// Shape parameters for `final.json`.
-    fn describe(&self, s: u32) -> serde_json::Value;
-    /// Whether bodies of this kind count in the solid fraction of a box sample.
-    fn is_grain(&self) -> bool {
-        true
-    }
-    /// Contact of shape `s` at a pose with a point `p` (a boundary node of a
-    /// deformable body): the signed distance from the surface (the gap), the unit
-    /// outward normal of the surface at the closest point, and that point. `None`:
-    /// this kind does not meet points (a scene that needs it is refused at load).
-    fn point_contact(&self, _s: u32, _pos: [f64; 2], _rot: f64, _p: [f64; 2]) -> Option<PointContact2> {
-        None
-    }
-}
-
-/// A point against a shape's surface ([`ShapeStore2::point_contact`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PointContact2 {
-    pub gap: f64,
-    /// From the shape towards the point.
-    pub normal: [f64; 2],
-    /// Closest point of the surface.
-    pub point: [f64; 2],
-}
-
-/// A raw contact found by a narrow phase, before the law is applied.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RawContact2 {
-    /// Candidate and antagonist bodies; the normal points from j to i.
-    pub i: u32,
-    pub j: u32,
-    /// Feature index for shapes that touch at several points (0 otherwise).
-    pub feature: u32,
-    pub point: [f64; 2],
-    pub normal: [f64; 2],
-    /// Signed distance (negative: interpenetration).
-    pub gap: f64,
-}
-
-/// What a narrow phase sees.
-pub struct DetectCtx<'a> {
-    /// Store of the first kind of the registered pair, and of the second.
-    pub a: &'a dyn ShapeStore2,
-    pub b: &'a dyn ShapeStore2,
-    pub bodies: &'a Bodies2,
-    /// Contacts are reported while the gap is below the alert distance.
-    pub alert: f64,
-}
-
-/// A narrow phase for one pair of shape kinds. `pairs[k] = [body of kind A, body of
-/// kind B]` in the order the detector was registered with.
-pub trait PairDetector2: Send + Sync {
-    fn detect(&self, ctx: &DetectCtx<'_>, pairs: &[[u32; 2]], out: &mut Vec<RawContact2>);
-}
-
 /// Makes bodies from parameters (`[[generate]]` sections of a scene).
-pub trait Generator2: Send + Sync {
-    fn generate(&self, params: &toml::Table, out: &mut SceneBuilder2<'_>) -> Result<(), ParamError>;
+pub trait Generator<D: Dim>: Send + Sync {
+    fn generate(&self, params: &toml::Table, out: &mut SceneBuilder<'_, D>) -> Result<(), ParamError>;
 }
 
 /// Writes extra outputs every `output.every` steps (`[output] writers = [...]`).
@@ -182,30 +53,38 @@ pub trait Writer2: Send {
     }
 }
 
-/// A shape kind: its name and how to make its empty store.
-pub struct ShapeKindDef {
-    pub name: &'static str,
-    pub new_store: fn() -> Box<dyn ShapeStore2>,
-}
-
 /// The plugin interface, after bevy's `Plugin`: add what you provide to the registry.
 pub trait Plugin {
     fn name(&self) -> &'static str;
     fn build(&self, reg: &mut Registry);
 }
 
+/// What plugins provide for one dimension: shape kinds, pair detectors keyed by
+/// the pair of kinds, generators.
+pub struct Tables<D: Dim> {
+    pub(crate) shapes: BTreeMap<&'static str, ShapeKindDef<D>>,
+    pub(crate) detectors: BTreeMap<(&'static str, &'static str), Arc<dyn PairDetector<D>>>,
+    pub(crate) generators: BTreeMap<&'static str, Box<dyn Generator<D>>>,
+}
+
+impl<D: Dim> Default for Tables<D> {
+    fn default() -> Self {
+        Tables {
+            shapes: BTreeMap::new(),
+            detectors: BTreeMap::new(),
+            generators: BTreeMap::new(),
+        }
+    }
+}
+
 /// Everything plugins provide, by name.
 #[derive(Default)]
 pub struct Registry {
     plugins: Vec<&'static str>,
-    pub(crate) shapes: BTreeMap<&'static str, ShapeKindDef>,
-    pub(crate) detectors: BTreeMap<(&'static str, &'static str), Arc<dyn PairDetector2>>,
-    pub(crate) generators: BTreeMap<&'static str, Box<dyn Generator2>>,
     pub(crate) laws: BTreeMap<&'static str, LawDef>,
     pub(crate) writers: BTreeMap<&'static str, fn() -> Box<dyn Writer2>>,
-    pub(crate) shapes3: BTreeMap<&'static str, crate::registry3::ShapeKindDef3>,
-    pub(crate) detectors3: BTreeMap<(&'static str, &'static str), Arc<dyn crate::registry3::PairDetector3>>,
-    pub(crate) generators3: BTreeMap<&'static str, Box<dyn crate::registry3::Generator3>>,
+    t2: Tables<D2>,
+    t3: Tables<D3>,
 }
 
 impl Registry {
@@ -224,14 +103,23 @@ impl Registry {
     pub fn plugins(&self) -> Vec<&'static str> {
         self.plugins.clone()
     }
-    pub fn add_shape(&mut self, def: ShapeKindDef) {
-        self.shapes.insert(def.name, def);
+    /// The tables of dimension D.
+    pub fn tables<D: Dim>(&self) -> &Tables<D> {
+        let t: &dyn Any = if D::N == 2 { &self.t2 } else { &self.t3 };
+        t.downcast_ref().expect("Dim is sealed: D2 or D3")
     }
-    pub fn add_detector(&mut self, a: &'static str, b: &'static str, d: Arc<dyn PairDetector2>) {
-        self.detectors.insert((a, b), d);
+    fn tables_mut<D: Dim>(&mut self) -> &mut Tables<D> {
+        let t: &mut dyn Any = if D::N == 2 { &mut self.t2 } else { &mut self.t3 };
+        t.downcast_mut().expect("Dim is sealed: D2 or D3")
     }
-    pub fn add_generator(&mut self, name: &'static str, g: Box<dyn Generator2>) {
-        self.generators.insert(name, g);
+    pub fn add_shape<D: Dim>(&mut self, def: ShapeKindDef<D>) {
+        self.tables_mut::<D>().shapes.insert(def.name, def);
+    }
+    pub fn add_detector<D: Dim>(&mut self, a: &'static str, b: &'static str, d: Arc<dyn PairDetector<D>>) {
+        self.tables_mut::<D>().detectors.insert((a, b), d);
+    }
+    pub fn add_generator<D: Dim>(&mut self, name: &'static str, g: Box<dyn Generator<D>>) {
+        self.tables_mut::<D>().generators.insert(name, g);
     }
     pub fn add_law(&mut self, def: LawDef) {
         self.laws.insert(def.name, def);
@@ -243,23 +131,22 @@ impl Registry {
     pub fn writer(&self, name: &str) -> Option<fn() -> Box<dyn Writer2>> {
         self.writers.get(name).copied()
     }
-    pub fn shape_kinds(&self) -> Vec<&'static str> {
-        self.shapes.keys().copied().collect()
+    /// The shape kinds of dimension D.
+    pub fn shape_kinds<D: Dim>(&self) -> Vec<&'static str> {
+        self.tables::<D>().shapes.keys().copied().collect()
     }
-    pub fn generator_names(&self) -> Vec<&'static str> {
-        self.generators.keys().copied().collect()
+    pub fn generator_names<D: Dim>(&self) -> Vec<&'static str> {
+        self.tables::<D>().generators.keys().copied().collect()
     }
     pub fn law_names(&self) -> Vec<&'static str> {
         self.laws.keys().copied().collect()
     }
     /// The detector for a pair of kinds, and whether the registered order is (b, a).
-    pub fn detector(&self, a: &str, b: &str) -> Option<(Arc<dyn PairDetector2>, bool)> {
-        if let Some((_, d)) = self.detectors.iter().find(|((x, y), _)| *x == a && *y == b) {
+    pub fn detector<D: Dim>(&self, a: &str, b: &str) -> Option<(Arc<dyn PairDetector<D>>, bool)> {
+        let d = &self.tables::<D>().detectors;
+        if let Some((_, d)) = d.iter().find(|((x, y), _)| *x == a && *y == b) {
             return Some((d.clone(), false));
         }
-        self.detectors
-            .iter()
-            .find(|((x, y), _)| *x == b && *y == a)
-            .map(|(_, d)| (d.clone(), true))
+        d.iter().find(|((x, y), _)| *x == b && *y == a).map(|(_, d)| (d.clone(), true))
     }
 }

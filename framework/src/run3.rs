@@ -7,7 +7,7 @@ use crate::output::out3::{final_json3, write_vtk3, History3};
 use crate::output::vtk::VtkWriter;
 use crate::run::{dd_solver, history_sink, io, save_state_text, write_rank_totals, RunError, RunSummary};
 use crate::scene::load3::Scene3;
-use crate::world3::World3;
+use crate::world::World3;
 use std::path::Path;
 use std::time::Instant;
 

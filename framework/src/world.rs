@@ -1,11 +1,13 @@
-//! A loaded 2D scene and its state: bodies, shapes, materials, laws, drives and the
-//! contact set. Built by [`crate::scene`], advanced by [`crate::engine`].
+//! A loaded scene and its state (2D or 3D): bodies, shapes, materials, laws, drives
+//! and the contact set. Built by [`crate::scene`], advanced by [`crate::engine`].
 
 use crate::detect::{Detector, DetectorTable};
-use crate::drive::DofDrive;
+use crate::dim::{Dim, Vector, D2, D3};
+use crate::drive::BodyDrive;
+use crate::engine::PrevContact;
 use crate::law::ContactLaw;
-use crate::registry::{RawContact2, ShapeStore2};
-use crate::rigid2d::{Bodies2, Contacts2};
+use crate::model::{Bodies, Contacts};
+use crate::shape::{Aabb, RawContact, ShapeStore};
 use crate::solver::SolverSettings;
 
 /// A material: its name and density (kg/m³; per unit depth in 2D).
@@ -13,13 +15,6 @@ use crate::solver::SolverSettings;
 pub struct Material {
     pub name: String,
     pub density: f64,
-}
-
-/// The drives of one body, per degree of freedom (x, y, rot).
-#[derive(Clone, Debug, PartialEq)]
-pub struct BodyDrive2 {
-    pub body: u32,
-    pub dof: [Option<DofDrive>; 3],
 }
 
 /// Time integration settings.
@@ -33,65 +28,90 @@ pub struct TimeSettings {
     pub steps: u64,
 }
 
-/// The four walls bounding a box sample, for the solid fraction and the biaxial
-/// stresses of the history.
+/// The walls bounding a box sample (x−, x+, y−, y+ and in 3D z−, z+): the solid
+/// fraction, the stresses, ε1 (along the last axis) and the pressure drives.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BoxWalls {
-    pub left: u32,
-    pub right: u32,
-    pub bottom: u32,
-    pub top: u32,
+    /// Wall bodies, 2N used.
+    pub walls: [u32; 6],
     /// ε1 is measured from the box height at this time.
     pub strain_from: f64,
 }
 
+impl BoxWalls {
+    /// Which wall body b is (0..2N), if any.
+    pub fn wall_of(&self, b: usize, n: usize) -> Option<usize> {
+        self.walls[..2 * n].iter().position(|&x| x as usize == b)
+    }
+}
+
 /// The scene in memory.
-pub struct World2 {
-    pub bodies: Bodies2,
+pub struct World<D: Dim> {
+    pub bodies: Bodies<D>,
     /// Optional user names of bodies (for outputs), by body id.
     pub names: Vec<Option<String>>,
     /// One store per shape kind used by the scene; `bodies.shape[b].kind` indexes it.
-    pub shapes: Vec<Box<dyn ShapeStore2>>,
+    pub shapes: Vec<Box<dyn ShapeStore<D>>>,
     pub materials: Vec<Material>,
     /// Law of each material pair, `laws[ma * nm + mb]`.
     pub laws: Vec<Option<ContactLaw>>,
-    pub drives: Vec<BodyDrive2>,
-    pub gravity: [f64; 2],
+    pub drives: Vec<BodyDrive>,
+    /// Which bodies are fixed (no degree of freedom ever moves).
+    pub fixed: Vec<bool>,
+    pub gravity: D::Point,
     pub time: TimeSettings,
     pub solver: SolverSettings,
     /// Alert distance of the detection.
     pub alert: f64,
     pub box_walls: Option<BoxWalls>,
-    /// Box height when ε1 starts (set by the engine).
+    /// Box height (along the last axis) when ε1 starts (set by the engine).
     pub box_h0: Option<f64>,
-    pub detectors: DetectorTable,
+    pub detectors: DetectorTable<D>,
     /// Current time and completed steps.
     pub t: f64,
     pub step: u64,
     /// The last step's contacts (impulses kept for the warm start).
-    pub contacts: Contacts2,
-    /// Contact impulses resultant per body over the last step, Σ ±H r (N·s).
-    pub reaction: Vec<[f64; 3]>,
-    pub(crate) scratch: Scratch,
+    pub contacts: Contacts<D>,
+    /// Contact impulse resultant per body over the last step, Σ ±H r (N·s).
+    pub reaction: Vec<D::Twist>,
+    pub(crate) scratch: Scratch<D>,
 }
+
+/// The 2D world.
+pub type World2 = World<D2>;
+/// The 3D world.
+pub type World3 = World<D3>;
 
 /// Buffers reused from step to step.
-#[derive(Default)]
-pub(crate) struct Scratch {
-    pub detector: Detector,
-    pub raw: Vec<RawContact2>,
-    pub v_begin: Vec<[f64; 3]>,
+pub(crate) struct Scratch<D: Dim> {
+    pub detector: Detector<D>,
+    pub raw: Vec<RawContact<D>>,
+    pub v_begin: Vec<D::Twist>,
     pub order: Vec<u32>,
-    pub prev_keys: Vec<(crate::rigid2d::contacts::ContactKey, [f64; 2])>,
-    pub next: Contacts2,
+    pub prev_keys: Vec<PrevContact<D>>,
+    pub next: Contacts<D>,
 }
 
-impl World2 {
+impl<D: Dim> Default for Scratch<D> {
+    fn default() -> Self {
+        Scratch {
+            detector: Detector::default(),
+            raw: vec![],
+            v_begin: vec![],
+            order: vec![],
+            prev_keys: vec![],
+            next: Contacts::default(),
+        }
+    }
+}
+
+impl<D: Dim> World<D> {
     /// V⁻, the velocities at the start of the step being computed (kept by the
     /// free-velocity stage).
-    pub fn velocity_begin(&self) -> &[[f64; 3]] {
+    pub fn velocity_begin(&self) -> &[D::Twist] {
         &self.scratch.v_begin
     }
+    /// The contact law between two materials (`None`: they do not interact).
     pub fn law(&self, ma: u16, mb: u16) -> Option<ContactLaw> {
         self.laws[ma as usize * self.materials.len() + mb as usize]
     }
@@ -105,28 +125,97 @@ impl World2 {
             None => format!("body {b} ({})", self.kind_name(b)),
         }
     }
-    /// Inner box of the box sample [x0, x1] × [y0, y1] from its walls' bounding boxes.
-    pub fn box_extent(&self) -> Option<[f64; 4]> {
-        let bw = self.box_walls.as_ref()?;
-        let bb = |b: u32| {
-            let s = self.bodies.shape[b as usize];
-            self.shapes[s.kind as usize].aabb(s.index, self.bodies.pos[b as usize], self.bodies.rot[b as usize])
-        };
-        Some([bb(bw.left).max[0], bb(bw.right).min[0], bb(bw.bottom).max[1], bb(bw.top).min[1]])
+    /// Bounding box of body b at its pose.
+    pub fn aabb(&self, b: usize) -> Aabb<D> {
+        let s = self.bodies.shape[b];
+        self.shapes[s.kind as usize].aabb(s.index, self.bodies.pos[b], self.bodies.rot[b])
     }
-    /// Σ area of the grains (movable bodies of grain shapes) / box area.
+    /// Whether body b is a grain (a body of a grain shape, neither fixed nor driven).
+    pub fn is_grain(&self, b: usize) -> bool {
+        let s = self.bodies.shape[b];
+        self.shapes[s.kind as usize].is_grain() && !self.fixed[b] && !self.drives.iter().any(|d| d.body as usize == b)
+    }
+    /// The inner box of the box sample, from its walls' bounding boxes.
+    pub fn box_extent(&self) -> Option<Aabb<D>> {
+        let w = self.box_walls.as_ref()?.walls;
+        Some(Aabb {
+            min: D::Point::from_fn(|k| self.aabb(w[2 * k] as usize).max[k]),
+            max: D::Point::from_fn(|k| self.aabb(w[2 * k + 1] as usize).min[k]),
+        })
+    }
+    /// Σ grain areas (3D: volumes) / box area (volume).
     pub fn solid_fraction(&self) -> Option<f64> {
-        let [x0, x1, y0, y1] = self.box_extent()?;
-        let mut a = 0.0;
-        for b in 0..self.bodies.len() {
-            let s = self.bodies.shape[b];
-            if self.shapes[s.kind as usize].is_grain() && self.bodies.movable(b) {
-                a += self.bodies.volume[b];
+        let e = self.box_extent()?;
+        let v: f64 = (0..self.bodies.len())
+            .filter(|&b| self.is_grain(b))
+            .map(|b| self.bodies.volume[b])
+            .sum();
+        Some(v / (0..D::N).map(|k| e.max[k] - e.min[k]).product::<f64>())
+    }
+    /// The measure of the box face normal to axis `k` (2D: a length per unit depth).
+    pub fn box_face(e: &Aabb<D>, k: usize) -> f64 {
+        (0..D::N).filter(|&a| a != k).map(|a| e.max[a] - e.min[a]).product()
+    }
+    /// Mean stresses on the box walls (σ_xx, σ_yy[, σ_zz]), compression positive,
+    /// from the last step's reactions (impulse / h over the wall's face).
+    pub fn box_stresses(&self) -> Option<D::Point> {
+        let e = self.box_extent()?;
+        let w = self.box_walls.as_ref()?.walls;
+        let h = self.time.h;
+        let f = |b: u32, k: usize| self.reaction.get(b as usize).map_or(0.0, |r| r[k]) / h;
+        Some(D::Point::from_fn(|k| {
+            0.5 * (f(w[2 * k + 1], k) - f(w[2 * k], k)) / Self::box_face(&e, k)
+        }))
+    }
+    /// Number of contacts carrying a normal impulse, per body.
+    pub fn loaded_contacts(&self) -> Vec<u32> {
+        let mut count = vec![0u32; self.bodies.len()];
+        let c = &self.contacts;
+        for a in 0..c.len() {
+            if c.r[a][0] > 0.0 {
+                for b in c.bodies[a] {
+                    count[b as usize] += 1;
+                }
             }
         }
-        Some(a / ((x1 - x0) * (y1 - y0)))
+        count
     }
-    /// Energies (kinetic, gravity potential) of the bodies impulses can move.
+    /// Coordination numbers over the grains: `z` = 2 N_c / N_g with N_c the
+    /// grain–grain contacts carrying a normal impulse, and `z_m`, the same without
+    /// the rattlers (grains with fewer than 2 loaded contacts, walls included),
+    /// counting grain–grain contacts between non-rattlers and the non-rattlers'
+    /// wall contacts once.
+    pub fn coordination(&self) -> (f64, f64) {
+        let n = self.bodies.len();
+        let grain: Vec<bool> = (0..n).map(|b| self.is_grain(b)).collect();
+        let count = self.loaded_contacts();
+        let c = &self.contacts;
+        let ng = grain.iter().filter(|&&g| g).count();
+        let ngg = (0..c.len())
+            .filter(|&a| c.r[a][0] > 0.0 && c.bodies[a].iter().all(|&b| grain[b as usize]))
+            .count();
+        let (mut sum_m, mut n_m) = (0usize, 0usize);
+        for b in 0..n {
+            if grain[b] && count[b] >= 2 {
+                n_m += 1;
+                sum_m += count[b] as usize;
+            }
+        }
+        let z = if ng > 0 { 2.0 * ngg as f64 / ng as f64 } else { 0.0 };
+        let z_m = if n_m > 0 { sum_m as f64 / n_m as f64 } else { 0.0 };
+        (z, z_m)
+    }
+    /// The largest grain size (radius of a disk or sphere).
+    pub fn max_grain_size(&self) -> f64 {
+        (0..self.bodies.len())
+            .filter(|&b| self.is_grain(b))
+            .map(|b| {
+                let s = self.bodies.shape[b];
+                self.shapes[s.kind as usize].size(s.index)
+            })
+            .fold(0.0, f64::max)
+    }
+    /// Kinetic energy and gravity potential of the bodies impulses can move.
     pub fn energies(&self) -> (f64, f64) {
         let (mut ek, mut ep) = (0.0, 0.0);
         let b = &self.bodies;
@@ -134,9 +223,8 @@ impl World2 {
             if !b.movable(k) {
                 continue;
             }
-            let (v, m, i, x) = (b.vel[k], b.mass[k], b.inertia[k], b.pos[k]);
-            ek += 0.5 * (m * v[0] * v[0] + m * v[1] * v[1] + i * v[2] * v[2]);
-            ep -= m * (self.gravity[0] * x[0] + self.gravity[1] * x[1]);
+            ek += D::kinetic_energy(b.mass[k], &b.inertia[k], &b.rot[k], &b.vel[k]);
+            ep -= b.mass[k] * self.gravity.dot(&b.pos[k]);
         }
         (ek, ep)
     }

@@ -46,7 +46,7 @@ fn compaction(mu: f64) -> (f64, f64, f64) {
     let _ = std::fs::remove_dir_all(&dir);
     // relative to the energy scale of the loading, p × V_box (rigid grains)
     let e = w.box_extent().unwrap();
-    let pv = 1e4 * (e[1] - e[0]) * (e[3] - e[2]) * (e[5] - e[4]);
+    let pv = 1e4 * (0..3).map(|k| e.max[k] - e.min[k]).product::<f64>();
     (nu_bulk, z_bulk, ek / pv)
 }
 

@@ -178,8 +178,8 @@ rigid_family!(
     Rigid2, D2, crate::world::World2, 2
 );
 rigid_family!(
-    /// 3D rigid bodies ([`crate::rigid3d`], [`crate::world3::World3`]).
-    Rigid3, D3, crate::world3::World3, 3
+    /// 3D rigid bodies ([`crate::rigid3d`], [`crate::world::World3`]).
+    Rigid3, D3, crate::world::World3, 3
 );
 
 pub use crate::dim::d3::InvMass3;

@@ -92,7 +92,24 @@ impl Dim for D2 {
     type Block = Block2;
     type InvMass = [f64; 3];
     type Inertia = f64;
+    type RotVec = f64;
 
+    fn rot_identity() -> f64 {
+        0.0
+    }
+    fn rot_from_vec(r: &f64) -> f64 {
+        *r
+    }
+    fn rot_to_vec(r: &f64) -> f64 {
+        *r
+    }
+    fn rotate(r: &f64, p: &[f64; 2]) -> [f64; 2] {
+        let (s, c) = r.sin_cos();
+        [c * p[0] - s * p[1], s * p[0] + c * p[1]]
+    }
+    fn rot_mul(a: &f64, b: &f64) -> f64 {
+        a + b
+    }
     fn normalize_rot(r: f64) -> f64 {
         r
     }
@@ -116,6 +133,17 @@ impl Dim for D2 {
         pos[0] += dq[0];
         pos[1] += dq[1];
         *rot += dq[2];
+    }
+    fn kinetic_energy(m: f64, i: &f64, _rot: &f64, v: &[f64; 3]) -> f64 {
+        0.5 * (m * v[0] * v[0] + m * v[1] * v[1] + i * v[2] * v[2])
+    }
+    #[inline]
+    fn free_flight(v: &mut [f64; 3], m: f64, _i: &f64, _rot: &f64, im: &[f64; 3], g: &[f64; 2], h: f64) {
+        v[0] += h * im[0] * m * g[0];
+        v[1] += h * im[1] * m * g[1];
+    }
+    fn apply_moment(v: &mut [f64; 3], i: &f64, _inv: &[f64; 3], _axis: usize, hm: f64) {
+        v[2] += hm / i;
     }
     fn rot_finite(r: &f64) -> bool {
         r.is_finite()

@@ -224,7 +224,23 @@ impl Dim for D3 {
     type Block = Block3;
     type InvMass = InvMass3;
     type Inertia = [f64; 3];
+    type RotVec = [f64; 3];
 
+    fn rot_identity() -> [f64; 4] {
+        [1.0, 0.0, 0.0, 0.0]
+    }
+    fn rot_from_vec(r: &[f64; 3]) -> [f64; 4] {
+        rotation::from_rotation_vector(*r)
+    }
+    fn rot_to_vec(q: &[f64; 4]) -> [f64; 3] {
+        rotation::to_rotation_vector(*q)
+    }
+    fn rotate(q: &[f64; 4], p: &[f64; 3]) -> [f64; 3] {
+        rotation::rotate(*q, *p)
+    }
+    fn rot_mul(a: &[f64; 4], b: &[f64; 4]) -> [f64; 4] {
+        rotation::normalize(rotation::quat_mul(*a, *b))
+    }
     fn normalize_rot(q: [f64; 4]) -> [f64; 4] {
         rotation::normalize(q)
     }
@@ -250,6 +266,37 @@ impl Dim for D3 {
         let rot = [h * vm[3], h * vm[4], h * vm[5]];
         if rot != [0.0; 3] {
             *q = rotation::normalize(rotation::quat_mul(rotation::from_rotation_vector(rot), *q));
+        }
+    }
+    fn kinetic_energy(m: f64, i: &[f64; 3], q: &[f64; 4], v: &[f64; 6]) -> f64 {
+        let iw = world_inertia(q, i);
+        let w = [v[3], v[4], v[5]];
+        let iwv = coulomb::mul(&iw, w);
+        0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) + 0.5 * (w[0] * iwv[0] + w[1] * iwv[1] + w[2] * iwv[2])
+    }
+    #[inline]
+    fn free_flight(v: &mut [f64; 6], m: f64, i: &[f64; 3], q: &[f64; 4], inv: &InvMass3, g: &[f64; 3], h: f64) {
+        for a in 0..3 {
+            v[a] += h * inv.m[a] * m * g[a];
+        }
+        if !Self::isotropic(i) {
+            // gyroscopic torque −ω × (I_w ω), explicit
+            let iw = world_inertia(q, i);
+            let om = [v[3], v[4], v[5]];
+            let l = coulomb::mul(&iw, om);
+            let tq = cross(om, l);
+            let dw = coulomb::mul(&inv.i, [-h * tq[0], -h * tq[1], -h * tq[2]]);
+            for a in 0..3 {
+                v[3 + a] += dw[a];
+            }
+        }
+    }
+    fn apply_moment(v: &mut [f64; 6], _i: &[f64; 3], inv: &InvMass3, axis: usize, hm: f64) {
+        let mut tq = [0.0; 3];
+        tq[axis] = hm;
+        let dw = coulomb::mul(&inv.i, tq);
+        for a in 0..3 {
+            v[3 + a] += dw[a];
         }
     }
     fn rot_finite(q: &[f64; 4]) -> bool {

@@ -94,8 +94,15 @@ macro_rules! vector {
 }
 vector!(2 3 4 6);
 
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for super::D2 {}
+    impl Sealed for super::D3 {}
+}
+
 /// What differs between 2D and 3D rigid bodies and their contacts (module docs).
-pub trait Dim: Copy + Default + Debug + PartialEq + Send + Sync + 'static {
+/// Sealed: the two dimensions are [`D2`] and [`D3`].
+pub trait Dim: sealed::Sealed + Copy + Default + Debug + PartialEq + Send + Sync + 'static {
     /// Space dimension (2 or 3).
     const N: usize;
     /// Degrees of freedom of a rigid body (3 or 6).
@@ -121,7 +128,20 @@ pub trait Dim: Copy + Default + Debug + PartialEq + Send + Sync + 'static {
     /// A body's rotational inertia: I about the centre in 2D, the principal
     /// moments (body frame) in 3D.
     type Inertia: Pod;
+    /// A rotation as a vector, as scene files give it: the angle (rad) in 2D, the
+    /// rotation vector (axis × angle) in 3D.
+    type RotVec: Pod;
 
+    /// The identity orientation.
+    fn rot_identity() -> Self::Rot;
+    /// The orientation of a rotation vector.
+    fn rot_from_vec(r: &Self::RotVec) -> Self::Rot;
+    /// The rotation vector of an orientation.
+    fn rot_to_vec(r: &Self::Rot) -> Self::RotVec;
+    /// `r p`: a body-frame vector in the world frame.
+    fn rotate(r: &Self::Rot, p: &Self::Point) -> Self::Point;
+    /// `a ∘ b`: the rotation b, then a.
+    fn rot_mul(a: &Self::Rot, b: &Self::Rot) -> Self::Rot;
     /// A valid orientation close to `r` (3D: the quaternion normalised).
     fn normalize_rot(r: Self::Rot) -> Self::Rot;
     /// M̂⁻¹ of a body of mass m and inertia I at orientation `rot`, restricted to the
@@ -135,6 +155,16 @@ pub trait Dim: Copy + Default + Debug + PartialEq + Send + Sync + 'static {
     /// The θ-method's position update `q⁺ = q⁻ + h((1 − θ)V⁻ + θV⁺)` (3D: the
     /// rotation increment applied as an exact rotation).
     fn integrate(pos: &mut Self::Point, rot: &mut Self::Rot, v0: &Self::Twist, v1: &Self::Twist, h: f64, theta: f64);
+    /// ½ Vᵀ M V of a body.
+    fn kinetic_energy(mass: f64, inertia: &Self::Inertia, rot: &Self::Rot, v: &Self::Twist) -> f64;
+    /// The free-flight increment of a movable body's velocity over a step:
+    /// `h M̂⁻¹ m g` on its translations and, in 3D, the explicit gyroscopic torque
+    /// `−ω × (I_w ω)` of a body whose inertia is not isotropic.
+    #[allow(clippy::too_many_arguments)]
+    fn free_flight(v: &mut Self::Twist, mass: f64, inertia: &Self::Inertia, rot: &Self::Rot, inv: &Self::InvMass, g: &Self::Point, h: f64);
+    /// An imposed moment's impulse `hm` about the world axis `axis` (2D: the only
+    /// one): ω += I⁻¹ hm.
+    fn apply_moment(v: &mut Self::Twist, inertia: &Self::Inertia, inv: &Self::InvMass, axis: usize, hm: f64);
     /// Whether an orientation is finite.
     fn rot_finite(r: &Self::Rot) -> bool;
 

@@ -87,11 +87,11 @@ pub fn problem_from_world(w: &World2) -> FcProblem {
 }
 
 /// The local problem of the last step of a 3D world (call it right after
-/// [`crate::world3::World3::step`]): with `H_bᵀ` (3 × 6) of contact α seen from body b,
+/// [`crate::world::World3::step`]): with `H_bᵀ` (3 × 6) of contact α seen from body b,
 /// rows `(e_k, d_b × e_k)` for the frame vectors e_k = n, t1, t2 (+ for the candidate,
 /// − for the antagonist), `W_αβ = Σ_b H_bαᵀ M̂_b⁻¹ H_bβ` with `M̂_b⁻¹ = diag(m⁻¹) ⊕
 /// I_w⁻¹`, and `q_α = (u_free,n − ū, u_free,t1, u_free,t2)`.
-pub fn problem_from_world3(w: &crate::world3::World3) -> FcProblem {
+pub fn problem_from_world3(w: &crate::world::World3) -> FcProblem {
     use crate::rigid3d::bodies::cross;
     let c = &w.contacts;
     let b = &w.bodies;

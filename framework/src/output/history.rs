@@ -111,14 +111,15 @@ impl<W: Write> History<W> {
 /// stresses σ1 = (|F_top| + |F_bottom|)/(2W) and σ2 = (|F_left| + |F_right|)/(2H)
 /// from the contact forces on the walls, and sin φ = (σ1 − σ2)/(σ1 + σ2).
 pub fn box_measures(w: &World2) -> (f64, f64, f64, f64, f64) {
-    let (Some(bw), Some([x0, x1, y0, y1])) = (&w.box_walls, w.box_extent()) else {
+    let (Some(bw), Some(e)) = (&w.box_walls, w.box_extent()) else {
         return (f64::NAN, f64::NAN, f64::NAN, f64::NAN, f64::NAN);
     };
     let h = w.time.h;
-    let (width, height) = (x1 - x0, y1 - y0);
+    let (width, height) = (e.max[0] - e.min[0], e.max[1] - e.min[1]);
+    let [left, right, bottom, top, ..] = bw.walls;
     let f = |b: u32, k: usize| w.reaction[b as usize][k].abs() / h;
-    let s1 = (f(bw.top, 1) + f(bw.bottom, 1)) / (2.0 * width);
-    let s2 = (f(bw.left, 0) + f(bw.right, 0)) / (2.0 * height);
+    let s1 = (f(top, 1) + f(bottom, 1)) / (2.0 * width);
+    let s2 = (f(left, 0) + f(right, 0)) / (2.0 * height);
     let sphi = if s1 + s2 > 0.0 { (s1 - s2) / (s1 + s2) } else { 0.0 };
     let eps1 = w.box_h0.map(|h0| (h0 - height) / h0).unwrap_or(0.0);
     (w.solid_fraction().unwrap_or(f64::NAN), eps1, s1, s2, sphi)

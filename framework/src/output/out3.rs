@@ -12,9 +12,9 @@
 use super::history::{solver_fields, SOLVER_COLUMNS};
 use super::vtk::{cells, export, piece, VtkWriter};
 use crate::engine::StepReport;
-use crate::registry3::Glyph3;
 use crate::rigid3d::bodies::to_rotation_vector;
-use crate::world3::World3;
+use crate::shape::Glyph3;
+use crate::world::World3;
 use serde::Serialize;
 use std::io::Write;
 use std::path::Path;
@@ -106,8 +106,8 @@ impl<W: Write> History3<W> {
         }
         if self.has_box {
             let nu = w.solid_fraction().unwrap_or(f64::NAN);
-            let e = w.box_extent().unwrap_or([f64::NAN; 6]);
-            let eps1 = w.box_h0.map_or(0.0, |h0| (h0 - (e[5] - e[4])) / h0);
+            let h = w.box_extent().map_or(f64::NAN, |e| e.max[2] - e.min[2]);
+            let eps1 = w.box_h0.map_or(0.0, |h0| (h0 - h) / h0);
             let sg = w.box_stresses().unwrap_or([f64::NAN; 3]);
             let p = (sg[0] + sg[1] + sg[2]) / 3.0;
             let q = sg[2] - 0.5 * (sg[0] + sg[1]);
@@ -244,9 +244,17 @@ pub fn write_vtk3(v: &mut VtkWriter, w: &World3, dir: &Path, frame: u32) -> std:
         omega.extend_from_slice(&b.vel[k][3..]);
         id.push(k as f64);
         mat.push(b.material[k] as f64);
-        match glyph {
-            Glyph3::Sphere(r) => radius.push(r),
-            Glyph3::Faces(faces) => {
+        let faces = match glyph {
+            Glyph3::Ball(r) => {
+                radius.push(r);
+                continue;
+            }
+            Glyph3::Faces(faces) => faces,
+            Glyph3::Polygon(p) => vec![p],
+            Glyph3::Segment(p, q, _) => vec![vec![p, q]],
+        };
+        {
+            {
                 radius.push(0.0);
                 for f in faces {
                     for p in f {

@@ -113,7 +113,7 @@ impl VtkWriter {
             let glyph = store.glyph(s.index, b.pos[k], b.rot[k]);
             pts.extend_from_slice(&[b.pos[k][0], b.pos[k][1], 0.0]);
             radius.push(match glyph {
-                Glyph2::Disk(r) => r,
+                Glyph2::Ball(r) => r,
                 _ => store.size(s.index),
             });
             vel.extend_from_slice(&[b.vel[k][0], b.vel[k][1], 0.0]);
@@ -122,8 +122,9 @@ impl VtkWriter {
             id.push(k as f64);
             mat.push(b.material[k] as f64);
             let poly: Vec<[f64; 2]> = match glyph {
-                Glyph2::Disk(_) => continue,
+                Glyph2::Ball(_) => continue,
                 Glyph2::Polygon(p) => p,
+                Glyph2::Faces(f) => f.concat(),
                 Glyph2::Segment(p, q, th) => {
                     let d = [q[0] - p[0], q[1] - p[1]];
                     let l = (d[0] * d[0] + d[1] * d[1]).sqrt().max(f64::MIN_POSITIVE);

@@ -1,9 +1,10 @@
-//! Incremental construction of a 2D scene, used by the loader for explicit bodies
-//! and by plugins' generators.
+//! Incremental construction of a scene (2D or 3D), used by the loader for explicit
+//! bodies and by plugins' generators.
 
-use crate::registry::{ParamError, Registry, ShapeStore2};
-use crate::rigid2d::bodies::ShapeRef;
-use crate::rigid2d::Bodies2;
+use crate::dim::{Dim, Vector, D2, D3};
+use crate::drive::{BodyDrive, DofDrive};
+use crate::model::{Bodies, ShapeRef};
+use crate::registry::{ParamError, Registry, ShapeStore};
 use crate::world::Material;
 use std::collections::BTreeMap;
 
@@ -31,28 +32,37 @@ pub(crate) fn material_param(materials: &[Material], params: &toml::Table, key: 
 }
 
 /// Bodies under construction, with the shape stores of the kinds they use.
-pub struct SceneBuilder2<'r> {
+pub struct SceneBuilder<'r, D: Dim> {
     pub(crate) registry: &'r Registry,
-    pub(crate) bodies: Bodies2,
+    pub(crate) bodies: Bodies<D>,
     pub(crate) names: Vec<Option<String>>,
-    pub(crate) shapes: Vec<Box<dyn ShapeStore2>>,
+    pub(crate) fixed: Vec<bool>,
+    pub(crate) shapes: Vec<Box<dyn ShapeStore<D>>>,
     pub(crate) kind_ids: BTreeMap<&'static str, u16>,
     pub(crate) materials: Vec<Material>,
     pub(crate) origins: Vec<Origin>,
     pub(crate) origin: Origin,
+    pub(crate) drives: Vec<BodyDrive>,
 }
 
-impl<'r> SceneBuilder2<'r> {
+/// The 2D builder.
+pub type SceneBuilder2<'r> = SceneBuilder<'r, D2>;
+/// The 3D builder.
+pub type SceneBuilder3<'r> = SceneBuilder<'r, D3>;
+
+impl<'r, D: Dim> SceneBuilder<'r, D> {
     pub(crate) fn new(registry: &'r Registry, materials: Vec<Material>) -> Self {
-        SceneBuilder2 {
+        SceneBuilder {
             registry,
-            bodies: Bodies2::default(),
+            bodies: Bodies::default(),
             names: vec![],
+            fixed: vec![],
             shapes: vec![],
             kind_ids: BTreeMap::new(),
             materials,
             origins: vec![],
             origin: Origin::Body(0),
+            drives: vec![],
         }
     }
 
@@ -71,7 +81,7 @@ impl<'r> SceneBuilder2<'r> {
         if let Some(&k) = self.kind_ids.get(name) {
             return Some(k);
         }
-        let (&static_name, def) = self.registry.shapes.get_key_value(name)?;
+        let (&static_name, def) = self.registry.tables::<D>().shapes.get_key_value(name)?;
         let id = self.shapes.len() as u16;
         self.shapes.push((def.new_store)());
         self.kind_ids.insert(static_name, id);
@@ -83,21 +93,35 @@ impl<'r> SceneBuilder2<'r> {
         self.shapes.get_mut(kind as usize)?.as_any_mut().downcast_mut::<T>()
     }
 
-    pub fn store(&self, kind: u16) -> &dyn ShapeStore2 {
+    pub fn store(&self, kind: u16) -> &dyn ShapeStore<D> {
         self.shapes[kind as usize].as_ref()
     }
 
-    /// Adds a body whose shape is `shape` (already in its store); mass and inertia
-    /// come from the shape and the material's density.
-    pub fn add_body(&mut self, shape: ShapeRef, material: u16, pos: [f64; 2], rot: f64, vel: [f64; 3]) -> u32 {
-        let mp = self.shapes[shape.kind as usize].mass_properties(shape.index, self.materials[material as usize].density);
+    /// Adds a body whose shape is `shape` (already in its store), placed at `pos`
+    /// with the orientation of the rotation vector `rot` (2D: the angle); mass and
+    /// inertia come from the shape and the material's density. A shape not given
+    /// in its principal frame is moved so that the body's position is its centre
+    /// of mass ([`ShapeStore::principal_frame`]).
+    pub fn add_body(&mut self, shape: ShapeRef, material: u16, pos: D::Point, rot: D::RotVec, vel: D::Twist) -> u32 {
+        let store = &self.shapes[shape.kind as usize];
+        let mp = store.mass_properties(shape.index, self.materials[material as usize].density);
+        let (c, rc) = store.principal_frame(shape.index);
+        let mut q = D::rot_from_vec(&rot);
+        let mut pos = pos;
+        if !c.is_zero() || rc != D::rot_identity() {
+            let dc = D::rotate(&q, &c);
+            pos = D::Point::from_fn(|k| pos[k] + dc[k]);
+            q = D::rot_mul(&q, &rc);
+        }
         self.names.push(None);
+        self.fixed.push(false);
         self.origins.push(self.origin);
-        self.bodies.push(pos, rot, vel, mp.mass, mp.inertia, mp.area, shape, material)
+        self.bodies.push(pos, q, vel, mp.mass, mp.inertia, mp.volume, shape, material)
     }
 
     /// Makes a body immovable.
     pub fn set_fixed(&mut self, b: u32) {
+        self.fixed[b as usize] = true;
         self.bodies.set_fixed(b as usize);
     }
 
@@ -106,7 +130,24 @@ impl<'r> SceneBuilder2<'r> {
     }
 
     /// Position of body b.
-    pub fn position(&self, b: u32) -> [f64; 2] {
+    pub fn position(&self, b: u32) -> D::Point {
         self.bodies.pos[b as usize]
+    }
+
+    /// Drives the degrees of freedom of a body (2D: x, y, rot; 3D: x, y, z, rx,
+    /// ry, rz; `None`: free). A generator that drives a body by velocity sets its
+    /// initial velocity to the drive's value at t = 0 ([`Self::set_velocity`]).
+    pub fn drive(&mut self, b: u32, dof: [Option<DofDrive>; 6]) {
+        self.drives.push(BodyDrive { body: b, dof });
+    }
+
+    /// Sets a body's initial velocity (v, ω in world axes).
+    pub fn set_velocity(&mut self, b: u32, vel: D::Twist) {
+        self.bodies.vel[b as usize] = vel;
+    }
+
+    /// Sets a body's name (for outputs and `[output] box`).
+    pub fn set_name(&mut self, b: u32, name: &str) {
+        self.names[b as usize] = Some(name.to_string());
     }
 }

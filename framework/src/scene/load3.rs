@@ -5,18 +5,20 @@
 //! and the key, as in 2D.
 
 use super::builder::Origin;
-use super::builder3::SceneBuilder3;
+use super::builder::SceneBuilder3;
 use super::locate::Seg;
 use super::schema::{BodySpec3, SceneFile};
 use super::{
-    alert_distance, at, check_overlaps, k, laws, laws_and_detectors, materials, origin_path, parse, time_settings, validate_solver,
-    BodyInfo, Ctx, OutputSettings,
+    alert_distance, at, check_overlaps, k, laws, laws_and_detectors, materials, parse, time_settings, validate_solver, BodyInfo, Ctx,
+    OutputSettings,
 };
-use crate::detect3::{Detector3, DetectorTable3};
+use crate::detect::{Detector, DetectorTable};
+use crate::dim::D3;
+use crate::drive::BodyDrive;
 use crate::error::InputError;
 use crate::registry::{ParamError, Registry};
 use crate::rigid2d::bodies::ShapeRef;
-use crate::world3::{BodyDrive3, BoxWalls3, World3};
+use crate::world::{BoxWalls, World3};
 
 /// A loaded 3D scene: the world and how to write it.
 pub struct Scene3 {
@@ -62,13 +64,13 @@ pub fn load_str_with(text: &str, file: &str, registry: &Registry, deformable: bo
     add_bodies(&cx, &sf, &mut b, &mut drives)?;
     for (g, spec) in sf.generate.iter().enumerate() {
         let base = [k("generate"), Seg::Index(g)];
-        let gen = registry.generators3.get(spec.kind.as_str()).ok_or_else(|| {
+        let gen = registry.tables::<D3>().generators.get(spec.kind.as_str()).ok_or_else(|| {
             cx.err(
                 &at(&base, &[k("kind")]),
                 format!(
                     "unknown 3D generator `{}`; installed: {}",
                     spec.kind,
-                    registry.generator_names3().join(", ")
+                    registry.generator_names::<D3>().join(", ")
                 ),
             )
         })?;
@@ -81,7 +83,7 @@ pub fn load_str_with(text: &str, file: &str, registry: &Registry, deformable: bo
         return Err(cx.err(&[], "the scene has no bodies"));
     }
     let n = b.bodies.len();
-    let driven: Vec<bool> = (0..n).map(|i| drives.iter().any(|d: &BodyDrive3| d.body as usize == i)).collect();
+    let driven: Vec<bool> = (0..n).map(|i| drives.iter().any(|d: &BodyDrive| d.body as usize == i)).collect();
     let info: Vec<BodyInfo> = (0..n)
         .map(|i| BodyInfo {
             material: b.bodies.material[i] as usize,
@@ -91,16 +93,18 @@ pub fn load_str_with(text: &str, file: &str, registry: &Registry, deformable: bo
         })
         .collect();
     let kinds: Vec<&'static str> = b.shapes.iter().map(|x| x.kind()).collect();
-    let table = DetectorTable3 {
+    let table = DetectorTable {
         nk: kinds.len(),
-        table: laws_and_detectors(&cx, &info, &b.materials, &kinds, &laws, &declared, |x, y| registry.detector3(x, y))?,
+        table: laws_and_detectors(&cx, &info, &b.materials, &kinds, &laws, &declared, |x, y| {
+            registry.detector::<D3>(x, y)
+        })?,
     };
     let sizes: Vec<f64> = (0..n)
         .map(|i| b.shapes[b.bodies.shape[i].kind as usize].size(b.bodies.shape[i].index))
         .collect();
     let alert = alert_distance(&cx, &sf.detection, &sizes)?;
     let mut raw = vec![];
-    Detector3::default().detect(&b.bodies, &b.shapes, &table, 0.0, &mut raw);
+    Detector::default().detect(&b.bodies, &b.shapes, &table, 0.0, &mut raw);
     let contacts = raw.iter().map(|rc| (rc.i as usize, rc.j as usize, rc.gap));
     let material = |x: usize| b.bodies.material[x] as usize;
     check_overlaps(&cx, &sf.detection, contacts, &sizes, &laws, nm, material, &b.names, &b.origins)?;
@@ -114,7 +118,7 @@ pub fn load_str_with(text: &str, file: &str, registry: &Registry, deformable: bo
                     .map(|p| p as u32)
                     .ok_or_else(|| cx.err(&[k("output"), k("box3"), k(key)], format!("no body is named `{name}`")))
             };
-            Some(BoxWalls3 {
+            Some(BoxWalls {
                 walls: [
                     find("xmin", &bs.xmin)?,
                     find("xmax", &bs.xmax)?,
@@ -127,23 +131,14 @@ pub fn load_str_with(text: &str, file: &str, registry: &Registry, deformable: bo
             })
         }
     };
-    // a pressure drive pushes a wall of the box sample along the wall's axis
-    for d in &drives {
-        for (dof, drv) in d.dof.iter().enumerate() {
-            if !drv.as_ref().is_some_and(|x| x.has_pressure()) {
-                continue;
-            }
-            let wall = box_walls.as_ref().and_then(|bw| bw.walls.iter().position(|&x| x == d.body));
-            if wall.is_none_or(|wl| wl / 2 != dof) {
-                let name = ["x", "y", "z", "rx", "ry", "rz"][dof];
-                let base = origin_path(b.origins[d.body as usize], "drive");
-                return Err(cx.err(
-                    &at(&base, &[k(name)]),
-                    "a pressure drive needs the body to be a wall of `[output] box3`, driven along its own axis (x for xmin/xmax, ...)",
-                ));
-            }
-        }
-    }
+    super::check_pressure_drives(
+        &cx,
+        &drives,
+        box_walls.as_ref(),
+        &b.origins,
+        &["x", "y", "z", "rx", "ry", "rz"],
+        "box3",
+    )?;
     if let Some(w) = sf.output.writers.first() {
         return Err(cx.err(
             &[k("output"), k("writers"), Seg::Index(0)],
@@ -191,7 +186,7 @@ pub fn load_str_with(text: &str, file: &str, registry: &Registry, deformable: bo
     ))
 }
 
-fn add_bodies(cx: &Ctx, sf: &SceneFile<BodySpec3>, b: &mut SceneBuilder3, drives: &mut Vec<BodyDrive3>) -> Result<(), InputError> {
+fn add_bodies(cx: &Ctx, sf: &SceneFile<BodySpec3>, b: &mut SceneBuilder3, drives: &mut Vec<BodyDrive>) -> Result<(), InputError> {
     for (i, spec) in sf.bodies.iter().enumerate() {
         let base = [k("bodies"), Seg::Index(i)];
         let p = |key: &str| at(&base, &[k(key)]);
@@ -202,7 +197,7 @@ fn add_bodies(cx: &Ctx, sf: &SceneFile<BodySpec3>, b: &mut SceneBuilder3, drives
                 format!(
                     "unknown 3D shape `{}`; installed: {}",
                     spec.shape,
-                    b.registry.shape_kinds3().join(", ")
+                    b.registry.shape_kinds::<D3>().join(", ")
                 ),
             )
         })?;
@@ -253,7 +248,7 @@ fn add_bodies(cx: &Ctx, sf: &SceneFile<BodySpec3>, b: &mut SceneBuilder3, drives
                     dof[slot] = Some(dd.clone());
                 }
             }
-            drives.push(BodyDrive3 { body: id, dof });
+            drives.push(BodyDrive { body: id, dof });
         }
     }
     Ok(())

@@ -8,7 +8,6 @@
 //! degrees of freedom that do not exist.
 
 pub mod builder;
-pub mod builder3;
 pub mod load3;
 pub mod locate;
 pub mod restart;
@@ -16,9 +15,11 @@ pub mod restart3;
 pub mod schema;
 
 use crate::detect::{Detector, DetectorTable};
+use crate::dim::D2;
+use crate::drive::BodyDrive;
 use crate::error::{line_of, InputError};
 use crate::registry::{ParamError, Registry};
-use crate::world::{BodyDrive2, BoxWalls, Material, TimeSettings, World2};
+use crate::world::{BoxWalls, Material, TimeSettings, World2};
 use builder::{Origin, SceneBuilder2};
 use locate::{locate, path_string, Seg};
 pub use restart::restart;
@@ -329,13 +330,13 @@ fn load_parsed(cx: &Ctx, sf: SceneFile, registry: &Registry) -> Result<Scene, In
     add_bodies(&cx, &sf, &mut b, &mut drives)?;
     for (g, spec) in sf.generate.iter().enumerate() {
         let base = [k("generate"), Seg::Index(g)];
-        let gen = registry.generators.get(spec.kind.as_str()).ok_or_else(|| {
+        let gen = registry.tables::<D2>().generators.get(spec.kind.as_str()).ok_or_else(|| {
             cx.err(
                 &at(&base, &[k("kind")]),
                 format!(
                     "unknown generator `{}`; installed: {}",
                     spec.kind,
-                    registry.generator_names().join(", ")
+                    registry.generator_names::<D2>().join(", ")
                 ),
             )
         })?;
@@ -353,14 +354,16 @@ fn load_parsed(cx: &Ctx, sf: SceneFile, registry: &Registry) -> Result<Scene, In
         .map(|i| BodyInfo {
             material: b.bodies.material[i] as usize,
             kind: b.bodies.shape[i].kind as usize,
-            movable: b.bodies.movable(i) || drives.iter().any(|d: &BodyDrive2| d.body as usize == i),
+            movable: b.bodies.movable(i) || drives.iter().any(|d: &BodyDrive| d.body as usize == i),
             origin: b.origins[i],
         })
         .collect();
     let kinds: Vec<&'static str> = b.shapes.iter().map(|x| x.kind()).collect();
     let table = DetectorTable {
         nk: kinds.len(),
-        table: laws_and_detectors(&cx, &info, &b.materials, &kinds, &laws, &declared, |x, y| registry.detector(x, y))?,
+        table: laws_and_detectors(&cx, &info, &b.materials, &kinds, &laws, &declared, |x, y| {
+            registry.detector::<D2>(x, y)
+        })?,
     };
     let sizes: Vec<f64> = (0..b.bodies.len())
         .map(|i| b.shapes[b.bodies.shape[i].kind as usize].size(b.bodies.shape[i].index))
@@ -382,15 +385,14 @@ fn load_parsed(cx: &Ctx, sf: SceneFile, registry: &Registry) -> Result<Scene, In
                     .map(|p| p as u32)
                     .ok_or_else(|| cx.err(&[k("output"), k("box"), k(key)], format!("no body is named `{name}`")))
             };
+            let (l, r) = (find("left", &bs.left)?, find("right", &bs.right)?);
             Some(BoxWalls {
-                left: find("left", &bs.left)?,
-                right: find("right", &bs.right)?,
-                bottom: find("bottom", &bs.bottom)?,
-                top: find("top", &bs.top)?,
+                walls: [l, r, find("bottom", &bs.bottom)?, find("top", &bs.top)?, u32::MAX, u32::MAX],
                 strain_from: bs.strain_from,
             })
         }
     };
+    check_pressure_drives(&cx, &drives, box_walls.as_ref(), &b.origins, &["x", "y", "rot"], "box")?;
     for (i, w) in sf.output.writers.iter().enumerate() {
         if !registry.writers.contains_key(w.as_str()) {
             return Err(cx.err(&[k("output"), k("writers"), Seg::Index(i)], format!("unknown writer `{w}`")));
@@ -409,6 +411,7 @@ fn load_parsed(cx: &Ctx, sf: SceneFile, registry: &Registry) -> Result<Scene, In
         materials: b.materials,
         laws,
         drives,
+        fixed: b.fixed,
         gravity,
         time,
         solver: sf.solver,
@@ -599,7 +602,7 @@ pub(crate) fn laws<B>(
     Ok((table, declared))
 }
 
-fn add_bodies(cx: &Ctx, sf: &SceneFile, b: &mut SceneBuilder2, drives: &mut Vec<BodyDrive2>) -> Result<(), InputError> {
+fn add_bodies(cx: &Ctx, sf: &SceneFile, b: &mut SceneBuilder2, drives: &mut Vec<BodyDrive>) -> Result<(), InputError> {
     for (i, spec) in sf.bodies.iter().enumerate() {
         let base = [k("bodies"), Seg::Index(i)];
         let p = |key: &str| at(&base, &[k(key)]);
@@ -607,7 +610,11 @@ fn add_bodies(cx: &Ctx, sf: &SceneFile, b: &mut SceneBuilder2, drives: &mut Vec<
         let kind = b.kind(&spec.shape).ok_or_else(|| {
             cx.err(
                 &p("shape"),
-                format!("unknown shape `{}`; installed: {}", spec.shape, b.registry.shape_kinds().join(", ")),
+                format!(
+                    "unknown shape `{}`; installed: {}",
+                    spec.shape,
+                    b.registry.shape_kinds::<D2>().join(", ")
+                ),
             )
         })?;
         let material = b.material(&spec.material).ok_or_else(|| {
@@ -655,20 +662,45 @@ fn add_bodies(cx: &Ctx, sf: &SceneFile, b: &mut SceneBuilder2, drives: &mut Vec<
             b.set_fixed(id);
         }
         if let Some(d) = &spec.drive {
-            let mut dof: [Option<crate::drive::DofDrive>; 3] = Default::default();
+            let mut dof: [Option<crate::drive::DofDrive>; 6] = Default::default();
             for (slot, (name, dd)) in [("x", &d.x), ("y", &d.y), ("rot", &d.rot)].into_iter().enumerate() {
                 if let Some(dd) = dd {
                     dd.validate().map_err(|m| cx.err(&at(&base, &[k("drive"), k(name)]), m))?;
-                    if dd.has_pressure() {
-                        return Err(cx.err(
-                            &at(&base, &[k("drive"), k(name)]),
-                            "pressure drives act on the walls of 3D box samples (`[output] box3`); in 2D impose a force",
-                        ));
-                    }
                     dof[slot] = Some(dd.clone());
                 }
             }
-            drives.push(BodyDrive2 { body: id, dof });
+            drives.push(BodyDrive { body: id, dof });
+        }
+    }
+    Ok(())
+}
+
+/// A pressure (or servo) drive pushes a wall of the box sample along the wall's
+/// own axis (x for the walls normal to x, …); anything else is refused, naming the
+/// drive. `dofs`: the names of the drive's degrees of freedom; `section`: the
+/// `[output]` key naming the box's walls.
+pub(crate) fn check_pressure_drives(
+    cx: &Ctx,
+    drives: &[BodyDrive],
+    box_walls: Option<&BoxWalls>,
+    origins: &[Origin],
+    dofs: &[&str],
+    section: &str,
+) -> Result<(), InputError> {
+    let n = (dofs.len() + 1) / 2;
+    for d in drives {
+        for (dof, drv) in d.dof.iter().enumerate().take(dofs.len()) {
+            if !drv.as_ref().is_some_and(|x| x.has_pressure()) {
+                continue;
+            }
+            let wall = box_walls.and_then(|bw| bw.wall_of(d.body as usize, n));
+            if wall.is_none_or(|wl| wl / 2 != dof) {
+                let base = origin_path(origins[d.body as usize], "drive");
+                return Err(cx.err(
+                    &at(&base, &[k(dofs[dof])]),
+                    format!("a pressure drive needs the body to be a wall of `[output] {section}`, driven along its own axis (x for the walls normal to x, ...)"),
+                ));
+            }
         }
     }
     Ok(())

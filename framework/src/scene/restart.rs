@@ -96,6 +96,7 @@ pub fn restart_str(w: &mut World2, text: &str, file: &str) -> Result<(), InputEr
         c.u_free.push([0.0; 2]);
         c.gap.push(sc.gap);
         c.point.push(sc.point);
+        c.joint.push(Default::default());
         c.key.push(ContactKey {
             i,
             j,

@@ -10,7 +10,7 @@ use crate::error::InputError;
 use crate::rigid2d::contacts::ContactKey;
 use crate::rigid3d::contacts::Frame3;
 use crate::rigid3d::Contacts3;
-use crate::world3::World3;
+use crate::world::World3;
 use serde::Deserialize;
 use std::path::Path;
 

@@ -1,5 +1,5 @@
 //! 2D contacts of deformable bodies: boundary nodes against rigid shapes
-//! (node-to-surface through [`nscdd::registry::ShapeStore2::point_contact`]) and
+//! (node-to-surface through [`nscdd::registry::ShapeStore<D2>::point_contact`]) and
 //! against the boundary segments of other deformable bodies (node-to-segment).
 //!
 //! A contact α has a candidate side, always one boundary node of a deformable body
@@ -129,7 +129,7 @@ pub fn detect(w: &World2, fe: &[crate::body::FeBody], alert: f64, out: &mut Vec<
                 if p[0] < a.min[0] - alert || p[0] > a.max[0] + alert || p[1] < a.min[1] - alert || p[1] > a.max[1] + alert {
                     continue;
                 }
-                if let Some(pc) = store.point_contact(s.index, x, rot, p) {
+                if let Some(pc) = store.point_contact(s.index, x, rot, p, [0.0; 2]) {
                     if pc.gap <= alert {
                         out.push(RawFe {
                             body: fb as u32,

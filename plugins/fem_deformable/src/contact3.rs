@@ -1,10 +1,10 @@
 //! 3D contacts of deformable bodies: boundary nodes against rigid shapes
-//! (node-to-surface through [`nscdd::registry3::ShapeStore3::point_contact`]:
+//! (node-to-surface through [`nscdd::registry::ShapeStore<D3>::point_contact`]:
 //! spheres, planes, boxes) and against the boundary triangles of other deformable
 //! bodies (node-to-face).
 //!
 //! A contact α has a candidate side on a deformable body, one boundary node or
-//! (against rigid kinds that meet faces, [`nscdd::registry3::ShapeStore3::meets_faces`]:
+//! (against rigid kinds that meet faces, [`nscdd::registry::ShapeStore<D3>::meets_faces`]:
 //! spheres) the closest point of a boundary triangle, and an antagonist side: a
 //! rigid body j with the lever arm d = p − x_j of the contact point, or a point
 //! of a boundary triangle (corners a, b, c with barycentric weights) of another
@@ -29,7 +29,7 @@ use crate::nodes::{FeContacts, FeSide, NodeSet};
 use nscdd::dim::coulomb3::{self as coulomb, Sym3};
 use nscdd::rigid3d::bodies::cross;
 use nscdd::rigid3d::contacts::{point_velocity, Block3, Frame3};
-use nscdd::world3::World3;
+use nscdd::world::World3;
 
 pub type FeSide3 = FeSide<3>;
 pub type NodeSet3 = NodeSet<3>;

@@ -35,7 +35,7 @@ use nscdd::scene::locate::{locate, path_string, Seg};
 use nscdd::scene::{OutputSettings, Scene};
 use nscdd::world::Material;
 use nscdd::world::World2;
-use nscdd::world3::World3;
+use nscdd::world::World3;
 use serde::Deserialize;
 use std::path::Path;
 

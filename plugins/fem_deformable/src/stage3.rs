@@ -18,7 +18,7 @@ use nscdd::rigid2d::contacts::Target;
 use nscdd::rigid3d::contacts::{tangents, Block3};
 use nscdd::solver::nlgs;
 use nscdd::solver::SolveReport;
-use nscdd::world3::World3;
+use nscdd::world::World3;
 use std::time::Instant;
 
 /// The deformable bodies of a 3D scene and their contacts.

@@ -9,7 +9,7 @@
 //!    mean time per step of each stage.
 //!
 //!     cargo run --release -p nscdd-polyhedra --example bench_poly [steps] [courses] [bricks]
-use nscdd::registry3::RawContact3;
+use nscdd::registry::RawContact3;
 use nscdd::rigid3d::bodies::from_rotation_vector;
 use nscdd_polyhedra::detect::{poly_poly, PolyScratch};
 use nscdd_polyhedra::generate::box_points;

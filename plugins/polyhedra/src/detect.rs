@@ -32,11 +32,12 @@
 
 use crate::hull::{cross, dot, norm, sub};
 use crate::shapes::{unit, Poly, Polyhedra};
-use nscdd::registry3::{DetectCtx3, PairDetector3, RawContact3};
+use nscdd::dim::D3;
+use nscdd::registry::{DetectCtx, PairDetector, RawContact3};
 use nscdd::rigid3d::bodies::rotate;
 use nscdd_spheres::shapes::{closest_on_triangle, Spheres};
 
-fn polys<'a>(ctx: &'a DetectCtx3<'_>, first: bool) -> &'a Polyhedra {
+fn polys<'a>(ctx: &'a DetectCtx<'_, D3>, first: bool) -> &'a Polyhedra {
     let s = if first { ctx.a } else { ctx.b };
     s.as_any().downcast_ref::<Polyhedra>().expect("polyhedron store")
 }
@@ -335,8 +336,8 @@ pub fn poly_poly(
 /// Polyhedron–polyhedron.
 pub struct PolyPoly;
 
-impl PairDetector3 for PolyPoly {
-    fn detect(&self, ctx: &DetectCtx3<'_>, pairs: &[[u32; 2]], out: &mut Vec<RawContact3>) {
+impl PairDetector<D3> for PolyPoly {
+    fn detect(&self, ctx: &DetectCtx<'_, D3>, pairs: &[[u32; 2]], out: &mut Vec<RawContact3>) {
         let (sa, sb) = (polys(ctx, true), polys(ctx, false));
         let b = ctx.bodies;
         let mut sc = PolyScratch::default();
@@ -353,8 +354,8 @@ impl PairDetector3 for PolyPoly {
 /// vertices within alert), its vertices share its area.
 pub struct PolyPlane;
 
-impl PairDetector3 for PolyPlane {
-    fn detect(&self, ctx: &DetectCtx3<'_>, pairs: &[[u32; 2]], out: &mut Vec<RawContact3>) {
+impl PairDetector<D3> for PolyPlane {
+    fn detect(&self, ctx: &DetectCtx<'_, D3>, pairs: &[[u32; 2]], out: &mut Vec<RawContact3>) {
         let sa = polys(ctx, true);
         let b = ctx.bodies;
         let mut wv = vec![];
@@ -437,8 +438,8 @@ pub fn closest_surface(p: &Poly, wv: &[[f64; 3]], q: [f64; 4], c: [f64; 3], hint
 /// Polyhedron (candidate) – sphere (antagonist).
 pub struct PolySphere;
 
-impl PairDetector3 for PolySphere {
-    fn detect(&self, ctx: &DetectCtx3<'_>, pairs: &[[u32; 2]], out: &mut Vec<RawContact3>) {
+impl PairDetector<D3> for PolySphere {
+    fn detect(&self, ctx: &DetectCtx<'_, D3>, pairs: &[[u32; 2]], out: &mut Vec<RawContact3>) {
         let sa = polys(ctx, true);
         let ss = ctx.b.as_any().downcast_ref::<Spheres>().expect("sphere store");
         let b = ctx.bodies;

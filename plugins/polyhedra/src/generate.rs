@@ -2,12 +2,13 @@
 //! voussoirs on two fixed supports, and a tilting table.
 
 use crate::shapes::Polyhedra;
+use nscdd::dim::D3;
 use nscdd::drive::{DofDrive, Phase, Shape, TimeFn};
 use nscdd::params::{array, boolean, count, number, only_keys, positive};
+use nscdd::registry::Generator;
 use nscdd::registry::ParamError;
-use nscdd::registry3::Generator3;
 use nscdd::rigid2d::bodies::ShapeRef;
-use nscdd::scene::builder3::SceneBuilder3;
+use nscdd::scene::builder::SceneBuilder3;
 
 /// The 8 corners of a box [lo, hi].
 pub fn box_points(lo: [f64; 3], hi: [f64; 3]) -> Vec<[f64; 3]> {
@@ -43,7 +44,7 @@ pub fn add_points(out: &mut SceneBuilder3<'_>, points: &[[f64; 3]], material: u1
 /// base slab under it (2L wider than the wall, H thick).
 pub struct BrickWall;
 
-impl Generator3 for BrickWall {
+impl Generator<D3> for BrickWall {
     fn generate(&self, p: &toml::Table, out: &mut SceneBuilder3<'_>) -> Result<(), ParamError> {
         only_keys(p, &["kind", "material", "brick", "courses", "bricks", "origin", "base_material"])?;
         let material = out.material_param(p, "material")?;
@@ -90,7 +91,7 @@ impl Generator3 for BrickWall {
 /// `supports = false`, on whatever the scene puts there (piers).
 pub struct Arch;
 
-impl Generator3 for Arch {
+impl Generator<D3> for Arch {
     fn generate(&self, p: &toml::Table, out: &mut SceneBuilder3<'_>) -> Result<(), ParamError> {
         only_keys(
             p,
@@ -156,7 +157,7 @@ impl Generator3 for Arch {
 /// β = atan2(d₀z, d₀x): sine drives, so the hinge stays in place.
 pub struct TiltingTable;
 
-impl Generator3 for TiltingTable {
+impl Generator<D3> for TiltingTable {
     fn generate(&self, p: &toml::Table, out: &mut SceneBuilder3<'_>) -> Result<(), ParamError> {
         only_keys(p, &["kind", "material", "size", "origin", "hinge", "rate", "max_angle", "start"])?;
         let material = out.material_param(p, "material")?;

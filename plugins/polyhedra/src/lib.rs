@@ -13,7 +13,7 @@
 //! let mut reg = nscdd::registry::Registry::new();
 //! reg.add_plugin(&nscdd_spheres::SpheresPlugin);
 //! reg.add_plugin(&nscdd_polyhedra::PolyhedraPlugin);
-//! assert!(reg.shape_kinds3().contains(&"polyhedron"));
+//! assert!(reg.shape_kinds::<nscdd::dim::D3>().contains(&"polyhedron"));
 //! ```
 
 pub mod detect;
@@ -21,8 +21,8 @@ pub mod generate;
 pub mod hull;
 pub mod shapes;
 
+use nscdd::registry::ShapeKindDef;
 use nscdd::registry::{Plugin, Registry};
-use nscdd::registry3::ShapeKindDef3;
 use shapes::Polyhedra;
 use std::sync::Arc;
 
@@ -34,16 +34,16 @@ impl Plugin for PolyhedraPlugin {
         "polyhedra"
     }
     fn build(&self, reg: &mut Registry) {
-        reg.add_shape3(ShapeKindDef3 {
+        reg.add_shape(ShapeKindDef {
             name: Polyhedra::KIND,
             new_store: || Box::new(Polyhedra::default()),
         });
-        reg.add_detector3(Polyhedra::KIND, Polyhedra::KIND, Arc::new(detect::PolyPoly));
-        reg.add_detector3(Polyhedra::KIND, nscdd_spheres::shapes::Planes::KIND, Arc::new(detect::PolyPlane));
-        reg.add_detector3(Polyhedra::KIND, nscdd_spheres::shapes::Spheres::KIND, Arc::new(detect::PolySphere));
-        reg.add_generator3("brick_wall", Box::new(generate::BrickWall));
-        reg.add_generator3("arch", Box::new(generate::Arch));
-        reg.add_generator3("tilting_table", Box::new(generate::TiltingTable));
+        reg.add_detector(Polyhedra::KIND, Polyhedra::KIND, Arc::new(detect::PolyPoly));
+        reg.add_detector(Polyhedra::KIND, nscdd_spheres::shapes::Planes::KIND, Arc::new(detect::PolyPlane));
+        reg.add_detector(Polyhedra::KIND, nscdd_spheres::shapes::Spheres::KIND, Arc::new(detect::PolySphere));
+        reg.add_generator("brick_wall", Box::new(generate::BrickWall));
+        reg.add_generator("arch", Box::new(generate::Arch));
+        reg.add_generator("tilting_table", Box::new(generate::TiltingTable));
     }
 }
 

@@ -3,9 +3,10 @@
 //! normals and edges for detection.
 
 use crate::hull::{hull, moments, norm, principal, quat_of, sub, Hull};
+use nscdd::dim::D3;
 use nscdd::params::only_keys;
 use nscdd::registry::ParamError;
-use nscdd::registry3::{Aabb3, Glyph3, MassProps3, PointContact3, ShapeStore3};
+use nscdd::registry::{Aabb3, Glyph3, MassProps3, PointContact3, ShapeStore};
 use nscdd::rigid3d::bodies::rotate;
 use std::any::Any;
 
@@ -116,7 +117,7 @@ impl Polyhedra {
     }
 }
 
-impl ShapeStore3 for Polyhedra {
+impl ShapeStore<D3> for Polyhedra {
     fn kind(&self) -> &'static str {
         Self::KIND
     }

@@ -5,7 +5,7 @@
 use nscdd::output::out3::final_json3;
 use nscdd::scene::load3::{load_str, Scene3};
 use nscdd::scene::restart3::restart3_str;
-use nscdd::world3::World3;
+use nscdd::world::World3;
 use nscdd_polyhedra::generate::box_points;
 
 const G: f64 = 9.81;

@@ -2,7 +2,7 @@
 //! their points under small rotations, a block on an incline fails at
 //! α* = arctan(min(μ, b/h)) by the right mechanism, arches stand or collapse.
 use nscdd::scene::load3::{load_str, Scene3};
-use nscdd::world3::World3;
+use nscdd::world::World3;
 
 fn world(text: &str) -> World3 {
     match load_str(text, "test.toml", &nscdd_polyhedra::registry()) {

@@ -4,7 +4,7 @@
 //! multi-point face contacts and the joints cut by the interfaces.
 use nscdd::dd::{DdSettings, Nscdd3};
 use nscdd::scene::load3::load_str;
-use nscdd::world3::World3;
+use nscdd::world::World3;
 
 fn wall(law: &str) -> World3 {
     let text = format!(

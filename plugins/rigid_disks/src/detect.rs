@@ -8,7 +8,8 @@
 
 use crate::shapes::{Disks, HalfPlanes, Walls};
 use nalgebra::Vector2;
-use nscdd::registry::{DetectCtx, PairDetector2, RawContact2};
+use nscdd::dim::D2;
+use nscdd::registry::{DetectCtx, PairDetector, RawContact2};
 
 type V = Vector2<f64>;
 
@@ -35,6 +36,7 @@ fn rounded(i: u32, j: u32, feature: u32, pi: V, pj: V, ri: f64, rj: f64, alert: 
         point: [p.x, p.y],
         normal: [n.x, n.y],
         gap,
+        area: 0.0,
     })
 }
 
@@ -79,8 +81,8 @@ fn closest_segments(a: V, b: V, c: V, d: V) -> (V, V) {
 }
 
 pub struct DiskDisk;
-impl PairDetector2 for DiskDisk {
-    fn detect(&self, cx: &DetectCtx<'_>, pairs: &[[u32; 2]], out: &mut Vec<RawContact2>) {
+impl PairDetector<D2> for DiskDisk {
+    fn detect(&self, cx: &DetectCtx<'_, D2>, pairs: &[[u32; 2]], out: &mut Vec<RawContact2>) {
         let disks = cx.a.as_any().downcast_ref::<Disks>().expect("disk store");
         let b = cx.bodies;
         for &[p, q] in pairs {
@@ -103,8 +105,8 @@ impl PairDetector2 for DiskDisk {
 }
 
 pub struct DiskWall;
-impl PairDetector2 for DiskWall {
-    fn detect(&self, cx: &DetectCtx<'_>, pairs: &[[u32; 2]], out: &mut Vec<RawContact2>) {
+impl PairDetector<D2> for DiskWall {
+    fn detect(&self, cx: &DetectCtx<'_, D2>, pairs: &[[u32; 2]], out: &mut Vec<RawContact2>) {
         let disks = cx.a.as_any().downcast_ref::<Disks>().expect("disk store");
         let walls = cx.b.as_any().downcast_ref::<Walls>().expect("wall store");
         let b = cx.bodies;
@@ -130,8 +132,8 @@ impl PairDetector2 for DiskWall {
 }
 
 pub struct DiskHalfPlane;
-impl PairDetector2 for DiskHalfPlane {
-    fn detect(&self, cx: &DetectCtx<'_>, pairs: &[[u32; 2]], out: &mut Vec<RawContact2>) {
+impl PairDetector<D2> for DiskHalfPlane {
+    fn detect(&self, cx: &DetectCtx<'_, D2>, pairs: &[[u32; 2]], out: &mut Vec<RawContact2>) {
         let disks = cx.a.as_any().downcast_ref::<Disks>().expect("disk store");
         let b = cx.bodies;
         for &[d, h] in pairs {
@@ -148,6 +150,7 @@ impl PairDetector2 for DiskHalfPlane {
                     point: [p.x, p.y],
                     normal: [n.x, n.y],
                     gap,
+                    area: 0.0,
                 });
             }
         }
@@ -155,8 +158,8 @@ impl PairDetector2 for DiskHalfPlane {
 }
 
 pub struct WallWall;
-impl PairDetector2 for WallWall {
-    fn detect(&self, cx: &DetectCtx<'_>, pairs: &[[u32; 2]], out: &mut Vec<RawContact2>) {
+impl PairDetector<D2> for WallWall {
+    fn detect(&self, cx: &DetectCtx<'_, D2>, pairs: &[[u32; 2]], out: &mut Vec<RawContact2>) {
         let walls = cx.a.as_any().downcast_ref::<Walls>().expect("wall store");
         let b = cx.bodies;
         for &[p, q] in pairs {
@@ -183,8 +186,8 @@ impl PairDetector2 for WallWall {
 
 /// A wall against a half-plane touches by its two rounded ends (features 0 and 1).
 pub struct WallHalfPlane;
-impl PairDetector2 for WallHalfPlane {
-    fn detect(&self, cx: &DetectCtx<'_>, pairs: &[[u32; 2]], out: &mut Vec<RawContact2>) {
+impl PairDetector<D2> for WallHalfPlane {
+    fn detect(&self, cx: &DetectCtx<'_, D2>, pairs: &[[u32; 2]], out: &mut Vec<RawContact2>) {
         let walls = cx.a.as_any().downcast_ref::<Walls>().expect("wall store");
         let b = cx.bodies;
         for &[w, h] in pairs {
@@ -204,6 +207,7 @@ impl PairDetector2 for WallHalfPlane {
                         point: [p.x, p.y],
                         normal: [n.x, n.y],
                         gap,
+                        area: 0.0,
                     });
                 }
             }

@@ -3,8 +3,9 @@
 //! the same sample for the same seed on every machine (ChaCha8).
 
 use crate::shapes::Disks;
+use nscdd::dim::D2;
 use nscdd::params::{array, count, number, only_keys, positive};
-use nscdd::registry::{Generator2, ParamError};
+use nscdd::registry::{Generator, ParamError};
 use nscdd::rigid2d::bodies::ShapeRef;
 use nscdd::scene::builder::SceneBuilder2;
 use rand::{RngExt, SeedableRng};
@@ -139,7 +140,7 @@ impl Deposit {
     }
 }
 
-impl Generator2 for DiskDeposit {
+impl Generator<D2> for DiskDeposit {
     fn generate(&self, p: &toml::Table, out: &mut SceneBuilder2<'_>) -> Result<(), ParamError> {
         only_keys(p, &["material", "count", "radius_min", "radius_max", "box", "seed"])?;
         let material = out.material_param(p, "material")?;
@@ -216,7 +217,7 @@ fn lattice(p: &toml::Table, out: &mut SceneBuilder2<'_>, triangular: bool) -> Re
 /// `square_lattice`: `nx` × `ny` disks of `radius`, centres `spacing` apart
 /// (default 2 × radius: touching), the first at `origin`.
 pub struct SquareLattice;
-impl Generator2 for SquareLattice {
+impl Generator<D2> for SquareLattice {
     fn generate(&self, p: &toml::Table, out: &mut SceneBuilder2<'_>) -> Result<(), ParamError> {
         lattice(p, out, false)
     }
@@ -225,7 +226,7 @@ impl Generator2 for SquareLattice {
 /// `triangular_lattice`: rows of `nx` disks, every other row shifted by half a
 /// spacing, rows spacing·√3/2 apart (touching by default: the densest packing).
 pub struct TriangularLattice;
-impl Generator2 for TriangularLattice {
+impl Generator<D2> for TriangularLattice {
     fn generate(&self, p: &toml::Table, out: &mut SceneBuilder2<'_>) -> Result<(), ParamError> {
         lattice(p, out, true)
     }

@@ -13,7 +13,7 @@
 //! ```
 //! let mut reg = nscdd::registry::Registry::new();
 //! reg.add_plugin(&nscdd_rigid_disks::RigidDisks);
-//! assert!(reg.shape_kinds().contains(&"disk"));
+//! assert!(reg.shape_kinds::<nscdd::dim::D2>().contains(&"disk"));
 //! ```
 
 pub mod detect;

@@ -1,8 +1,9 @@
 //! Shape stores of the plugin: disks, walls (thick segments with rounded ends, like
 //! LMGC90's JONCx) and half-planes.
 
+use nscdd::dim::D2;
 use nscdd::params::{number, only_keys, positive};
-use nscdd::registry::{Aabb2, Glyph2, MassProps2, ParamError, PointContact2, ShapeStore2};
+use nscdd::registry::{Aabb2, Glyph2, MassProps2, ParamError, PointContact2, ShapeStore};
 use std::any::Any;
 use std::f64::consts::PI;
 
@@ -16,7 +17,7 @@ impl Disks {
     pub const KIND: &'static str = "disk";
 }
 
-impl ShapeStore2 for Disks {
+impl ShapeStore<D2> for Disks {
     fn kind(&self) -> &'static str {
         Self::KIND
     }
@@ -47,7 +48,7 @@ impl ShapeStore2 for Disks {
         let area = PI * r * r;
         let mass = density * area;
         MassProps2 {
-            area,
+            volume: area,
             mass,
             inertia: 0.5 * mass * r * r,
         }
@@ -56,12 +57,12 @@ impl ShapeStore2 for Disks {
         self.radius[s as usize]
     }
     fn glyph(&self, s: u32, _x: [f64; 2], _rot: f64) -> Glyph2 {
-        Glyph2::Disk(self.radius[s as usize])
+        Glyph2::Ball(self.radius[s as usize])
     }
     fn describe(&self, s: u32) -> serde_json::Value {
         serde_json::json!({ "radius": self.radius[s as usize] })
     }
-    fn point_contact(&self, s: u32, x: [f64; 2], _rot: f64, p: [f64; 2]) -> Option<PointContact2> {
+    fn point_contact(&self, s: u32, x: [f64; 2], _rot: f64, p: [f64; 2], _hint: [f64; 2]) -> Option<PointContact2> {
         round_contact(x, self.radius[s as usize], p)
     }
 }
@@ -101,7 +102,7 @@ impl Walls {
     }
 }
 
-impl ShapeStore2 for Walls {
+impl ShapeStore<D2> for Walls {
     fn kind(&self) -> &'static str {
         Self::KIND
     }
@@ -133,7 +134,7 @@ impl ShapeStore2 for Walls {
         let (l, t) = (self.length[s as usize], self.thickness[s as usize]);
         let mass = density * l * t;
         MassProps2 {
-            area: l * t,
+            volume: l * t,
             mass,
             inertia: mass * (l * l + t * t) / 12.0,
         }
@@ -152,7 +153,7 @@ impl ShapeStore2 for Walls {
         false
     }
     /// The closest point of the centre segment, then as for a disk of radius T/2.
-    fn point_contact(&self, s: u32, x: [f64; 2], rot: f64, p: [f64; 2]) -> Option<PointContact2> {
+    fn point_contact(&self, s: u32, x: [f64; 2], rot: f64, p: [f64; 2], _hint: [f64; 2]) -> Option<PointContact2> {
         let (a, b) = self.ends(s, x, rot);
         let ab = [b[0] - a[0], b[1] - a[1]];
         let t = (((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1]) / (ab[0] * ab[0] + ab[1] * ab[1])).clamp(0.0, 1.0);
@@ -176,7 +177,7 @@ impl HalfPlanes {
     }
 }
 
-impl ShapeStore2 for HalfPlanes {
+impl ShapeStore<D2> for HalfPlanes {
     fn kind(&self) -> &'static str {
         Self::KIND
     }
@@ -220,7 +221,7 @@ impl ShapeStore2 for HalfPlanes {
     }
     fn mass_properties(&self, _s: u32, density: f64) -> MassProps2 {
         MassProps2 {
-            area: 1.0,
+            volume: 1.0,
             mass: density,
             inertia: density / 6.0,
         }
@@ -246,7 +247,7 @@ impl ShapeStore2 for HalfPlanes {
     fn is_grain(&self) -> bool {
         false
     }
-    fn point_contact(&self, _s: u32, x: [f64; 2], rot: f64, p: [f64; 2]) -> Option<PointContact2> {
+    fn point_contact(&self, _s: u32, x: [f64; 2], rot: f64, p: [f64; 2], _hint: [f64; 2]) -> Option<PointContact2> {
         let n = Self::normal(rot);
         let gap = (p[0] - x[0]) * n[0] + (p[1] - x[1]) * n[1];
         Some(PointContact2 {

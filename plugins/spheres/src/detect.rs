@@ -3,10 +3,11 @@
 //! second body) towards the candidate sphere.
 
 use crate::shapes::{Boxes, Planes, Spheres};
-use nscdd::registry3::{DetectCtx3, PairDetector3, RawContact3};
+use nscdd::dim::D3;
+use nscdd::registry::{DetectCtx, PairDetector, RawContact3};
 use nscdd::rigid3d::bodies::{dot, rotate, rotate_inv};
 
-fn spheres<'a>(ctx: &'a DetectCtx3<'_>, first: bool) -> &'a Spheres {
+fn spheres<'a>(ctx: &'a DetectCtx<'_, D3>, first: bool) -> &'a Spheres {
     let s = if first { ctx.a } else { ctx.b };
     s.as_any().downcast_ref::<Spheres>().expect("sphere store")
 }
@@ -14,8 +15,8 @@ fn spheres<'a>(ctx: &'a DetectCtx3<'_>, first: bool) -> &'a Spheres {
 /// Sphere–sphere: gap = |x_i − x_j| − r_i − r_j.
 pub struct SphereSphere;
 
-impl PairDetector3 for SphereSphere {
-    fn detect(&self, ctx: &DetectCtx3<'_>, pairs: &[[u32; 2]], out: &mut Vec<RawContact3>) {
+impl PairDetector<D3> for SphereSphere {
+    fn detect(&self, ctx: &DetectCtx<'_, D3>, pairs: &[[u32; 2]], out: &mut Vec<RawContact3>) {
         let (sa, sb) = (spheres(ctx, true), spheres(ctx, false));
         let b = ctx.bodies;
         for &[i, j] in pairs {
@@ -48,8 +49,8 @@ impl PairDetector3 for SphereSphere {
 /// Sphere–plane: gap = n·(x_s − x_p) − r, n the plane's z axis.
 pub struct SpherePlane;
 
-impl PairDetector3 for SpherePlane {
-    fn detect(&self, ctx: &DetectCtx3<'_>, pairs: &[[u32; 2]], out: &mut Vec<RawContact3>) {
+impl PairDetector<D3> for SpherePlane {
+    fn detect(&self, ctx: &DetectCtx<'_, D3>, pairs: &[[u32; 2]], out: &mut Vec<RawContact3>) {
         let sa = spheres(ctx, true);
         let _ = ctx.b.as_any().downcast_ref::<Planes>().expect("plane store");
         let b = ctx.bodies;
@@ -79,8 +80,8 @@ impl PairDetector3 for SpherePlane {
 /// the box is pushed out through the nearest face.
 pub struct SphereBox;
 
-impl PairDetector3 for SphereBox {
-    fn detect(&self, ctx: &DetectCtx3<'_>, pairs: &[[u32; 2]], out: &mut Vec<RawContact3>) {
+impl PairDetector<D3> for SphereBox {
+    fn detect(&self, ctx: &DetectCtx<'_, D3>, pairs: &[[u32; 2]], out: &mut Vec<RawContact3>) {
         let sa = spheres(ctx, true);
         let bx = ctx.b.as_any().downcast_ref::<Boxes>().expect("box store");
         let b = ctx.bodies;

@@ -3,11 +3,12 @@
 //! the random one takes `seed` and gives the same sample on every machine (ChaCha8).
 
 use crate::shapes::Spheres;
+use nscdd::dim::D3;
 use nscdd::params::{array, count, only_keys, positive};
+use nscdd::registry::Generator;
 use nscdd::registry::ParamError;
-use nscdd::registry3::Generator3;
 use nscdd::rigid2d::bodies::ShapeRef;
-use nscdd::scene::builder3::SceneBuilder3;
+use nscdd::scene::builder::SceneBuilder3;
 use rand::{RngExt, SeedableRng};
 
 fn add_sphere(out: &mut SceneBuilder3<'_>, kind: u16, material: u16, r: f64, x: [f64; 3]) {
@@ -26,7 +27,7 @@ fn add_sphere(out: &mut SceneBuilder3<'_>, kind: u16, material: u16, r: f64, x: 
 /// cannot hold the spheres.
 pub struct SpherePacking;
 
-impl Generator3 for SpherePacking {
+impl Generator<D3> for SpherePacking {
     fn generate(&self, p: &toml::Table, out: &mut SceneBuilder3<'_>) -> Result<(), ParamError> {
         only_keys(
             p,
@@ -141,7 +142,7 @@ impl Generator3 for SpherePacking {
 /// `spacing` (default 2 × radius: touching) from `origin` (the first centre).
 pub struct SphereLattice;
 
-impl Generator3 for SphereLattice {
+impl Generator<D3> for SphereLattice {
     fn generate(&self, p: &toml::Table, out: &mut SceneBuilder3<'_>) -> Result<(), ParamError> {
         only_keys(p, &["kind", "material", "nx", "ny", "nz", "radius", "spacing", "origin"])?;
         let material = out.material_param(p, "material")?;

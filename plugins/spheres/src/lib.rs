@@ -14,15 +14,15 @@
 //! ```
 //! let mut reg = nscdd::registry::Registry::new();
 //! reg.add_plugin(&nscdd_spheres::SpheresPlugin);
-//! assert!(reg.shape_kinds3().contains(&"sphere"));
+//! assert!(reg.shape_kinds::<nscdd::dim::D3>().contains(&"sphere"));
 //! ```
 
 pub mod detect;
 pub mod generate;
 pub mod shapes;
 
+use nscdd::registry::ShapeKindDef;
 use nscdd::registry::{Plugin, Registry};
-use nscdd::registry3::ShapeKindDef3;
 use shapes::{Boxes, Planes, Spheres};
 use std::sync::Arc;
 
@@ -34,23 +34,23 @@ impl Plugin for SpheresPlugin {
         "spheres"
     }
     fn build(&self, reg: &mut Registry) {
-        reg.add_shape3(ShapeKindDef3 {
+        reg.add_shape(ShapeKindDef {
             name: Spheres::KIND,
             new_store: || Box::new(Spheres::default()),
         });
-        reg.add_shape3(ShapeKindDef3 {
+        reg.add_shape(ShapeKindDef {
             name: Planes::KIND,
             new_store: || Box::new(Planes::default()),
         });
-        reg.add_shape3(ShapeKindDef3 {
+        reg.add_shape(ShapeKindDef {
             name: Boxes::KIND,
             new_store: || Box::new(Boxes::default()),
         });
-        reg.add_detector3(Spheres::KIND, Spheres::KIND, Arc::new(detect::SphereSphere));
-        reg.add_detector3(Spheres::KIND, Planes::KIND, Arc::new(detect::SpherePlane));
-        reg.add_detector3(Spheres::KIND, Boxes::KIND, Arc::new(detect::SphereBox));
-        reg.add_generator3("sphere_packing", Box::new(generate::SpherePacking));
-        reg.add_generator3("sphere_lattice", Box::new(generate::SphereLattice));
+        reg.add_detector(Spheres::KIND, Spheres::KIND, Arc::new(detect::SphereSphere));
+        reg.add_detector(Spheres::KIND, Planes::KIND, Arc::new(detect::SpherePlane));
+        reg.add_detector(Spheres::KIND, Boxes::KIND, Arc::new(detect::SphereBox));
+        reg.add_generator("sphere_packing", Box::new(generate::SpherePacking));
+        reg.add_generator("sphere_lattice", Box::new(generate::SphereLattice));
     }
 }
 

@@ -1,8 +1,9 @@
 //! Shape stores: spheres, planes (half-spaces) and boxes (rectangular cuboids).
 
+use nscdd::dim::D3;
 use nscdd::params::{array, only_keys, positive};
 use nscdd::registry::ParamError;
-use nscdd::registry3::{Aabb3, FaceContact3, Glyph3, MassProps3, PointContact3, ShapeStore3};
+use nscdd::registry::{Aabb3, FaceContact3, Glyph3, MassProps3, PointContact3, ShapeStore};
 use nscdd::rigid3d::bodies::{rotate, rotate_inv};
 use std::any::Any;
 use std::f64::consts::PI;
@@ -31,7 +32,7 @@ impl Spheres {
     pub const KIND: &'static str = "sphere";
 }
 
-impl ShapeStore3 for Spheres {
+impl ShapeStore<D3> for Spheres {
     fn kind(&self) -> &'static str {
         Self::KIND
     }
@@ -55,9 +56,10 @@ impl ShapeStore3 for Spheres {
         true
     }
     /// The triangle's closest point to the centre c: gap |q − c| − r.
-    fn face_contact(&self, s: u32, x: [f64; 3], _q: [f64; 4], tri: &[[f64; 3]; 3]) -> Option<FaceContact3> {
+    fn face_contact(&self, s: u32, x: [f64; 3], _q: [f64; 4], tri: &[[f64; 3]]) -> Option<FaceContact3> {
         let r = self.radius[s as usize];
-        let bary = closest_on_triangle(x, tri);
+        let [a, b, c] = tri else { return None };
+        let bary = closest_on_triangle(x, &[*a, *b, *c]);
         let q: [f64; 3] = std::array::from_fn(|c| bary[0] * tri[0][c] + bary[1] * tri[1][c] + bary[2] * tri[2][c]);
         let d = [q[0] - x[0], q[1] - x[1], q[2] - x[2]];
         let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
@@ -100,7 +102,7 @@ impl ShapeStore3 for Spheres {
         self.radius[s as usize]
     }
     fn glyph(&self, s: u32, _x: [f64; 3], _q: [f64; 4]) -> Glyph3 {
-        Glyph3::Sphere(self.radius[s as usize])
+        Glyph3::Ball(self.radius[s as usize])
     }
     fn describe(&self, s: u32) -> serde_json::Value {
         serde_json::json!({ "radius": self.radius[s as usize] })
@@ -120,7 +122,7 @@ impl Planes {
     pub const KIND: &'static str = "plane";
 }
 
-impl ShapeStore3 for Planes {
+impl ShapeStore<D3> for Planes {
     fn kind(&self) -> &'static str {
         Self::KIND
     }
@@ -201,7 +203,7 @@ impl Boxes {
     pub const KIND: &'static str = "box";
 }
 
-impl ShapeStore3 for Boxes {
+impl ShapeStore<D3> for Boxes {
     fn kind(&self) -> &'static str {
         Self::KIND
     }
