@@ -11,6 +11,7 @@
 //!   three-disk pyramid (friction threshold 2 − √3, statics' forces);
 //! - [`impacts`]: Newton's cradle (Moreau's simultaneous impact law) and a
 //!   bouncing ball (rest time, energy conservation with θ = ½, e = 1);
+//! - [`pressure`]: a pressure drive on a wall of a 2D box sample (wall force σ H);
 //! - [`determinism`]: bitwise-identical reruns.
 
 mod common;
@@ -26,3 +27,6 @@ mod impacts;
 
 #[path = "physics/determinism.rs"]
 mod determinism;
+
+#[path = "physics/pressure.rs"]
+mod pressure;
