@@ -125,6 +125,7 @@ fn parse_subdomains3(v: &str) -> Result<(u32, u32, u32), String> {
 
 /// The command line's decomposition over the scene's: `--subdomains` sets (or makes)
 /// it, `--scheme` and `--threads` change it.
+#[allow(dead_code)]
 fn apply_decomposition(
     s: &mut nscdd::scene::Scene,
     subdomains: Option<&str>,
@@ -297,55 +298,18 @@ fn main() -> ExitCode {
                 Err(e) => return input_error(e),
             };
             let quiet = quiet || !ranks.root();
-            let loaded = match nscdd::scene::load_any(&scene, &reg) {
-                Ok(nscdd::scene::AnyScene::D3(s3)) => {
-                    let flags = run3::Flags {
-                        subdomains: subdomains.as_deref(),
-                        scheme: scheme.as_deref(),
-                        threads: threads.as_deref(),
-                        restart: restart.as_deref(),
-                    };
-                    return run3::run(s3, &scene, &out, quiet, flags, &ranks);
-                }
-                Ok(nscdd::scene::AnyScene::D2(s)) => Ok(s),
-                Err(e) => Err(e.to_string()),
-            }
-            .and_then(|mut s| {
-                apply_decomposition(&mut s, subdomains.as_deref(), scheme.as_deref(), threads.as_deref())?;
-                if let Some(state) = &restart {
-                    check_restart_dir(&out, state)?;
-                    nscdd::scene::restart(&mut s.world, state).map_err(|e| e.to_string())?;
-                }
-                Ok(s)
-            });
-            let digest = loaded.as_ref().map_err(Clone::clone).map(|s| {
-                let w = &s.world;
-                ranks::digest(&scene, &nscdd::output::final_json(w), (&s.decomposition, &w.time, &w.solver))
-            });
-            if let Err(code) = ranks.agree(digest, &out) {
-                return code;
-            }
-            let Ok(mut s) = loaded else {
-                unreachable!("agreed on a loaded scene")
+            let flags = run3::Flags {
+                subdomains: subdomains.as_deref(),
+                scheme: scheme.as_deref(),
+                threads: threads.as_deref(),
+                restart: restart.as_deref(),
             };
-            let steps = s.world.time.steps;
-            let bar = report::progress(quiet, steps, s.world.step);
-            let res = nscdd::run::run_on(&mut s, &reg, &out, ranks.cluster(), |w, rep| {
-                report::on_step(&bar, steps, w.step, rep)
-            });
-            bar.finish_and_clear();
-            let dd = |sum: &nscdd::run::RunSummary| match &s.decomposition {
-                Some(c) => format!(
-                    " ({}x{} subdomains, {:?}, {} migrations{})",
-                    c.dd.nx,
-                    c.dd.ny,
-                    c.dd.scheme,
-                    sum.migrations,
-                    report::on_ranks(ranks.size())
-                ),
-                None => String::new(),
-            };
-            report::finish_on(&ranks, res, s.world.solver.norm.name(), dd, &out)
+            match nscdd::scene::load_any(&scene, &reg) {
+                Ok(nscdd::scene::AnyScene::D2(s)) => run3::run(s, &reg, &scene, &out, quiet, flags, &ranks),
+                Ok(nscdd::scene::AnyScene::D3(s)) => run3::run(s, &reg, &scene, &out, quiet, flags, &ranks),
+                // every rank learns that a rank failed; rank 0 prints the message
+                Err(e) => ranks.agree(Err(e.to_string()), &out).err().unwrap_or(ExitCode::from(2)),
+            }
         }
         Cmd::SolveFc {
             problem,

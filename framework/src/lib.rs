@@ -37,7 +37,6 @@ pub mod registry;
 pub mod rigid2d;
 pub mod rigid3d;
 pub mod run;
-pub mod run3;
 pub mod scene;
 pub mod shape;
 pub mod solver;

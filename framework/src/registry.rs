@@ -34,13 +34,13 @@ pub trait Generator<D: Dim>: Send + Sync {
 }
 
 /// Writes extra outputs every `output.every` steps (`[output] writers = [...]`).
-pub trait Writer2: Send {
-    fn write(&mut self, world: &crate::world::World2, dir: &std::path::Path, frame: u32) -> std::io::Result<()>;
+pub trait Writer<D: Dim>: Send {
+    fn write(&mut self, world: &crate::world::World<D>, dir: &std::path::Path, frame: u32) -> std::io::Result<()>;
     /// A frame of a decomposed (NSCDD) run, with the subdomains of the bodies and
     /// contacts; by default the plain frame.
     fn write_dd(
         &mut self,
-        world: &crate::world::World2,
+        world: &crate::world::World<D>,
         _dd: &crate::dd::DdView,
         dir: &std::path::Path,
         frame: u32,
@@ -65,6 +65,7 @@ pub struct Tables<D: Dim> {
     pub(crate) shapes: BTreeMap<&'static str, ShapeKindDef<D>>,
     pub(crate) detectors: BTreeMap<(&'static str, &'static str), Arc<dyn PairDetector<D>>>,
     pub(crate) generators: BTreeMap<&'static str, Box<dyn Generator<D>>>,
+    pub(crate) writers: BTreeMap<&'static str, fn() -> Box<dyn Writer<D>>>,
 }
 
 impl<D: Dim> Default for Tables<D> {
@@ -73,6 +74,7 @@ impl<D: Dim> Default for Tables<D> {
             shapes: BTreeMap::new(),
             detectors: BTreeMap::new(),
             generators: BTreeMap::new(),
+            writers: BTreeMap::new(),
         }
     }
 }
@@ -82,7 +84,6 @@ impl<D: Dim> Default for Tables<D> {
 pub struct Registry {
     plugins: Vec<&'static str>,
     pub(crate) laws: BTreeMap<&'static str, LawDef>,
-    pub(crate) writers: BTreeMap<&'static str, fn() -> Box<dyn Writer2>>,
     t2: Tables<D2>,
     t3: Tables<D3>,
 }
@@ -124,12 +125,12 @@ impl Registry {
     pub fn add_law(&mut self, def: LawDef) {
         self.laws.insert(def.name, def);
     }
-    pub fn add_writer(&mut self, name: &'static str, make: fn() -> Box<dyn Writer2>) {
-        self.writers.insert(name, make);
+    pub fn add_writer<D: Dim>(&mut self, name: &'static str, make: fn() -> Box<dyn Writer<D>>) {
+        self.tables_mut::<D>().writers.insert(name, make);
     }
     /// A writer's constructor by name.
-    pub fn writer(&self, name: &str) -> Option<fn() -> Box<dyn Writer2>> {
-        self.writers.get(name).copied()
+    pub fn writer<D: Dim>(&self, name: &str) -> Option<fn() -> Box<dyn Writer<D>>> {
+        self.tables::<D>().writers.get(name).copied()
     }
     /// The shape kinds of dimension D.
     pub fn shape_kinds<D: Dim>(&self) -> Vec<&'static str> {

@@ -1,11 +1,13 @@
-//! Running a loaded scene to its end and writing its outputs in a directory.
+//! Running a loaded scene (2D or 3D) to its end and writing its outputs in a
+//! directory.
 
-use crate::dd::Nscdd;
+use crate::dd::{NscddOf, Rigid};
+use crate::dim::Dim;
 use crate::engine::{Diverged, StepReport};
 use crate::output::{final_json, history::History};
-use crate::registry::{Registry, Writer2};
+use crate::registry::{Registry, Writer};
 use crate::scene::Scene;
-use crate::world::World2;
+use crate::world::World;
 use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
@@ -155,53 +157,71 @@ pub(crate) fn write_rank_totals<D: crate::dd::Family>(dd: &mut Option<crate::dd:
     Ok(())
 }
 
-fn save_state(dir: &Path, name: &str, w: &World2) -> Result<(), RunError> {
+fn save_state<D: Dim>(dir: &Path, name: &str, w: &World<D>) -> Result<(), RunError> {
     save_state_text(dir, name, &final_json(w))
 }
 
 /// Runs `scene` for its number of steps, writing `history.csv`, the writers' frames
-/// every `output.every` steps (and at the first and last step) and `final.json` in
-/// `dir`. `on_step` is called after every step (progress display). With
-/// `scene.decomposition` set, every step is an NSCDD step ([`Nscdd`]), history.csv
-/// gains the NSCDD columns and the VTK frames the subdomain arrays.
-pub fn run(scene: &mut Scene, registry: &Registry, dir: &Path, on_step: impl FnMut(&World2, &StepReport)) -> Result<RunSummary, RunError> {
+/// (VTK with `output.vtk`) every `output.every` steps (and at the first and last
+/// step), `checkpoint.json` every `output.checkpoint_every` steps and `final.json`
+/// in `dir`. `on_step` is called after every step (progress display). With
+/// `scene.decomposition` set, every step is an NSCDD step ([`NscddOf`]),
+/// history.csv gains the NSCDD columns and the VTK frames the subdomain arrays.
+pub fn run<D: Dim>(
+    scene: &mut Scene<D>,
+    registry: &Registry,
+    dir: &Path,
+    on_step: impl FnMut(&World<D>, &StepReport),
+) -> Result<RunSummary, RunError> {
     run_on(scene, registry, dir, None, on_step)
+}
+
+/// The writers of a run (rank 0 only).
+fn writers<D: Dim>(scene: &Scene<D>, registry: &Registry, root: bool) -> Vec<Box<dyn Writer<D>>> {
+    let mut out: Vec<Box<dyn Writer<D>>> = vec![];
+    if !root {
+        return out;
+    }
+    let names = scene
+        .output
+        .vtk
+        .then_some("vtk")
+        .into_iter()
+        .chain(scene.output.writers.iter().map(|s| s.as_str()));
+    // the loader checked every name
+    out.extend(names.filter_map(|n| registry.writer::<D>(n)).map(|make| make()));
+    out
 }
 
 /// [`run`], as one rank of a multi-process run when `cluster` is given: every rank
 /// steps the whole world and sweeps its subdomains ([`crate::dd::ranks`]); rank 0
 /// writes the outputs (the same files as one process, and `ranks.json`).
-pub fn run_on(
-    scene: &mut Scene,
+pub fn run_on<D: Dim>(
+    scene: &mut Scene<D>,
     registry: &Registry,
     dir: &Path,
     cluster: Option<Box<dyn crate::dd::Cluster>>,
-    mut on_step: impl FnMut(&World2, &StepReport),
+    mut on_step: impl FnMut(&World<D>, &StepReport),
 ) -> Result<RunSummary, RunError> {
     let start = Instant::now();
     let root = cluster.as_ref().is_none_or(|c| c.rank() == 0);
     // a decomposed run steps with NSCDD; outputs take its report and view
-    let mut dd: Option<Nscdd> = dd_solver(scene.decomposition.as_ref(), cluster)?;
+    let mut dd: Option<NscddOf<Rigid<D>>> = dd_solver(scene.decomposition.as_ref(), cluster)?;
+    let mut writers = writers(scene, registry, root);
     let w = &mut scene.world;
     let mut hist = History::with_columns(history_sink(dir, root)?, w, dd.is_some()).map_err(io(dir, "history.csv"))?;
-    let mut writers: Vec<Box<dyn Writer2>> = vec![];
-    if scene.output.vtk && root {
-        writers.push((registry.writers["vtk"])());
-    }
-    for name in scene.output.writers.iter().filter(|_| root) {
-        writers.push((registry.writers[name.as_str()])());
-    }
     let mut frame = 0u32;
-    let write_frame = |writers: &mut Vec<Box<dyn Writer2>>, w: &World2, dd: &Option<Nscdd>, frame: u32| -> std::io::Result<()> {
-        let view = dd.as_ref().map(|n| n.view(w));
-        for wr in writers.iter_mut() {
-            match &view {
-                Some(v) => wr.write_dd(w, v, dir, frame)?,
-                None => wr.write(w, dir, frame)?,
+    let write_frame =
+        |writers: &mut Vec<Box<dyn Writer<D>>>, w: &World<D>, dd: &Option<NscddOf<Rigid<D>>>, frame: u32| -> std::io::Result<()> {
+            let view = dd.as_ref().map(|n| n.view(w));
+            for wr in writers.iter_mut() {
+                match &view {
+                    Some(v) => wr.write_dd(w, v, dir, frame)?,
+                    None => wr.write(w, dir, frame)?,
+                }
             }
-        }
-        Ok(())
-    };
+            Ok(())
+        };
     write_frame(&mut writers, w, &dd, frame).map_err(io(dir, "the first output frame"))?;
     frame += 1;
     let mut sum = RunSummary::default();

@@ -26,7 +26,7 @@ fn compaction(mu: f64) -> (f64, f64, f64) {
     let reg = nscdd_spheres::registry();
     let mut s = nscdd::scene::load3::load_str(&text, "triaxial3d.toml", &reg).unwrap();
     let dir = std::env::temp_dir().join(format!("nscdd-compaction-{}-{mu}", std::process::id()));
-    let sum = nscdd::run3::run3(&mut s, &dir, |_, _| {}).unwrap();
+    let sum = nscdd::run::run(&mut s, &nscdd_spheres::registry(), &dir, |_, _| {}).unwrap();
     let w = &s.world;
     let (nu_bulk, z_bulk, rattlers) = w.bulk_measures(4.0 * w.max_grain_size()).unwrap();
     // translational kinetic energy of the grains (rattlers may keep spinning)

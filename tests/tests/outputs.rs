@@ -94,7 +94,8 @@ fn run_writes_history_final_and_vtk() {
     assert_eq!(bodies[1]["kind"], "disk");
     let contacts = fin["contacts"].as_array().unwrap();
     assert!(contacts.len() >= 5 + 10, "floor and lattice contacts");
-    for key in ["bodies", "point", "normal", "r_n", "r_t", "gap"] {
+    assert_eq!(fin["dimension"], 2);
+    for key in ["bodies", "feature", "point", "normal", "r", "impulse", "gap"] {
         assert!(contacts[0].get(key).is_some(), "contact field {key}");
     }
 

@@ -222,7 +222,7 @@ position = [0.1, 0.2, {R:?}]
     ));
     let dir = std::env::temp_dir().join(format!("nscdd-spheres-out-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let sum = nscdd::run3::run3(&mut s, &dir, |_, _| {}).unwrap();
+    let sum = nscdd::run::run(&mut s, &nscdd_spheres::registry(), &dir, |_, _| {}).unwrap();
     assert_eq!(sum.steps, 50);
     let w = &s.world;
     rel("weight on the box", w.reaction[0][2] / w.time.h, -w.bodies.mass[1] * G, 1e-9);
@@ -386,12 +386,12 @@ seed = 9
     let tmp = |n: &str| std::env::temp_dir().join(format!("nscdd-restart3-{}-{n}", std::process::id()));
     let (a, b, c) = (tmp("whole"), tmp("first"), tmp("second"));
     let mut whole = load(&scene(80));
-    nscdd::run3::run3(&mut whole, &a, |_, _| {}).unwrap();
+    nscdd::run::run(&mut whole, &nscdd_spheres::registry(), &a, |_, _| {}).unwrap();
     let mut first = load(&scene(40));
-    nscdd::run3::run3(&mut first, &b, |_, _| {}).unwrap();
+    nscdd::run::run(&mut first, &nscdd_spheres::registry(), &b, |_, _| {}).unwrap();
     let mut second = load(&scene(80));
-    nscdd::scene::restart3::restart3(&mut second.world, &b.join("final.json")).unwrap();
-    nscdd::run3::run3(&mut second, &c, |_, _| {}).unwrap();
+    nscdd::scene::restart(&mut second.world, &b.join("final.json")).unwrap();
+    nscdd::run::run(&mut second, &nscdd_spheres::registry(), &c, |_, _| {}).unwrap();
     let (x, y) = (
         std::fs::read_to_string(a.join("final.json")).unwrap(),
         std::fs::read_to_string(c.join("final.json")).unwrap(),
@@ -402,7 +402,7 @@ seed = 9
     assert!(whole.world.contacts.len() > 10);
     // a 2D state is refused, naming the key
     let mut third = load(&scene(80));
-    let e = nscdd::scene::restart3::restart3_str(
+    let e = nscdd::scene::restart::restart_str(
         &mut third.world,
         "{\"dimension\": 2, \"step\": 1, \"time\": 0.001, \"bodies\": [], \"contacts\": []}",
         "s.json",

@@ -11,6 +11,7 @@ use crate::engine::{Diverged, StepReport};
 use crate::model::{ContactKey, Contacts};
 use crate::norms::Sums;
 use crate::solver::nlgs;
+use crate::world::World;
 
 /// A body family as NSCDD sees it (see the module docs).
 pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'static {
@@ -70,116 +71,106 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     fn step_with(w: &mut Self::World, stage: &mut super::NscddOf<Self>) -> Result<StepReport, Diverged>;
 }
 
-/// The NSCDD family of the rigid bodies of one dimension `$d` in the world `$world`:
-/// every operation is the dimension's ([`Dim`]) or the generic contact set's and
-/// NLGS's.
-macro_rules! rigid_family {
-    ($(#[$doc:meta])* $name:ident, $d:ty, $world:ty, $space:expr) => {
-        $(#[$doc])*
-        #[derive(Clone, Copy, Debug, Default)]
-        pub struct $name;
+/// The NSCDD family of the rigid bodies of dimension D: every operation is the
+/// dimension's ([`Dim`]) or the generic contact set's and NLGS's.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Rigid<D: Dim>(std::marker::PhantomData<D>);
 
-        impl Family for $name {
-            type V = <$d as Dim>::Twist;
-            type InvMass = <$d as Dim>::InvMass;
-            type Contacts = Contacts<$d>;
-            type World = $world;
-            const SPACE: usize = $space;
+/// 2D rigid bodies ([`crate::world::World2`]).
+pub type Rigid2 = Rigid<D2>;
+/// 3D rigid bodies ([`crate::world::World3`]).
+pub type Rigid3 = Rigid<D3>;
 
-            fn len(c: &Self::Contacts) -> usize {
-                c.len()
-            }
-            fn reserve(c: &mut Self::Contacts, n: usize) {
-                c.reserve(n);
-            }
-            fn push_contact(dst: &mut Self::Contacts, src: &Self::Contacts, a: usize, li: u32, lj: u32) {
-                dst.push_from(src, a, li, lj);
-            }
-            fn bodies(c: &Self::Contacts, a: usize) -> [u32; 2] {
-                c.bodies[a]
-            }
-            fn key(c: &Self::Contacts, a: usize) -> ContactKey {
-                c.key[a]
-            }
-            fn point(c: &Self::Contacts, a: usize) -> [f64; 3] {
-                let mut p = [0.0; 3];
-                p[..<$d as Dim>::N].copy_from_slice(c.point[a].as_ref());
-                p
-            }
-            fn copy_r(dst: &mut Self::Contacts, ga: usize, src: &Self::Contacts, la: usize) {
-                dst.r[ga] = src.r[la];
-            }
-            fn r(c: &Self::Contacts, a: usize) -> &[f64] {
-                c.r[a].as_ref()
-            }
-            fn r_mut(c: &mut Self::Contacts, a: usize) -> &mut [f64] {
-                c.r[a].as_mut()
-            }
-            fn copy_delassus(c: &mut Self::Contacts, inv: &[Self::InvMass]) {
-                c.refresh_delassus(inv);
-            }
-            fn warm_start(c: &Self::Contacts, vel: &mut [Self::V], inv: &[Self::InvMass]) {
-                c.apply_all(vel, inv);
-            }
-            fn sweep(c: &mut Self::Contacts, vel: &mut [Self::V], inv: &[Self::InvMass], order: &[u32], omega: f64, sums: Option<&mut Sums>) {
-                nlgs::sweep(c, vel, inv, order, omega, sums);
-            }
-            fn scale_inv(im: Self::InvMass, m: f64) -> Self::InvMass {
-                <$d as Dim>::scale_inv(&im, m)
-            }
-            fn apply_impulse(v: &mut Self::V, im: &Self::InvMass, f: &Self::V) {
-                <$d as Dim>::apply_inv(v, im, f);
-            }
-            fn glue(v: &mut Self::V, f: &mut Self::V, im: &Self::InvMass, dv: &Self::V) {
-                <$d as Dim>::glue(v, f, im, dv);
-            }
-            fn n_bodies(w: &Self::World) -> usize {
-                w.bodies.len()
-            }
-            fn movable(w: &Self::World, g: usize) -> bool {
-                w.bodies.movable(g)
-            }
-            fn inv_mass(w: &Self::World, g: usize) -> Self::InvMass {
-                w.bodies.inv_mass[g]
-            }
-            fn rho2(w: &Self::World, g: usize) -> f64 {
-                w.bodies.rho2(g)
-            }
-            fn contacts(w: &Self::World) -> &Self::Contacts {
-                &w.contacts
-            }
-            fn contacts_mut(w: &mut Self::World) -> &mut Self::Contacts {
-                &mut w.contacts
-            }
-            fn vel(w: &Self::World) -> &[Self::V] {
-                &w.bodies.vel
-            }
-            fn vel_mut(w: &mut Self::World) -> &mut [Self::V] {
-                &mut w.bodies.vel
-            }
-            fn order(w: &Self::World) -> &[u32] {
-                &w.scratch.order
-            }
-            fn residual(w: &Self::World) -> f64 {
-                nlgs::residual(&w.contacts, &w.bodies.vel)
-            }
-            fn solver(w: &Self::World) -> &crate::solver::SolverSettings {
-                &w.solver
-            }
-            fn step_with(w: &mut Self::World, stage: &mut super::NscddOf<Self>) -> Result<StepReport, Diverged> {
-                w.step_with(stage)
-            }
-        }
-    };
+impl<D: Dim> Family for Rigid<D> {
+    type V = D::Twist;
+    type InvMass = D::InvMass;
+    type Contacts = Contacts<D>;
+    type World = World<D>;
+    const SPACE: usize = D::N;
+
+    fn len(c: &Self::Contacts) -> usize {
+        c.len()
+    }
+    fn reserve(c: &mut Self::Contacts, n: usize) {
+        c.reserve(n);
+    }
+    fn push_contact(dst: &mut Self::Contacts, src: &Self::Contacts, a: usize, li: u32, lj: u32) {
+        dst.push_from(src, a, li, lj);
+    }
+    fn bodies(c: &Self::Contacts, a: usize) -> [u32; 2] {
+        c.bodies[a]
+    }
+    fn key(c: &Self::Contacts, a: usize) -> ContactKey {
+        c.key[a]
+    }
+    fn point(c: &Self::Contacts, a: usize) -> [f64; 3] {
+        let mut p = [0.0; 3];
+        p[..D::N].copy_from_slice(c.point[a].as_ref());
+        p
+    }
+    fn copy_r(dst: &mut Self::Contacts, ga: usize, src: &Self::Contacts, la: usize) {
+        dst.r[ga] = src.r[la];
+    }
+    fn r(c: &Self::Contacts, a: usize) -> &[f64] {
+        c.r[a].as_ref()
+    }
+    fn r_mut(c: &mut Self::Contacts, a: usize) -> &mut [f64] {
+        c.r[a].as_mut()
+    }
+    fn copy_delassus(c: &mut Self::Contacts, inv: &[Self::InvMass]) {
+        c.refresh_delassus(inv);
+    }
+    fn warm_start(c: &Self::Contacts, vel: &mut [Self::V], inv: &[Self::InvMass]) {
+        c.apply_all(vel, inv);
+    }
+    fn sweep(c: &mut Self::Contacts, vel: &mut [Self::V], inv: &[Self::InvMass], order: &[u32], omega: f64, sums: Option<&mut Sums>) {
+        nlgs::sweep(c, vel, inv, order, omega, sums);
+    }
+    fn scale_inv(im: Self::InvMass, m: f64) -> Self::InvMass {
+        D::scale_inv(&im, m)
+    }
+    fn apply_impulse(v: &mut Self::V, im: &Self::InvMass, f: &Self::V) {
+        D::apply_inv(v, im, f);
+    }
+    fn glue(v: &mut Self::V, f: &mut Self::V, im: &Self::InvMass, dv: &Self::V) {
+        D::glue(v, f, im, dv);
+    }
+    fn n_bodies(w: &Self::World) -> usize {
+        w.bodies.len()
+    }
+    fn movable(w: &Self::World, g: usize) -> bool {
+        w.bodies.movable(g)
+    }
+    fn inv_mass(w: &Self::World, g: usize) -> Self::InvMass {
+        w.bodies.inv_mass[g]
+    }
+    fn rho2(w: &Self::World, g: usize) -> f64 {
+        w.bodies.rho2(g)
+    }
+    fn contacts(w: &Self::World) -> &Self::Contacts {
+        &w.contacts
+    }
+    fn contacts_mut(w: &mut Self::World) -> &mut Self::Contacts {
+        &mut w.contacts
+    }
+    fn vel(w: &Self::World) -> &[Self::V] {
+        &w.bodies.vel
+    }
+    fn vel_mut(w: &mut Self::World) -> &mut [Self::V] {
+        &mut w.bodies.vel
+    }
+    fn order(w: &Self::World) -> &[u32] {
+        &w.scratch.order
+    }
+    fn residual(w: &Self::World) -> f64 {
+        nlgs::residual(&w.contacts, &w.bodies.vel)
+    }
+    fn solver(w: &Self::World) -> &crate::solver::SolverSettings {
+        &w.solver
+    }
+    fn step_with(w: &mut Self::World, stage: &mut super::NscddOf<Self>) -> Result<StepReport, Diverged> {
+        w.step_with(stage)
+    }
 }
-
-rigid_family!(
-    /// 2D rigid bodies ([`crate::rigid2d`], [`crate::world::World2`]).
-    Rigid2, D2, crate::world::World2, 2
-);
-rigid_family!(
-    /// 3D rigid bodies ([`crate::rigid3d`], [`crate::world::World3`]).
-    Rigid3, D3, crate::world::World3, 3
-);
 
 pub use crate::dim::d3::InvMass3;

@@ -55,7 +55,7 @@ pub mod transport;
 
 use crate::rigid2d::contacts::ContactKey;
 pub use cluster::{Cluster, Solo};
-pub use family::{Family, Rigid2, Rigid3};
+pub use family::{Family, Rigid, Rigid2, Rigid3};
 pub use partition::{Decomposition, FGammaStore, Grid, Interface};
 pub use ranks::RankState;
 pub use schemes::Scheme;

@@ -163,6 +163,13 @@ impl Dim for D2 {
             arm_j: arm(x_j),
         }
     }
+    fn normal(f: &Frame2) -> [f64; 2] {
+        f.n
+    }
+    fn to_world(f: &Frame2, r: &[f64; 2]) -> [f64; 2] {
+        // t = (−n_y, n_x)
+        [r[0] * f.n[0] - r[1] * f.n[1], r[0] * f.n[1] + r[1] * f.n[0]]
+    }
     #[inline(always)]
     fn local_velocity(f: &Frame2, vi: &[f64; 3], vj: &[f64; 3]) -> [f64; 2] {
         local_velocity(f, *vi, *vj)

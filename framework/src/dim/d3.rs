@@ -313,6 +313,12 @@ impl Dim for D3 {
             d_j: arm(x_j),
         }
     }
+    fn normal(f: &Frame3) -> [f64; 3] {
+        f.basis[0]
+    }
+    fn to_world(f: &Frame3, r: &[f64; 3]) -> [f64; 3] {
+        to_world(&f.basis, *r)
+    }
     #[inline(always)]
     fn local_velocity(f: &Frame3, vi: &[f64; 6], vj: &[f64; 6]) -> [f64; 3] {
         local_velocity(f, vi, vj)

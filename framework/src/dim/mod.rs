@@ -94,6 +94,21 @@ macro_rules! vector {
 }
 vector!(2 3 4 6);
 
+/// The components of a small value as a slice (a rotation vector, an angle).
+pub trait Coords {
+    fn coords(&self) -> &[f64];
+}
+impl Coords for f64 {
+    fn coords(&self) -> &[f64] {
+        std::slice::from_ref(self)
+    }
+}
+impl<const N: usize> Coords for [f64; N] {
+    fn coords(&self) -> &[f64] {
+        self
+    }
+}
+
 mod sealed {
     pub trait Sealed {}
     impl Sealed for super::D2 {}
@@ -130,7 +145,7 @@ pub trait Dim: sealed::Sealed + Copy + Default + Debug + PartialEq + Send + Sync
     type Inertia: Pod;
     /// A rotation as a vector, as scene files give it: the angle (rad) in 2D, the
     /// rotation vector (axis × angle) in 3D.
-    type RotVec: Pod;
+    type RotVec: Pod + Coords;
 
     /// The identity orientation.
     fn rot_identity() -> Self::Rot;
@@ -171,6 +186,10 @@ pub trait Dim: sealed::Sealed + Copy + Default + Debug + PartialEq + Send + Sync
     /// The frame of a contact at `point` with unit normal `normal` (from j to i)
     /// between bodies whose centres are `x_i`, `x_j`.
     fn frame(point: &Self::Point, normal: &Self::Point, x_i: &Self::Point, x_j: &Self::Point) -> Self::Frame;
+    /// The unit normal of a frame (from j to i).
+    fn normal(f: &Self::Frame) -> Self::Point;
+    /// A local vector in world axes (`B r`: the impulse on i).
+    fn to_world(f: &Self::Frame, r: &Self::Local) -> Self::Point;
     /// u = H_iᵀ V_i − H_jᵀ V_j.
     fn local_velocity(f: &Self::Frame, vi: &Self::Twist, vj: &Self::Twist) -> Self::Local;
     /// V_i += M̂_i⁻¹ H_i Δr, V_j −= M̂_j⁻¹ H_j Δr.

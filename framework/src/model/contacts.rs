@@ -5,7 +5,7 @@
 //! `Vec` per scalar made the 2D sweep 1.75× faster (docs/PERFORMANCE.md).
 
 use crate::dim::joint::Joint;
-use crate::dim::{Dim, Vector, D3};
+use crate::dim::{Dim, Vector};
 use serde::{Deserialize, Serialize};
 
 /// Identity of a contact between steps: the two bodies and a feature index (for
@@ -131,9 +131,9 @@ impl<D: Dim> Contacts<D> {
     }
 }
 
-impl Contacts<D3> {
-    /// World impulse B r of contact α.
-    pub fn world_impulse(&self, a: usize) -> [f64; 3] {
-        crate::dim::d3::to_world(&self.frame[a].basis, self.r[a])
+impl<D: Dim> Contacts<D> {
+    /// World impulse B r of contact α (on its candidate body i).
+    pub fn world_impulse(&self, a: usize) -> D::Point {
+        D::to_world(&self.frame[a], &self.r[a])
     }
 }

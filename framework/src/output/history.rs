@@ -1,18 +1,37 @@
-//! `history.csv`: one row per step.
+//! `history.csv`: one row per step, the same columns in 2D and 3D with the
+//! dimension's names ([`History`]).
 
 use crate::dd::DdStepReport;
+use crate::dim::{Coords, Dim, Vector};
 use crate::engine::StepReport;
-use crate::world::World2;
+use crate::world::{World, World3};
 use std::io::Write;
 
-/// Writes the history rows; the columns are fixed when the run starts.
-pub struct History<W: Write> {
+/// Writes the history rows; the columns are fixed when the run starts:
+///
+/// - [`SOLVER_COLUMNS`]: the step, its solve and the energies;
+/// - per named or driven body `_x, _y[, _z]`, its rotation (`_rot` in 2D, the
+///   rotation vector `_rx, _ry, _rz` in 3D), the contact force resultant
+///   `_fx, _fy[, _fz]` (N) and moment (`_m` in 2D, `_mx, _my, _mz` in 3D);
+/// - with a box sample (`[output] box` / `box3`): `solid_fraction`, `eps1` (along
+///   the last axis), `sigma_xx, sigma_yy[, sigma_zz]` (Pa, compression positive),
+///   `p` (mean), `q` (axial − mean lateral), `q_over_p`, `sin_phi`
+///   ((σ_axial − σ_lateral)/(σ_axial + σ_lateral)), `z` (grain–grain
+///   coordination), `z_m` (loaded contacts per grain without the rattlers), and in
+///   3D, away from the walls (inner box shrunk by 4 largest radii,
+///   [`World3::bulk_measures`](crate::world::World3)), `nu_bulk, z_bulk,
+///   rattlers_bulk`;
+/// - the stage timings, then with NSCDD [`DD_COLUMNS`].
+pub struct History<W: Write, D: Dim> {
     out: W,
     /// Bodies with their own columns: named or driven ones.
     tracked: Vec<(u32, String)>,
     has_box: bool,
     /// NSCDD columns (a decomposed run).
     dd: bool,
+    /// Margin of the 3D bulk measures: 4 × the largest grain radius.
+    margin: f64,
+    _dim: std::marker::PhantomData<D>,
 }
 
 /// The NSCDD columns, after the timings.
@@ -27,13 +46,22 @@ pub const DD_COLUMNS: [&str; 8] = [
     "subdomains",
 ];
 
-impl<W: Write> History<W> {
-    pub fn new(out: W, w: &World2) -> std::io::Result<Self> {
+/// Column suffixes of a tracked body: position, rotation, force, moment.
+fn body_columns(n: usize) -> Vec<&'static str> {
+    if n == 2 {
+        vec!["x", "y", "rot", "fx", "fy", "m"]
+    } else {
+        vec!["x", "y", "z", "rx", "ry", "rz", "fx", "fy", "fz", "mx", "my", "mz"]
+    }
+}
+
+impl<W: Write, D: Dim> History<W, D> {
+    pub fn new(out: W, w: &World<D>) -> std::io::Result<Self> {
         Self::with_columns(out, w, false)
     }
 
     /// With `dd`, the NSCDD columns [`DD_COLUMNS`] follow the timings.
-    pub fn with_columns(mut out: W, w: &World2, dd: bool) -> std::io::Result<Self> {
+    pub fn with_columns(mut out: W, w: &World<D>, dd: bool) -> std::io::Result<Self> {
         let mut tracked: Vec<(u32, String)> = vec![];
         for b in 0..w.bodies.len() {
             let driven = w.drives.iter().any(|d| d.body as usize == b);
@@ -46,12 +74,16 @@ impl<W: Write> History<W> {
         let has_box = w.box_walls.is_some();
         let mut head = String::from(SOLVER_COLUMNS);
         for (_, n) in &tracked {
-            for c in ["x", "y", "rot", "fx", "fy", "m"] {
+            for c in body_columns(D::N) {
                 head.push_str(&format!(",{n}_{c}"));
             }
         }
         if has_box {
-            head.push_str(",solid_fraction,eps1,sigma1,sigma2,sin_phi");
+            head.push_str(if D::N == 2 {
+                ",solid_fraction,eps1,sigma_xx,sigma_yy,p,q,q_over_p,sin_phi,z,z_m"
+            } else {
+                ",solid_fraction,eps1,sigma_xx,sigma_yy,sigma_zz,p,q,q_over_p,sin_phi,z,z_m,nu_bulk,z_bulk,rattlers_bulk"
+            });
         }
         head.push_str(",t_detect,t_delassus,t_nlgs,t_update,t_output");
         if dd {
@@ -61,35 +93,40 @@ impl<W: Write> History<W> {
             }
         }
         writeln!(out, "{head}")?;
-        Ok(History { out, tracked, has_box, dd })
+        let margin = 4.0 * w.max_grain_size();
+        Ok(History {
+            out,
+            tracked,
+            has_box,
+            dd,
+            margin,
+            _dim: std::marker::PhantomData,
+        })
     }
 
-    pub fn row(&mut self, w: &World2, r: &StepReport, t_output: f64) -> std::io::Result<()> {
+    pub fn row(&mut self, w: &World<D>, r: &StepReport, t_output: f64) -> std::io::Result<()> {
         self.row_dd(w, r, None, t_output)
     }
 
     /// A row; `dd` fills the NSCDD columns (empty when the history has them and
     /// `dd` is `None`).
-    pub fn row_dd(&mut self, w: &World2, r: &StepReport, dd: Option<&DdStepReport>, t_output: f64) -> std::io::Result<()> {
+    pub fn row_dd(&mut self, w: &World<D>, r: &StepReport, dd: Option<&DdStepReport>, t_output: f64) -> std::io::Result<()> {
         let (ek, ep) = w.energies();
         let mut s = solver_fields(w.step, w.t, w.bodies.len(), r, ek, ep);
         let h = w.time.h;
         for (b, _) in &self.tracked {
             let b = *b as usize;
             let (p, f) = (w.bodies.pos[b], w.reaction[b]);
-            s.push_str(&format!(
-                ",{:e},{:e},{:e},{:e},{:e},{:e}",
-                p[0],
-                p[1],
-                w.bodies.rot[b],
-                f[0] / h,
-                f[1] / h,
-                f[2] / h
-            ));
+            let rot = D::rot_to_vec(&w.bodies.rot[b]);
+            for x in p.as_ref().iter().chain(rot.coords()) {
+                s.push_str(&format!(",{x:e}"));
+            }
+            for x in f.as_ref() {
+                s.push_str(&format!(",{:e}", x / h));
+            }
         }
         if self.has_box {
-            let (nu, eps1, s1, s2, sphi) = box_measures(w);
-            s.push_str(&format!(",{nu:e},{eps1:e},{s1:e},{s2:e},{sphi:e}"));
+            box_fields(w, self.margin, &mut s);
         }
         let tm = r.times;
         s.push_str(&format!(
@@ -107,22 +144,28 @@ impl<W: Write> History<W> {
     }
 }
 
-/// Box sample measures: solid fraction ν, axial strain ε1 = (H0 − H)/H0, mean wall
-/// stresses σ1 = (|F_top| + |F_bottom|)/(2W) and σ2 = (|F_left| + |F_right|)/(2H)
-/// from the contact forces on the walls, and sin φ = (σ1 − σ2)/(σ1 + σ2).
-pub fn box_measures(w: &World2) -> (f64, f64, f64, f64, f64) {
-    let (Some(bw), Some(e)) = (&w.box_walls, w.box_extent()) else {
-        return (f64::NAN, f64::NAN, f64::NAN, f64::NAN, f64::NAN);
-    };
-    let h = w.time.h;
-    let (width, height) = (e.max[0] - e.min[0], e.max[1] - e.min[1]);
-    let [left, right, bottom, top, ..] = bw.walls;
-    let f = |b: u32, k: usize| w.reaction[b as usize][k].abs() / h;
-    let s1 = (f(top, 1) + f(bottom, 1)) / (2.0 * width);
-    let s2 = (f(left, 0) + f(right, 0)) / (2.0 * height);
-    let sphi = if s1 + s2 > 0.0 { (s1 - s2) / (s1 + s2) } else { 0.0 };
-    let eps1 = w.box_h0.map(|h0| (h0 - height) / h0).unwrap_or(0.0);
-    (w.solid_fraction().unwrap_or(f64::NAN), eps1, s1, s2, sphi)
+/// The box sample's fields of a row (see [`History`]).
+fn box_fields<D: Dim>(w: &World<D>, margin: f64, s: &mut String) {
+    let nu = w.solid_fraction().unwrap_or(f64::NAN);
+    let height = w.box_extent().map_or(f64::NAN, |e| e.max[D::N - 1] - e.min[D::N - 1]);
+    let eps1 = w.box_h0.map_or(0.0, |h0| (h0 - height) / h0);
+    let sg = w.box_stresses().unwrap_or(D::Point::from_fn(|_| f64::NAN));
+    let axial = sg[D::N - 1];
+    let lateral = (0..D::N - 1).map(|k| sg[k]).sum::<f64>() / (D::N - 1) as f64;
+    let p = (0..D::N).map(|k| sg[k]).sum::<f64>() / D::N as f64;
+    let q = axial - lateral;
+    let sin_phi = if axial + lateral != 0.0 { q / (axial + lateral) } else { 0.0 };
+    s.push_str(&format!(",{nu:e},{eps1:e}"));
+    for k in 0..D::N {
+        s.push_str(&format!(",{:e}", sg[k]));
+    }
+    let (z, zm) = w.coordination();
+    let q_over_p = if p != 0.0 { q / p } else { 0.0 };
+    s.push_str(&format!(",{p:e},{q:e},{q_over_p:e},{sin_phi:e},{z:e},{zm:e}"));
+    if let Some(w3) = (w as &dyn std::any::Any).downcast_ref::<World3>() {
+        let (nb, zb, rb) = w3.bulk_measures(margin).unwrap_or((f64::NAN, f64::NAN, f64::NAN));
+        s.push_str(&format!(",{nb:e},{zb:e},{rb:e}"));
+    }
 }
 
 /// The NSCDD fields of a history row (empty fields without a report).

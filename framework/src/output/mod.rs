@@ -5,80 +5,99 @@ pub mod history;
 pub mod out3;
 pub mod vtk;
 
-use crate::world::World2;
+use crate::dim::Dim;
+use crate::world::World;
 use serde::Serialize;
 
 #[derive(Serialize)]
-struct BodyOut<'a> {
+#[serde(bound = "")]
+struct BodyOut<'a, D: Dim> {
     id: u32,
     #[serde(skip_serializing_if = "Option::is_none")]
     name: Option<&'a str>,
     kind: &'static str,
     material: &'a str,
-    position: [f64; 2],
-    rotation: f64,
-    velocity: [f64; 3],
+    position: D::Point,
+    /// The angle in 2D, the rotation vector (axis × angle) in 3D.
+    rotation: D::RotVec,
+    /// 3D: the unit quaternion (w, x, y, z), exact for a restart.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    quaternion: Option<D::Rot>,
+    velocity: D::Twist,
     fixed: bool,
     shape: serde_json::Value,
 }
 
 #[derive(Serialize)]
-struct ContactOut {
+#[serde(bound = "")]
+struct ContactOut<D: Dim> {
     bodies: [u32; 2],
     feature: u32,
-    point: [f64; 2],
-    normal: [f64; 2],
-    r_n: f64,
-    r_t: f64,
+    point: D::Point,
+    normal: D::Point,
+    /// The impulse in the contact frame, normal first (N·s).
+    r: D::Local,
+    /// The impulse on the candidate body in world axes (N·s).
+    impulse: D::Point,
     gap: f64,
+    /// An intact bonded joint (law `mohr_coulomb`).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    bonded: bool,
 }
 
 #[derive(Serialize)]
-struct FinalOut<'a> {
+#[serde(bound = "")]
+struct FinalOut<'a, D: Dim> {
+    dimension: u8,
     step: u64,
     time: f64,
     #[serde(skip_serializing_if = "Option::is_none")]
     box_h0: Option<f64>,
-    bodies: Vec<BodyOut<'a>>,
-    contacts: Vec<ContactOut>,
+    bodies: Vec<BodyOut<'a, D>>,
+    contacts: Vec<ContactOut<D>>,
 }
 
-/// The state as `final.json`: step, time, `box_h0` (the box height ε1 is measured
-/// from, once set), bodies (id, name, kind, material, position, rotation, velocity,
-/// fixed, shape) and contacts (bodies [candidate, antagonist], feature, point, normal
-/// from antagonist to candidate, impulses r_n, r_t in N·s, gap in m). It is also a
-/// restart file ([`crate::scene::restart`]).
-pub fn final_json(w: &World2) -> String {
+/// The state as `final.json`: the dimension, step, time, `box_h0` (the box height
+/// ε1 is measured from, once set), bodies (id, name, kind, material, position,
+/// rotation (3D: a rotation vector, and the quaternion), velocity (v, ω), fixed,
+/// shape) and contacts (bodies [candidate, antagonist], feature, point, normal
+/// from antagonist to candidate, the impulse `r` in the contact frame and
+/// `impulse` in world axes (N·s), gap (m), `bonded` for an intact joint). It is
+/// also a restart file ([`crate::scene::restart`]).
+pub fn final_json<D: Dim>(w: &World<D>) -> String {
     let b = &w.bodies;
     let bodies = (0..b.len())
         .map(|k| {
             let s = b.shape[k];
-            BodyOut {
+            BodyOut::<D> {
                 id: k as u32,
                 name: w.names[k].as_deref(),
                 kind: w.kind_name(k),
                 material: &w.materials[b.material[k] as usize].name,
                 position: b.pos[k],
-                rotation: b.rot[k],
+                rotation: D::rot_to_vec(&b.rot[k]),
+                quaternion: (D::N == 3).then_some(b.rot[k]),
                 velocity: b.vel[k],
-                fixed: !b.movable(k),
+                fixed: w.fixed[k],
                 shape: w.shapes[s.kind as usize].describe(s.index),
             }
         })
         .collect();
     let c = &w.contacts;
     let contacts = (0..c.len())
-        .map(|a| ContactOut {
+        .map(|a| ContactOut::<D> {
             bodies: c.bodies[a],
             feature: c.key[a].feature,
             point: c.point[a],
-            normal: c.frame[a].n,
-            r_n: c.r[a][0],
-            r_t: c.r[a][1],
+            normal: D::normal(&c.frame[a]),
+            r: c.r[a],
+            impulse: c.world_impulse(a),
             gap: c.gap[a],
+            bonded: c.joint[a].bonded(),
         })
         .collect();
     let mut s = serde_json::to_string_pretty(&FinalOut {
+        dimension: D::N as u8,
         step: w.step,
         time: w.t,
         box_h0: w.box_h0,

@@ -15,14 +15,16 @@
 //! so that a stopped run leaves valid series). Files are written with `vtkio`.
 
 use crate::dd::DdView;
-use crate::registry::{Glyph2, Registry, Writer2};
+use crate::dim::{D2, D3};
+use crate::registry::{Glyph2, Registry, Writer};
 use crate::world::World2;
 use std::io::Write;
 use std::path::Path;
 use vtkio::model::{Attribute, Attributes, ByteOrder, DataSet, PolyDataPiece, Version, VertexNumbers, Vtk};
 
 pub(crate) fn register_builtin(r: &mut Registry) {
-    r.add_writer("vtk", || Box::new(VtkWriter::default()));
+    r.add_writer::<D2>("vtk", || Box::new(VtkWriter::default()));
+    r.add_writer::<D3>("vtk", || Box::new(VtkWriter::default()));
 }
 
 /// Writes the VTK frames and `.pvd` series.
@@ -85,12 +87,18 @@ impl VtkWriter {
     }
 }
 
-impl Writer2 for VtkWriter {
+impl Writer<D2> for VtkWriter {
     fn write(&mut self, w: &World2, dir: &Path, frame: u32) -> std::io::Result<()> {
         self.frame(w, None, dir, frame)
     }
     fn write_dd(&mut self, w: &World2, dd: &DdView, dir: &Path, frame: u32) -> std::io::Result<()> {
         self.frame(w, Some(dd), dir, frame)
+    }
+}
+
+impl Writer<D3> for VtkWriter {
+    fn write(&mut self, w: &crate::world::World3, dir: &Path, frame: u32) -> std::io::Result<()> {
+        super::out3::write_vtk3(self, w, dir, frame)
     }
 }
 

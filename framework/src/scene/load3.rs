@@ -21,12 +21,7 @@ use crate::rigid2d::bodies::ShapeRef;
 use crate::world::{BoxWalls, World3};
 
 /// A loaded 3D scene: the world and how to write it.
-pub struct Scene3 {
-    pub world: World3,
-    pub output: OutputSettings,
-    /// NSCDD settings (`[decomposition]`, nx × ny × nz); `None`: one domain.
-    pub decomposition: Option<crate::dd::DdConfig>,
-}
+pub type Scene3 = super::Scene<D3>;
 
 /// Loads a 3D scene from its text; `file` names it in messages.
 pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene3, InputError> {
@@ -139,11 +134,10 @@ pub fn load_str_with(text: &str, file: &str, registry: &Registry, deformable: bo
         &["x", "y", "z", "rx", "ry", "rz"],
         "box3",
     )?;
-    if let Some(w) = sf.output.writers.first() {
-        return Err(cx.err(
-            &[k("output"), k("writers"), Seg::Index(0)],
-            format!("unknown writer `{w}` for a 3D scene"),
-        ));
+    for (i, w) in sf.output.writers.iter().enumerate() {
+        if registry.writer::<D3>(w).is_none() {
+            return Err(cx.err(&[k("output"), k("writers"), Seg::Index(i)], format!("unknown writer `{w}`")));
+        }
     }
     let movable = (0..n).filter(|&i| b.bodies.movable(i)).count();
     let decomposition = match &sf.decomposition {
@@ -177,7 +171,7 @@ pub fn load_str_with(text: &str, file: &str, registry: &Registry, deformable: bo
             output: OutputSettings {
                 every: sf.output.every,
                 vtk: sf.output.vtk,
-                writers: vec![],
+                writers: sf.output.writers,
                 checkpoint_every: sf.output.checkpoint_every,
             },
             decomposition,

@@ -11,15 +11,14 @@ pub mod builder;
 pub mod load3;
 pub mod locate;
 pub mod restart;
-pub mod restart3;
 pub mod schema;
 
 use crate::detect::{Detector, DetectorTable};
-use crate::dim::D2;
+use crate::dim::{Dim, D2};
 use crate::drive::BodyDrive;
 use crate::error::{line_of, InputError};
 use crate::registry::{ParamError, Registry};
-use crate::world::{BoxWalls, Material, TimeSettings, World2};
+use crate::world::{BoxWalls, Material, TimeSettings, World, World2};
 use builder::{Origin, SceneBuilder2};
 use locate::{locate, path_string, Seg};
 pub use restart::restart;
@@ -36,8 +35,8 @@ pub struct OutputSettings {
 }
 
 /// A loaded scene: the world and how to write it.
-pub struct Scene {
-    pub world: World2,
+pub struct Scene<D: Dim = D2> {
+    pub world: World<D>,
     pub output: OutputSettings,
     /// NSCDD settings (`[decomposition]`); `None`: the one-domain engine.
     /// [`crate::run::run`] steps with [`crate::dd::Nscdd`] when set.
@@ -394,7 +393,7 @@ fn load_parsed(cx: &Ctx, sf: SceneFile, registry: &Registry) -> Result<Scene, In
     };
     check_pressure_drives(&cx, &drives, box_walls.as_ref(), &b.origins, &["x", "y", "rot"], "box")?;
     for (i, w) in sf.output.writers.iter().enumerate() {
-        if !registry.writers.contains_key(w.as_str()) {
+        if registry.writer::<D2>(w).is_none() {
             return Err(cx.err(&[k("output"), k("writers"), Seg::Index(i)], format!("unknown writer `{w}`")));
         }
     }

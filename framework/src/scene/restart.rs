@@ -11,47 +11,63 @@
 //! decomposition, outputs, the end time, drives. It may not change the bodies (their
 //! number and kinds are checked) nor the step h (the saved time must be step × h).
 
+use crate::dim::joint::Joint;
+use crate::dim::{Dim, Vector};
 use crate::error::InputError;
-use crate::rigid2d::contacts::{ContactKey, Frame2};
-use crate::rigid2d::Contacts2;
-use crate::world::World2;
+use crate::model::{ContactKey, Contacts};
+use crate::world::World;
 use serde::Deserialize;
 use std::path::Path;
 
 #[derive(Deserialize)]
-struct SavedBody {
+#[serde(bound = "")]
+struct SavedBody<D: Dim> {
     id: u32,
     kind: String,
-    position: [f64; 2],
-    rotation: f64,
-    velocity: [f64; 3],
+    position: D::Point,
+    /// The angle in 2D, the rotation vector in 3D.
+    rotation: D::RotVec,
+    /// 3D: the exact orientation (the rotation vector is for reading).
+    #[serde(default)]
+    quaternion: Option<D::Rot>,
+    velocity: D::Twist,
 }
 
 #[derive(Deserialize)]
-struct SavedContact {
+#[serde(bound = "")]
+struct SavedContact<D: Dim> {
     bodies: [u32; 2],
     #[serde(default)]
     feature: Option<u32>,
-    point: [f64; 2],
-    normal: [f64; 2],
-    r_n: f64,
-    r_t: f64,
+    point: D::Point,
+    normal: D::Point,
+    /// The impulse in the contact frame (normal first).
+    #[serde(default)]
+    r: Option<D::Local>,
+    /// 2D states written before `r`: its two components.
+    #[serde(default)]
+    r_n: Option<f64>,
+    #[serde(default)]
+    r_t: Option<f64>,
     gap: f64,
+    #[serde(default)]
+    bonded: bool,
 }
 
 #[derive(Deserialize)]
-struct Saved {
+#[serde(bound = "")]
+struct Saved<D: Dim> {
     step: u64,
     time: f64,
     #[serde(default)]
     box_h0: Option<f64>,
-    bodies: Vec<SavedBody>,
-    contacts: Vec<SavedContact>,
+    bodies: Vec<SavedBody<D>>,
+    contacts: Vec<SavedContact<D>>,
 }
 
 /// Loads the saved state in `path` into `w` (a world loaded from the scene that
 /// wrote it). Errors name the file, the line and the key.
-pub fn restart(w: &mut World2, path: &Path) -> Result<(), InputError> {
+pub fn restart<D: Dim>(w: &mut World<D>, path: &Path) -> Result<(), InputError> {
     let file = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|e| InputError {
         file: file.clone(),
@@ -63,20 +79,56 @@ pub fn restart(w: &mut World2, path: &Path) -> Result<(), InputError> {
 }
 
 /// [`restart`] from the text of a saved state; `file` names it in messages.
-pub fn restart_str(w: &mut World2, text: &str, file: &str) -> Result<(), InputError> {
+pub fn restart_str<D: Dim>(w: &mut World<D>, text: &str, file: &str) -> Result<(), InputError> {
     let ck = StateChecks { text, file };
-    let saved: Saved =
-        serde_json::from_str(text).map_err(|e| ck.err(Some(e.line()), String::new(), format!("not a saved state (final.json): {e}")))?;
+    let dimension = serde_json::from_str::<serde_json::Value>(text)
+        .ok()
+        .and_then(|v| v.get("dimension").and_then(|d| d.as_u64()))
+        .unwrap_or(2);
+    if dimension != D::N as u64 {
+        return Err(ck.err(
+            ck.line_of("dimension", 0),
+            "dimension".into(),
+            format!("the state is {dimension}D, the scene {}", D::NAME),
+        ));
+    }
+    let saved: Saved<D> = serde_json::from_str(text).map_err(|e| {
+        ck.err(
+            Some(e.line()),
+            String::new(),
+            format!("not a saved state (final.json of a {} run): {e}", D::NAME),
+        )
+    })?;
     let nb = w.bodies.len();
-    let finite = |sb: &SavedBody| sb.position.iter().chain(&sb.velocity).all(|x| x.is_finite()) && sb.rotation.is_finite();
+    let finite = |sb: &SavedBody<D>| {
+        sb.position.as_ref().iter().chain(sb.velocity.as_ref()).all(|x| x.is_finite())
+            && D::rot_finite(&sb.quaternion.unwrap_or_else(|| D::rot_from_vec(&sb.rotation)))
+    };
     ck.bodies(
         saved.bodies.iter().map(|sb| (sb.id, sb.kind.as_str(), finite(sb))),
         |k| w.kind_name(k),
         nb,
     )?;
     let expected = ck.time(saved.step, saved.time, &w.time)?;
-    let mut c = Contacts2::default();
-    for (a, sc) in saved.contacts.iter().enumerate() {
+    let b = &mut w.bodies;
+    for (k, sb) in saved.bodies.iter().enumerate() {
+        b.pos[k] = sb.position;
+        b.rot[k] = sb.quaternion.unwrap_or_else(|| D::rot_from_vec(&sb.rotation));
+        b.vel[k] = sb.velocity;
+        b.refresh_inverse(k);
+    }
+    w.contacts = saved_contacts(&ck, &saved.contacts, &w.bodies.pos)?;
+    w.step = saved.step;
+    w.t = expected;
+    w.box_h0 = saved.box_h0;
+    Ok(())
+}
+
+/// The saved contacts (keys, impulses, bonds: the next step's warm start).
+fn saved_contacts<D: Dim>(ck: &StateChecks, saved: &[SavedContact<D>], pos: &[D::Point]) -> Result<Contacts<D>, InputError> {
+    let nb = pos.len();
+    let mut c = Contacts::default();
+    for (a, sc) in saved.iter().enumerate() {
         let [i, j] = sc.bodies;
         if i as usize >= nb || j as usize >= nb {
             return Err(ck.err(
@@ -85,35 +137,27 @@ pub fn restart_str(w: &mut World2, text: &str, file: &str) -> Result<(), InputEr
                 format!("body ids must be below {nb}"),
             ));
         }
+        let r = match (sc.r, sc.r_n, sc.r_t) {
+            (Some(r), _, _) => r,
+            (None, Some(rn), Some(rt)) if D::N == 2 => D::Local::from_fn(|k| [rn, rt][k]),
+            _ => return Err(ck.err(ck.line_of("gap", a), format!("contacts[{a}].r"), "missing impulse `r`".into())),
+        };
         c.bodies.push([i, j]);
-        c.frame.push(Frame2 {
-            n: sc.normal,
-            ..Default::default()
-        });
+        c.frame.push(D::frame(&sc.point, &sc.normal, &pos[i as usize], &pos[j as usize]));
         c.block.push(Default::default());
         c.target.push(Default::default());
-        c.r.push([sc.r_n, sc.r_t]);
-        c.u_free.push([0.0; 2]);
+        c.r.push(r);
+        c.u_free.push(D::Local::zero());
         c.gap.push(sc.gap);
         c.point.push(sc.point);
-        c.joint.push(Default::default());
         c.key.push(ContactKey {
             i,
             j,
             feature: sc.feature.unwrap_or(0),
         });
+        c.joint.push(if sc.bonded { Joint::RESTORED } else { Joint::default() });
     }
-    let b = &mut w.bodies;
-    for (k, sb) in saved.bodies.iter().enumerate() {
-        b.pos[k] = sb.position;
-        b.rot[k] = sb.rotation;
-        b.vel[k] = sb.velocity;
-    }
-    w.contacts = c;
-    w.step = saved.step;
-    w.t = expected;
-    w.box_h0 = saved.box_h0;
-    Ok(())
+    Ok(c)
 }
 
 /// The checks every restart file gets, whatever the dimension: errors name the

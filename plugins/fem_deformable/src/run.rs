@@ -6,9 +6,10 @@
 use crate::body::FeBody;
 use crate::mesh::cell_stress;
 use crate::scene::{FeScene2, FeScene3};
+use nscdd::dim::D2;
 use nscdd::engine::{Diverged, StepReport};
 use nscdd::output::vtk::VtkWriter;
-use nscdd::registry::Writer2;
+use nscdd::registry::Writer;
 use nscdd::scene::OutputSettings;
 use std::fmt::Write as _;
 use std::io::Write;
@@ -71,7 +72,7 @@ impl FeRunnable for FeScene2 {
         self.world.energies().0
     }
     fn write_rigid(&self, vtk: &mut VtkWriter, dir: &Path, frame: u32) -> std::io::Result<()> {
-        vtk.write(&self.world, dir, frame)
+        Writer::<D2>::write(vtk, &self.world, dir, frame)
     }
     fn final_json(&self) -> String {
         nscdd::output::final_json(&self.world)
@@ -104,10 +105,10 @@ impl FeRunnable for FeScene3 {
         self.world.energies().0
     }
     fn write_rigid(&self, vtk: &mut VtkWriter, dir: &Path, frame: u32) -> std::io::Result<()> {
-        nscdd::output::out3::write_vtk3(vtk, &self.world, dir, frame)
+        Writer::<nscdd::dim::D3>::write(vtk, &self.world, dir, frame)
     }
     fn final_json(&self) -> String {
-        nscdd::output::out3::final_json3(&self.world)
+        nscdd::output::final_json(&self.world)
     }
 }
 
@@ -181,7 +182,7 @@ pub fn run<S: FeRunnable>(s: &mut S, dir: &Path, mut progress: impl FnMut(u64, u
         progress(step, n);
     }
     hist.flush().map_err(io(dir, "history.csv"))?;
-    vtk.finish(dir).map_err(io(dir, "VTK series"))?;
+    Writer::<D2>::finish(&mut vtk, dir).map_err(io(dir, "VTK series"))?;
     if s.output().vtk {
         let mut pvd = String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n");
         for (t, f) in &frames {

@@ -2,9 +2,9 @@
 //! strength and fails 2 % above it, in tension (a hanging block: σ_t A against m g)
 //! and in shear (a flat block on a tilted base: c A + μ N against the downhill pull);
 //! bonds are made at the first step only and survive a restart.
-use nscdd::output::out3::final_json3;
+use nscdd::output::final_json;
 use nscdd::scene::load3::{load_str, Scene3};
-use nscdd::scene::restart3::restart3_str;
+use nscdd::scene::restart::restart_str;
 use nscdd::world::World3;
 use nscdd_polyhedra::generate::box_points;
 
@@ -150,10 +150,10 @@ fn bonds_are_made_at_the_first_step_only_and_survive_a_restart() {
     run(&mut a, 20);
     let mut b = world(&text);
     run(&mut b, 10);
-    let saved = final_json3(&b);
+    let saved = final_json(&b);
     assert!(saved.contains("\"bonded\": true"));
     let mut c = world(&text);
-    restart3_str(&mut c, &saved, "final.json").unwrap();
+    restart_str(&mut c, &saved, "final.json").unwrap();
     run(&mut c, 10);
     assert_eq!(bonds(&c), 4);
     assert_eq!(a.bodies.pos, c.bodies.pos);

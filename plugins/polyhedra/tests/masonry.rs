@@ -406,7 +406,7 @@ fn outputs_draw_the_blocks_and_their_contact_points() {
     let mut s = load_str(&text, "stack.toml", &nscdd_polyhedra::registry()).unwrap();
     let dir = std::env::temp_dir().join(format!("nscdd-poly-out-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    nscdd::run3::run3(&mut s, &dir, |_, _| {}).unwrap();
+    nscdd::run::run(&mut s, &nscdd_polyhedra::registry(), &dir, |_, _| {}).unwrap();
     for f in ["points.pvd", "walls.pvd", "vtk/points_000002.vtp", "vtk/walls_000002.vtp"] {
         assert!(dir.join(f).exists(), "{f}");
     }

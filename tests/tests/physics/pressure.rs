@@ -73,7 +73,9 @@ origin = [0.01, 0.01]
 
 #[test]
 fn pressure_on_a_2d_box_wall_balances_the_grains() {
-    let mut s = scene(&box_scene(&format!("x = {{ pressure = {SIGMA} }}, y = {{ velocity = 0.0 }}, rot = {{ velocity = 0.0 }}")));
+    let mut s = scene(&box_scene(&format!(
+        "x = {{ pressure = {SIGMA} }}, y = {{ velocity = 0.0 }}, rot = {{ velocity = 0.0 }}"
+    )));
     steps(&mut s, 3000);
     let w = &s.world;
     let e = w.box_extent().unwrap();
