@@ -9,7 +9,7 @@ mod bench3;
 mod fem;
 mod ranks;
 mod report;
-mod run3;
+mod run;
 
 use clap::{Parser, Subcommand};
 use nscdd::fc::{FcNorm, FcOptions};
@@ -121,20 +121,6 @@ fn parse_subdomains3(v: &str) -> Result<(u32, u32, u32), String> {
         [a, b, c] => Ok((n(a).ok_or_else(bad)?, n(b).ok_or_else(bad)?, n(c).ok_or_else(bad)?)),
         _ => Err(bad()),
     }
-}
-
-/// The command line's decomposition over the scene's: `--subdomains` sets (or makes)
-/// it, `--scheme` and `--threads` change it.
-#[allow(dead_code)]
-fn apply_decomposition(
-    s: &mut nscdd::scene::Scene,
-    subdomains: Option<&str>,
-    scheme: Option<&str>,
-    threads: Option<&str>,
-) -> Result<(), String> {
-    let w = &s.world;
-    let movable = (0..w.bodies.len()).filter(|&b| w.bodies.movable(b)).count();
-    apply_decomposition_to(&mut s.decomposition, movable, false, subdomains, scheme, threads)
 }
 
 /// The command line's decomposition flags over a scene's `[decomposition]` (`dim3`:
@@ -298,15 +284,15 @@ fn main() -> ExitCode {
                 Err(e) => return input_error(e),
             };
             let quiet = quiet || !ranks.root();
-            let flags = run3::Flags {
+            let flags = run::Flags {
                 subdomains: subdomains.as_deref(),
                 scheme: scheme.as_deref(),
                 threads: threads.as_deref(),
                 restart: restart.as_deref(),
             };
             match nscdd::scene::load_any(&scene, &reg) {
-                Ok(nscdd::scene::AnyScene::D2(s)) => run3::run(s, &reg, &scene, &out, quiet, flags, &ranks),
-                Ok(nscdd::scene::AnyScene::D3(s)) => run3::run(s, &reg, &scene, &out, quiet, flags, &ranks),
+                Ok(nscdd::scene::AnyScene::D2(s)) => run::run(s, &reg, &scene, &out, quiet, flags, &ranks),
+                Ok(nscdd::scene::AnyScene::D3(s)) => run::run(s, &reg, &scene, &out, quiet, flags, &ranks),
                 // every rank learns that a rank failed; rank 0 prints the message
                 Err(e) => ranks.agree(Err(e.to_string()), &out).err().unwrap_or(ExitCode::from(2)),
             }
