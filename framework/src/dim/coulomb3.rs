@@ -395,19 +395,7 @@ fn slide_general<B: Block3>(w: &B, s0: f64, u0t: [f64; 2], mu: f64) -> Option<[f
         let (s, c) = phi.sin_cos();
         w0[0] + mu * (w0[1] * c + w0[2] * s)
     };
-    // r(φ), g(φ) = u_t · d⊥ and h(φ) = u_t · d, where W_nn + μ W_nt·d > 0
-    let eval = |phi: f64| -> Option<([f64; 3], f64, f64)> {
-        let (s, c) = phi.sin_cos();
-        let d = den(phi);
-        if !(d > 0.0) {
-            return None;
-        }
-        let rn = -s0 / d;
-        let r = [rn, mu * rn * c, mu * rn * s];
-        let u = w.mul(r);
-        let (ut1, ut2) = (u[1] + u0t[0], u[2] + u0t[1]);
-        Some((r, -ut1 * s + ut2 * c, ut1 * c + ut2 * s))
-    };
+    let eval = |phi: f64| slip_eval(w, s0, u0t, mu, phi);
     // sample angles; where the pivot W_nn + μ W_nt·d changes sign, add the point just
     // inside the admissible arc (r_n grows without bound there, and g may change sign
     // between that point and the first sample)
