@@ -151,7 +151,7 @@ fn apply_drives<D: Dim>(w: &mut World<D>) {
                 Imposed::Servo(sigma, gain, vmax) => {
                     // the stress the grains exerted on the wall over the last step
                     if let (Some(wl), Some(e)) = (wall(k, dof), &extent) {
-                        let area = World::<D>::box_face(e, dof);
+                        let area = e.face(dof);
                         let measured = -sign(wl) * reaction.get(k).map_or(0.0, |r| r[dof]) / (h * area);
                         b.vel[k][dof] = sign(wl) * (gain * (sigma - measured)).clamp(-vmax, vmax);
                     }
@@ -159,7 +159,7 @@ fn apply_drives<D: Dim>(w: &mut World<D>) {
                 _ => {
                     let imposed = match drv.at(t_theta) {
                         Imposed::Pressure(sigma) => match (wall(k, dof), &extent) {
-                            (Some(wl), Some(e)) => Imposed::Force(sign(wl) * sigma * World::<D>::box_face(e, dof)),
+                            (Some(wl), Some(e)) => Imposed::Force(sign(wl) * sigma * e.face(dof)),
                             _ => Imposed::Free,
                         },
                         other => other,

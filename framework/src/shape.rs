@@ -63,6 +63,11 @@ impl<D: Dim> Aabb<D> {
     pub fn is_bounded(&self) -> bool {
         self.min.as_ref().iter().chain(self.max.as_ref()).all(|x| x.is_finite())
     }
+    /// The measure of the face normal to axis `k`: the product of the other sides
+    /// (2D: a length, per unit depth).
+    pub fn face(&self, k: usize) -> f64 {
+        (0..D::N).filter(|&a| a != k).map(|a| self.max[a] - self.min[a]).product()
+    }
     /// The largest side.
     pub fn extent(&self) -> f64 {
         (0..D::N).map(|k| self.max[k] - self.min[k]).fold(0.0, f64::max)

@@ -152,10 +152,6 @@ impl<D: Dim> World<D> {
             .sum();
         Some(v / (0..D::N).map(|k| e.max[k] - e.min[k]).product::<f64>())
     }
-    /// The measure of the box face normal to axis `k` (2D: a length per unit depth).
-    pub fn box_face(e: &Aabb<D>, k: usize) -> f64 {
-        (0..D::N).filter(|&a| a != k).map(|a| e.max[a] - e.min[a]).product()
-    }
     /// Mean stresses on the box walls (σ_xx, σ_yy[, σ_zz]), compression positive,
     /// from the last step's reactions (impulse / h over the wall's face).
     pub fn box_stresses(&self) -> Option<D::Point> {
@@ -164,7 +160,7 @@ impl<D: Dim> World<D> {
         let h = self.time.h;
         let f = |b: u32, k: usize| self.reaction.get(b as usize).map_or(0.0, |r| r[k]) / h;
         Some(D::Point::from_fn(|k| {
-            0.5 * (f(w[2 * k + 1], k) - f(w[2 * k], k)) / Self::box_face(&e, k)
+            0.5 * (f(w[2 * k + 1], k) - f(w[2 * k], k)) / e.face(k)
         }))
     }
     /// Number of contacts carrying a normal impulse, per body.

@@ -1,10 +1,11 @@
 //! The VTK frames of a 3D run (the history and `final.json` are
-//! [`super::history`]'s and [`super::final_json`], as in 2D) (`vtk/bodies_*.vtp`: one point per body with `id`, `radius`,
+//! [`super::history`]'s and [`super::final_json`], as in 2D): `vtk/bodies_*.vtp`,
+//! one point per body with `id`, `radius`,
 //! `velocity`, `angular_velocity` (vectors), `material`; `vtk/walls_*.vtp`: planes
 //! and boxes as polygons; `vtk/contacts_*.vtp`: a line per contact with `r_n`,
 //! `r_t` = |r_t|, `f_n`, `gap`; `vtk/points_*.vtp`: a vertex per contact point
 //! with the contact force on the candidate body as the vector `force` (impulse / h,
-//! world axes), `f_n`, `gap` and `bonded` (1 for an intact mortar joint)), with the
+//! world axes), `f_n`, `gap` and `bonded` (1 for an intact mortar joint), with the
 //! series `bodies.pvd`, `walls.pvd`, `contacts.pvd`, `points.pvd`. Polyhedra and
 //! other faceted shapes are drawn as their faces in `walls_*.vtp` (cell `id`: the
 //! body).
@@ -42,18 +43,14 @@ pub(crate) fn write_vtk3(v: &mut VtkWriter, w: &World3, dir: &Path, frame: u32) 
             Glyph3::Polygon(p) => vec![p],
             Glyph3::Segment(p, q, _) => vec![vec![p, q]],
         };
-        {
-            {
-                radius.push(0.0);
-                for f in faces {
-                    for p in f {
-                        wconn.push((wpts.len() / 3) as u64);
-                        wpts.extend_from_slice(&p);
-                    }
-                    woff.push(wconn.len() as u64);
-                    wid.push(k as f64);
-                }
+        radius.push(0.0);
+        for f in faces {
+            for p in f {
+                wconn.push((wpts.len() / 3) as u64);
+                wpts.extend_from_slice(&p);
             }
+            woff.push(wconn.len() as u64);
+            wid.push(k as f64);
         }
     }
     let verts = cells((0..n as u64).collect(), (1..=n as u64).collect());

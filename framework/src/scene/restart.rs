@@ -33,6 +33,13 @@ struct SavedBody<D: Dim> {
     velocity: D::Twist,
 }
 
+impl<D: Dim> SavedBody<D> {
+    /// The saved orientation: the quaternion where given (3D), else the rotation.
+    fn rot(&self) -> D::Rot {
+        self.quaternion.unwrap_or_else(|| D::rot_from_vec(&self.rotation))
+    }
+}
+
 #[derive(Deserialize)]
 #[serde(bound = "")]
 struct SavedContact<D: Dim> {
@@ -102,7 +109,7 @@ pub fn restart_str<D: Dim>(w: &mut World<D>, text: &str, file: &str) -> Result<(
     let nb = w.bodies.len();
     let finite = |sb: &SavedBody<D>| {
         sb.position.as_ref().iter().chain(sb.velocity.as_ref()).all(|x| x.is_finite())
-            && D::rot_finite(&sb.quaternion.unwrap_or_else(|| D::rot_from_vec(&sb.rotation)))
+            && D::rot_finite(&sb.rot())
     };
     ck.bodies(
         saved.bodies.iter().map(|sb| (sb.id, sb.kind.as_str(), finite(sb))),
@@ -113,7 +120,7 @@ pub fn restart_str<D: Dim>(w: &mut World<D>, text: &str, file: &str) -> Result<(
     let b = &mut w.bodies;
     for (k, sb) in saved.bodies.iter().enumerate() {
         b.pos[k] = sb.position;
-        b.rot[k] = sb.quaternion.unwrap_or_else(|| D::rot_from_vec(&sb.rotation));
+        b.rot[k] = sb.rot();
         b.vel[k] = sb.velocity;
         b.refresh_inverse(k);
     }
