@@ -159,9 +159,7 @@ impl<D: Dim> World<D> {
         let w = self.box_walls.as_ref()?.walls;
         let h = self.time.h;
         let f = |b: u32, k: usize| self.reaction.get(b as usize).map_or(0.0, |r| r[k]) / h;
-        Some(D::Point::from_fn(|k| {
-            0.5 * (f(w[2 * k + 1], k) - f(w[2 * k], k)) / e.face(k)
-        }))
+        Some(D::Point::from_fn(|k| 0.5 * (f(w[2 * k + 1], k) - f(w[2 * k], k)) / e.face(k)))
     }
     /// Number of contacts carrying a normal impulse, per body.
     pub fn loaded_contacts(&self) -> Vec<u32> {

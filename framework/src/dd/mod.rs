@@ -47,6 +47,8 @@ pub mod gluing;
 #[cfg(feature = "mpi")]
 pub mod mpi;
 pub mod partition;
+mod rank_balance;
+mod rank_link;
 pub mod ranks;
 pub mod schemes;
 pub mod subdomain;

@@ -107,10 +107,8 @@ pub fn restart_str<D: Dim>(w: &mut World<D>, text: &str, file: &str) -> Result<(
         )
     })?;
     let nb = w.bodies.len();
-    let finite = |sb: &SavedBody<D>| {
-        sb.position.as_ref().iter().chain(sb.velocity.as_ref()).all(|x| x.is_finite())
-            && D::rot_finite(&sb.rot())
-    };
+    let finite =
+        |sb: &SavedBody<D>| sb.position.as_ref().iter().chain(sb.velocity.as_ref()).all(|x| x.is_finite()) && D::rot_finite(&sb.rot());
     ck.bodies(
         saved.bodies.iter().map(|sb| (sb.id, sb.kind.as_str(), finite(sb))),
         |k| w.kind_name(k),

@@ -17,6 +17,7 @@
 //! ```
 
 pub mod detect;
+pub mod detect_plane_sphere;
 pub mod generate;
 pub mod hull;
 pub mod shapes;

@@ -1,0 +1,130 @@
+//! Helpers of the `nscdd` binary's bad-input tests: a valid base scene, a scratch
+//! directory, running the binary, and the check that a malformed scene gives exit 2
+//! and one message naming the file, the line and the key.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+pub const BIN: &str = env!("CARGO_BIN_EXE_nscdd");
+
+/// A valid scene: a disk resting on a fixed floor.
+pub const BASE: &str = r#"[time]
+step = 1e-3
+steps = 10
+
+[[materials]]
+name = "grain"
+density = 2600.0
+
+[[laws]]
+materials = ["grain", "grain"]
+friction = 0.3
+
+[[bodies]]
+name = "floor"
+shape = "halfplane"
+material = "grain"
+position = [0.0, 0.0]
+fixed = true
+
+[[bodies]]
+name = "ball"
+shape = "disk"
+material = "grain"
+position = [0.0, 0.1]
+radius = 0.1
+"#;
+
+/// A fresh directory for one test.
+pub fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("nscdd-bad-input-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("temp dir");
+    d
+}
+
+pub fn nscdd(args: &[&std::ffi::OsStr]) -> Output {
+    Command::new(BIN).args(args).output().expect("the nscdd binary runs")
+}
+
+pub fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+/// `base` with `from` replaced by `to` (which must occur once).
+pub fn edit(base: &str, from: &str, to: &str) -> String {
+    assert_eq!(base.matches(from).count(), 1, "`{from}` must occur once in the base scene");
+    base.replacen(from, to, 1)
+}
+
+/// 1-based line of the first line of `scene` that contains `marker`.
+pub fn line_of(scene: &str, marker: &str) -> usize {
+    scene
+        .lines()
+        .position(|l| l.contains(marker))
+        .unwrap_or_else(|| panic!("`{marker}` is not in the scene"))
+        + 1
+}
+
+pub struct Case {
+    pub name: &'static str,
+    pub scene: String,
+    /// The key path the message must name.
+    pub key: &'static str,
+    /// A text on the line the message must name.
+    pub marker: &'static str,
+}
+
+pub fn check_bad(c: &Case) {
+    let dir = scratch(c.name);
+    let path = dir.join(format!("{}.toml", c.name));
+    std::fs::write(&path, &c.scene).expect("write scene");
+    let line = line_of(&c.scene, c.marker);
+    let expected = format!("{}:{}: key `{}`: ", path.display(), line, c.key);
+    let out = dir.join("out");
+
+    let check = nscdd(&["check".as_ref(), path.as_os_str()]);
+    let run = nscdd(&[
+        "run".as_ref(),
+        path.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+        "--quiet".as_ref(),
+    ]);
+    for (what, o) in [("check", &check), ("run", &run)] {
+        let err = text(&o.stderr);
+        println!("{} ({what}): {}", c.name, err.trim_end());
+        assert_eq!(o.status.code(), Some(2), "{}: `{what}` must exit with 2; stderr: {err}", c.name);
+        assert!(!err.contains("panicked"), "{}: `{what}` panicked: {err}", c.name);
+        assert_eq!(
+            err.trim_end().lines().count(),
+            1,
+            "{}: `{what}` must print one message: {err}",
+            c.name
+        );
+        assert!(
+            err.contains(&expected),
+            "{}: `{what}` stderr must contain `{expected}`, got: {err}",
+            c.name
+        );
+        assert!(
+            text(&o.stdout).trim().is_empty(),
+            "{}: `{what}` printed on stdout: {}",
+            c.name,
+            text(&o.stdout)
+        );
+    }
+    let entries: Vec<String> = std::fs::read_dir(&out)
+        .expect("DIR exists")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(entries, ["error.txt"], "{}: DIR must hold only error.txt", c.name);
+    let saved = std::fs::read_to_string(out.join("error.txt")).expect("error.txt");
+    assert!(
+        saved.contains(&expected),
+        "{}: error.txt must hold the message, got: {saved}",
+        c.name
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,0 +1,224 @@
+//! The `nscdd` binary on malformed decompositions (the scene's `[decomposition]`
+//! and the `--subdomains`, `--scheme`, `--threads` flags) and restarts: exit code
+//! 2 and one message naming the file, line and key, or the flag; a valid
+//! `--subdomains` runs NSCDD; a restart continues without overwriting its own run.
+
+mod common;
+
+use common::*;
+use std::path::PathBuf;
+
+/// BASE with a `[decomposition]` section holding `body`.
+fn with_decomposition(body: &str) -> String {
+    format!("{BASE}\n[decomposition]\n{body}\n")
+}
+
+#[test]
+fn zero_subdomains_in_the_scene() {
+    check_bad(&Case {
+        name: "dd_zero_nx",
+        scene: with_decomposition("nx = 0\nny = 1"),
+        key: "decomposition.nx",
+        marker: "nx = 0",
+    });
+}
+
+#[test]
+fn negative_subdomains_in_the_scene() {
+    check_bad(&Case {
+        name: "dd_negative_ny",
+        scene: with_decomposition("nx = 1\nny = -2"),
+        key: "decomposition.ny",
+        marker: "ny = -2",
+    });
+}
+
+#[test]
+fn unknown_scheme_in_the_scene() {
+    check_bad(&Case {
+        name: "dd_scheme",
+        scene: with_decomposition("nx = 1\nny = 1\nscheme = \"ring\""),
+        key: "decomposition.scheme",
+        marker: "ring",
+    });
+}
+
+#[test]
+fn unknown_key_in_the_decomposition() {
+    check_bad(&Case {
+        name: "dd_unknown",
+        scene: with_decomposition("nx = 1\nnz = 2"),
+        key: "decomposition.nz",
+        marker: "nz = 2",
+    });
+}
+
+#[test]
+fn zero_repartition_period() {
+    check_bad(&Case {
+        name: "dd_repartition",
+        scene: with_decomposition("nx = 1\nrepartition_every = 0"),
+        key: "decomposition.repartition_every",
+        marker: "repartition_every",
+    });
+}
+
+#[test]
+fn more_subdomains_than_the_sample_holds_in_the_scene() {
+    // one movable body: at most one subdomain
+    check_bad(&Case {
+        name: "dd_too_many",
+        scene: with_decomposition("nx = 2\nny = 2"),
+        key: "decomposition.nx",
+        marker: "nx = 2",
+    });
+}
+
+/// `nscdd run BASE --out DIR ARGS...` must exit with 2, print one line naming `flag`
+/// and leave only error.txt in DIR.
+fn check_bad_flags(name: &str, scene: &str, args: &[&str], flag: &str) {
+    let dir = scratch(name);
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, scene).expect("write scene");
+    let out = dir.join("out");
+    let mut a: Vec<&std::ffi::OsStr> = vec![
+        "run".as_ref(),
+        path.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+        "--quiet".as_ref(),
+    ];
+    a.extend(args.iter().map(std::ffi::OsStr::new));
+    let o = nscdd(&a);
+    let err = text(&o.stderr);
+    println!("{name}: {}", err.trim_end());
+    assert_eq!(o.status.code(), Some(2), "{name}: exit 2 expected; stderr: {err}");
+    assert!(!err.contains("panicked"), "{name}: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{name}: one message: {err}");
+    assert!(
+        err.starts_with("error: ") && err.contains(flag),
+        "{name}: the message must name `{flag}`: {err}"
+    );
+    let entries: Vec<String> = std::fs::read_dir(&out)
+        .expect("DIR exists")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(entries, ["error.txt"], "{name}: DIR must hold only error.txt");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn malformed_subdomains_flag() {
+    for (k, v) in ["2x", "0x2", "-1x2", "2x0", "x2", "2", "2x2x2", "ax2", "1.5x2", ""]
+        .iter()
+        .enumerate()
+    {
+        check_bad_flags(&format!("flag_subdomains_{k}"), BASE, &["--subdomains", v], "--subdomains");
+    }
+}
+
+#[test]
+fn more_subdomains_than_the_sample_holds_on_the_command_line() {
+    check_bad_flags("flag_too_many", BASE, &["--subdomains", "2x1"], "--subdomains");
+}
+
+#[test]
+fn unknown_scheme_flag() {
+    check_bad_flags("flag_scheme", BASE, &["--subdomains", "1x1", "--scheme", "ring"], "--scheme");
+}
+
+#[test]
+fn bad_threads_flag() {
+    for (k, v) in ["0", "-2", "two"].iter().enumerate() {
+        check_bad_flags(
+            &format!("flag_threads_{k}"),
+            BASE,
+            &["--subdomains", "1x1", "--threads", v],
+            "--threads",
+        );
+    }
+}
+
+#[test]
+fn scheme_flag_without_a_decomposition() {
+    check_bad_flags("flag_scheme_alone", BASE, &["--scheme", "centralized"], "--scheme");
+}
+
+#[test]
+fn subdomains_flag_runs_nscdd() {
+    let dir = scratch("flag_ok");
+    let path = dir.join("scene.toml");
+    // the flags override the scene's section
+    std::fs::write(&path, with_decomposition("nx = 1\nny = 1\nscheme = \"decentralized\"")).expect("write scene");
+    let out = dir.join("out");
+    let o = nscdd(&[
+        "run".as_ref(),
+        path.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+        "--quiet".as_ref(),
+        "--subdomains".as_ref(),
+        "1x1".as_ref(),
+        "--scheme".as_ref(),
+        "centralized".as_ref(),
+        "--threads".as_ref(),
+        "2".as_ref(),
+    ]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(err.contains("1x1 subdomains") && err.contains("Centralized"), "{err}");
+    let hist = std::fs::read_to_string(out.join("history.csv")).expect("history.csv");
+    let head = hist.lines().next().unwrap();
+    assert!(
+        head.ends_with(",nscdd_iterations,egluing,egluing_rel,interface_bodies,links,migrations,prevailing,subdomains"),
+        "{head}"
+    );
+    assert_eq!(hist.lines().count(), 11);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn missing_restart_file() {
+    check_bad_flags(
+        "flag_restart_missing",
+        BASE,
+        &["--restart", "/nonexistent/final.json"],
+        "/nonexistent/final.json",
+    );
+}
+
+#[test]
+fn restart_continues_and_never_overwrites_its_own_run() {
+    let dir = scratch("restart");
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, BASE).expect("write scene");
+    let first = dir.join("first");
+    let run = |out: &PathBuf, extra: &[&std::ffi::OsStr]| {
+        let mut a: Vec<&std::ffi::OsStr> = vec![
+            "run".as_ref(),
+            path.as_os_str(),
+            "--out".as_ref(),
+            out.as_os_str(),
+            "--quiet".as_ref(),
+        ];
+        a.extend_from_slice(extra);
+        nscdd(&a)
+    };
+    // a first run of 10 steps; the scene then asks for 20
+    assert_eq!(run(&first, &[]).status.code(), Some(0));
+    std::fs::write(&path, edit(BASE, "steps = 10", "steps = 20")).expect("write scene");
+    let state = first.join("final.json");
+    let before = std::fs::read_to_string(first.join("history.csv")).unwrap();
+    let o = run(&first, &["--restart".as_ref(), state.as_os_str()]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.starts_with("error: --out:") && err.contains("restart file"), "{err}");
+    assert_eq!(std::fs::read_to_string(first.join("history.csv")).unwrap(), before, "nothing lost");
+    let second = dir.join("second");
+    let o = run(&second, &["--restart".as_ref(), state.as_os_str()]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let hist = std::fs::read_to_string(second.join("history.csv")).unwrap();
+    assert_eq!(hist.lines().count(), 11, "steps 11 to 20");
+    assert!(hist.lines().nth(1).unwrap().starts_with("11,"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
