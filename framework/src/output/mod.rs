@@ -2,7 +2,6 @@
 //! the VTK series (see [`vtk`]). Column and field names are listed in the README.
 
 pub mod history;
-pub mod out3;
 pub mod vtk;
 
 use crate::dim::Dim;
