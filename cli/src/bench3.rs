@@ -51,7 +51,7 @@ origin = [{r}, {r}, {r}]
 
 /// 3D NLGS contact updates per second on one thread.
 pub fn nlgs3(reg: &Registry, n: usize, sweeps: usize) {
-    let mut s = nscdd::scene::load3::load_str(&lattice3(n), "bench-lattice3", reg).expect("bench scene");
+    let mut s = nscdd::scene::Scene3::load_str(&lattice3(n), "bench-lattice3", reg).expect("bench scene");
     let w = &mut s.world;
     for _ in 0..5 {
         w.step().expect("bench step");

@@ -44,7 +44,7 @@ fn every_3d_example_loads_and_steps() {
     let reg = nscdd_spheres::registry();
     for s in nscdd_examples::SCENES_3D {
         let text = std::fs::read_to_string(root().join(s)).unwrap();
-        let mut scene = nscdd::scene::load3::load_str(&text, s, &reg).unwrap_or_else(|e| panic!("{e}"));
+        let mut scene = nscdd::scene::Scene3::load_str(&text, s, &reg).unwrap_or_else(|e| panic!("{e}"));
         assert!(scene.world.bodies.len() >= 1000, "{s}: a sample of at least 1000 bodies");
         for _ in 0..5 {
             scene.world.step().unwrap_or_else(|e| panic!("{s}: {e}"));

@@ -24,7 +24,7 @@ fn compaction(mu: f64) -> (f64, f64, f64) {
         .replace("friction = 0.3", &format!("friction = {mu:?}"))
         .replace("every = 50", "every = 0\nvtk = false");
     let reg = nscdd_spheres::registry();
-    let mut s = nscdd::scene::load3::load_str(&text, "triaxial3d.toml", &reg).unwrap();
+    let mut s = nscdd::scene::Scene3::load_str(&text, "triaxial3d.toml", &reg).unwrap();
     let dir = std::env::temp_dir().join(format!("nscdd-compaction-{}-{mu}", std::process::id()));
     let sum = nscdd::run::run(&mut s, &nscdd_spheres::registry(), &dir, |_, _| {}).unwrap();
     let w = &s.world;

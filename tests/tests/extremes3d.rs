@@ -11,7 +11,7 @@
 //! only seen within the alert distance); a loaded contact may creep by the velocity
 //! error the solver leaves, allowed as 10 % of g h per step (as in 2D).
 
-use nscdd::scene::load3::Scene3;
+use nscdd::scene::Scene3;
 
 const G: f64 = 9.81;
 
@@ -27,7 +27,7 @@ struct Figures {
 
 fn run(case: &str, text: &str) -> (Scene3, Figures) {
     let reg = nscdd_spheres::registry();
-    let mut s = nscdd::scene::load3::load_str(text, case, &reg).unwrap_or_else(|e| panic!("{case}: {e}"));
+    let mut s = nscdd::scene::Scene3::load_str(text, case, &reg).unwrap_or_else(|e| panic!("{case}: {e}"));
     let mut f = Figures::default();
     for _ in 0..s.world.time.steps {
         let rep = s.world.step().unwrap_or_else(|d| panic!("{case}: {d}"));

@@ -10,7 +10,7 @@
 //! position update is exact for a constant acceleration, so the measured
 //! accelerations match the analytic ones to rounding (relative 1e-9).
 
-use nscdd::scene::load3::Scene3;
+use nscdd::scene::Scene3;
 
 const G: f64 = 9.81;
 const R: f64 = 0.05;
@@ -18,7 +18,7 @@ const RHO: f64 = 2500.0;
 
 fn load(text: &str) -> Scene3 {
     let reg = nscdd_spheres::registry();
-    nscdd::scene::load3::load_str(text, "test3.toml", &reg).unwrap_or_else(|e| panic!("{e}\n{text}"))
+    nscdd::scene::Scene3::load_str(text, "test3.toml", &reg).unwrap_or_else(|e| panic!("{e}\n{text}"))
 }
 
 fn steps(s: &mut Scene3, n: usize) {

@@ -142,7 +142,7 @@ pub trait Dim: sealed::Sealed + Copy + Default + Debug + PartialEq + Send + Sync
     type InvMass: Pod;
     /// A body's rotational inertia: I about the centre in 2D, the principal
     /// moments (body frame) in 3D.
-    type Inertia: Pod;
+    type Inertia: Pod + Coords;
     /// A rotation as a vector, as scene files give it: the angle (rad) in 2D, the
     /// rotation vector (axis × angle) in 3D.
     type RotVec: Pod + Coords;

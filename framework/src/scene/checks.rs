@@ -4,6 +4,8 @@
 //! line and the key.
 
 use super::*;
+use crate::drive::BodyDrive;
+use crate::world::BoxWalls;
 
 /// Checks that every pair of materials that can touch (two bodies, one of them
 /// movable) has a law, and makes the detector table of the kinds (`kinds[id]`: the

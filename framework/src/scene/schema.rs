@@ -2,9 +2,12 @@
 //! shape- and generator-specific keys are checked by the plugin that owns them.
 //! See the README's "Scene files" section for a complete description.
 
+use crate::dim::{Dim, D2, D3};
 use crate::drive::DofDrive;
 use crate::solver::SolverSettings;
+use serde::de::DeserializeOwned;
 use serde::Deserialize;
+use std::fmt::Debug;
 
 fn two() -> u8 {
     2
@@ -22,8 +25,7 @@ fn overlap() -> f64 {
     0.05
 }
 
-/// A scene file; `B` is the body entry of its dimension ([`BodySpec`] in 2D,
-/// [`BodySpec3`] in 3D).
+/// A scene file; `B` is the body entry of its dimension ([`BodySpec<D>`]).
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields, bound(deserialize = "B: Deserialize<'de>"))]
 pub struct SceneFile<B = BodySpec> {
@@ -129,26 +131,33 @@ pub struct LawSpec {
     pub params: toml::Table,
 }
 
+/// A body of a scene file of dimension `D`.
 #[derive(Deserialize, Debug)]
-pub struct BodySpec {
-    /// Shape kind (`disk`, `wall`, `halfplane`, ...).
+#[serde(bound = "")]
+pub struct BodySpec<D: SceneDim = D2> {
+    /// Shape kind (`disk`, `wall`, `halfplane`, `sphere`, `plane`, `box`, ...).
     pub shape: String,
     pub material: String,
-    /// Optional unique name, used by outputs and `[output.box]`.
+    /// Optional unique name, used by outputs and `[output.box]`/`box3`.
     pub name: Option<String>,
-    pub position: [f64; 2],
+    /// (x, y) in 2D, (x, y, z) in 3D.
+    pub position: D::Point,
+    /// The angle (rad) in 2D; in 3D a rotation vector (axis × angle, rad).
     #[serde(default)]
-    pub rotation: f64,
-    /// (v_x, v_y, ω).
+    pub rotation: D::RotVec,
+    /// (v_x, v_y, ω) in 2D; (v_x, v_y, v_z, ω_x, ω_y, ω_z) in 3D, ω in the world frame.
     #[serde(default)]
-    pub velocity: [f64; 3],
+    pub velocity: D::Twist,
     #[serde(default)]
     pub fixed: bool,
-    pub drive: Option<DriveSpec2>,
+    pub drive: Option<D::DriveSpec>,
     /// Shape-specific keys, checked by the shape's plugin.
     #[serde(flatten)]
     pub params: toml::Table,
 }
+
+/// A body of a 3D scene.
+pub type BodySpec3 = BodySpec<D3>;
 
 /// Driven degrees of freedom of a 2D body.
 #[derive(Deserialize, Debug, Default)]
@@ -157,28 +166,6 @@ pub struct DriveSpec2 {
     pub x: Option<DofDrive>,
     pub y: Option<DofDrive>,
     pub rot: Option<DofDrive>,
-}
-
-/// A body of a 3D scene.
-#[derive(Deserialize, Debug)]
-pub struct BodySpec3 {
-    /// Shape kind (`sphere`, `plane`, `box`, ...).
-    pub shape: String,
-    pub material: String,
-    pub name: Option<String>,
-    pub position: [f64; 3],
-    /// Orientation as a rotation vector (axis × angle, rad).
-    #[serde(default)]
-    pub rotation: [f64; 3],
-    /// (v_x, v_y, v_z, ω_x, ω_y, ω_z), ω in the world frame.
-    #[serde(default)]
-    pub velocity: [f64; 6],
-    #[serde(default)]
-    pub fixed: bool,
-    pub drive: Option<DriveSpec3>,
-    /// Shape-specific keys, checked by the shape's plugin.
-    #[serde(flatten)]
-    pub params: toml::Table,
 }
 
 /// Driven degrees of freedom of a 3D body (rotations about the world axes).
@@ -191,6 +178,60 @@ pub struct DriveSpec3 {
     pub rx: Option<DofDrive>,
     pub ry: Option<DofDrive>,
     pub rz: Option<DofDrive>,
+}
+
+/// What a scene file spells differently in each dimension: the drive keys of a
+/// body and the `[output]` key naming a box sample's walls.
+pub trait SceneDim: Dim {
+    /// A body's `drive = { … }` table.
+    type DriveSpec: DeserializeOwned + Debug;
+    /// The drive keys, in the order of the degrees of freedom.
+    const DOF_NAMES: &'static [&'static str];
+    /// The `[output]` key of a box sample (`box`, `box3`) and the other dimension's.
+    const BOX_KEY: &'static str;
+    const OTHER_BOX_KEY: &'static str;
+    /// The drives of a table, per degree of freedom.
+    fn drives(d: &Self::DriveSpec) -> Vec<Option<&DofDrive>>;
+    /// The box sample's wall keys and body names (walls normal to x, min then max,
+    /// then y, then z) and `strain_from`.
+    fn box_walls(o: &OutputSpec) -> Option<(Vec<(&'static str, &str)>, f64)>;
+}
+
+impl SceneDim for D2 {
+    type DriveSpec = DriveSpec2;
+    const DOF_NAMES: &'static [&'static str] = &["x", "y", "rot"];
+    const BOX_KEY: &'static str = "box";
+    const OTHER_BOX_KEY: &'static str = "box3";
+    fn drives(d: &DriveSpec2) -> Vec<Option<&DofDrive>> {
+        vec![d.x.as_ref(), d.y.as_ref(), d.rot.as_ref()]
+    }
+    fn box_walls(o: &OutputSpec) -> Option<(Vec<(&'static str, &str)>, f64)> {
+        let b = o.box_walls.as_ref()?;
+        let names = vec![("left", b.left.as_str()), ("right", &b.right), ("bottom", &b.bottom), ("top", &b.top)];
+        Some((names, b.strain_from))
+    }
+}
+
+impl SceneDim for D3 {
+    type DriveSpec = DriveSpec3;
+    const DOF_NAMES: &'static [&'static str] = &["x", "y", "z", "rx", "ry", "rz"];
+    const BOX_KEY: &'static str = "box3";
+    const OTHER_BOX_KEY: &'static str = "box";
+    fn drives(d: &DriveSpec3) -> Vec<Option<&DofDrive>> {
+        [&d.x, &d.y, &d.z, &d.rx, &d.ry, &d.rz].map(|x| x.as_ref()).to_vec()
+    }
+    fn box_walls(o: &OutputSpec) -> Option<(Vec<(&'static str, &str)>, f64)> {
+        let b = o.box3.as_ref()?;
+        let names = vec![
+            ("xmin", b.xmin.as_str()),
+            ("xmax", &b.xmax),
+            ("ymin", &b.ymin),
+            ("ymax", &b.ymax),
+            ("zmin", &b.zmin),
+            ("zmax", &b.zmax),
+        ];
+        Some((names, b.strain_from))
+    }
 }
 
 #[derive(Deserialize, Debug)]

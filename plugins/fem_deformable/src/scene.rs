@@ -174,7 +174,7 @@ pub struct FeScene3 {
 /// Loads a 3D scene (`dimension = 3`) that may hold `[[deformable]]` entries.
 /// Subdomains by model are 2D only for now: asking for them is an input error.
 pub fn load3_str(text: &str, file: &str, dir: &Path, registry: &Registry) -> Result<FeScene3, InputError> {
-    let (scene, entries) = nscdd::scene::load3::load_str_with(text, file, registry, true)?;
+    let (scene, entries) = nscdd::scene::Scene3::load_str_with(text, file, registry, true)?;
     if scene.decomposition.is_some() {
         return Err(err(
             text,

@@ -87,7 +87,7 @@ bricks = {bricks}
 "#
     );
     let t = Instant::now();
-    let mut world = match nscdd::scene::load3::load_str(&text, "bench.toml", &nscdd_polyhedra::registry()) {
+    let mut world = match nscdd::scene::Scene3::load_str(&text, "bench.toml", &nscdd_polyhedra::registry()) {
         Ok(s) => s.world,
         Err(e) => panic!("{e}"),
     };

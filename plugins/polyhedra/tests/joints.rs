@@ -3,7 +3,7 @@
 //! and in shear (a flat block on a tilted base: c A + μ N against the downhill pull);
 //! bonds are made at the first step only and survive a restart.
 use nscdd::output::final_json;
-use nscdd::scene::load3::{load_str, Scene3};
+use nscdd::scene::Scene3;
 use nscdd::scene::restart::restart_str;
 use nscdd::world::World3;
 use nscdd_polyhedra::generate::box_points;
@@ -12,7 +12,7 @@ const G: f64 = 9.81;
 const RHO: f64 = 2000.0;
 
 fn world(text: &str) -> World3 {
-    match load_str(text, "test.toml", &nscdd_polyhedra::registry()) {
+    match Scene3::load_str(text, "test.toml", &nscdd_polyhedra::registry()) {
         Ok(Scene3 { world, .. }) => world,
         Err(e) => panic!("{e}"),
     }
@@ -176,7 +176,7 @@ fn mortar_joint_input_errors_name_the_key() {
             "restitution",
         ),
     ] {
-        let e = load_str(&scene([0.0, 0.0, -G], law, &bodies), "t.toml", &nscdd_polyhedra::registry())
+        let e = Scene3::load_str(&scene([0.0, 0.0, -G], law, &bodies), "t.toml", &nscdd_polyhedra::registry())
             .err()
             .expect(law);
         assert!(e.key.ends_with(key), "{law}: {e}");

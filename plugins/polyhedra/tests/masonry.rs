@@ -1,11 +1,11 @@
 //! Masonry validation: stacks carry the exact weights, face–face contacts keep
 //! their points under small rotations, a block on an incline fails at
 //! α* = arctan(min(μ, b/h)) by the right mechanism, arches stand or collapse.
-use nscdd::scene::load3::{load_str, Scene3};
+use nscdd::scene::Scene3;
 use nscdd::world::World3;
 
 fn world(text: &str) -> World3 {
-    match load_str(text, "test.toml", &nscdd_polyhedra::registry()) {
+    match Scene3::load_str(text, "test.toml", &nscdd_polyhedra::registry()) {
         Ok(Scene3 { world, .. }) => world,
         Err(e) => panic!("{e}"),
     }
@@ -403,7 +403,7 @@ fn stack_exports_a_frictional_contact_problem_that_solve_fc_solves() {
 #[test]
 fn outputs_draw_the_blocks_and_their_contact_points() {
     let text = stack(20, 0.0, "[output]\nevery = 10\n");
-    let mut s = load_str(&text, "stack.toml", &nscdd_polyhedra::registry()).unwrap();
+    let mut s = Scene3::load_str(&text, "stack.toml", &nscdd_polyhedra::registry()).unwrap();
     let dir = std::env::temp_dir().join(format!("nscdd-poly-out-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     nscdd::run::run(&mut s, &nscdd_polyhedra::registry(), &dir, |_, _| {}).unwrap();
@@ -516,7 +516,7 @@ fn generator_input_errors_name_the_key() {
         ),
     ] {
         let text = format!("{head}[[generate]]\n{gen}\n");
-        let e = load_str(&text, "t.toml", &nscdd_polyhedra::registry()).err().expect(gen);
+        let e = Scene3::load_str(&text, "t.toml", &nscdd_polyhedra::registry()).err().expect(gen);
         assert!(e.key.ends_with(key) && e.line.is_some(), "{gen}: {e}");
     }
 }

@@ -3,7 +3,7 @@
 //! bitwise the same with 1 or 2 threads; the interface multipliers glue the
 //! multi-point face contacts and the joints cut by the interfaces.
 use nscdd::dd::{DdSettings, Nscdd3};
-use nscdd::scene::load3::load_str;
+use nscdd::scene::Scene3;
 use nscdd::world::World3;
 
 fn wall(law: &str) -> World3 {
@@ -43,7 +43,7 @@ courses = 6
 bricks = 5
 "#
     );
-    match load_str(&text, "wall.toml", &nscdd_polyhedra::registry()) {
+    match Scene3::load_str(&text, "wall.toml", &nscdd_polyhedra::registry()) {
         Ok(s) => s.world,
         Err(e) => panic!("{e}"),
     }
