@@ -1,9 +1,10 @@
 //! `nscdd bench`: the figures of docs/PERFORMANCE.md.
 //!
-//! - `nlgs`: NLGS throughput, contact updates per second on one thread, on a dense
-//!   packing (a triangular lattice of touching disks resting in a box under gravity,
-//!   settled for a few steps so that every contact carries load), timing plain
-//!   sweeps of the solver's hot loop.
+//! - `nlgs` (2D), `nlgs3` (3D): NLGS throughput, contact updates per second on one
+//!   thread, on a dense packing (a triangular lattice of touching disks in a box, a
+//!   cubic lattice of touching spheres in a box of planes, under gravity, μ = 0.3,
+//!   settled for 5 steps so that every contact carries load), timing plain sweeps
+//!   of the solver's hot loop; one generic function for both dimensions.
 //! - `deposit`: time per step of a deposit split by stage (detection, Delassus
 //!   blocks, NLGS, update, output), from the example scene's settings.
 
@@ -11,7 +12,8 @@ use nscdd::registry::Registry;
 use nscdd::solver::nlgs;
 use std::time::Instant;
 
-fn lattice_scene(n: usize) -> String {
+/// The 2D bench packing: a triangular lattice of touching disks in a box of walls.
+pub fn lattice(n: usize) -> String {
     let nx = (n as f64).sqrt().round().max(2.0) as usize;
     let ny = n.div_ceil(nx);
     let r = 0.01;
@@ -71,14 +73,59 @@ origin = [{r}, {r}]
     )
 }
 
-/// NLGS contact updates per second on one thread.
-pub fn nlgs(reg: &Registry, n: usize, sweeps: usize) {
-    let mut s = nscdd::scene::load_str(&lattice_scene(n), "bench-lattice", reg).expect("bench scene");
+/// The 3D bench packing: a cubic lattice of touching spheres resting on a floor in
+/// a box of planes.
+pub fn lattice3(n: usize) -> String {
+    let k = (n as f64).cbrt().ceil().max(2.0) as usize;
+    let r = 0.01;
+    let l = 2.0 * r * k as f64;
+    let plane = |name: &str, pos: [f64; 3], rot: [f64; 3]| {
+        format!(
+            "[[bodies]]\nname = \"{name}\"\nshape = \"plane\"\nmaterial = \"g\"\nposition = {pos:?}\nrotation = {rot:?}\nfixed = true\n"
+        )
+    };
+    let h = std::f64::consts::FRAC_PI_2;
+    format!(
+        r#"dimension = 3
+[time]
+step = 1e-3
+steps = 1
+[solver]
+tolerance = 1e-4
+max_sweeps = 200
+[[materials]]
+name = "g"
+density = 1000.0
+[[laws]]
+materials = ["g", "g"]
+friction = 0.3
+{}{}{}{}{}
+[[generate]]
+kind = "sphere_lattice"
+material = "g"
+nx = {k}
+ny = {k}
+nz = {k}
+radius = {r}
+origin = [{r}, {r}, {r}]
+"#,
+        plane("floor", [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]),
+        plane("x0", [0.0, 0.0, 0.0], [0.0, h, 0.0]),
+        plane("x1", [l, 0.0, 0.0], [0.0, -h, 0.0]),
+        plane("y0", [0.0, 0.0, 0.0], [-h, 0.0, 0.0]),
+        plane("y1", [0.0, l, 0.0], [h, 0.0, 0.0]),
+    )
+}
+
+/// NLGS contact updates per second on one thread, in either dimension: the scene
+/// settles for 5 steps, then plain sweeps of the solver's hot loop over one more
+/// step's contact set are timed.
+pub fn nlgs<D: nscdd::scene::schema::SceneDim>(reg: &Registry, name: &str, scene: &str, sweeps: usize) {
+    let mut s = nscdd::scene::Scene::<D>::load_str(scene, name, reg).expect("bench scene");
     let w = &mut s.world;
     for _ in 0..5 {
         w.step().expect("bench step");
     }
-    // one more step's contact set, solved by timed plain sweeps
     let c = &mut w.contacts;
     let mut order = vec![];
     nlgs::make_order(&mut order, c.len(), &w.solver, 0);
@@ -90,7 +137,7 @@ pub fn nlgs(reg: &Registry, n: usize, sweeps: usize) {
     let dt = t.elapsed().as_secs_f64();
     let updates = (c.len() * sweeps) as f64;
     println!(
-        "{{\"bench\":\"nlgs\",\"bodies\":{},\"contacts\":{},\"sweeps\":{},\"seconds\":{:.4},\"updates_per_second\":{:.4e},\"ns_per_update\":{:.2}}}",
+        "{{\"bench\":\"{name}\",\"bodies\":{},\"contacts\":{},\"sweeps\":{},\"seconds\":{:.4},\"updates_per_second\":{:.4e},\"ns_per_update\":{:.2}}}",
         w.bodies.len(),
         c.len(),
         sweeps,
@@ -108,7 +155,7 @@ pub fn deposit(reg: &Registry, n: usize, steps: usize) {
     let mut s = nscdd::scene::load_str(&text, "deposit.toml", reg).expect("deposit scene");
     let dir = std::env::temp_dir().join(format!("nscdd-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
-    let mut vtk = (reg.writer("vtk").expect("vtk writer"))();
+    let mut vtk = (reg.writer::<nscdd::dim::D2>("vtk").expect("vtk writer"))();
     let every = s.output.every.max(1) as usize;
     let (mut det, mut del, mut sol, mut upd, mut out, mut sweeps, mut contacts) = (0.0, 0.0, 0.0, 0.0, 0.0, 0u64, 0usize);
     let t_all = Instant::now();

@@ -4,7 +4,6 @@
 //! 2 bad input (the message names the file, the line and the key).
 
 mod bench;
-mod bench3;
 #[cfg(feature = "fem")]
 mod fem;
 mod ranks;
@@ -15,6 +14,7 @@ use clap::{Parser, Subcommand};
 use nscdd::fc::{FcNorm, FcOptions};
 use nscdd::norms::Criterion;
 use std::path::PathBuf;
+use nscdd::dim::{D2, D3};
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -384,8 +384,8 @@ fn main() -> ExitCode {
             subdomains,
         } => {
             match which.as_str() {
-                "nlgs" => bench::nlgs(&reg, disks.unwrap_or(10000), repeat.unwrap_or(200)),
-                "nlgs3" => bench3::nlgs3(&reg, disks.unwrap_or(10648), repeat.unwrap_or(200)),
+                "nlgs" => bench::nlgs::<D2>(&reg, "nlgs", &bench::lattice(disks.unwrap_or(10000)), repeat.unwrap_or(200)),
+                "nlgs3" => bench::nlgs::<D3>(&reg, "nlgs3", &bench::lattice3(disks.unwrap_or(10648)), repeat.unwrap_or(200)),
                 "deposit" => bench::deposit(&reg, disks.unwrap_or(10000), repeat.unwrap_or(200)),
                 _ => {
                     let list: Result<Vec<_>, _> = subdomains.split(',').map(parse_subdomains).collect();
