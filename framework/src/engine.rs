@@ -24,6 +24,7 @@ use crate::law::target_velocity;
 use crate::model::{ContactKey, Target};
 use crate::solver::nlgs;
 use crate::solver::SolveReport;
+use crate::world::PrevContact;
 use crate::world::World;
 use std::time::Instant;
 
@@ -202,14 +203,6 @@ fn dist2<P: Vector>(a: &P, b: &P) -> f64 {
     d.dot(&d)
 }
 
-/// A contact of the last step, as the next step's warm start and bonds read it.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct PrevContact<D: Dim> {
-    pub key: ContactKey,
-    pub r: D::Local,
-    pub bonded: bool,
-    pub point: D::Point,
-}
 
 /// This step's contact set from the raw contacts: frames, W_αα, ū, the warm start
 /// (applied at once to the free velocities) and the bonds of mortar joints.

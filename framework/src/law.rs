@@ -25,7 +25,7 @@
 //! e = 0 for ever (see `dim::joint`).
 
 use crate::params::{number, only_keys};
-use crate::registry::{ParamError, Registry};
+use crate::params::ParamError;
 
 /// Parameters of the law of one pair of materials.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -153,19 +153,22 @@ fn parse_mohr_coulomb(t: &toml::Table) -> Result<ContactLaw, ParamError> {
     })
 }
 
-pub(crate) fn register_builtin(r: &mut Registry) {
-    r.add_law(LawDef {
-        name: "coulomb",
-        parse: parse_coulomb,
-    });
-    r.add_law(LawDef {
-        name: "frictionless",
-        parse: parse_frictionless,
-    });
-    r.add_law(LawDef {
-        name: "mohr_coulomb",
-        parse: parse_mohr_coulomb,
-    });
+/// The framework's own laws: `coulomb`, `frictionless`, `mohr_coulomb`.
+pub(crate) fn builtin() -> [LawDef; 3] {
+    [
+        LawDef {
+            name: "coulomb",
+            parse: parse_coulomb,
+        },
+        LawDef {
+            name: "frictionless",
+            parse: parse_frictionless,
+        },
+        LawDef {
+            name: "mohr_coulomb",
+            parse: parse_mohr_coulomb,
+        },
+    ]
 }
 
 #[cfg(test)]

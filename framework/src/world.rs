@@ -4,9 +4,8 @@
 use crate::detect::{Detector, DetectorTable};
 use crate::dim::{Dim, Vector, D2, D3};
 use crate::drive::BodyDrive;
-use crate::engine::PrevContact;
 use crate::law::ContactLaw;
-use crate::model::{Bodies, Contacts};
+use crate::model::{Bodies, ContactKey, Contacts};
 use crate::shape::{Aabb, RawContact, ShapeStore};
 use crate::solver::SolverSettings;
 
@@ -222,4 +221,13 @@ impl<D: Dim> World<D> {
         }
         (ek, ep)
     }
+}
+
+/// A contact of the last step, as the next step's warm start and bonds read it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PrevContact<D: Dim> {
+    pub key: ContactKey,
+    pub r: D::Local,
+    pub bonded: bool,
+    pub point: D::Point,
 }

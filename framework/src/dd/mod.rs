@@ -447,23 +447,18 @@ impl<D: Family> NscddOf<D> {
                 if iface.fresh.iter().any(|&f| f) {
                     team.with_all(|subs| glue_stage(subs, iface, set.scheme, transport, true, bufs));
                 }
-                let mut stages = 0;
-                while stages < max_stages {
-                    stages += 1;
-                    let check = stages % k == 0 || stages == max_stages;
+                crate::solver::check_loop(max_stages, k, |check| {
                     // sweeps and gluing; with `check`, the sums reduced in subdomain order
                     let (sums, parts) = team.stage(per, sv.relaxation, check, set.scheme, transport, bufs);
-                    if check {
+                    check && {
                         let mut g = GluePartial::default();
                         for p in &parts {
                             g.merge(p);
                         }
-                        if converged(&sums, &g, rep) {
-                            break;
-                        }
+                        converged(&sums, &g, rep)
                     }
-                }
-                stages
+                })
+                .0
             });
             rep.exchange = self.transport.stats();
             stages

@@ -376,10 +376,7 @@ pub(super) fn iterate<D: Family>(
     if d.iface.fresh.iter().any(|&f| f) {
         st.glue(d, scheme, true, &mut own);
     }
-    let mut stages = 0;
-    while stages < max_stages {
-        stages += 1;
-        let check = stages % k == 0 || stages == max_stages;
+    let (stages, _) = crate::solver::check_loop(max_stages, k, |check| {
         for s in d.subs.iter_mut().filter(|s| st.rank_of[s.id as usize] == me) {
             s.sweeps(per, omega, check);
         }
@@ -387,13 +384,11 @@ pub(super) fn iterate<D: Family>(
         if !d.iface.is_empty() {
             st.glue(d, scheme, false, &mut own);
         }
-        if check {
+        check && {
             let (sums, g) = st.check(d, &own);
-            if converged(&sums, &g) {
-                break;
-            }
+            converged(&sums, &g)
         }
-    }
+    });
     st.share_results(d);
     let t = &mut st.totals;
     t.steps += 1;

@@ -187,28 +187,28 @@ pub fn solve<const D: usize>(p: &FcProblem, opts: &FcOptions) -> FcSolution {
     let qs = q_scale(&p.q);
     let mut r = vec![[0.0; D]; nc];
     let mut u = vec![[0.0; D]; nc];
-    let k = opts.check_every.max(1);
-    let mut sweeps = 0;
-    let mut converged = nc == 0;
-    while !converged && sweeps < opts.max_sweeps {
-        sweeps += 1;
-        let check = sweeps % k == 0 || sweeps == opts.max_sweeps;
-        match opts.norm {
+    let (sweeps, mut converged) = if nc == 0 {
+        (0, true)
+    } else {
+        crate::solver::check_loop(opts.max_sweeps, opts.check_every, |check| match opts.norm {
             FcNorm::Natural => {
                 b.sweep(&q, &p.mu, &mut r, None);
-                if check {
+                check && {
                     b.velocity(&q, &r, &mut u);
-                    converged = residual(&u, &r, &p.mu, qs) < opts.tol;
+                    residual(&u, &r, &p.mu, qs) < opts.tol
                 }
             }
             FcNorm::Lmgc(c) if check => {
                 let mut sums = Sums::default();
                 b.sweep(&q, &p.mu, &mut r, Some(&mut sums));
-                converged = Norms::from_sums(&sums, opts.tol).converged(c);
+                Norms::from_sums(&sums, opts.tol).converged(c)
             }
-            FcNorm::Lmgc(_) => b.sweep(&q, &p.mu, &mut r, None),
-        }
-    }
+            FcNorm::Lmgc(_) => {
+                b.sweep(&q, &p.mu, &mut r, None);
+                false
+            }
+        })
+    };
     b.velocity(&q, &r, &mut u);
     let residual = residual(&u, &r, &p.mu, qs);
     if opts.max_sweeps == 0 && opts.norm == FcNorm::Natural {

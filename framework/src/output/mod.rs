@@ -8,6 +8,26 @@ use crate::dim::Dim;
 use crate::world::World;
 use serde::Serialize;
 
+/// Writes extra outputs every `output.every` steps (`[output] writers = [...]`).
+pub trait Writer<D: Dim>: Send {
+    fn write(&mut self, world: &World<D>, dir: &std::path::Path, frame: u32) -> std::io::Result<()>;
+    /// A frame of a decomposed (NSCDD) run, with the subdomains of the bodies and
+    /// contacts; by default the plain frame.
+    fn write_dd(
+        &mut self,
+        world: &World<D>,
+        _dd: &crate::dd::DdView,
+        dir: &std::path::Path,
+        frame: u32,
+    ) -> std::io::Result<()> {
+        self.write(world, dir, frame)
+    }
+    /// Called once at the end of the run.
+    fn finish(&mut self, _dir: &std::path::Path) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
 #[derive(Serialize)]
 #[serde(bound = "")]
 struct BodyOut<'a, D: Dim> {

@@ -24,18 +24,13 @@
 //! written with `vtkio`.
 
 use crate::dd::DdView;
-use crate::dim::{Coords, Dim, Vector, D2, D3};
-use crate::registry::{Registry, Writer};
+use super::Writer;
+use crate::dim::{Coords, Dim, Vector};
 use crate::shape::Glyph;
 use crate::world::World;
 use std::io::Write;
 use std::path::Path;
 use vtkio::model::{Attribute, Attributes, ByteOrder, DataSet, PolyDataPiece, Version, VertexNumbers, Vtk};
-
-pub(crate) fn register_builtin(r: &mut Registry) {
-    r.add_writer::<D2>("vtk", || Box::new(VtkWriter::default()));
-    r.add_writer::<D3>("vtk", || Box::new(VtkWriter::default()));
-}
 
 /// Writes the VTK frames and `.pvd` series.
 #[derive(Default)]

@@ -7,7 +7,7 @@
 //! kinds without a detector, bodies overlapping beyond the tolerance, and drives of
 //! degrees of freedom that do not exist.
 
-pub mod builder;
+pub use crate::registry::builder;
 mod checks;
 mod load;
 pub mod locate;

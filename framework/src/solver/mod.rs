@@ -56,23 +56,45 @@ impl SolverSettings {
     /// residual is left to the caller.
     pub fn run_sweeps(&self, mut sweep: impl FnMut(Option<&mut Sums>)) -> SolveReport {
         let mut report = SolveReport::default();
-        let k = self.check_every.max(1);
-        while report.sweeps < self.max_sweeps {
-            report.sweeps += 1;
-            if report.sweeps % k == 0 || report.sweeps == self.max_sweeps {
-                let mut sums = Sums::default();
-                sweep(Some(&mut sums));
-                report.norms = Norms::from_sums(&sums, self.tolerance);
-                if report.norms.converged(self.norm) {
-                    report.converged = true;
-                    break;
-                }
-            } else {
+        (report.sweeps, report.converged) = check_loop(self.max_sweeps, self.check_every, |check| {
+            if !check {
                 sweep(None);
+                return false;
             }
-        }
+            let mut sums = Sums::default();
+            sweep(Some(&mut sums));
+            report.norms = Norms::from_sums(&sums, self.tolerance);
+            report.norms.converged(self.norm)
+        });
         report
     }
+}
+
+/// The one convergence-check loop, shared by the one-domain NLGS
+/// ([`SolverSettings::run_sweeps`]), the NSCDD stages on threads and on MPI ranks,
+/// and the deformable bodies' stages: at most `max` iterations (a sweep, or a
+/// stage of sweeps and gluing), a check every `every` iterations and at the last
+/// one. `iterate(check)` runs one iteration and, when `check` is set, says whether
+/// the criterion holds (its answer is ignored otherwise). Returns the iterations
+/// run and whether the criterion held.
+///
+/// ```
+/// let mut seen = vec![];
+/// let (n, ok) = nscdd::solver::check_loop(10, 3, |check| { seen.push(check); check && seen.len() == 6 });
+/// assert_eq!((n, ok), (6, true));
+/// assert_eq!(seen, [false, false, true, false, false, true]);
+/// ```
+pub fn check_loop(max: u32, every: u32, mut iterate: impl FnMut(bool) -> bool) -> (u32, bool) {
+    let k = every.max(1);
+    let mut n = 0;
+    while n < max {
+        n += 1;
+        let check = n % k == 0 || n == max;
+        if iterate(check) && check {
+            return (n, true);
+        }
+    }
+    (n, false)
 }
 
 /// What one contact solve did.

@@ -84,21 +84,22 @@ impl ContactStage<World2> for Coupled<'_> {
         let (mut subs, ifaces_r, ifaces_f) = self.split(w);
         let s = w.solver.clone();
         let mut report = SolveReport::default();
-        let k = s.check_every.max(1);
         let none = w.contacts.is_empty() && self.fe.contacts.is_empty();
-        while !none && report.sweeps < s.max_sweeps {
-            report.sweeps += 1;
-            let check = report.sweeps % k == 0 || report.sweeps == s.max_sweeps;
-            let mut sums = Sums::default();
-            for sd in subs.iter_mut() {
-                let mut part = Sums::default();
-                let mut sm = check.then_some(&mut part);
-                nscdd::solver::nlgs::sweep(&mut sd.contacts, &mut sd.vel, &sd.inv, &[], s.relaxation, sm.as_deref_mut());
-                stage2::sweep(&mut sd.fec, &mut sd.sets, &mut sd.vel, &sd.inv, s.relaxation, sm);
-                sums.merge(&part);
-            }
-            let (jump2, links, v2, copies) = glue(&mut subs, &ifaces_r, &ifaces_f, w);
-            if check {
+        let egluing = &mut self.egluing;
+        if !none {
+            (report.sweeps, report.converged) = nscdd::solver::check_loop(s.max_sweeps, s.check_every, |check| {
+                let mut sums = Sums::default();
+                for sd in subs.iter_mut() {
+                    let mut part = Sums::default();
+                    let mut sm = check.then_some(&mut part);
+                    nscdd::solver::nlgs::sweep(&mut sd.contacts, &mut sd.vel, &sd.inv, &[], s.relaxation, sm.as_deref_mut());
+                    stage2::sweep(&mut sd.fec, &mut sd.sets, &mut sd.vel, &sd.inv, s.relaxation, sm);
+                    sums.merge(&part);
+                }
+                let (jump2, links, v2, copies) = glue(&mut subs, &ifaces_r, &ifaces_f, w);
+                if !check {
+                    return false;
+                }
                 report.norms = Norms::from_sums(&sums, s.tolerance);
                 let eg = if links == 0 { 0.0 } else { jump2.sqrt() / links as f64 };
                 // QuadWR, or the RMS velocity of the interface copies when the
@@ -110,12 +111,9 @@ impl ContactStage<World2> for Coupled<'_> {
                 };
                 let rms = if copies > 0 { (v2 / copies as f64).sqrt() } else { 0.0 };
                 let scale = if sums.sum_wrwr > nscdd::norms::VANISHING { quad_wr } else { rms };
-                self.egluing = if scale > 0.0 { eg / scale } else { eg };
-                if report.norms.converged(s.norm) && self.egluing < s.tolerance {
-                    report.converged = true;
-                    break;
-                }
-            }
+                *egluing = if scale > 0.0 { eg / scale } else { eg };
+                report.norms.converged(s.norm) && *egluing < s.tolerance
+            });
         }
         if none {
             report.converged = true;

@@ -22,7 +22,10 @@
 
 use crate::dim::{Dim, D2, D3};
 use crate::law::LawDef;
-use crate::scene::builder::SceneBuilder;
+pub mod builder;
+
+use builder::SceneBuilder;
+pub use crate::output::Writer;
 pub use crate::shape::*;
 use std::any::Any;
 use std::collections::BTreeMap;
@@ -31,26 +34,6 @@ use std::sync::Arc;
 /// Makes bodies from parameters (`[[generate]]` sections of a scene).
 pub trait Generator<D: Dim>: Send + Sync {
     fn generate(&self, params: &toml::Table, out: &mut SceneBuilder<'_, D>) -> Result<(), ParamError>;
-}
-
-/// Writes extra outputs every `output.every` steps (`[output] writers = [...]`).
-pub trait Writer<D: Dim>: Send {
-    fn write(&mut self, world: &crate::world::World<D>, dir: &std::path::Path, frame: u32) -> std::io::Result<()>;
-    /// A frame of a decomposed (NSCDD) run, with the subdomains of the bodies and
-    /// contacts; by default the plain frame.
-    fn write_dd(
-        &mut self,
-        world: &crate::world::World<D>,
-        _dd: &crate::dd::DdView,
-        dir: &std::path::Path,
-        frame: u32,
-    ) -> std::io::Result<()> {
-        self.write(world, dir, frame)
-    }
-    /// Called once at the end of the run.
-    fn finish(&mut self, _dir: &std::path::Path) -> std::io::Result<()> {
-        Ok(())
-    }
 }
 
 /// The plugin interface, after bevy's `Plugin`: add what you provide to the registry.
@@ -92,8 +75,11 @@ impl Registry {
     /// A registry holding the framework's own laws and writers.
     pub fn new() -> Self {
         let mut r = Registry::default();
-        crate::law::register_builtin(&mut r);
-        crate::output::vtk::register_builtin(&mut r);
+        for def in crate::law::builtin() {
+            r.add_law(def);
+        }
+        r.add_writer::<D2>("vtk", || Box::<crate::output::vtk::VtkWriter>::default());
+        r.add_writer::<D3>("vtk", || Box::<crate::output::vtk::VtkWriter>::default());
         r
     }
     pub fn add_plugin(&mut self, p: &dyn Plugin) -> &mut Self {
