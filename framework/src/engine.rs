@@ -20,8 +20,8 @@
 use crate::dim::joint::Joint;
 use crate::dim::{Dim, Vector};
 use crate::drive::Imposed;
-use crate::law::target_velocity;
-use crate::model::{ContactKey, Target};
+use crate::law::{LawInput, LawStep};
+use crate::model::ContactKey;
 use crate::solver::nlgs;
 use crate::solver::SolveReport;
 use crate::world::PrevContact;
@@ -207,7 +207,11 @@ fn dist2<P: Vector>(a: &P, b: &P) -> f64 {
 /// This step's contact set from the raw contacts: frames, W_αα, ū, the warm start
 /// (applied at once to the free velocities) and the bonds of mortar joints.
 pub fn build_contacts<D: Dim>(w: &mut World<D>) {
-    let (h, theta) = (w.time.h, w.time.theta);
+    let step = LawStep {
+        h: w.time.h,
+        theta: w.time.theta,
+        first: w.step == 0,
+    };
     let s = &mut w.scratch;
     s.prev_keys.clear();
     let old = &w.contacts;
@@ -220,6 +224,8 @@ pub fn build_contacts<D: Dim>(w: &mut World<D>) {
     s.prev_keys.sort_unstable_by_key(|x| x.key);
     let c = &mut s.next;
     c.clear();
+    s.laws.clear();
+    s.w.clear();
     let b = &w.bodies;
     let nm = w.materials.len();
     for rc in &s.raw {
@@ -229,9 +235,10 @@ pub fn build_contacts<D: Dim>(w: &mut World<D>) {
         if !(D::w_nn(&wb) > 0.0) {
             continue;
         }
-        let Some(law) = w.laws[b.material[i] as usize * nm + b.material[j] as usize] else {
+        let slot = b.material[i] as usize * nm + b.material[j] as usize;
+        if w.laws[slot].is_none() {
             continue;
-        };
+        }
         let u_begin = D::local_velocity(&frame, &s.v_begin[i], &s.v_begin[j]);
         let u_free = D::local_velocity(&frame, &b.vel[i], &b.vel[j]);
         let key = ContactKey {
@@ -251,30 +258,28 @@ pub fn build_contacts<D: Dim>(w: &mut World<D>) {
             _ => continued(&s.prev_keys, at, key, rc.point, w.alert),
         };
         let r = near.or(exact).map_or(D::Local::zero(), |p| s.prev_keys[p].r);
-        let bonded = match near {
-            Some(p) => s.prev_keys[p].bonded,
-            // bonds are made at the first step only
-            None => w.step == 0 && rc.gap <= law.bond_gap,
-        };
-        let joint = if bonded && law.is_cohesive() && rc.area > 0.0 {
-            Joint::of(law.cohesion, law.tensile, law.mu, rc.area, h)
-        } else {
-            Joint::default()
-        };
+        s.laws.push(
+            slot,
+            LawInput {
+                gap: rc.gap,
+                un_begin: u_begin[0],
+                un_free: u_free[0],
+                area: rc.area,
+                was_bonded: near.map(|p| s.prev_keys[p].bonded),
+            },
+        );
+        s.w.push(wb);
         c.bodies.push([rc.i, rc.j]);
         c.frame.push(frame);
-        c.block.push(D::block(wb, law.mu));
-        c.target.push(Target {
-            u_target: target_velocity(rc.gap, u_begin[0], u_free[0], h, theta, law.e),
-            mu: law.mu,
-        });
         c.r.push(r);
         c.u_free.push(u_free);
         c.gap.push(rc.gap);
         c.point.push(rc.point);
         c.key.push(key);
-        c.joint.push(joint);
     }
+    // ū, μ and the joints: each law once, on all the contacts of its pairs
+    s.laws.run(&w.laws, &step, &mut c.target, &mut c.joint);
+    c.block.extend(s.w.iter().zip(&c.target).map(|(wb, t)| D::block(*wb, t.mu)));
     std::mem::swap(&mut w.contacts, &mut s.next);
     w.contacts.apply_all(&mut w.bodies.vel, &w.bodies.inv_mass);
 }

@@ -23,50 +23,244 @@
 //! bodies that carries tension up to `tensile_strength` and shear up to
 //! `cohesion + μ σ_n` (stresses, Pa) until it fails, then acts as `coulomb` with
 //! e = 0 for ever (see `dim::joint`).
+//!
+//! A law is a registered type: a [`LawDef`] (name and parameter parser, added by
+//! [`crate::registry::Registry::add_law`]) makes, for each pair of materials of a
+//! scene, a value implementing [`Law`]. At each step's contact build the engine
+//! hands every law the contacts of its pairs in one batch ([`Law::contacts`]: one
+//! call per pair of materials, none per contact) and gets back what the local
+//! solver needs of each contact: the target ū, the friction coefficient μ and the
+//! bonded joint, if any. The solver's kernels (the exact Signorini–Coulomb
+//! solvers and the joint solver of `dim`) are shared by every law; a law whose
+//! local problem is of another kind needs a kernel in `dim` as well.
+//!
+//! ```
+//! use nscdd::dim::joint::Joint;
+//! use nscdd::law::{Law, LawDef, LawInput, LawStep};
+//! use nscdd::model::Target;
+//! /// Friction growing with the impact speed (a toy).
+//! #[derive(Debug)]
+//! struct SpeedFriction { mu0: f64, k: f64 }
+//! impl Law for SpeedFriction {
+//!     fn contacts(&self, step: &LawStep, inputs: &[LawInput], target: &mut [Target], _joint: &mut [Joint]) {
+//!         for (c, t) in inputs.iter().zip(target) {
+//!             let u_target = nscdd::law::target_velocity(c.gap, c.un_begin, c.un_free, step.h, step.theta, 0.0);
+//!             *t = Target { u_target, mu: self.mu0 + self.k * c.un_begin.abs() };
+//!         }
+//!     }
+//! }
+//! let mut reg = nscdd::registry::Registry::new();
+//! reg.add_law(LawDef {
+//!     name: "speed_friction",
+//!     parse: |t| {
+//!         nscdd::params::only_keys(t, &["mu0", "k"])?;
+//!         let mu0 = nscdd::params::number(t, "mu0", None)?;
+//!         let k = nscdd::params::number(t, "k", Some(0.0))?;
+//!         Ok(std::sync::Arc::new(SpeedFriction { mu0, k }))
+//!     },
+//! });
+//! assert!(reg.law_names().contains(&"speed_friction"));
+//! ```
 
-use crate::params::{number, only_keys};
+use crate::dim::joint::Joint;
+use crate::model::Target;
 use crate::params::ParamError;
+use crate::params::{number, only_keys};
+use std::sync::Arc;
 
-/// Parameters of the law of one pair of materials.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct ContactLaw {
+/// What a law sees of one contact when the step's contact set is built.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LawInput {
+    /// Gap g at the start of the step (m).
+    pub gap: f64,
+    /// Normal relative velocity u_n⁻ at the start of the step.
+    pub un_begin: f64,
+    /// Free normal relative velocity u_n,free.
+    pub un_free: f64,
+    /// Area (3D) or length (2D) of a face-to-face contact; 0 for a point contact.
+    pub area: f64,
+    /// A contact continued from the last step: whether it was bonded then;
+    /// `None` for a new contact.
+    pub was_bonded: Option<bool>,
+}
+
+/// The step's constants a law reads.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LawStep {
+    /// Step h (s).
+    pub h: f64,
+    /// θ of the θ-method.
+    pub theta: f64,
+    /// The scene's first step (bonds are made then).
+    pub first: bool,
+}
+
+/// What the local solver gets of one contact: ū and μ, and its bonded joint
+/// (`Joint::default()`: none).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LawOutput {
+    pub target: Target,
+    pub joint: Joint,
+}
+
+/// A contact law between one pair of materials, with its parameters (module
+/// docs). Implementations are plain data: the engine calls them once per pair of
+/// materials and step with every contact of the pair.
+pub trait Law: Send + Sync + std::fmt::Debug {
+    /// ū and μ (`target[k]`) and the joint (`joint[k]`) of each contact
+    /// `inputs[k]`; both hold defaults on entry (no joint).
+    fn contacts(&self, step: &LawStep, inputs: &[LawInput], target: &mut [Target], joint: &mut [Joint]);
+    /// [`Law::contacts`] for one contact (outside the time loop's hot paths).
+    fn contact(&self, step: &LawStep, input: &LawInput) -> LawOutput {
+        let (mut t, mut j) = ([Target::default()], [Joint::default()]);
+        self.contacts(step, std::slice::from_ref(input), &mut t, &mut j);
+        LawOutput { target: t[0], joint: j[0] }
+    }
+    /// Whether contacts may be bonded joints, which need detectors that report
+    /// contact areas.
+    fn bonds(&self) -> bool {
+        false
+    }
+}
+
+/// A law kind: its name and the parser of its parameters (the keys of a
+/// `[[laws]]` entry other than `materials` and `law`).
+pub struct LawDef {
+    pub name: &'static str,
+    pub parse: fn(&toml::Table) -> Result<Arc<dyn Law>, ParamError>,
+}
+
+/// Signorini–Coulomb with Newton restitution (laws `coulomb` and, μ = 0,
+/// `frictionless`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Coulomb {
     /// Friction coefficient μ ≥ 0.
     pub mu: f64,
     /// Newton restitution coefficient e ∈ [0, 1].
     pub e: f64,
-    /// Cohesion c of a bonded joint (Pa; 0: no joint).
-    #[serde(default)]
+}
+
+impl Law for Coulomb {
+    fn contacts(&self, step: &LawStep, inputs: &[LawInput], target: &mut [Target], _joint: &mut [Joint]) {
+        for (c, t) in inputs.iter().zip(target) {
+            *t = Target {
+                u_target: target_velocity(c.gap, c.un_begin, c.un_free, step.h, step.theta, self.e),
+                mu: self.mu,
+            };
+        }
+    }
+}
+
+/// A mortar joint (law `mohr_coulomb`): contacts closer than `bond_gap` at the
+/// first step are bonded, with tensile strength σ_t and shear strength c + μ σ_n
+/// over their area, until they fail; then Coulomb with e = 0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MohrCoulomb {
+    pub mu: f64,
+    /// Cohesion c (Pa).
     pub cohesion: f64,
-    /// Tensile strength σ_t of a bonded joint (Pa).
-    #[serde(default)]
+    /// Tensile strength σ_t (Pa), at most c/μ.
     pub tensile: f64,
     /// Contacts closer than this at the first step are bonded (m).
-    #[serde(default)]
     pub bond_gap: f64,
 }
 
-impl ContactLaw {
-    /// A Signorini–Coulomb law with friction μ and restitution e.
-    pub fn coulomb(mu: f64, e: f64) -> ContactLaw {
-        ContactLaw {
-            mu,
-            e,
-            cohesion: 0.0,
-            tensile: 0.0,
-            bond_gap: 0.0,
+impl Law for MohrCoulomb {
+    fn contacts(&self, step: &LawStep, inputs: &[LawInput], target: &mut [Target], joint: &mut [Joint]) {
+        for ((c, t), j) in inputs.iter().zip(target).zip(joint) {
+            *t = Target {
+                u_target: target_velocity(c.gap, c.un_begin, c.un_free, step.h, step.theta, 0.0),
+                mu: self.mu,
+            };
+            // bonds are made at the first step only
+            let bonded = c.was_bonded.unwrap_or(step.first && c.gap <= self.bond_gap);
+            if bonded && c.area > 0.0 {
+                *j = Joint::of(self.cohesion, self.tensile, self.mu, c.area, step.h);
+            }
         }
     }
-
-    /// Whether contacts of this law can be bonded joints (`mohr_coulomb`).
-    pub fn is_cohesive(&self) -> bool {
-        self.cohesion > 0.0 || self.tensile > 0.0
+    fn bonds(&self) -> bool {
+        true
     }
 }
 
-/// A law kind: its name and its parameter parser.
-pub struct LawDef {
-    pub name: &'static str,
-    pub parse: fn(&toml::Table) -> Result<ContactLaw, ParamError>,
+/// A step's contacts and their pairs of materials, for one call of each law
+/// (buffers reused from step to step).
+#[derive(Default)]
+pub(crate) struct LawBatches {
+    /// In contact order.
+    inputs: Vec<LawInput>,
+    slot: Vec<u32>,
+    /// The contacts of each pair of materials, `idx[start[s]..start[s + 1]]`.
+    start: Vec<u32>,
+    idx: Vec<u32>,
+    /// One pair's inputs and outputs.
+    g_in: Vec<LawInput>,
+    g_target: Vec<Target>,
+    g_joint: Vec<Joint>,
+}
+
+impl LawBatches {
+    pub fn clear(&mut self) {
+        self.inputs.clear();
+        self.slot.clear();
+    }
+    /// The next contact, of the pair of materials `slot`.
+    #[inline]
+    pub fn push(&mut self, slot: usize, input: LawInput) {
+        self.inputs.push(input);
+        self.slot.push(slot as u32);
+    }
+    /// Every law on its contacts, one call per pair of materials, into `target`
+    /// and `joint` (contact order).
+    pub fn run(&mut self, laws: &[Option<Arc<dyn Law>>], step: &LawStep, target: &mut Vec<Target>, joint: &mut Vec<Joint>) {
+        let n = self.inputs.len();
+        target.clear();
+        target.resize(n, Target::default());
+        joint.clear();
+        joint.resize(n, Joint::default());
+        let Some(&s0) = self.slot.first() else { return };
+        if self.slot.iter().all(|&s| s == s0) {
+            // one pair of materials: no gathering
+            if let Some(law) = &laws[s0 as usize] {
+                law.contacts(step, &self.inputs, target, joint);
+            }
+            return;
+        }
+        // the contacts by pair (a counting sort, contact order kept within a pair)
+        self.start.clear();
+        self.start.resize(laws.len() + 1, 0);
+        for &s in &self.slot {
+            self.start[s as usize + 1] += 1;
+        }
+        for k in 0..laws.len() {
+            self.start[k + 1] += self.start[k];
+        }
+        self.idx.resize(n, 0);
+        let mut next = self.start.clone();
+        for (a, &s) in self.slot.iter().enumerate() {
+            self.idx[next[s as usize] as usize] = a as u32;
+            next[s as usize] += 1;
+        }
+        for (s, law) in laws.iter().enumerate() {
+            let (Some(law), lo, hi) = (law, self.start[s] as usize, self.start[s + 1] as usize) else { continue };
+            if lo == hi {
+                continue;
+            }
+            let idx = &self.idx[lo..hi];
+            self.g_in.clear();
+            self.g_in.extend(idx.iter().map(|&a| self.inputs[a as usize]));
+            self.g_target.clear();
+            self.g_target.resize(idx.len(), Target::default());
+            self.g_joint.clear();
+            self.g_joint.resize(idx.len(), Joint::default());
+            law.contacts(step, &self.g_in, &mut self.g_target, &mut self.g_joint);
+            for (k, &a) in idx.iter().enumerate() {
+                target[a as usize] = self.g_target[k];
+                joint[a as usize] = self.g_joint[k];
+            }
+        }
+    }
 }
 
 /// The target normal velocity ū of the law (see the module docs).
@@ -92,21 +286,21 @@ fn restitution(t: &toml::Table) -> Result<f64, ParamError> {
     Ok(e)
 }
 
-fn parse_coulomb(t: &toml::Table) -> Result<ContactLaw, ParamError> {
+fn parse_coulomb(t: &toml::Table) -> Result<Arc<dyn Law>, ParamError> {
     only_keys(t, &["friction", "restitution"])?;
     let mu = number(t, "friction", None)?;
     if mu < 0.0 {
         return Err(ParamError::new("friction", format!("μ must be ≥ 0, got {mu}")));
     }
-    Ok(ContactLaw::coulomb(mu, restitution(t)?))
+    Ok(Arc::new(Coulomb { mu, e: restitution(t)? }))
 }
 
-fn parse_frictionless(t: &toml::Table) -> Result<ContactLaw, ParamError> {
+fn parse_frictionless(t: &toml::Table) -> Result<Arc<dyn Law>, ParamError> {
     only_keys(t, &["restitution"])?;
-    Ok(ContactLaw::coulomb(0.0, restitution(t)?))
+    Ok(Arc::new(Coulomb { mu: 0.0, e: restitution(t)? }))
 }
 
-fn parse_mohr_coulomb(t: &toml::Table) -> Result<ContactLaw, ParamError> {
+fn parse_mohr_coulomb(t: &toml::Table) -> Result<Arc<dyn Law>, ParamError> {
     only_keys(t, &["friction", "cohesion", "tensile_strength", "bond_gap"])?;
     let mu = number(t, "friction", None)?;
     if mu <= 0.0 {
@@ -144,13 +338,12 @@ fn parse_mohr_coulomb(t: &toml::Table) -> Result<ContactLaw, ParamError> {
     if bond_gap < 0.0 {
         return Err(ParamError::new("bond_gap", format!("must be ≥ 0 (m), got {bond_gap}")));
     }
-    Ok(ContactLaw {
+    Ok(Arc::new(MohrCoulomb {
         mu,
-        e: 0.0,
         cohesion,
         tensile: tensile.min(apex),
         bond_gap,
-    })
+    }))
 }
 
 /// The framework's own laws: `coulomb`, `frictionless`, `mohr_coulomb`.

@@ -4,7 +4,8 @@
 use crate::detect::{Detector, DetectorTable};
 use crate::dim::{Dim, Vector, D2, D3};
 use crate::drive::BodyDrive;
-use crate::law::ContactLaw;
+use crate::law::{Law, LawBatches};
+use std::sync::Arc;
 use crate::model::{Bodies, ContactKey, Contacts};
 use crate::shape::{Aabb, RawContact, ShapeStore};
 use crate::solver::SolverSettings;
@@ -53,7 +54,7 @@ pub struct World<D: Dim> {
     pub shapes: Vec<Box<dyn ShapeStore<D>>>,
     pub materials: Vec<Material>,
     /// Law of each material pair, `laws[ma * nm + mb]`.
-    pub laws: Vec<Option<ContactLaw>>,
+    pub laws: Vec<Option<Arc<dyn Law>>>,
     pub drives: Vec<BodyDrive>,
     /// Which bodies are fixed (no degree of freedom ever moves).
     pub fixed: Vec<bool>,
@@ -89,6 +90,10 @@ pub(crate) struct Scratch<D: Dim> {
     pub order: Vec<u32>,
     pub prev_keys: Vec<PrevContact<D>>,
     pub next: Contacts<D>,
+    /// The contacts by pair of materials, for the laws.
+    pub laws: LawBatches,
+    /// W_αα of the contacts being built.
+    pub w: Vec<D::W>,
 }
 
 impl<D: Dim> Default for Scratch<D> {
@@ -100,6 +105,8 @@ impl<D: Dim> Default for Scratch<D> {
             order: vec![],
             prev_keys: vec![],
             next: Contacts::default(),
+            laws: LawBatches::default(),
+            w: vec![],
         }
     }
 }
@@ -111,8 +118,8 @@ impl<D: Dim> World<D> {
         &self.scratch.v_begin
     }
     /// The contact law between two materials (`None`: they do not interact).
-    pub fn law(&self, ma: u16, mb: u16) -> Option<ContactLaw> {
-        self.laws[ma as usize * self.materials.len() + mb as usize]
+    pub fn law(&self, ma: u16, mb: u16) -> Option<&dyn Law> {
+        self.laws[ma as usize * self.materials.len() + mb as usize].as_deref()
     }
     pub fn kind_name(&self, b: usize) -> &'static str {
         self.shapes[self.bodies.shape[b].kind as usize].kind()

@@ -30,3 +30,6 @@ mod determinism;
 
 #[path = "physics/pressure.rs"]
 mod pressure;
+
+#[path = "physics/plugin_law.rs"]
+mod plugin_law;

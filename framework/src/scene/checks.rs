@@ -16,7 +16,7 @@ pub(crate) fn laws_and_detectors<T>(
     bodies: &[BodyInfo],
     materials: &[Material],
     kinds: &[&'static str],
-    laws: &[Option<crate::law::ContactLaw>],
+    laws: &[Option<std::sync::Arc<dyn crate::law::Law>>],
     declared: &[bool],
     lookup: impl Fn(&str, &str) -> Option<T>,
 ) -> Result<Vec<Option<T>>, InputError> {
@@ -94,7 +94,7 @@ pub(crate) fn check_overlaps(
     d: &schema::DetectionSpec,
     contacts: impl Iterator<Item = (usize, usize, f64)>,
     sizes: &[f64],
-    laws: &[Option<crate::law::ContactLaw>],
+    laws: &[Option<std::sync::Arc<dyn crate::law::Law>>],
     nm: usize,
     material: impl Fn(usize) -> usize,
     names: &[Option<String>],
@@ -249,7 +249,7 @@ pub(crate) fn laws<B>(
     nm: usize,
     materials: &[Material],
     dimension: u8,
-) -> Result<(Vec<Option<crate::law::ContactLaw>>, Vec<bool>), InputError> {
+) -> Result<(Vec<Option<std::sync::Arc<dyn crate::law::Law>>>, Vec<bool>), InputError> {
     let mut table = vec![None; nm * nm];
     let mut declared = vec![false; nm * nm];
     for (i, l) in sf.laws.iter().enumerate() {
@@ -276,10 +276,10 @@ pub(crate) fn laws<B>(
                 None
             }
         };
-        if dimension == 2 && law.is_some_and(|x| x.is_cohesive()) {
+        if dimension == 2 && law.as_ref().is_some_and(|x| x.bonds()) {
             return Err(cx.err(
                 &at(&base, &[k("law")]),
-                format!("`{}` bonds 3D rigid bodies (joints of faces); a 2D scene cannot use it", l.law),
+                format!("`{}` bonds contacts through their areas, which no 2D detector reports yet (3D face contacts do); a 2D scene cannot use it", l.law),
             ));
         }
         let (a, c) = (ids[0] as usize, ids[1] as usize);
@@ -287,7 +287,7 @@ pub(crate) fn laws<B>(
             return Err(cx.err(&at(&base, &[k("materials")]), "a law for this pair of materials is already given"));
         }
         for (x, y) in [(a, c), (c, a)] {
-            table[x * nm + y] = law;
+            table[x * nm + y] = law.clone();
             declared[x * nm + y] = true;
         }
     }

@@ -14,7 +14,7 @@ use crate::contact2::*;
 pub use crate::nodes::fill_set;
 use nscdd::dim::coulomb2 as coulomb;
 use nscdd::engine::{ContactStage, Diverged};
-use nscdd::law::target_velocity;
+use nscdd::law::{Law, LawInput, LawOutput, LawStep};
 use nscdd::norms::{natural_map_sq, Sums};
 use nscdd::rigid2d::contacts::{Block2, Target};
 use nscdd::solver::nlgs;
@@ -171,6 +171,7 @@ impl Deformables2 {
             let Some(law) = w.law(body.material, mat_j) else { continue };
             let u_begin = [vb_i[0] - ub_j[0], vb_i[1] - ub_j[1]];
             let u_free = [vf_i[0] - uf_j[0], vf_i[1] - uf_j[1]];
+            let lo = law_output(law, rc.gap, u_begin[0], u_free[0], (h, theta, w.step));
             let key = (rc.body, rc.node, key_j, feature);
             let r = match self.prev.binary_search_by_key(&key, |x| x.0) {
                 Ok(p) => self.prev[p].1,
@@ -181,11 +182,11 @@ impl Deformables2 {
             c.frame.push(n);
             c.block.push(Block2 {
                 w: wb,
-                pre: coulomb::precompute(wb, law.mu),
+                pre: coulomb::precompute(wb, lo.target.mu),
             });
             c.target.push(Target {
-                u_target: node_target(rc.gap, u_begin[0], u_free[0], h, theta, law.e),
-                mu: law.mu,
+                u_target: node_target(rc.gap, u_begin[0], h, theta, lo.target.u_target),
+                mu: lo.target.mu,
             });
             c.r.push(r);
             c.u_free.push(u_free);
@@ -308,13 +309,25 @@ pub fn update_bodies(bodies: &mut [FeBody], h: f64, theta: f64, step: u64) -> Re
 /// free motion predicts a penetration: the framework's Moreau form would then
 /// impose u_n ≥ 0 and hold a node at the distance g from the surface, an error
 /// of the order h·u that large steps (quasi-static loading of a stiff body) make
-/// visible. Closed contacts (g ≤ 0) follow the framework's law (restitution e).
-pub fn node_target(gap: f64, un_begin: f64, un_free: f64, h: f64, theta: f64, e: f64) -> f64 {
+/// visible. Closed contacts (g ≤ 0) take the law's target `closed`.
+pub fn node_target(gap: f64, un_begin: f64, h: f64, theta: f64, closed: f64) -> f64 {
     if gap > 0.0 {
         -(gap + h * (1.0 - theta) * un_begin) / (h * theta)
     } else {
-        target_velocity(gap, un_begin, un_free, h, theta, e)
+        closed
     }
+}
+
+/// The law's ū and μ for a node contact (FE contacts are never bonded).
+pub fn law_output(law: &dyn Law, gap: f64, un_begin: f64, un_free: f64, (h, theta, step): (f64, f64, u64)) -> LawOutput {
+    let input = LawInput {
+        gap,
+        un_begin,
+        un_free,
+        area: 0.0,
+        was_bonded: None,
+    };
+    law.contact(&LawStep { h, theta, first: step == 0 }, &input)
 }
 
 /// u_α of a deformable contact from the current velocities.

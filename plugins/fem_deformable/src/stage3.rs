@@ -10,7 +10,7 @@
 use crate::body::FeBody;
 use crate::contact3::*;
 use crate::nodes::fill_set;
-use crate::stage2::{free_velocities, node_target, update_bodies, FeTimes};
+use crate::stage2::{free_velocities, law_output, node_target, update_bodies, FeTimes};
 use nscdd::dim::coulomb3 as coulomb;
 use nscdd::engine::{ContactStage, Diverged};
 use nscdd::norms::{natural_map_sq, Sums};
@@ -170,6 +170,7 @@ impl Deformables3 {
             let Some(law) = w.law(body.material, mat_j) else { continue };
             let u_begin: [f64; 3] = std::array::from_fn(|q| ub_i[q] - ub_j[q]);
             let u_free: [f64; 3] = std::array::from_fn(|q| uf_i[q] - uf_j[q]);
+            let lo = law_output(law, rc.gap, u_begin[0], u_free[0], (h, theta, w.step));
             let key = (rc.body, cand_key, key_j, feature);
             let r = match self.prev.binary_search_by_key(&key, |x| x.0) {
                 Ok(p) => self.prev[p].1,
@@ -183,8 +184,8 @@ impl Deformables3 {
                 pre: coulomb::precompute(&wb),
             });
             c.target.push(Target {
-                u_target: node_target(rc.gap, u_begin[0], u_free[0], h, theta, law.e),
-                mu: law.mu,
+                u_target: node_target(rc.gap, u_begin[0], h, theta, lo.target.u_target),
+                mu: lo.target.mu,
             });
             c.r.push(r);
             c.u_free.push(u_free);
