@@ -76,7 +76,7 @@ fn downhill_acceleration(s: &mut Scene3, n: usize) -> f64 {
     let alpha_pos = s.world.bodies.pos[1];
     steps(s, n);
     let p = s.world.bodies.pos[1];
-    let n_hat = nscdd::rigid3d::bodies::rotate(s.world.bodies.rot[0], [0.0, 0.0, 1.0]);
+    let n_hat = nscdd::dim::rotation::rotate(s.world.bodies.rot[0], [0.0, 0.0, 1.0]);
     let sdir = [n_hat[2], 0.0, -n_hat[0]];
     let d: f64 = (0..3).map(|k| (p[k] - alpha_pos[k]) * sdir[k]).sum();
     let t = s.world.t;

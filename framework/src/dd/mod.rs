@@ -55,7 +55,7 @@ pub mod subdomain;
 pub mod team;
 pub mod transport;
 
-use crate::rigid2d::contacts::ContactKey;
+use crate::model::ContactKey;
 pub use cluster::{Cluster, Solo};
 pub use family::{Family, Rigid, Rigid2, Rigid3};
 pub use partition::{Decomposition, FGammaStore, Grid, Interface};

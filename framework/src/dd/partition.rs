@@ -10,7 +10,7 @@
 
 use super::family::Family;
 use super::subdomain::{Neighbor, Subdomain, OWN};
-use crate::rigid2d::contacts::ContactKey;
+use crate::model::ContactKey;
 
 /// The grid of subdomains over the contact points' bounding box (nz = 1 in 2D,
 /// whose points have z = 0).
@@ -215,6 +215,46 @@ pub fn decompose_owned<D: Family>(
     let order = D::order(w);
     let ns = grid.len();
     let nb = D::n_bodies(w);
+    let (mut subs, mult, mut copy_of) = split_contacts::<D>(c, &owner, ns, nb);
+    // copies' M̂_E⁻¹ and W_αα; the visiting order restricted to each subdomain
+    let mut local_of = vec![0u32; D::len(c)];
+    for sub in subs.iter_mut() {
+        if built(sub.id) {
+            sub.inv_mass = sub
+                .body_global
+                .iter()
+                .map(|&g| D::scale_inv(D::inv_mass(w, g as usize), mult[g as usize] as f64))
+                .collect();
+            sub.copy_delassus();
+        }
+        for (la, &ga) in sub.contact_global.iter().enumerate() {
+            local_of[ga as usize] = la as u32;
+        }
+    }
+    for &a in order {
+        subs[owner[a as usize] as usize].order.push(local_of[a as usize]);
+    }
+    // interface bodies: copies grouped by body, in subdomain order
+    copy_of.sort_by_key(|e| e.0); // stable: subdomain order kept
+    let iface = interface::<D>(w, &mut subs, &copy_of, &mult, store);
+    link_chains(&mut subs, &iface);
+    for sub in subs.iter_mut().filter(|s| built(s.id)) {
+        sub.init_velocities(v_free);
+    }
+    Decomposition {
+        grid: Some(grid),
+        owner,
+        mult,
+        subs,
+        iface,
+    }
+}
+
+/// The contacts of each subdomain in storage order, with a copy of each of their
+/// bodies made on first sight; returns the subdomains, each body's number of
+/// copies and the copies as (body, subdomain, local id).
+#[allow(clippy::type_complexity)]
+fn split_contacts<D: Family>(c: &D::Contacts, owner: &[u32], ns: usize, nb: usize) -> (Vec<Subdomain<D>>, Vec<u32>, Vec<(u32, u32, u32)>) {
     let mut subs: Vec<Subdomain<D>> = (0..ns)
         .map(|s| Subdomain {
             id: s as u32,
@@ -251,26 +291,13 @@ pub fn decompose_owned<D: Family>(
             sub.push_contact(c, a, li, lj);
         }
     }
-    // copies' M̂_E⁻¹ and W_αα; the visiting order restricted to each subdomain
-    let mut local_of = vec![0u32; D::len(c)];
-    for sub in subs.iter_mut() {
-        if built(sub.id) {
-            sub.inv_mass = sub
-                .body_global
-                .iter()
-                .map(|&g| D::scale_inv(D::inv_mass(w, g as usize), mult[g as usize] as f64))
-                .collect();
-            sub.copy_delassus();
-        }
-        for (la, &ga) in sub.contact_global.iter().enumerate() {
-            local_of[ga as usize] = la as u32;
-        }
-    }
-    for &a in order {
-        subs[owner[a as usize] as usize].order.push(local_of[a as usize]);
-    }
-    // interface bodies: copies grouped by body, in subdomain order
-    copy_of.sort_by_key(|e| e.0); // stable: subdomain order kept
+    (subs, mult, copy_of)
+}
+
+/// The interface: the movable bodies copied in several subdomains (copies sorted
+/// by body, in subdomain order), with the copies' F_Γ from the previous step
+/// where the same subdomains held them.
+fn interface<D: Family>(w: &D::World, subs: &mut [Subdomain<D>], copy_of: &[(u32, u32, u32)], mult: &[u32], store: &FGammaStore<D::V>) -> Interface {
     let mut iface = Interface {
         start: vec![0],
         ..Default::default()
@@ -319,7 +346,11 @@ pub fn decompose_owned<D: Family>(
         }
         iface.start.push(iface.sub.len() as u32);
     }
-    // neighbors and chains
+    iface
+}
+
+/// Each subdomain's neighbours and the chains of its interface copies.
+fn link_chains<D: Family>(subs: &mut [Subdomain<D>], iface: &Interface) {
     for sub in subs.iter_mut() {
         sub.chain_start.push(0);
         for q in 0..sub.iface.len() {
@@ -343,15 +374,5 @@ pub fn decompose_owned<D: Family>(
             }
             sub.chain_start.push(sub.chain.len() as u32);
         }
-    }
-    for sub in subs.iter_mut().filter(|s| built(s.id)) {
-        sub.init_velocities(v_free);
-    }
-    Decomposition {
-        grid: Some(grid),
-        owner,
-        mult,
-        subs,
-        iface,
     }
 }

@@ -92,7 +92,7 @@ pub fn problem_from_world(w: &World2) -> FcProblem {
 /// − for the antagonist), `W_αβ = Σ_b H_bαᵀ M̂_b⁻¹ H_bβ` with `M̂_b⁻¹ = diag(m⁻¹) ⊕
 /// I_w⁻¹`, and `q_α = (u_free,n − ū, u_free,t1, u_free,t2)`.
 pub fn problem_from_world3(w: &crate::world::World3) -> FcProblem {
-    use crate::rigid3d::bodies::cross;
+    use crate::dim::d3::cross;
     let c = &w.contacts;
     let b = &w.bodies;
     let nc = c.len();

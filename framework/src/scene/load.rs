@@ -11,7 +11,7 @@ use crate::dim::{Coords, Vector};
 use crate::drive::BodyDrive;
 use crate::error::InputError;
 use crate::registry::{ParamError, Registry};
-use crate::rigid2d::bodies::ShapeRef;
+use crate::model::ShapeRef;
 use crate::world::{BoxWalls, World};
 
 /// The scene of a parsed file of dimension `D`.
@@ -19,19 +19,6 @@ pub(crate) fn load_parsed<D: SceneDim>(cx: &Ctx, sf: SceneFile<BodySpec<D>>, reg
     let gravity = gravity::<D>(cx, &sf)?;
     if D::N == 2 && sf.decomposition.as_ref().is_some_and(|d| d.nz.is_some()) {
         return Err(cx.err(&[k("decomposition"), k("nz")], "`nz` splits along z: 3D scenes only"));
-    }
-    let other_box = match D::N {
-        2 => sf.output.box3.is_some(),
-        _ => sf.output.box_walls.is_some(),
-    };
-    if other_box {
-        let msg = format!(
-            "`{}` names the walls of a box sample in the other dimension; in {} use `{}`",
-            D::OTHER_BOX_KEY,
-            D::NAME,
-            D::BOX_KEY
-        );
-        return Err(cx.err(&[k("output"), k(D::OTHER_BOX_KEY)], msg));
     }
     let time = super::time_settings(cx, &sf)?;
     super::validate_solver(cx, &sf.solver)?;
@@ -75,11 +62,7 @@ pub(crate) fn load_parsed<D: SceneDim>(cx: &Ctx, sf: SceneFile<BodySpec<D>>, reg
     super::check_overlaps(cx, &sf.detection, contacts, &sizes, &laws, nm, material, &b.names, &b.origins)?;
     let box_walls = box_walls::<D>(cx, &sf, &b.names)?;
     super::check_pressure_drives(cx, &drives, box_walls.as_ref(), &b.origins, D::DOF_NAMES, D::BOX_KEY)?;
-    for (i, w) in sf.output.writers.iter().enumerate() {
-        if registry.writer::<D>(w).is_none() {
-            return Err(cx.err(&[k("output"), k("writers"), Seg::Index(i)], format!("unknown writer `{w}`")));
-        }
-    }
+    check_writers::<D>(cx, &sf, registry)?;
     let movable = (0..n).filter(|&i| b.bodies.movable(i)).count();
     let decomposition = match &sf.decomposition {
         None => None,
@@ -106,17 +89,26 @@ pub(crate) fn load_parsed<D: SceneDim>(cx: &Ctx, sf: SceneFile<BodySpec<D>>, reg
         reaction: vec![D::Twist::zero(); n],
         scratch: Default::default(),
     };
-    let output = OutputSettings {
-        every: sf.output.every,
-        vtk: sf.output.vtk,
-        writers: sf.output.writers,
-        checkpoint_every: sf.output.checkpoint_every,
-    };
     Ok(Scene {
         world,
-        output,
+        output: OutputSettings {
+            every: sf.output.every,
+            vtk: sf.output.vtk,
+            writers: sf.output.writers,
+            checkpoint_every: sf.output.checkpoint_every,
+        },
         decomposition,
     })
+}
+
+/// Every writer of `[output] writers` is registered for the dimension.
+fn check_writers<D: SceneDim>(cx: &Ctx, sf: &SceneFile<BodySpec<D>>, registry: &Registry) -> Result<(), InputError> {
+    for (i, w) in sf.output.writers.iter().enumerate() {
+        if registry.writer::<D>(w).is_none() {
+            return Err(cx.err(&[k("output"), k("writers"), Seg::Index(i)], format!("unknown writer `{w}`")));
+        }
+    }
+    Ok(())
 }
 
 /// `gravity`: D finite numbers; by default 9.81 m/s² along −y (2D) or −z (3D).
@@ -147,8 +139,22 @@ fn generate<D: SceneDim>(cx: &Ctx, sf: &SceneFile<BodySpec<D>>, registry: &Regis
     Ok(())
 }
 
-/// `[output] box` (2D) / `box3` (3D): the walls of a box sample, by body name.
+/// `[output] box` (2D) / `box3` (3D): the walls of a box sample, by body name
+/// (the other dimension's key refused).
 fn box_walls<D: SceneDim>(cx: &Ctx, sf: &SceneFile<BodySpec<D>>, names: &[Option<String>]) -> Result<Option<BoxWalls>, InputError> {
+    let other_box = match D::N {
+        2 => sf.output.box3.is_some(),
+        _ => sf.output.box_walls.is_some(),
+    };
+    if other_box {
+        let msg = format!(
+            "`{}` names the walls of a box sample in the other dimension; in {} use `{}`",
+            D::OTHER_BOX_KEY,
+            D::NAME,
+            D::BOX_KEY
+        );
+        return Err(cx.err(&[k("output"), k(D::OTHER_BOX_KEY)], msg));
+    }
     let Some((keys, strain_from)) = D::box_walls(&sf.output) else {
         return Ok(None);
     };

@@ -17,7 +17,7 @@
 
 use crate::nodes::FeContacts;
 pub use crate::nodes::FeKey;
-use nscdd::rigid2d::contacts::Block2;
+use nscdd::dim::d2::Block2;
 use nscdd::world::World2;
 
 /// A 2D side: one node, or the two ends of a segment.
@@ -79,7 +79,7 @@ pub fn rigid_apply(n: [f64; 2], arm: [f64; 2], dr: [f64; 2], v: &mut [f64; 3], i
 /// H_jᵀ M̂_j⁻¹ H_j of a rigid antagonist: the framework's W_αα with the rigid body
 /// as the antagonist and nothing as the candidate.
 pub fn rigid_delassus(n: [f64; 2], arm: [f64; 2], im: [f64; 3]) -> [f64; 3] {
-    let f = nscdd::rigid2d::contacts::Frame2 {
+    let f = nscdd::dim::d2::Frame2 {
         n,
         arm_i: [0.0; 2],
         arm_j: arm,

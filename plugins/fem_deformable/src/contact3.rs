@@ -15,7 +15,7 @@
 //! face points per small sphere (one per face in a dent) were tried: faces
 //! sharing nodes make a near-singular set of W_αα that NLGS converges on very
 //! slowly (thousands of sweeps for one sphere). The frame is the framework's
-//! B = [n t1 t2] ([`nscdd::rigid3d::contacts::tangents`]), n from the antagonist
+//! B = [n t1 t2] ([`nscdd::dim::d3::tangents`]), n from the antagonist
 //! to the candidate. The local velocity is u = B (Σ_k w_k v_k)_cand − B v_p,j with
 //! v_p,j = v_j + ω_j × d (rigid) or Σ_k w_k v_k (deformable), and
 //! W_αα = B (Σ_kl w_k w_l G_kl)_cand Bᵀ + (rigid: Bᵀ K_j B, K_j = m⁻¹ + [d]×ᵀ I⁻¹ [d]×;
@@ -27,8 +27,8 @@ use crate::body::FeBody;
 pub use crate::nodes::FeKey;
 use crate::nodes::{FeContacts, FeSide, NodeSet};
 use nscdd::dim::coulomb3::{self as coulomb, Sym3};
-use nscdd::rigid3d::bodies::cross;
-use nscdd::rigid3d::contacts::{point_velocity, Block3, Frame3};
+use nscdd::dim::d3::cross;
+use nscdd::dim::d3::{point_velocity, Block3, Frame3};
 use nscdd::world::World3;
 
 pub type FeSide3 = FeSide<3>;

@@ -26,8 +26,8 @@ use crate::stage2::{self, Deformables2};
 use nscdd::dim::coulomb2 as coulomb;
 use nscdd::engine::ContactStage;
 use nscdd::norms::{Norms, Sums};
-use nscdd::rigid2d::contacts::Block2;
-use nscdd::rigid2d::Contacts2;
+use nscdd::dim::d2::Block2;
+use nscdd::model::Contacts2;
 use nscdd::solver::SolveReport;
 use nscdd::world::World2;
 

@@ -201,7 +201,7 @@ pub struct FeContacts<C, A, F, B, const D: usize> {
     pub anta: Vec<A>,
     pub frame: Vec<F>,
     pub block: Vec<B>,
-    pub target: Vec<nscdd::rigid2d::contacts::Target>,
+    pub target: Vec<nscdd::model::Target>,
     pub r: Vec<[f64; D]>,
     pub u_free: Vec<[f64; D]>,
     pub gap: Vec<f64>,

@@ -14,8 +14,8 @@ use crate::stage2::{free_velocities, law_output, node_target, update_bodies, FeT
 use nscdd::dim::coulomb3 as coulomb;
 use nscdd::engine::{ContactStage, Diverged};
 use nscdd::norms::{natural_map_sq, Sums};
-use nscdd::rigid2d::contacts::Target;
-use nscdd::rigid3d::contacts::{tangents, Block3};
+use nscdd::model::Target;
+use nscdd::dim::d3::{tangents, Block3};
 use nscdd::solver::nlgs;
 use nscdd::solver::SolveReport;
 use nscdd::world::World3;

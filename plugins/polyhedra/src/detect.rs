@@ -32,7 +32,7 @@ use crate::hull::{cross, dot, norm, sub};
 use crate::shapes::{unit, Poly, Polyhedra};
 use nscdd::dim::D3;
 use nscdd::registry::{DetectCtx, PairDetector, RawContact3};
-use nscdd::rigid3d::bodies::rotate;
+use nscdd::dim::rotation::rotate;
 
 pub(crate) fn polys<'a>(ctx: &'a DetectCtx<'_, D3>, first: bool) -> &'a Polyhedra {
     let s = if first { ctx.a } else { ctx.b };
@@ -350,7 +350,7 @@ impl PairDetector<D3> for PolyPoly {
 mod tests {
     use super::*;
     use crate::generate::box_points;
-    use nscdd::rigid3d::bodies::from_rotation_vector;
+    use nscdd::dim::rotation::from_rotation_vector;
 
     /// Separation of two vertex sets by brute force over every face normal and
     /// every cross product of edges; and over the face normals only.
@@ -449,7 +449,7 @@ mod tests {
         // each body at its principal frame (centroid on the z axis), the lower one
         // turned about z and 0.1 mm down
         let turn = from_rotation_vector([0.0, 0.0, std::f64::consts::PI / n as f64]);
-        let qd = nscdd::rigid3d::bodies::quat_mul(turn, qd);
+        let qd = nscdd::dim::rotation::quat_mul(turn, qd);
         poly_poly(&up, cu, qu, &down, [cd[0], cd[1], cd[2] - 1e-4], qd, 0, 1, 0.002, &mut sc, &mut out);
         assert!((1..=4).contains(&out.len()), "{} points", out.len());
         let total: f64 = out.iter().map(|c| c.area).sum();

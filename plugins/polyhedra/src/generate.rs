@@ -7,7 +7,7 @@ use nscdd::drive::{DofDrive, Phase, Shape, TimeFn};
 use nscdd::params::{array, boolean, count, number, only_keys, positive};
 use nscdd::registry::Generator;
 use nscdd::registry::ParamError;
-use nscdd::rigid2d::bodies::ShapeRef;
+use nscdd::model::ShapeRef;
 use nscdd::scene::builder::SceneBuilder3;
 
 /// The 8 corners of a box [lo, hi].

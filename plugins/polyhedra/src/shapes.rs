@@ -7,7 +7,7 @@ use nscdd::dim::D3;
 use nscdd::params::only_keys;
 use nscdd::registry::ParamError;
 use nscdd::registry::{Aabb3, Glyph3, MassProps3, PointContact3, ShapeStore};
-use nscdd::rigid3d::bodies::rotate;
+use nscdd::dim::rotation::rotate;
 use std::any::Any;
 
 /// One convex polyhedron in its principal frame.

@@ -203,7 +203,7 @@ fn tilting(b: f64, h: f64, mu: f64, alpha_deg: f64) -> (f64, f64) {
         let d = [0, 1, 2].map(|k| w.bodies.pos[0][k] - w.bodies.pos[1][k]);
         // the block's pose in the table's frame: Rₜᵀ (x_b − x_t), qₜ⁻¹ q_b
         let qi = [qt[0], -qt[1], -qt[2], -qt[3]];
-        (nscdd::rigid3d::bodies::rotate(qi, d), nscdd::rigid3d::bodies::quat_mul(qi, qb))
+        (nscdd::dim::rotation::rotate(qi, d), nscdd::dim::rotation::quat_mul(qi, qb))
     };
     let (x0, q0) = rel(&w);
     let qt0 = w.bodies.rot[1];
@@ -212,7 +212,7 @@ fn tilting(b: f64, h: f64, mu: f64, alpha_deg: f64) -> (f64, f64) {
         w.step().unwrap();
     }
     // the table's rotation since t = 0 (its principal frame need not be the world's)
-    let qt = nscdd::rigid3d::bodies::quat_mul(w.bodies.rot[1], [qt0[0], -qt0[1], -qt0[2], -qt0[3]]);
+    let qt = nscdd::dim::rotation::quat_mul(w.bodies.rot[1], [qt0[0], -qt0[1], -qt0[2], -qt0[3]]);
     let tilt = 2.0 * qt[0].abs().min(1.0).acos();
     // drives act at step ends: the tilt stops within rate × h of max_angle
     assert!((tilt - alpha_deg.to_radians()).abs() <= 0.02 * 2e-3, "table at {tilt} rad");
@@ -298,7 +298,7 @@ fn arch(t_over_r: f64, steps: usize) -> f64 {
 /// Relative rotations (about y) at the 25 joints of the arch, from the right
 /// springing: joint k lies between voussoirs k − 1 and k, at π k / 24.
 fn joint_rotations(w: &World3, q0: &[[f64; 4]]) -> Vec<f64> {
-    use nscdd::rigid3d::bodies::{quat_mul, to_rotation_vector};
+    use nscdd::dim::rotation::{quat_mul, to_rotation_vector};
     let theta = |b: usize| {
         let q = q0[b];
         to_rotation_vector(quat_mul(w.bodies.rot[b], [q[0], -q[1], -q[2], -q[3]]))[1]

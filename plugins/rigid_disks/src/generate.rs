@@ -6,7 +6,7 @@ use crate::shapes::Disks;
 use nscdd::dim::D2;
 use nscdd::params::{array, count, number, only_keys, positive};
 use nscdd::registry::{Generator, ParamError};
-use nscdd::rigid2d::bodies::ShapeRef;
+use nscdd::model::ShapeRef;
 use nscdd::scene::builder::SceneBuilder2;
 use rand::{RngExt, SeedableRng};
 

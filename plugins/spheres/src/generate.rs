@@ -7,7 +7,7 @@ use nscdd::dim::D3;
 use nscdd::params::{array, count, only_keys, positive};
 use nscdd::registry::Generator;
 use nscdd::registry::ParamError;
-use nscdd::rigid2d::bodies::ShapeRef;
+use nscdd::model::ShapeRef;
 use nscdd::scene::builder::SceneBuilder3;
 use rand::{RngExt, SeedableRng};
 

@@ -4,7 +4,7 @@ use nscdd::dim::D3;
 use nscdd::params::{array, only_keys, positive};
 use nscdd::registry::ParamError;
 use nscdd::registry::{Aabb3, FaceContact3, Glyph3, MassProps3, PointContact3, ShapeStore};
-use nscdd::rigid3d::bodies::{rotate, rotate_inv};
+use nscdd::dim::rotation::{rotate, rotate_inv};
 use std::any::Any;
 use std::f64::consts::PI;
 

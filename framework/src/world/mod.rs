@@ -1,6 +1,8 @@
 //! A loaded scene and its state (2D or 3D): bodies, shapes, materials, laws, drives
 //! and the contact set. Built by [`crate::scene`], advanced by [`crate::engine`].
 
+pub mod bulk;
+
 use crate::detect::{Detector, DetectorTable};
 use crate::dim::{Dim, Vector, D2, D3};
 use crate::drive::BodyDrive;
