@@ -21,6 +21,8 @@
 //! }
 //! ```
 
+pub use error::Error;
+
 pub mod dd;
 pub mod detect;
 pub mod dim;

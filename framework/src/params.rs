@@ -1,22 +1,7 @@
 //! Helpers for plugins reading their own keys from a scene table, with messages that
 //! name the key.
 
-/// A shape-specific key that failed, with the reason (located in the scene file by
-/// the loader).
-#[derive(Clone, Debug, PartialEq)]
-pub struct ParamError {
-    pub key: String,
-    pub msg: String,
-}
-
-impl ParamError {
-    pub fn new(key: impl Into<String>, msg: impl Into<String>) -> Self {
-        ParamError {
-            key: key.into(),
-            msg: msg.into(),
-        }
-    }
-}
+pub use crate::error::ParamError;
 
 /// A finite number (integers accepted); `default` when the key is absent.
 pub fn number(t: &toml::Table, key: &str, default: Option<f64>) -> Result<f64, ParamError> {

@@ -3,7 +3,7 @@
 
 use crate::dd::{NscddOf, Rigid};
 use crate::dim::Dim;
-use crate::engine::{Diverged, StepReport};
+use crate::engine::StepReport;
 use crate::output::{final_json, history::History};
 use crate::registry::{Registry, Writer};
 use crate::scene::Scene;
@@ -12,26 +12,9 @@ use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
-/// Why a run stopped early.
-#[derive(Debug)]
-pub enum RunError {
-    /// An output could not be written.
-    Io(String),
-    /// A non-finite state; what was written so far is kept.
-    Diverged(Diverged),
-    /// A multi-process run that cannot start (ranks against the decomposition).
-    Ranks(String),
-}
-
-impl std::fmt::Display for RunError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            RunError::Io(m) => write!(f, "{m}"),
-            RunError::Diverged(d) => write!(f, "{d}"),
-            RunError::Ranks(m) => write!(f, "{m}"),
-        }
-    }
-}
+/// Why a run stopped early: the library's [`crate::Error`] (`Io`, `Diverged`,
+/// `Ranks`).
+pub type RunError = crate::error::Error;
 
 /// What a finished run did.
 #[derive(Clone, Debug, Default, PartialEq)]

@@ -10,19 +10,7 @@ use crate::dim::{Dim, Vector};
 use crate::drive::DofDrive;
 use crate::model::{all_free, Bodies, Contacts};
 
-/// A step produced a non-finite state.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Diverged {
-    pub step: u64,
-    pub body: u32,
-    pub message: String,
-}
-
-impl std::fmt::Display for Diverged {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "the run diverged at step {}: {}", self.step, self.message)
-    }
-}
+pub use crate::error::Diverged;
 
 impl Diverged {
     /// Body k (labelled `label`) has a non-finite state after step `step`.
