@@ -48,7 +48,14 @@ pub fn check(scene: &Path, reg: &Registry) -> ExitCode {
 pub fn run(scene: &Path, out: &Path, quiet: bool, reg: &Registry, unsupported: Option<&str>) -> ExitCode {
     use nscdd_fem_deformable::scene::FeScene;
     if let Some(flag) = unsupported {
-        eprintln!("error: {flag} is not supported for scenes with deformable bodies (use [decomposition] by_model = true)");
+        eprintln!(
+            "error: {flag} is not supported for scenes with deformable bodies yet (they run in one process, one thread; `[decomposition] by_model = true` splits them by model)"
+        );
+        return ExitCode::from(2);
+    }
+    let ranks = crate::ranks::launched_size();
+    if ranks > 1 {
+        eprintln!("error: started as one of {ranks} MPI ranks, but scenes with deformable bodies run in one process for now: run without mpirun");
         return ExitCode::from(2);
     }
     match nscdd_fem_deformable::scene::load_any(scene, reg) {

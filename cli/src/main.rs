@@ -226,13 +226,18 @@ fn main() -> ExitCode {
             out,
             quiet,
             subdomains,
+            scheme,
+            threads,
             restart,
-            ..
         } if fem::has_deformable(scene) => {
-            let flag = subdomains
-                .as_ref()
-                .map(|_| "--subdomains")
-                .or(restart.as_ref().map(|_| "--restart"));
+            let flag = [
+                (subdomains.is_some(), "--subdomains"),
+                (scheme.is_some(), "--scheme"),
+                (threads.is_some(), "--threads"),
+                (restart.is_some(), "--restart"),
+            ]
+            .into_iter()
+            .find_map(|(given, f)| given.then_some(f));
             return fem::run(scene, out, *quiet, &reg, flag);
         }
         _ => {}

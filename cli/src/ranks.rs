@@ -22,7 +22,8 @@ pub struct Ranks {
 
 /// The rank count an MPI launcher gave this process (1 without a launcher).
 #[cfg_attr(feature = "mpi", allow(dead_code))]
-fn launched_size() -> u32 {
+/// The number of processes the MPI launcher started (1 without one).
+pub fn launched_size() -> u32 {
     ["OMPI_COMM_WORLD_SIZE", "PMI_SIZE"]
         .iter()
         .find_map(|v| std::env::var(v).ok()?.parse().ok())

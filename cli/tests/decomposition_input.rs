@@ -222,3 +222,32 @@ fn restart_continues_and_never_overwrites_its_own_run() {
     assert!(hist.lines().nth(1).unwrap().starts_with("11,"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A scene with deformable bodies refuses what it cannot run yet (NSCDD flags, a
+/// restart, MPI ranks) with exit 2 and a message naming it, before running.
+#[cfg(feature = "fem")]
+#[test]
+fn deformable_scenes_refuse_what_they_cannot_run() {
+    let dir = common::scratch("fe_refusals");
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/scenes/foundation.toml");
+    let out = dir.join("out");
+    let cases: [(&[&str], &str, &str); 5] = [
+        (&["--threads", "2"], "", "--threads"),
+        (&["--scheme", "centralized"], "", "--scheme"),
+        (&["--subdomains", "2x1"], "", "--subdomains"),
+        (&["--restart", "x.json"], "", "--restart"),
+        (&[], "2", "MPI ranks"),
+    ];
+    for (flags, ranks, said) in cases {
+        let mut cmd = std::process::Command::new(common::BIN);
+        cmd.args(["run", scene, "--quiet", "--out"]).arg(&out).args(flags);
+        if !ranks.is_empty() {
+            cmd.env("OMPI_COMM_WORLD_SIZE", ranks);
+        }
+        let o = cmd.output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{flags:?}: {err}");
+        assert!(err.contains(said), "{flags:?}: {err}");
+        assert!(!out.join("history.csv").exists(), "{flags:?} ran");
+    }
+}

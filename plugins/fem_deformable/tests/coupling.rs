@@ -175,3 +175,29 @@ fn non_convergence_is_reported() {
     let (_, conv) = drop(1e7, 1e-2, 0.3, 0.5, 1);
     assert!(!conv, "one sweep cannot meet 1e-5 with a block landing on its base");
 }
+
+/// Settings a scene with deformable bodies cannot use yet are input errors naming
+/// the key, never ignored.
+#[test]
+fn unsupported_settings_are_refused() {
+    let cases = [
+        ("[decomposition]\nnx = 2", "decomposition"),
+        ("[decomposition]\nby_model = true\nthreads = 2", "decomposition.threads"),
+        ("[decomposition]\nby_model = true\nscheme = \"centralized\"", "decomposition.scheme"),
+        ("[decomposition]\nby_model = true\nsweeps_per_gluing = 3", "decomposition.sweeps_per_gluing"),
+        ("[decomposition]\nby_model = true\nrepartition_every = 5", "decomposition.repartition_every"),
+        ("[output]\ncheckpoint_every = 10", "output.checkpoint_every"),
+    ];
+    for (extra, key) in cases {
+        let text = foundation(extra, 1e-6);
+        let e = match nscdd_fem_deformable::scene::load_str(&text, "t.toml", std::path::Path::new("."), &registry()) {
+            Err(e) => e,
+            Ok(_) => panic!("accepted: {extra}"),
+        };
+        assert_eq!(e.key, key, "{e}");
+        assert!(e.line.is_some(), "{e}");
+    }
+    // the defaults written out are accepted
+    let ok = foundation("[decomposition]\nby_model = true\nthreads = 1\nscheme = \"decentralized\"", 1e-6);
+    assert!(nscdd_fem_deformable::scene::load_str(&ok, "t.toml", std::path::Path::new("."), &registry()).is_ok());
+}
