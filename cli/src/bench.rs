@@ -10,6 +10,7 @@
 
 use nscdd::registry::Registry;
 use nscdd::solver::nlgs;
+use nscdd::Error;
 use std::time::Instant;
 
 /// The 2D bench packing: a triangular lattice of touching disks in a box of walls.
@@ -120,11 +121,11 @@ origin = [{r}, {r}, {r}]
 /// NLGS contact updates per second on one thread, in either dimension: the scene
 /// settles for 5 steps, then plain sweeps of the solver's hot loop over one more
 /// step's contact set are timed.
-pub fn nlgs<D: nscdd::scene::schema::SceneDim>(reg: &Registry, name: &str, scene: &str, sweeps: usize) {
-    let mut s = nscdd::scene::Scene::<D>::load_str(scene, name, reg).expect("bench scene");
+pub fn nlgs<D: nscdd::scene::schema::SceneDim>(reg: &Registry, name: &str, scene: &str, sweeps: usize) -> Result<(), Error> {
+    let mut s = nscdd::scene::Scene::<D>::load_str(scene, name, reg)?;
     let w = &mut s.world;
     for _ in 0..5 {
-        w.step().expect("bench step");
+        w.step()?;
     }
     let c = &mut w.contacts;
     let mut order = vec![];
@@ -145,22 +146,30 @@ pub fn nlgs<D: nscdd::scene::schema::SceneDim>(reg: &Registry, name: &str, scene
         updates / dt,
         1e9 * dt / updates
     );
+    Ok(())
+}
+
+/// An example scene's text (the benches run from the repository root).
+fn example(name: &str) -> Result<String, Error> {
+    let path = format!("examples/scenes/{name}");
+    std::fs::read_to_string(&path).map_err(|e| Error::Io(format!("{path}: {e} (run the benches from the repository root)")))
 }
 
 /// Time per step of the deposit example, by stage.
-pub fn deposit(reg: &Registry, n: usize, steps: usize) {
-    let path = std::path::Path::new("examples/scenes/deposit.toml");
-    let text = std::fs::read_to_string(path).expect("run from the repository root: examples/scenes/deposit.toml");
+pub fn deposit(reg: &Registry, n: usize, steps: usize) -> Result<(), Error> {
+    let text = example("deposit.toml")?;
     let text = text.replace("count = 1000", &format!("count = {n}"));
-    let mut s = nscdd::scene::load_str(&text, "deposit.toml", reg).expect("deposit scene");
+    let mut s = nscdd::scene::load_str(&text, "deposit.toml", reg)?;
     let dir = std::env::temp_dir().join(format!("nscdd-bench-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    let mut vtk = (reg.writer::<nscdd::dim::D2>("vtk").expect("vtk writer"))();
+    std::fs::create_dir_all(&dir)?;
+    let mut vtk = (reg
+        .writer::<nscdd::dim::D2>("vtk")
+        .ok_or_else(|| Error::Io("no vtk writer registered".into()))?)();
     let every = s.output.every.max(1) as usize;
     let (mut det, mut del, mut sol, mut upd, mut out, mut sweeps, mut contacts) = (0.0, 0.0, 0.0, 0.0, 0.0, 0u64, 0usize);
     let t_all = Instant::now();
     for k in 1..=steps {
-        let r = s.world.step().expect("deposit step");
+        let r = s.world.step()?;
         det += r.times.detect;
         del += r.times.delassus;
         sol += r.times.nlgs;
@@ -169,7 +178,7 @@ pub fn deposit(reg: &Registry, n: usize, steps: usize) {
         contacts = r.contacts;
         let t = Instant::now();
         if k % every == 0 {
-            vtk.write(&s.world, &dir, k as u32).expect("vtk");
+            vtk.write(&s.world, &dir, k as u32)?;
             std::hint::black_box(nscdd::output::final_json(&s.world));
         }
         out += t.elapsed().as_secs_f64();
@@ -190,32 +199,32 @@ pub fn deposit(reg: &Registry, n: usize, steps: usize) {
         ms(out),
         ms(total)
     );
+    Ok(())
 }
 
 /// The biaxial example for `n` disks: `examples/scenes/biaxial.toml` with its box,
 /// walls and wall forces scaled by √(n / 2000) (the file unchanged for 2000).
-fn biaxial_text(n: usize) -> String {
-    let path = std::path::Path::new("examples/scenes/biaxial.toml");
-    let text = std::fs::read_to_string(path).expect("run from the repository root: examples/scenes/biaxial.toml");
+fn biaxial_text(n: usize) -> Result<String, Error> {
+    let text = example("biaxial.toml")?;
     let f = (n as f64 / 2000.0).sqrt();
-    let subst = |t: String, from: &str, to: String| {
-        assert!(t.contains(from), "examples/scenes/biaxial.toml changed: `{from}` not found");
-        t.replace(from, &to)
+    let subst = |t: String, from: &str, to: String| match t.contains(from) {
+        true => Ok(t.replace(from, &to)),
+        false => Err(Error::Io(format!("examples/scenes/biaxial.toml changed: `{from}` not found"))),
     };
-    let mut t = subst(text, "count = 2000", format!("count = {n}"));
+    let mut t = subst(text, "count = 2000", format!("count = {n}"))?;
     if n != 2000 {
         let (w, h) = (0.4 * f, 0.535 * f);
-        t = subst(t, "box = [0.0, 0.0, 0.4, 0.535]", format!("box = [0.0, 0.0, {w}, {h}]"));
-        t = subst(t, "position = [0.2, -0.01]", format!("position = [{}, -0.01]", w / 2.0));
-        t = subst(t, "position = [0.2, 0.55]", format!("position = [{}, {}]", w / 2.0, h + 0.015));
-        t = subst(t, "position = [-0.01, 0.28]", format!("position = [-0.01, {}]", 0.28 * f));
-        t = subst(t, "position = [0.41, 0.28]", format!("position = [{}, {}]", w + 0.01, 0.28 * f));
-        t = subst(t, "length = 0.5", format!("length = {}", 0.5 * f));
-        t = subst(t, "length = 0.6", format!("length = {}", 0.6 * f));
-        t = subst(t, "-4000.0", format!("{:.3}", -4000.0 * f));
-        t = subst(t, "-5200.0", format!("{:.3}", -5200.0 * f));
+        t = subst(t, "box = [0.0, 0.0, 0.4, 0.535]", format!("box = [0.0, 0.0, {w}, {h}]"))?;
+        t = subst(t, "position = [0.2, -0.01]", format!("position = [{}, -0.01]", w / 2.0))?;
+        t = subst(t, "position = [0.2, 0.55]", format!("position = [{}, {}]", w / 2.0, h + 0.015))?;
+        t = subst(t, "position = [-0.01, 0.28]", format!("position = [-0.01, {}]", 0.28 * f))?;
+        t = subst(t, "position = [0.41, 0.28]", format!("position = [{}, {}]", w + 0.01, 0.28 * f))?;
+        t = subst(t, "length = 0.5", format!("length = {}", 0.5 * f))?;
+        t = subst(t, "length = 0.6", format!("length = {}", 0.6 * f))?;
+        t = subst(t, "-4000.0", format!("{:.3}", -4000.0 * f))?;
+        t = subst(t, "-5200.0", format!("{:.3}", -5200.0 * f))?;
     }
-    t
+    Ok(t)
 }
 
 /// The end of the biaxial example's compaction phase (s).
@@ -235,11 +244,11 @@ struct DdRun {
 
 /// Loads the biaxial scene, compacts it with the one-domain engine (t < 0.3 s, the
 /// same steps for every call), then times `steps` NSCDD steps of the loading phase.
-fn dd_run(reg: &Registry, text: &str, steps: usize, settings: nscdd::dd::DdSettings) -> (DdRun, u64) {
-    let mut s = nscdd::scene::load_str(text, "biaxial.toml", reg).expect("biaxial scene");
+fn dd_run(reg: &Registry, text: &str, steps: usize, settings: nscdd::dd::DdSettings) -> Result<(DdRun, u64), Error> {
+    let mut s = nscdd::scene::load_str(text, "biaxial.toml", reg)?;
     let w = &mut s.world;
     while w.t < COMPACTED - 0.5 * w.time.h {
-        w.step().expect("compaction step");
+        w.step()?;
     }
     let start = w.step;
     let mut n = nscdd::dd::Nscdd::new(settings);
@@ -255,7 +264,7 @@ fn dd_run(reg: &Registry, text: &str, steps: usize, settings: nscdd::dd::DdSetti
     };
     for _ in 0..steps {
         let t = Instant::now();
-        let rep = n.step(w).expect("NSCDD step");
+        let rep = n.step(w)?;
         r.seconds += t.elapsed().as_secs_f64();
         r.solve_seconds += rep.times.nlgs;
         r.stages += rep.stages as u64;
@@ -265,14 +274,14 @@ fn dd_run(reg: &Registry, text: &str, steps: usize, settings: nscdd::dd::DdSetti
         r.contacts += rep.contacts as u64;
     }
     r.vel_bits = w.bodies.vel.iter().map(|v| v.map(f64::to_bits)).collect();
-    (r, start)
+    Ok((r, start))
 }
 
 /// NSCDD on the compacted biaxial sample: per decomposition, the stages (NSCDD
 /// iterations) over `steps` loading steps relative to one subdomain, and with two
 /// subdomains or more the wall time per step with 1 and 2 threads.
-pub fn nscdd(reg: &Registry, n: usize, steps: usize, subdomains: &[(u32, u32)]) {
-    let text = biaxial_text(n);
+pub fn nscdd(reg: &Registry, n: usize, steps: usize, subdomains: &[(u32, u32)]) -> Result<(), Error> {
+    let text = biaxial_text(n)?;
     let mut rows = Vec::new();
     let (mut s0, mut start, mut tol) = (None, 0, String::new());
     if let Ok(s) = nscdd::scene::load_str(&text, "biaxial.toml", reg) {
@@ -286,7 +295,7 @@ pub fn nscdd(reg: &Registry, n: usize, steps: usize, subdomains: &[(u32, u32)]) 
             threads,
             ..Default::default()
         };
-        let (one, st) = dd_run(reg, &text, steps, set(1));
+        let (one, st) = dd_run(reg, &text, steps, set(1))?;
         start = st;
         let stages0 = *s0.get_or_insert(one.stages);
         let per = |x: f64| 1e3 * x / steps as f64;
@@ -304,7 +313,7 @@ pub fn nscdd(reg: &Registry, n: usize, steps: usize, subdomains: &[(u32, u32)]) 
             "solve_ms_per_step_1": per(one.solve_seconds),
         });
         if nx * ny >= 2 {
-            let (two, _) = dd_run(reg, &text, steps, set(2));
+            let (two, _) = dd_run(reg, &text, steps, set(2))?;
             row["ms_per_step_2"] = per(two.seconds).into();
             row["solve_ms_per_step_2"] = per(two.solve_seconds).into();
             row["efficiency"] = (one.seconds / (2.0 * two.seconds)).into();
@@ -324,4 +333,5 @@ pub fn nscdd(reg: &Registry, n: usize, steps: usize, subdomains: &[(u32, u32)]) 
         "decompositions": rows,
     });
     println!("{out}");
+    Ok(())
 }

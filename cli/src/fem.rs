@@ -55,7 +55,9 @@ pub fn run(scene: &Path, out: &Path, quiet: bool, reg: &Registry, unsupported: O
     }
     let ranks = crate::ranks::launched_size();
     if ranks > 1 {
-        eprintln!("error: started as one of {ranks} MPI ranks, but scenes with deformable bodies run in one process for now: run without mpirun");
+        eprintln!(
+            "error: started as one of {ranks} MPI ranks, but scenes with deformable bodies run in one process for now: run without mpirun"
+        );
         return ExitCode::from(2);
     }
     match nscdd_fem_deformable::scene::load_any(scene, reg) {

@@ -11,10 +11,10 @@ mod report;
 mod run;
 
 use clap::{Parser, Subcommand};
+use nscdd::dim::{D2, D3};
 use nscdd::fc::{FcNorm, FcOptions};
 use nscdd::norms::Criterion;
 use std::path::PathBuf;
-use nscdd::dim::{D2, D3};
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -219,62 +219,11 @@ fn main() -> ExitCode {
     reg.add_plugin(&nscdd_spheres::SpheresPlugin);
     reg.add_plugin(&nscdd_polyhedra::PolyhedraPlugin);
     #[cfg(feature = "fem")]
-    match &cli.cmd {
-        Cmd::Check { scene } if fem::has_deformable(scene) => return fem::check(scene, &reg),
-        Cmd::Run {
-            scene,
-            out,
-            quiet,
-            subdomains,
-            scheme,
-            threads,
-            restart,
-        } if fem::has_deformable(scene) => {
-            let flag = [
-                (subdomains.is_some(), "--subdomains"),
-                (scheme.is_some(), "--scheme"),
-                (threads.is_some(), "--threads"),
-                (restart.is_some(), "--restart"),
-            ]
-            .into_iter()
-            .find_map(|(given, f)| given.then_some(f));
-            return fem::run(scene, out, *quiet, &reg, flag);
-        }
-        _ => {}
+    if let Some(code) = fem_dispatch(&cli.cmd, &reg) {
+        return code;
     }
     match cli.cmd {
-        Cmd::Check { scene } => match nscdd::scene::load_any(&scene, &reg) {
-            Ok(nscdd::scene::AnyScene::D3(s)) => {
-                let w = &s.world;
-                println!(
-                    "{}: ok — 3D, {} bodies, {} steps of {} s",
-                    scene.display(),
-                    w.bodies.len(),
-                    w.time.steps,
-                    w.time.h
-                );
-                ExitCode::SUCCESS
-            }
-            Ok(nscdd::scene::AnyScene::D2(s)) => {
-                let w = &s.world;
-                let dd = match &s.decomposition {
-                    Some(c) => format!(
-                        "; NSCDD {}x{} subdomains, {:?}, repartition every {} steps",
-                        c.dd.nx, c.dd.ny, c.dd.scheme, c.repartition_every
-                    ),
-                    None => String::new(),
-                };
-                println!(
-                    "{}: ok — {} bodies, {} steps of {} s{dd}",
-                    scene.display(),
-                    w.bodies.len(),
-                    w.time.steps,
-                    w.time.h
-                );
-                ExitCode::SUCCESS
-            }
-            Err(e) => input_error(e),
-        },
+        Cmd::Check { scene } => check(&scene, &reg),
         Cmd::Run {
             scene,
             out,
@@ -309,86 +258,15 @@ fn main() -> ExitCode {
             norm,
             check_every,
             export_json,
-        } => {
-            let norm = match norm.as_str() {
-                "natural" => FcNorm::Natural,
-                other => match Criterion::parse(other) {
-                    Some(c) => FcNorm::Lmgc(c),
-                    None => return input_error(format!("--norm: unknown norm `{other}`; expected natural, Quad, Maxm or QM/16")),
-                },
-            };
-            if !(tol > 0.0) || max_sweeps == 0 || check_every == 0 {
-                return input_error("--tol must be > 0, --max-sweeps and --check-every ≥ 1");
-            }
-            let p = match nscdd::fc::read_any(&problem) {
-                Ok(p) => p,
-                Err(e) => return input_error(e),
-            };
-            if let Some(path) = &export_json {
-                if let Err(e) = write_problem(&p, path) {
-                    eprintln!("error: {e}");
-                    return ExitCode::from(1);
-                }
-            }
-            let sol = p.solve(&FcOptions {
-                tol,
-                max_sweeps,
-                check_every,
-                norm,
-            });
-            println!("{}", serde_json::to_string(&sol).expect("plain data"));
-            if !sol.converged {
-                eprintln!("warning: not converged after {} sweeps (residual {:e})", sol.sweeps, sol.residual);
-            }
-            ExitCode::SUCCESS
-        }
-        Cmd::ExportFc { scene, steps, out } => {
-            let p = match nscdd::scene::load_any(&scene, &reg) {
-                Err(e) => return input_error(e),
-                Ok(nscdd::scene::AnyScene::D2(mut s)) => {
-                    for _ in 0..steps {
-                        if let Err(e) = s.world.step() {
-                            eprintln!("error: {e}");
-                            return ExitCode::from(1);
-                        }
-                    }
-                    nscdd::fc::problem_from_world(&s.world)
-                }
-                Ok(nscdd::scene::AnyScene::D3(mut s)) => {
-                    for _ in 0..steps {
-                        if let Err(e) = s.world.step() {
-                            eprintln!("error: {e}");
-                            return ExitCode::from(1);
-                        }
-                    }
-                    let bonded = s.world.contacts.joint.iter().filter(|j| j.bonded()).count();
-                    if bonded > 0 {
-                        eprintln!(
-                            "error: {bonded} contacts are intact mortar joints (law `mohr_coulomb`): a frictional-contact problem (FCLIB) cannot express their cohesion"
-                        );
-                        return ExitCode::from(2);
-                    }
-                    nscdd::fc::problem_from_world3(&s.world)
-                }
-            };
-            match write_problem(&p, &out) {
-                Ok(()) => {
-                    eprintln!("{} contacts (dim {}) written to {}", p.nc, p.dim, out.display());
-                    ExitCode::SUCCESS
-                }
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    ExitCode::from(1)
-                }
-            }
-        }
+        } => solve_fc(&problem, tol, max_sweeps, &norm, check_every, export_json.as_deref()),
+        Cmd::ExportFc { scene, steps, out } => export_fc(&scene, steps, &out, &reg),
         Cmd::Bench {
             which,
             disks,
             repeat,
             subdomains,
         } => {
-            match which.as_str() {
+            let done = match which.as_str() {
                 "nlgs" => bench::nlgs::<D2>(&reg, "nlgs", &bench::lattice(disks.unwrap_or(10000)), repeat.unwrap_or(200)),
                 "nlgs3" => bench::nlgs::<D3>(&reg, "nlgs3", &bench::lattice3(disks.unwrap_or(10648)), repeat.unwrap_or(200)),
                 "deposit" => bench::deposit(&reg, disks.unwrap_or(10000), repeat.unwrap_or(200)),
@@ -399,8 +277,160 @@ fn main() -> ExitCode {
                         Err(e) => return input_error(e),
                     }
                 }
+            };
+            if let Err(e) = done {
+                eprintln!("error: {e}");
+                return ExitCode::from(e.exit_code());
             }
             ExitCode::SUCCESS
+        }
+    }
+}
+
+/// Scenes with deformable bodies go to the deformable plugin (feature `fem`).
+#[cfg(feature = "fem")]
+fn fem_dispatch(cmd: &Cmd, reg: &nscdd::registry::Registry) -> Option<ExitCode> {
+    match cmd {
+        Cmd::Check { scene } if fem::has_deformable(scene) => Some(fem::check(scene, reg)),
+        Cmd::Run {
+            scene,
+            out,
+            quiet,
+            subdomains,
+            scheme,
+            threads,
+            restart,
+        } if fem::has_deformable(scene) => {
+            let flag = [
+                (subdomains.is_some(), "--subdomains"),
+                (scheme.is_some(), "--scheme"),
+                (threads.is_some(), "--threads"),
+                (restart.is_some(), "--restart"),
+            ]
+            .into_iter()
+            .find_map(|(given, f)| given.then_some(f));
+            Some(fem::run(scene, out, *quiet, reg, flag))
+        }
+        _ => None,
+    }
+}
+
+/// `nscdd check`: load, validate and describe a scene.
+fn check(scene: &std::path::Path, reg: &nscdd::registry::Registry) -> ExitCode {
+    match nscdd::scene::load_any(scene, reg) {
+        Ok(nscdd::scene::AnyScene::D3(s)) => {
+            let w = &s.world;
+            println!(
+                "{}: ok — 3D, {} bodies, {} steps of {} s",
+                scene.display(),
+                w.bodies.len(),
+                w.time.steps,
+                w.time.h
+            );
+            ExitCode::SUCCESS
+        }
+        Ok(nscdd::scene::AnyScene::D2(s)) => {
+            let w = &s.world;
+            let dd = match &s.decomposition {
+                Some(c) => format!(
+                    "; NSCDD {}x{} subdomains, {:?}, repartition every {} steps",
+                    c.dd.nx, c.dd.ny, c.dd.scheme, c.repartition_every
+                ),
+                None => String::new(),
+            };
+            println!(
+                "{}: ok — {} bodies, {} steps of {} s{dd}",
+                scene.display(),
+                w.bodies.len(),
+                w.time.steps,
+                w.time.h
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => input_error(e),
+    }
+}
+
+/// `nscdd solve-fc`: one frictional-contact problem, solved and printed as JSON.
+fn solve_fc(
+    problem: &std::path::Path,
+    tol: f64,
+    max_sweeps: u32,
+    norm: &str,
+    check_every: u32,
+    export_json: Option<&std::path::Path>,
+) -> ExitCode {
+    let norm = match norm {
+        "natural" => FcNorm::Natural,
+        other => match Criterion::parse(other) {
+            Some(c) => FcNorm::Lmgc(c),
+            None => return input_error(format!("--norm: unknown norm `{other}`; expected natural, Quad, Maxm or QM/16")),
+        },
+    };
+    if !(tol > 0.0) || max_sweeps == 0 || check_every == 0 {
+        return input_error("--tol must be > 0, --max-sweeps and --check-every ≥ 1");
+    }
+    let p = match nscdd::fc::read_any(problem) {
+        Ok(p) => p,
+        Err(e) => return input_error(e),
+    };
+    if let Some(path) = export_json {
+        if let Err(e) = write_problem(&p, path) {
+            eprintln!("error: {e}");
+            return ExitCode::from(1);
+        }
+    }
+    let sol = p.solve(&FcOptions {
+        tol,
+        max_sweeps,
+        check_every,
+        norm,
+    });
+    println!("{}", serde_json::to_string(&sol).expect("plain data"));
+    if !sol.converged {
+        eprintln!("warning: not converged after {} sweeps (residual {:e})", sol.sweeps, sol.residual);
+    }
+    ExitCode::SUCCESS
+}
+
+/// `nscdd export-fc`: the contact problem of a scene after `steps` steps.
+fn export_fc(scene: &std::path::Path, steps: u64, out: &std::path::Path, reg: &nscdd::registry::Registry) -> ExitCode {
+    let p = match nscdd::scene::load_any(scene, reg) {
+        Err(e) => return input_error(e),
+        Ok(nscdd::scene::AnyScene::D2(mut s)) => {
+            for _ in 0..steps {
+                if let Err(e) = s.world.step() {
+                    eprintln!("error: {e}");
+                    return ExitCode::from(1);
+                }
+            }
+            nscdd::fc::problem_from_world(&s.world)
+        }
+        Ok(nscdd::scene::AnyScene::D3(mut s)) => {
+            for _ in 0..steps {
+                if let Err(e) = s.world.step() {
+                    eprintln!("error: {e}");
+                    return ExitCode::from(1);
+                }
+            }
+            let bonded = s.world.contacts.joint.iter().filter(|j| j.bonded()).count();
+            if bonded > 0 {
+                eprintln!(
+                    "error: {bonded} contacts are intact mortar joints (law `mohr_coulomb`): a frictional-contact problem (FCLIB) cannot express their cohesion"
+                );
+                return ExitCode::from(2);
+            }
+            nscdd::fc::problem_from_world3(&s.world)
+        }
+    };
+    match write_problem(&p, out) {
+        Ok(()) => {
+            eprintln!("{} contacts (dim {}) written to {}", p.nc, p.dim, out.display());
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(1)
         }
     }
 }

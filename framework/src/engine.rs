@@ -203,7 +203,6 @@ fn dist2<P: Vector>(a: &P, b: &P) -> f64 {
     d.dot(&d)
 }
 
-
 /// This step's contact set from the raw contacts: frames, W_αα, ū, the warm start
 /// (applied at once to the free velocities) and the bonds of mortar joints.
 pub fn build_contacts<D: Dim>(w: &mut World<D>) {

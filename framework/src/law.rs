@@ -243,7 +243,9 @@ impl LawBatches {
             next[s as usize] += 1;
         }
         for (s, law) in laws.iter().enumerate() {
-            let (Some(law), lo, hi) = (law, self.start[s] as usize, self.start[s + 1] as usize) else { continue };
+            let (Some(law), lo, hi) = (law, self.start[s] as usize, self.start[s + 1] as usize) else {
+                continue;
+            };
             if lo == hi {
                 continue;
             }
@@ -297,7 +299,10 @@ fn parse_coulomb(t: &toml::Table) -> Result<Arc<dyn Law>, ParamError> {
 
 fn parse_frictionless(t: &toml::Table) -> Result<Arc<dyn Law>, ParamError> {
     only_keys(t, &["restitution"])?;
-    Ok(Arc::new(Coulomb { mu: 0.0, e: restitution(t)? }))
+    Ok(Arc::new(Coulomb {
+        mu: 0.0,
+        e: restitution(t)?,
+    }))
 }
 
 fn parse_mohr_coulomb(t: &toml::Table) -> Result<Arc<dyn Law>, ParamError> {

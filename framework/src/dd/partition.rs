@@ -297,7 +297,13 @@ fn split_contacts<D: Family>(c: &D::Contacts, owner: &[u32], ns: usize, nb: usiz
 /// The interface: the movable bodies copied in several subdomains (copies sorted
 /// by body, in subdomain order), with the copies' F_Γ from the previous step
 /// where the same subdomains held them.
-fn interface<D: Family>(w: &D::World, subs: &mut [Subdomain<D>], copy_of: &[(u32, u32, u32)], mult: &[u32], store: &FGammaStore<D::V>) -> Interface {
+fn interface<D: Family>(
+    w: &D::World,
+    subs: &mut [Subdomain<D>],
+    copy_of: &[(u32, u32, u32)],
+    mult: &[u32],
+    store: &FGammaStore<D::V>,
+) -> Interface {
     let mut iface = Interface {
         start: vec![0],
         ..Default::default()

@@ -13,13 +13,7 @@ pub trait Writer<D: Dim>: Send {
     fn write(&mut self, world: &World<D>, dir: &std::path::Path, frame: u32) -> std::io::Result<()>;
     /// A frame of a decomposed (NSCDD) run, with the subdomains of the bodies and
     /// contacts; by default the plain frame.
-    fn write_dd(
-        &mut self,
-        world: &World<D>,
-        _dd: &crate::dd::DdView,
-        dir: &std::path::Path,
-        frame: u32,
-    ) -> std::io::Result<()> {
+    fn write_dd(&mut self, world: &World<D>, _dd: &crate::dd::DdView, dir: &std::path::Path, frame: u32) -> std::io::Result<()> {
         self.write(world, dir, frame)
     }
     /// Called once at the end of the run.

@@ -23,8 +23,8 @@
 //! (rewritten at every frame, so that a stopped run leaves valid series). Files are
 //! written with `vtkio`.
 
-use crate::dd::DdView;
 use super::Writer;
+use crate::dd::DdView;
 use crate::dim::{Coords, Dim, Vector};
 use crate::shape::Glyph;
 use crate::world::World;
@@ -38,7 +38,14 @@ pub struct VtkWriter {
     pub(crate) frames: Vec<(f64, u32)>,
 }
 
-fn piece(points: Vec<f64>, verts: Option<VertexNumbers>, lines: Option<VertexNumbers>, polys: Option<VertexNumbers>, point: Vec<Attribute>, cell: Vec<Attribute>) -> Vtk {
+fn piece(
+    points: Vec<f64>,
+    verts: Option<VertexNumbers>,
+    lines: Option<VertexNumbers>,
+    polys: Option<VertexNumbers>,
+    point: Vec<Attribute>,
+    cell: Vec<Attribute>,
+) -> Vtk {
     Vtk {
         version: Version::new(),
         title: "nscdd".into(),

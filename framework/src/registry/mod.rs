@@ -24,9 +24,9 @@ use crate::dim::{Dim, D2, D3};
 use crate::law::LawDef;
 pub mod builder;
 
-use builder::SceneBuilder;
 pub use crate::output::Writer;
 pub use crate::shape::*;
+use builder::SceneBuilder;
 use std::any::Any;
 use std::collections::BTreeMap;
 use std::sync::Arc;

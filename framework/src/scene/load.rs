@@ -10,8 +10,8 @@ use crate::detect::{Detector, DetectorTable};
 use crate::dim::{Coords, Vector};
 use crate::drive::BodyDrive;
 use crate::error::InputError;
-use crate::registry::{ParamError, Registry};
 use crate::model::ShapeRef;
+use crate::registry::{ParamError, Registry};
 use crate::world::{BoxWalls, World};
 
 /// The scene of a parsed file of dimension `D`.
@@ -116,10 +116,7 @@ fn gravity<D: SceneDim>(cx: &Ctx, sf: &SceneFile<BodySpec<D>>) -> Result<D::Poin
     match sf.gravity.as_deref() {
         None => Ok(D::Point::from_fn(|a| if a + 1 == D::N { -9.81 } else { 0.0 })),
         Some(g) if g.len() == D::N && g.iter().all(|x| x.is_finite()) => Ok(D::Point::from_fn(|a| g[a])),
-        Some(_) => Err(cx.err(
-            &[k("gravity")],
-            format!("gravity must be {} finite numbers in {}", D::N, D::NAME),
-        )),
+        Some(_) => Err(cx.err(&[k("gravity")], format!("gravity must be {} finite numbers in {}", D::N, D::NAME))),
     }
 }
 
@@ -169,14 +166,22 @@ fn box_walls<D: SceneDim>(cx: &Ctx, sf: &SceneFile<BodySpec<D>>, names: &[Option
     Ok(Some(BoxWalls { walls, strain_from }))
 }
 
-fn add_bodies<D: SceneDim>(cx: &Ctx, sf: &SceneFile<BodySpec<D>>, b: &mut SceneBuilder<D>, drives: &mut Vec<BodyDrive>) -> Result<(), InputError> {
+fn add_bodies<D: SceneDim>(
+    cx: &Ctx,
+    sf: &SceneFile<BodySpec<D>>,
+    b: &mut SceneBuilder<D>,
+    drives: &mut Vec<BodyDrive>,
+) -> Result<(), InputError> {
     for (i, spec) in sf.bodies.iter().enumerate() {
         let base = [k("bodies"), Seg::Index(i)];
         let p = |key: &str| at(&base, &[k(key)]);
         b.origin = Origin::Body(i);
         let kind = b.kind(&spec.shape).ok_or_else(|| {
             let installed = b.registry.shape_kinds::<D>().join(", ");
-            cx.err(&p("shape"), format!("unknown {} shape `{}`; installed: {installed}", D::NAME, spec.shape))
+            cx.err(
+                &p("shape"),
+                format!("unknown {} shape `{}`; installed: {installed}", D::NAME, spec.shape),
+            )
         })?;
         let material = b.material(&spec.material).ok_or_else(|| {
             cx.err(
@@ -187,7 +192,12 @@ fn add_bodies<D: SceneDim>(cx: &Ctx, sf: &SceneFile<BodySpec<D>>, b: &mut SceneB
         let index = b.shapes[kind as usize]
             .push_params(&spec.params)
             .map_err(|e| cx.err(&p(&e.key), e.msg))?;
-        let values = spec.position.as_ref().iter().chain(spec.velocity.as_ref()).chain(spec.rotation.coords());
+        let values = spec
+            .position
+            .as_ref()
+            .iter()
+            .chain(spec.velocity.as_ref())
+            .chain(spec.rotation.coords());
         if values.clone().any(|x| !x.is_finite()) {
             return Err(cx.err(&p("position"), "position, rotation and velocity must be finite"));
         }
@@ -215,7 +225,8 @@ fn add_bodies<D: SceneDim>(cx: &Ctx, sf: &SceneFile<BodySpec<D>>, b: &mut SceneB
             let mut dof: [Option<crate::drive::DofDrive>; 6] = Default::default();
             for (slot, dd) in D::drives(d).into_iter().enumerate() {
                 if let Some(dd) = dd {
-                    dd.validate().map_err(|m| cx.err(&at(&base, &[k("drive"), k(D::DOF_NAMES[slot])]), m))?;
+                    dd.validate()
+                        .map_err(|m| cx.err(&at(&base, &[k("drive"), k(D::DOF_NAMES[slot])]), m))?;
                     dof[slot] = Some(dd.clone());
                 }
             }

@@ -207,7 +207,12 @@ impl SceneDim for D2 {
     }
     fn box_walls(o: &OutputSpec) -> Option<(Vec<(&'static str, &str)>, f64)> {
         let b = o.box_walls.as_ref()?;
-        let names = vec![("left", b.left.as_str()), ("right", &b.right), ("bottom", &b.bottom), ("top", &b.top)];
+        let names = vec![
+            ("left", b.left.as_str()),
+            ("right", &b.right),
+            ("bottom", &b.bottom),
+            ("top", &b.top),
+        ];
         Some((names, b.strain_from))
     }
 }

@@ -7,10 +7,10 @@ use crate::detect::{Detector, DetectorTable};
 use crate::dim::{Dim, Vector, D2, D3};
 use crate::drive::BodyDrive;
 use crate::law::{Law, LawBatches};
-use std::sync::Arc;
 use crate::model::{Bodies, ContactKey, Contacts};
 use crate::shape::{Aabb, RawContact, ShapeStore};
 use crate::solver::SolverSettings;
+use std::sync::Arc;
 
 /// A material: its name and density (kg/m³; per unit depth in 2D).
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]

@@ -24,10 +24,10 @@
 use crate::contact2::*;
 use crate::stage2::{self, Deformables2};
 use nscdd::dim::coulomb2 as coulomb;
-use nscdd::engine::ContactStage;
-use nscdd::norms::{Norms, Sums};
 use nscdd::dim::d2::Block2;
+use nscdd::engine::ContactStage;
 use nscdd::model::Contacts2;
+use nscdd::norms::{Norms, Sums};
 use nscdd::solver::SolveReport;
 use nscdd::world::World2;
 

@@ -13,11 +13,11 @@ use crate::body::FeBody;
 use crate::contact2::*;
 pub use crate::nodes::fill_set;
 use nscdd::dim::coulomb2 as coulomb;
+use nscdd::dim::d2::Block2;
 use nscdd::engine::{ContactStage, Diverged};
 use nscdd::law::{Law, LawInput, LawOutput, LawStep};
-use nscdd::norms::{natural_map_sq, Sums};
-use nscdd::dim::d2::Block2;
 use nscdd::model::Target;
+use nscdd::norms::{natural_map_sq, Sums};
 use nscdd::solver::nlgs;
 use nscdd::solver::SolveReport;
 use nscdd::world::World2;
@@ -328,7 +328,14 @@ pub fn law_output(law: &dyn Law, gap: f64, un_begin: f64, un_free: f64, (h, thet
         area: 0.0,
         was_bonded: None,
     };
-    law.contact(&LawStep { h, theta, first: step == 0 }, &input)
+    law.contact(
+        &LawStep {
+            h,
+            theta,
+            first: step == 0,
+        },
+        &input,
+    )
 }
 
 /// u_α of a deformable contact from the current velocities.

@@ -184,8 +184,14 @@ fn unsupported_settings_are_refused() {
         ("[decomposition]\nnx = 2", "decomposition"),
         ("[decomposition]\nby_model = true\nthreads = 2", "decomposition.threads"),
         ("[decomposition]\nby_model = true\nscheme = \"centralized\"", "decomposition.scheme"),
-        ("[decomposition]\nby_model = true\nsweeps_per_gluing = 3", "decomposition.sweeps_per_gluing"),
-        ("[decomposition]\nby_model = true\nrepartition_every = 5", "decomposition.repartition_every"),
+        (
+            "[decomposition]\nby_model = true\nsweeps_per_gluing = 3",
+            "decomposition.sweeps_per_gluing",
+        ),
+        (
+            "[decomposition]\nby_model = true\nrepartition_every = 5",
+            "decomposition.repartition_every",
+        ),
         ("[output]\ncheckpoint_every = 10", "output.checkpoint_every"),
     ];
     for (extra, key) in cases {

@@ -9,8 +9,8 @@
 //!    mean time per step of each stage.
 //!
 //!     cargo run --release -p nscdd-polyhedra --example bench_poly [steps] [courses] [bricks]
-use nscdd::registry::RawContact3;
 use nscdd::dim::rotation::from_rotation_vector;
+use nscdd::registry::RawContact3;
 use nscdd_polyhedra::detect::{poly_poly, PolyScratch};
 use nscdd_polyhedra::generate::box_points;
 use nscdd_polyhedra::shapes::Poly;

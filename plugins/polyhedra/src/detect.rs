@@ -30,9 +30,9 @@
 pub use crate::detect_plane_sphere::{closest_surface, PolyPlane, PolySphere};
 use crate::hull::{cross, dot, norm, sub};
 use crate::shapes::{unit, Poly, Polyhedra};
+use nscdd::dim::rotation::rotate;
 use nscdd::dim::D3;
 use nscdd::registry::{DetectCtx, PairDetector, RawContact3};
-use nscdd::dim::rotation::rotate;
 
 pub(crate) fn polys<'a>(ctx: &'a DetectCtx<'_, D3>, first: bool) -> &'a Polyhedra {
     let s = if first { ctx.a } else { ctx.b };

@@ -10,9 +10,9 @@
 use crate::detect::{polygon_area, polys};
 use crate::hull::{dot, norm, sub};
 use crate::shapes::{unit, Poly};
+use nscdd::dim::rotation::rotate;
 use nscdd::dim::D3;
 use nscdd::registry::{DetectCtx, PairDetector, RawContact3};
-use nscdd::dim::rotation::rotate;
 use nscdd_spheres::shapes::{closest_on_triangle, Spheres};
 
 /// Polyhedron–plane: each vertex within alert of the plane (normal: the plane's z

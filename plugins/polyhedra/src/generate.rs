@@ -4,10 +4,10 @@
 use crate::shapes::Polyhedra;
 use nscdd::dim::D3;
 use nscdd::drive::{DofDrive, Phase, Shape, TimeFn};
+use nscdd::model::ShapeRef;
 use nscdd::params::{array, boolean, count, number, only_keys, positive};
 use nscdd::registry::Generator;
 use nscdd::registry::ParamError;
-use nscdd::model::ShapeRef;
 use nscdd::scene::builder::SceneBuilder3;
 
 /// The 8 corners of a box [lo, hi].

@@ -3,11 +3,11 @@
 //! normals and edges for detection.
 
 use crate::hull::{hull, moments, norm, principal, quat_of, sub, Hull};
+use nscdd::dim::rotation::rotate;
 use nscdd::dim::D3;
 use nscdd::params::only_keys;
 use nscdd::registry::ParamError;
 use nscdd::registry::{Aabb3, Glyph3, MassProps3, PointContact3, ShapeStore};
-use nscdd::dim::rotation::rotate;
 use std::any::Any;
 
 /// One convex polyhedron in its principal frame.

@@ -3,8 +3,8 @@
 //! and in shear (a flat block on a tilted base: c A + μ N against the downhill pull);
 //! bonds are made at the first step only and survive a restart.
 use nscdd::output::final_json;
-use nscdd::scene::Scene3;
 use nscdd::scene::restart::restart_str;
+use nscdd::scene::Scene3;
 use nscdd::world::World3;
 use nscdd_polyhedra::generate::box_points;
 

@@ -4,9 +4,9 @@
 
 use crate::shapes::Disks;
 use nscdd::dim::D2;
+use nscdd::model::ShapeRef;
 use nscdd::params::{array, count, number, only_keys, positive};
 use nscdd::registry::{Generator, ParamError};
-use nscdd::model::ShapeRef;
 use nscdd::scene::builder::SceneBuilder2;
 use rand::{RngExt, SeedableRng};
 

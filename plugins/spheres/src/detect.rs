@@ -3,10 +3,10 @@
 //! second body) towards the candidate sphere.
 
 use crate::shapes::{Boxes, Planes, Spheres};
-use nscdd::dim::D3;
-use nscdd::registry::{DetectCtx, PairDetector, RawContact3};
 use nscdd::dim::d3::dot;
 use nscdd::dim::rotation::{rotate, rotate_inv};
+use nscdd::dim::D3;
+use nscdd::registry::{DetectCtx, PairDetector, RawContact3};
 
 fn spheres<'a>(ctx: &'a DetectCtx<'_, D3>, first: bool) -> &'a Spheres {
     let s = if first { ctx.a } else { ctx.b };

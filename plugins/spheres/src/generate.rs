@@ -4,10 +4,10 @@
 
 use crate::shapes::Spheres;
 use nscdd::dim::D3;
+use nscdd::model::ShapeRef;
 use nscdd::params::{array, count, only_keys, positive};
 use nscdd::registry::Generator;
 use nscdd::registry::ParamError;
-use nscdd::model::ShapeRef;
 use nscdd::scene::builder::SceneBuilder3;
 use rand::{RngExt, SeedableRng};
 

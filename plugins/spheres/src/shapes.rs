@@ -1,10 +1,10 @@
 //! Shape stores: spheres, planes (half-spaces) and boxes (rectangular cuboids).
 
+use nscdd::dim::rotation::{rotate, rotate_inv};
 use nscdd::dim::D3;
 use nscdd::params::{array, only_keys, positive};
 use nscdd::registry::ParamError;
 use nscdd::registry::{Aabb3, FaceContact3, Glyph3, MassProps3, PointContact3, ShapeStore};
-use nscdd::dim::rotation::{rotate, rotate_inv};
 use std::any::Any;
 use std::f64::consts::PI;
 

@@ -101,6 +101,8 @@ fn a_plugin_law_keeps_its_standoff_gap() {
     assert!((gap - delta).abs() <= bound, "rest gap {gap} vs δ = {delta} ± {bound}");
     assert!(b.vel[1][1].abs() < 1e-9, "vertical velocity {}", b.vel[1][1]);
     // a standoff law given a negative gap is refused at load time, naming the key
-    let err = nscdd::scene::load_str(&SCENE.replace("GAP", "-1.0"), "standoff.toml", &reg).err().expect("refused");
+    let err = nscdd::scene::load_str(&SCENE.replace("GAP", "-1.0"), "standoff.toml", &reg)
+        .err()
+        .expect("refused");
     assert_eq!(err.key, "laws[0].gap", "{err}");
 }
