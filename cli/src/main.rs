@@ -22,6 +22,10 @@ use std::process::ExitCode;
 struct Cli {
     #[command(subcommand)]
     cmd: Cmd,
+    /// Memory a scene may use (e.g. 8G, 500M; default: the memory available on this
+    /// machine): a generator asked for more bodies is refused before it allocates.
+    #[arg(long, global = true)]
+    max_memory: Option<String>,
 }
 
 #[derive(Subcommand)]
@@ -218,6 +222,12 @@ fn main() -> ExitCode {
     let mut reg = nscdd_rigid_disks::registry();
     reg.add_plugin(&nscdd_spheres::SpheresPlugin);
     reg.add_plugin(&nscdd_polyhedra::PolyhedraPlugin);
+    if let Some(m) = &cli.max_memory {
+        match nscdd::registry::limits::parse_size(m) {
+            Ok(bytes) => reg.set_max_memory(bytes),
+            Err(e) => return input_error(e),
+        }
+    }
     #[cfg(feature = "fem")]
     if let Some(code) = fem_dispatch(&cli.cmd, &reg) {
         return code;

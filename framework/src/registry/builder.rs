@@ -102,6 +102,33 @@ impl<'r, D: Dim> SceneBuilder<'r, D> {
     /// inertia come from the shape and the material's density. A shape not given
     /// in its principal frame is moved so that the body's position is its centre
     /// of mass ([`ShapeStore::principal_frame`]).
+    /// Checks, before a generator allocates, that `count` more bodies and `extra`
+    /// bytes of the generator's own working memory fit in the memory limit
+    /// ([`super::limits`]); the error names `key` with the estimate. Generators call
+    /// it with their counts (and grids) before building anything.
+    pub fn reserve(&self, key: &str, count: f64, extra: f64) -> Result<(), ParamError> {
+        let per = super::limits::bytes_per_body::<D>();
+        let need = (self.bodies.len() as f64 + count.max(0.0)) * per + extra.max(0.0);
+        let (limit, what) = super::limits::memory_limit(self.registry.max_memory());
+        if need.is_finite() && need <= limit && count <= u32::MAX as f64 / 2.0 {
+            return Ok(());
+        }
+        Err(ParamError::new(
+            key,
+            format!(
+                "needs ≈ {} ({}), more than {} ({}); make the sample smaller",
+                super::limits::human(need),
+                match (count > 0.0, extra > count * per) {
+                    (false, _) => "the generator's grid".to_string(),
+                    (true, false) => format!("{count} bodies"),
+                    (true, true) => format!("{count} bodies and the generator's grid"),
+                },
+                super::limits::human(limit),
+                what
+            ),
+        ))
+    }
+
     pub fn add_body(&mut self, shape: ShapeRef, material: u16, pos: D::Point, rot: D::RotVec, vel: D::Twist) -> u32 {
         let store = &self.shapes[shape.kind as usize];
         let mp = store.mass_properties(shape.index, self.materials[material as usize].density);

@@ -23,6 +23,7 @@
 use crate::dim::{Dim, D2, D3};
 use crate::law::LawDef;
 pub mod builder;
+pub mod limits;
 
 pub use crate::output::Writer;
 pub use crate::shape::*;
@@ -69,6 +70,8 @@ pub struct Registry {
     pub(crate) laws: BTreeMap<&'static str, LawDef>,
     t2: Tables<D2>,
     t3: Tables<D3>,
+    /// Memory a scene may use (bytes); `None`: the machine's available memory.
+    max_memory: Option<f64>,
 }
 
 impl Registry {
@@ -81,6 +84,14 @@ impl Registry {
         r.add_writer::<D2>("vtk", || Box::<crate::output::vtk::VtkWriter>::default());
         r.add_writer::<D3>("vtk", || Box::<crate::output::vtk::VtkWriter>::default());
         r
+    }
+    /// The memory a scene may use (bytes), checked by generators before they
+    /// allocate ([`limits`]); by default the machine's available memory.
+    pub fn set_max_memory(&mut self, bytes: f64) {
+        self.max_memory = Some(bytes);
+    }
+    pub fn max_memory(&self) -> Option<f64> {
+        self.max_memory
     }
     pub fn add_plugin(&mut self, p: &dyn Plugin) -> &mut Self {
         self.plugins.push(p.name());

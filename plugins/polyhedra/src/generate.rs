@@ -53,6 +53,7 @@ impl Generator<D3> for BrickWall {
             return Err(ParamError::new("brick", "3 positive sizes [L, W, H]"));
         }
         let (courses, n) = (count(p, "courses", None)?, count(p, "bricks", None)?);
+        out.reserve("courses", courses as f64 * (n as f64 + 1.0), 0.0)?;
         let o = array::<3>(p, "origin", Some([0.0; 3]))?;
         if p.contains_key("base_material") {
             let bm = out.material_param(p, "base_material")?;
@@ -116,6 +117,7 @@ impl Generator<D3> for Arch {
         }
         let d = positive(p, "depth", Some(t))?;
         let n = count(p, "voussoirs", None)?;
+        out.reserve("voussoirs", n as f64, 0.0)?;
         let o = array::<3>(p, "origin", Some([0.0; 3]))?;
         let (ri, re) = (r - 0.5 * t, r + 0.5 * t);
         for k in 0..n {

@@ -123,6 +123,10 @@ pub fn hull(points: &[[f64; 3]]) -> Result<Hull, String> {
             })
             .map(|q| on[q])
             .collect();
+        if keep.len() < 3 {
+            // round-off: points too close to a plane for their distance to the origin
+            return Err("the polyhedron is too flat for its size and position (a face lost its area to round-off)".into());
+        }
         for &v in &keep {
             used[v] = true;
         }

@@ -42,6 +42,11 @@ impl Poly {
     pub fn from_points(points: &[[f64; 3]]) -> Result<(Poly, [f64; 3], [f64; 4]), String> {
         let h = hull(points)?;
         let (volume, c, second) = moments(&h);
+        if !(volume > 0.0 && volume.is_finite()) {
+            return Err(format!(
+                "the polyhedron has no volume ({volume}): its vertices are (nearly) coplanar"
+            ));
+        }
         let (inertia, r) = principal(&second);
         // coordinates in the principal frame: Rᵀ (x − c)
         let to_local = |p: [f64; 3]| {

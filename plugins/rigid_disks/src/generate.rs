@@ -158,10 +158,15 @@ impl Generator<D2> for DiskDeposit {
             ));
         }
         let seed = count(p, "seed", Some(0))?;
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-        let kind = out.kind(Disks::KIND).expect("plugin shape");
         let cw = 2.0 * rmax;
-        let ncol = ((x1 - x0) / cw).ceil() as usize + 1;
+        let ncol = ((x1 - x0) / cw).ceil() + 1.0;
+        out.reserve("count", n as f64, 0.0)?;
+        out.reserve("box", 0.0, ncol * std::mem::size_of::<Vec<usize>>() as f64)?;
+        let ncol = ncol as usize;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let Some(kind) = out.kind(Disks::KIND) else {
+            return Err(ParamError::new("kind", "the disk shape kind is not installed"));
+        };
         let mut dep = Deposit {
             x0,
             y0,
@@ -197,6 +202,7 @@ fn lattice(p: &toml::Table, out: &mut SceneBuilder2<'_>, triangular: bool) -> Re
     only_keys(p, &["material", "nx", "ny", "radius", "spacing", "origin"])?;
     let material = out.material_param(p, "material")?;
     let (nx, ny) = (count(p, "nx", None)?, count(p, "ny", None)?);
+    out.reserve("nx", nx as f64 * ny as f64, 0.0)?;
     let r = positive(p, "radius", None)?;
     let s = number(p, "spacing", Some(2.0 * r))?;
     if s < 2.0 * r * (1.0 - 1e-12) {

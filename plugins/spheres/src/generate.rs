@@ -80,13 +80,17 @@ impl Generator<D3> for SpherePacking {
             }
             _ => return Err(ParamError::new("box", "give exactly one of `box` or `cylinder`")),
         };
+        // a grid of cells of size 2 rmax: a sphere's neighbours lie in the 27 cells around it
+        let cell = 2.0 * rmax;
+        let dims: [f64; 3] = std::array::from_fn(|k| ((hi[k] - lo[k]) / cell).ceil().max(1.0));
+        out.reserve("count", n as f64, 0.0)?;
+        let region = if p.contains_key("box") { "box" } else { "cylinder" };
+        out.reserve(region, 0.0, dims.iter().product::<f64>() * std::mem::size_of::<Vec<u32>>() as f64)?;
+        let dims = dims.map(|d| d as usize);
         let kind = out.kind(Spheres::KIND).expect("the plugin registers spheres");
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         let mut radii: Vec<f64> = (0..n).map(|_| rmin + (rmax - rmin) * rng.random::<f64>()).collect();
         radii.sort_by(|a, b| b.total_cmp(a));
-        // a grid of cells of size 2 rmax: a sphere's neighbours lie in the 27 cells around it
-        let cell = 2.0 * rmax;
-        let dims: [usize; 3] = std::array::from_fn(|k| (((hi[k] - lo[k]) / cell).ceil() as usize).max(1));
         let cidx = |x: [f64; 3]| -> [usize; 3] { std::array::from_fn(|k| (((x[k] - lo[k]) / cell) as usize).min(dims[k] - 1)) };
         let mut grid: Vec<Vec<u32>> = vec![Vec::new(); dims[0] * dims[1] * dims[2]];
         let mut placed: Vec<([f64; 3], f64)> = Vec::with_capacity(n);
@@ -147,6 +151,7 @@ impl Generator<D3> for SphereLattice {
         only_keys(p, &["kind", "material", "nx", "ny", "nz", "radius", "spacing", "origin"])?;
         let material = out.material_param(p, "material")?;
         let (nx, ny, nz) = (count(p, "nx", None)?, count(p, "ny", Some(1))?, count(p, "nz", Some(1))?);
+        out.reserve("nx", nx as f64 * ny as f64 * nz as f64, 0.0)?;
         let r = positive(p, "radius", None)?;
         let s = positive(p, "spacing", Some(2.0 * r))?;
         let o = array::<3>(p, "origin", Some([0.0; 3]))?;

@@ -1,0 +1,105 @@
+//! Scenes that crashed, aborted or hung `nscdd check` in a mutation campaign (issue
+//! 17), each the example scene with one line changed: now exit 2 with one message
+//! naming the file, the line and the key, before anything large is allocated.
+
+mod common;
+use common::*;
+
+/// `examples/scenes/NAME` with `from` replaced by `to` (once), checked.
+fn check_mutant(name: &str, from: &str, to: &str, extra: &[&str]) -> (Option<i32>, String) {
+    static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let k = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir = scratch(&format!("limits-{k}-{}", name.replace('.', "_")));
+    let text = std::fs::read_to_string(format!("{}/../examples/scenes/{name}", env!("CARGO_MANIFEST_DIR"))).unwrap();
+    assert!(text.contains(from), "{name}: `{from}` not found");
+    let path = dir.join(name);
+    std::fs::write(&path, text.replacen(from, to, 1)).unwrap();
+    let mut args: Vec<&std::ffi::OsStr> = vec!["check".as_ref(), path.as_os_str()];
+    args.extend(extra.iter().map(|a| std::ffi::OsStr::new(a)));
+    let o = nscdd(&args);
+    (o.status.code(), String::from_utf8_lossy(&o.stderr).into_owned())
+}
+
+#[track_caller]
+fn refused(name: &str, from: &str, to: &str, key: &str, said: &str) {
+    // a fixed limit: the same outcome on any machine
+    let (code, err) = check_mutant(name, from, to, &["--max-memory", "16G"]);
+    assert_eq!(code, Some(2), "{name} with `{to}`: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(err.contains(&format!("key `{key}`")), "{name} with `{to}`: {err}");
+    assert!(err.contains(said), "{name} with `{to}`: {err}");
+    assert_eq!(err.lines().count(), 1, "one message: {err}");
+}
+
+#[test]
+fn huge_counts_are_refused_with_the_estimate() {
+    // each hung for minutes (allocating and placing 10⁸ bodies)
+    refused(
+        "aqueduct.toml",
+        "voussoirs = 16",
+        "voussoirs = 100000000",
+        "generate[6].voussoirs",
+        "needs ≈",
+    );
+    refused(
+        "triaxial3d.toml",
+        "count = 1000",
+        "count = 100000000",
+        "generate[0].count",
+        "needs ≈",
+    );
+    refused("wall.toml", "courses = 10", "courses = 100000000", "generate[0].courses", "needs ≈");
+    refused("deposit.toml", "count = 1000", "count = 1000000000000", "generate[0].count", "PB");
+}
+
+#[test]
+fn huge_boxes_are_refused_before_their_grids() {
+    // a range panic (cols.len() overflowed to 0), an abort on a 1 TB allocation,
+    // and a capacity overflow, in the generators' neighbour grids
+    refused(
+        "deposit.toml",
+        "box = [0.0, 0.0, 1.0, 1.2]",
+        "box = [0.0, 0.0, 1e308, 1.2]",
+        "generate[0].box",
+        "grid",
+    );
+    refused(
+        "deposit.toml",
+        "box = [0.0, 0.0, 1.0, 1.2]",
+        "box = [0.0, 0.0, 1e9, 1.2]",
+        "generate[0].box",
+        "grid",
+    );
+    refused(
+        "triaxial3d.toml",
+        "box = [0.0, 0.0, 0.0, 0.13, 0.13, 0.13]",
+        "box = [0.0, -1e308, 0.0, 0.13, 0.13, 0.13]",
+        "generate[0].box",
+        "grid",
+    );
+}
+
+#[test]
+fn a_polyhedron_flattened_by_round_off_is_an_input_error() {
+    // an arch 10⁹ m from the origin: its faces lost their area (index out of bounds
+    // in hull.rs)
+    refused(
+        "aqueduct.toml",
+        "origin = [2.6, 0.0, 2.5]",
+        "origin = [1e9, 0.0, 2.5]",
+        "generate[7].kind",
+        "too flat",
+    );
+}
+
+#[test]
+fn max_memory_sets_the_limit() {
+    let (code, err) = check_mutant("deposit.toml", "count = 1000", "count = 1000", &["--max-memory", "1M"]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("--max-memory"), "{err}");
+    let (code, err) = check_mutant("deposit.toml", "count = 1000", "count = 1000", &["--max-memory", "1G"]);
+    assert_eq!(code, Some(0), "{err}");
+    let (code, err) = check_mutant("deposit.toml", "count = 1000", "count = 1000", &["--max-memory", "lots"]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("--max-memory"), "{err}");
+}
