@@ -10,12 +10,12 @@
 //! rather than to budget a run to the byte.
 //!
 //! ```
-//! let reg = nscdd::registry::Registry::new();
-//! let mut b = nscdd::registry::builder::SceneBuilder2::new(&reg, vec![]);
-//! assert!(b.reserve("count", 1e3, 0.0).is_ok());
-//! let e = b.reserve("count", 1e15, 0.0).unwrap_err();
-//! assert_eq!(e.key, "count");
-//! assert!(e.msg.contains("needs ≈"), "{}", e.msg);
+//! use nscdd::registry::limits::{bytes_per_body, human, parse_size};
+//! assert_eq!(parse_size("8G").unwrap(), 8.0 * 1024f64.powi(3));
+//! // what 10¹² spheres would need: refused by `SceneBuilder::reserve`
+//! let need = 1e12 * bytes_per_body::<nscdd::dim::D3>();
+//! assert!(human(need).ends_with("PB"), "{}", human(need));
+//! ```
 //! ```
 
 use crate::dim::Dim;
