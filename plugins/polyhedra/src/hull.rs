@@ -61,37 +61,7 @@ pub fn hull(points: &[[f64; 3]]) -> Result<Hull, String> {
         }
     }
     let n = pts.len();
-    let mut planes: Vec<([f64; 3], f64)> = vec![];
-    for i in 0..n {
-        for j in i + 1..n {
-            for k in j + 1..n {
-                let c = cross(sub(pts[j], pts[i]), sub(pts[k], pts[i]));
-                let l = norm(c);
-                if l <= eps * size {
-                    continue;
-                }
-                let nrm = [c[0] / l, c[1] / l, c[2] / l];
-                let d = dot(nrm, pts[i]);
-                let (mut above, mut below) = (false, false);
-                for p in &pts {
-                    let s = dot(nrm, *p) - d;
-                    above |= s > eps;
-                    below |= s < -eps;
-                }
-                let plane = match (above, below) {
-                    (false, _) => (nrm, d),
-                    (true, false) => ([-nrm[0], -nrm[1], -nrm[2]], -d),
-                    _ => continue,
-                };
-                if planes
-                    .iter()
-                    .all(|(m, e)| norm(sub(*m, plane.0)) > 1e-9 || (e - plane.1).abs() > eps)
-                {
-                    planes.push(plane);
-                }
-            }
-        }
-    }
+    let planes = support_planes(&pts, eps, size);
     if planes.len() < 4 {
         return Err("the vertices are coplanar: a polyhedron needs volume".into());
     }
@@ -147,6 +117,44 @@ pub fn hull(points: &[[f64; 3]]) -> Result<Hull, String> {
         .map(|f: Vec<usize>| f.into_iter().map(|v| map[v]).collect())
         .collect();
     Ok(Hull { vertices, faces, normals })
+}
+
+/// The distinct planes through three of `pts` that leave every point on one side
+/// (outward normal, offset): the hull's face planes.
+fn support_planes(pts: &[[f64; 3]], eps: f64, size: f64) -> Vec<([f64; 3], f64)> {
+    let n = pts.len();
+    let mut planes: Vec<([f64; 3], f64)> = vec![];
+    for i in 0..n {
+        for j in i + 1..n {
+            for k in j + 1..n {
+                let c = cross(sub(pts[j], pts[i]), sub(pts[k], pts[i]));
+                let l = norm(c);
+                if l <= eps * size {
+                    continue;
+                }
+                let nrm = [c[0] / l, c[1] / l, c[2] / l];
+                let d = dot(nrm, pts[i]);
+                let (mut above, mut below) = (false, false);
+                for p in pts {
+                    let s = dot(nrm, *p) - d;
+                    above |= s > eps;
+                    below |= s < -eps;
+                }
+                let plane = match (above, below) {
+                    (false, _) => (nrm, d),
+                    (true, false) => ([-nrm[0], -nrm[1], -nrm[2]], -d),
+                    _ => continue,
+                };
+                if planes
+                    .iter()
+                    .all(|(m, e)| norm(sub(*m, plane.0)) > 1e-9 || (e - plane.1).abs() > eps)
+                {
+                    planes.push(plane);
+                }
+            }
+        }
+    }
+    planes
 }
 
 /// Volume, centroid and the second moment C = ∫ (x − c)(x − c)ᵀ dV of a hull.

@@ -53,33 +53,7 @@ impl Generator<D3> for SpherePacking {
         let seed = count(p, "seed", Some(0))?;
         let attempts = count(p, "attempts", Some(1000))?.max(1);
         // the region: bounding box and an inside test for a sphere of radius r
-        let (lo, hi, cyl) = match (p.get("box"), p.get("cylinder")) {
-            (Some(_), None) => {
-                let b = array::<6>(p, "box", None)?;
-                if !(b[3] > b[0] && b[4] > b[1] && b[5] > b[2]) {
-                    return Err(ParamError::new(
-                        "box",
-                        "expected [x0, y0, z0, x1, y1, z1] with x1 > x0, y1 > y0, z1 > z0",
-                    ));
-                }
-                ([b[0], b[1], b[2]], [b[3], b[4], b[5]], None)
-            }
-            (None, Some(_)) => {
-                let c = array::<5>(p, "cylinder", None)?;
-                if !(c[2] > 0.0 && c[4] > c[3]) {
-                    return Err(ParamError::new(
-                        "cylinder",
-                        "expected [cx, cy, radius, z0, z1] with radius > 0 and z1 > z0",
-                    ));
-                }
-                (
-                    [c[0] - c[2], c[1] - c[2], c[3]],
-                    [c[0] + c[2], c[1] + c[2], c[4]],
-                    Some((c[0], c[1], c[2])),
-                )
-            }
-            _ => return Err(ParamError::new("box", "give exactly one of `box` or `cylinder`")),
-        };
+        let (lo, hi, cyl) = region(p)?;
         // a grid of cells of size 2 rmax: a sphere's neighbours lie in the 27 cells around it
         let cell = 2.0 * rmax;
         let dims: [f64; 3] = std::array::from_fn(|k| ((hi[k] - lo[k]) / cell).ceil().max(1.0));
@@ -140,6 +114,38 @@ impl Generator<D3> for SpherePacking {
         }
         Ok(())
     }
+}
+
+/// The region of a packing: its bounding box and, for a cylinder, (cx, cy, radius).
+#[allow(clippy::type_complexity)]
+fn region(p: &toml::Table) -> Result<([f64; 3], [f64; 3], Option<(f64, f64, f64)>), ParamError> {
+    Ok(match (p.get("box"), p.get("cylinder")) {
+        (Some(_), None) => {
+            let b = array::<6>(p, "box", None)?;
+            if !(b[3] > b[0] && b[4] > b[1] && b[5] > b[2]) {
+                return Err(ParamError::new(
+                    "box",
+                    "expected [x0, y0, z0, x1, y1, z1] with x1 > x0, y1 > y0, z1 > z0",
+                ));
+            }
+            ([b[0], b[1], b[2]], [b[3], b[4], b[5]], None)
+        }
+        (None, Some(_)) => {
+            let c = array::<5>(p, "cylinder", None)?;
+            if !(c[2] > 0.0 && c[4] > c[3]) {
+                return Err(ParamError::new(
+                    "cylinder",
+                    "expected [cx, cy, radius, z0, z1] with radius > 0 and z1 > z0",
+                ));
+            }
+            (
+                [c[0] - c[2], c[1] - c[2], c[3]],
+                [c[0] + c[2], c[1] + c[2], c[4]],
+                Some((c[0], c[1], c[2])),
+            )
+        }
+        _ => return Err(ParamError::new("box", "give exactly one of `box` or `cylinder`")),
+    })
 }
 
 /// `sphere_lattice`: `nx × ny × nz` spheres of `radius` on a cubic lattice of
