@@ -1,15 +1,19 @@
 #!/usr/bin/env python3
 """Mutation campaign over the example scenes (issue 17).
 
-Usage: python3 scripts/mutate_scenes.py BIN N [SEED]
+Usage: python3 scripts/mutate_scenes.py BIN N [SEED] [--run]
 
 Each mutant is an example scene (deformable ones left out) with 1 to 3 edits: a
 number set to 0, -1, ±1e308, nan, inf, 1e12, ...; a line deleted or duplicated;
 the file truncated. `BIN check MUTANT` must exit 0 or 2 within 5 s: a panic, an
 abort (another exit code) or a hang is written to target/mutants/ and printed.
+With `--run`, a mutant that `check` accepts is also run for 20 steps
+(`nscdd run --quiet`), which must exit 0, 1 (a reported divergence) or 2 within 20 s.
 """
 import random, re, subprocess, sys, pathlib, os
-BIN = sys.argv[1]; N = int(sys.argv[2]); seed = int(sys.argv[3]) if len(sys.argv) > 3 else 1
+RUN = '--run' in sys.argv
+args = [a for a in sys.argv[1:] if a != '--run']
+BIN = args[0]; N = int(args[1]); seed = int(args[2]) if len(args) > 2 else 1
 random.seed(seed)
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 scenes = [p for p in (ROOT / 'examples/scenes').glob('*.toml') if '[[deformable]]' not in p.read_text()]
@@ -44,6 +48,17 @@ for k in range(N):
         kind = None
         if 'panicked' in r.stderr: kind = 'panic'
         elif r.returncode not in (0, 2): kind = f'rc{r.returncode}'
+        elif RUN and r.returncode == 0:
+            short = re.sub(r'(?m)^(steps|duration) = .*$', 'steps = 20', text)
+            f.write_text(short)
+            outdir = f'/tmp/fuzz_out_{os.getpid()}'
+            try:
+                r = subprocess.run([BIN, 'run', str(f), '--quiet', '--out', outdir], capture_output=True, text=True, timeout=20, cwd=str(p.parent))
+                if 'panicked' in r.stderr: kind = 'run-panic'
+                elif r.returncode not in (0, 1, 2): kind = f'run-rc{r.returncode}'
+            except subprocess.TimeoutExpired:
+                kind = 'run-hang'; r = None
+            text = short
     except subprocess.TimeoutExpired:
         kind = 'hang'; r = None
     if kind:
