@@ -259,7 +259,11 @@ fn loaded_pile_velocities_match_one_domain_and_corners_are_glued() {
                 corners += 1;
                 let g = d.iface.body[ib] as usize;
                 let v: Vec<[f64; 3]> = r
-                    .map(|c| d.subs[d.iface.sub[c] as usize].interface_velocity(d.iface.slot[c] as usize))
+                    .map(|c| {
+                        let mut x = Vec::new();
+                        d.subs[d.iface.sub[c] as usize].interface_velocity(d.iface.slot[c] as usize, &mut x);
+                        [x[0], x[1], x[2]]
+                    })
                     .collect();
                 let v0 = v[0];
                 let spread = v.iter().flat_map(|x| (0..3).map(move |k| (x[k] - v0[k]).abs())).fold(0.0, f64::max) / (G * H);

@@ -87,8 +87,7 @@ impl GluePartial {
 /// |V|² = |v|² + ρ² |ω|² with ρ² = I/m: the first `space` components of V are
 /// translations, the others rotations.
 #[inline]
-pub fn norm2<V: AsRef<[f64]>>(v: &V, space: usize, rho2: f64) -> f64 {
-    let v = v.as_ref();
+pub fn norm2(v: &[f64], space: usize, rho2: f64) -> f64 {
     let mut s = 0.0;
     for &x in &v[..space] {
         s += x * x;
@@ -99,88 +98,82 @@ pub fn norm2<V: AsRef<[f64]>>(v: &V, space: usize, rho2: f64) -> f64 {
     s
 }
 
-/// V_{l+1} − V_l.
-#[inline]
-fn diff<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>>(a: &V, b: &V) -> V {
-    let mut out = V::default();
-    for ((o, x), y) in out.as_mut().iter_mut().zip(a.as_ref()).zip(b.as_ref()) {
-        *o = x - y;
-    }
-    out
-}
-
-/// Σ_l |V_{l+1} − V_l|² / m over the links of one chain of m copies.
-pub fn link_sum<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>>(v: &[V], space: usize, rho2: f64) -> f64 {
-    let m = v.len() as f64;
+/// Σ_l |V_{l+1} − V_l|² / m over the links of one chain of m copies of `d`
+/// degrees of freedom each (`v`: the copies one after the other).
+#[inline(always)]
+pub fn link_sum(v: &[f64], d: usize, space: usize, rho2: f64) -> f64 {
+    let m = v.len() / d;
     let mut s = 0.0;
-    for l in 1..v.len() {
-        let j = diff(&v[l], &v[l - 1]);
-        s += norm2(&j, space, rho2) / m;
+    for l in 1..m {
+        let (a, b) = (&v[l * d..(l + 1) * d], &v[(l - 1) * d..l * d]);
+        // |a − b|² as norm2 sums it
+        let mut n2 = 0.0;
+        for i in 0..space {
+            let x = a[i] - b[i];
+            n2 += x * x;
+        }
+        for i in space..d {
+            let x = a[i] - b[i];
+            n2 += rho2 * x * x;
+        }
+        s += n2 / m as f64;
     }
     s
 }
 
 /// Reusable buffers of [`chain_increments`].
-pub struct ChainScratch<V> {
+#[derive(Default)]
+pub struct ChainScratch {
     c: Vec<f64>,
-    d: Vec<V>,
+    y: Vec<f64>,
 }
 
-impl<V> Default for ChainScratch<V> {
-    fn default() -> Self {
-        ChainScratch {
-            c: Vec::new(),
-            d: Vec::new(),
-        }
-    }
-}
-
-/// ΔV_k = y_k − y_{k−1} with y = L⁻¹ [V] for the copies `v` (chain order), written
-/// to `dv` (same length). One link in closed form, a Thomas solve beyond.
-pub fn chain_increments<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>>(v: &[V], dv: &mut [V], s: &mut ChainScratch<V>) {
-    let m = v.len();
-    debug_assert_eq!(dv.len(), m);
-    let jump = |l: usize| diff(&v[l + 1], &v[l]);
+/// ΔV_k = y_k − y_{k−1} with y = L⁻¹ [V] for the m copies of `d` degrees of freedom
+/// in `v` (chain order, one after the other), written to `dv` (same length). One
+/// link in closed form, a Thomas solve beyond.
+#[inline(always)]
+pub fn chain_increments(v: &[f64], d: usize, dv: &mut [f64], s: &mut ChainScratch) {
+    let m = v.len() / d;
+    debug_assert_eq!(dv.len(), v.len());
+    let jump = |l: usize, i: usize| v[(l + 1) * d + i] - v[l * d + i];
     match m {
         0 => {}
-        1 => dv[0] = V::default(),
+        1 => dv.iter_mut().for_each(|x| *x = 0.0),
         2 => {
-            let j = jump(0);
-            let (mut y, mut ny) = (V::default(), V::default());
-            for ((a, b), x) in y.as_mut().iter_mut().zip(ny.as_mut()).zip(j.as_ref()) {
-                *a = 0.5 * x;
-                *b = -*a;
+            for i in 0..d {
+                let y = 0.5 * jump(0, i);
+                dv[i] = y;
+                dv[d + i] = -y;
             }
-            dv[0] = y;
-            dv[1] = ny;
         }
         _ => {
             // Thomas: L = tridiag(−1, 2, −1), n = m − 1 unknowns per degree of freedom
             let n = m - 1;
             s.c.clear();
-            s.d.clear();
+            s.y.clear();
             for l in 0..n {
-                let j = jump(l);
-                let (cp, dp) = if l == 0 { (0.0, V::default()) } else { (s.c[l - 1], s.d[l - 1]) };
+                let cp = if l == 0 { 0.0 } else { s.c[l - 1] };
                 let den = 2.0 + cp; // b − a c'_{l−1} with a = −1, b = 2
                 s.c.push(-1.0 / den);
-                let mut d = V::default();
-                for ((o, x), p) in d.as_mut().iter_mut().zip(j.as_ref()).zip(dp.as_ref()) {
-                    *o = (x + p) / den;
+                for i in 0..d {
+                    let dp = if l == 0 { 0.0 } else { s.y[(l - 1) * d + i] };
+                    s.y.push((jump(l, i) + dp) / den);
                 }
-                s.d.push(d);
             }
-            // back substitution into s.d (y)
+            // back substitution into s.y
             for l in (0..n - 1).rev() {
-                let (c, y1) = (s.c[l], s.d[l + 1]);
-                for (y, x1) in s.d[l].as_mut().iter_mut().zip(y1.as_ref()) {
-                    *y -= c * x1;
+                let c = s.c[l];
+                for i in 0..d {
+                    let y1 = s.y[(l + 1) * d + i];
+                    s.y[l * d + i] -= c * y1;
                 }
             }
-            for (k, out) in dv.iter_mut().enumerate() {
-                let yk = if k < n { s.d[k] } else { V::default() };
-                let ykm = if k > 0 { s.d[k - 1] } else { V::default() };
-                *out = diff(&yk, &ykm);
+            for k in 0..m {
+                for i in 0..d {
+                    let yk = if k < n { s.y[k * d + i] } else { 0.0 };
+                    let ykm = if k > 0 { s.y[(k - 1) * d + i] } else { 0.0 };
+                    dv[k * d + i] = yk - ykm;
+                }
             }
         }
     }
@@ -193,9 +186,10 @@ mod tests {
     fn chains_go_to_the_mean() {
         for m in 1..7 {
             let v: Vec<[f64; 3]> = (0..m).map(|k| [k as f64 * 1.5 - 2.0, (k * k) as f64, 0.3 * k as f64]).collect();
-            let mut dv = vec![[0.0; 3]; m];
-            let mut s: ChainScratch<[f64; 3]> = ChainScratch::default();
-            chain_increments(&v, &mut dv, &mut s);
+            let mut flat = vec![0.0; 3 * m];
+            let mut s = ChainScratch::default();
+            chain_increments(&v.concat(), 3, &mut flat, &mut s);
+            let dv: Vec<&[f64]> = flat.chunks_exact(3).collect();
             let mean: Vec<f64> = (0..3).map(|d| v.iter().map(|x| x[d]).sum::<f64>() / m as f64).collect();
             for k in 0..m {
                 for d in 0..3 {

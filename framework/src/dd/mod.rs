@@ -256,12 +256,12 @@ pub struct NscddOf<D: Family> {
     /// Whether the last grid was made over no contact (then the next step
     /// re-partitions).
     grid_empty: bool,
-    transport: InProcess<D::V>,
-    bufs: GlueBuffers<D::V>,
+    transport: InProcess,
+    bufs: GlueBuffers,
     v_free: Vec<D::V>,
     /// Set for a multi-process run ([`ranks`]): this process sweeps and glues only
     /// its ranks' subdomains.
-    ranks: Option<RankState<D::V>>,
+    ranks: Option<RankState>,
 }
 
 /// NSCDD of 2D rigid bodies.
@@ -305,7 +305,7 @@ impl<D: Family> NscddOf<D> {
     }
 
     /// The multi-process state (None in one process).
-    pub fn ranks_mut(&mut self) -> Option<&mut RankState<D::V>> {
+    pub fn ranks_mut(&mut self) -> Option<&mut RankState> {
         self.ranks.as_mut()
     }
 
@@ -494,13 +494,15 @@ pub fn write_back<D: Family>(d: &Decomposition<D>, w: &mut D::World) {
     }
     let ifc = &d.iface;
     let vel = D::vel_mut(w);
+    let mut vc = Vec::new();
     for ib in 0..ifc.len() {
         let r = ifc.copies(ib);
         let m = r.len() as f64;
         let mut v = D::V::default();
         for c in r {
-            let vc = d.subs[ifc.sub[c] as usize].interface_velocity(ifc.slot[c] as usize);
-            for (x, y) in v.as_mut().iter_mut().zip(vc.as_ref()) {
+            vc.clear();
+            d.subs[ifc.sub[c] as usize].interface_velocity(ifc.slot[c] as usize, &mut vc);
+            for (x, y) in v.as_mut().iter_mut().zip(&vc) {
                 *x += y;
             }
         }

@@ -8,20 +8,21 @@ use super::transport::{InProcess, Transport, TransportStats};
 use std::time::Instant;
 
 /// Buffers of the decentralized exchange between ranks, kept between steps.
-pub struct RankLink<V> {
+#[derive(Default)]
+pub struct RankLink {
     pub(super) me: u32,
     pub(super) rank_of: Vec<u32>,
     /// Ranks sharing interface bodies with this one (ascending).
     pub(super) peers: Vec<u32>,
-    /// Per peer: packet headers (from, to, copies) and values, then the message.
+    /// Per peer: packet headers (from, to, values) and values, then the message.
     pub(super) head: Vec<Vec<f64>>,
     pub(super) data: Vec<Vec<f64>>,
     pub(super) out: Vec<Vec<f64>>,
     pub(super) inbox: Vec<Vec<f64>>,
-    /// (to, from, peer, offset, copies) of the received packets, sorted.
+    /// (to, from, peer, offset, values) of the received packets, sorted.
     pub(super) index: Vec<(u32, u32, u32, u32, u32)>,
     /// Packets between two subdomains of this rank.
-    pub(super) local: InProcess<V>,
+    pub(super) local: InProcess,
     pub(super) pending: bool,
     /// This step's counts (messages sent by this rank) and exchange rounds.
     pub(super) stats: TransportStats,
@@ -32,30 +33,9 @@ pub struct RankLink<V> {
     pub(super) seconds: f64,
 }
 
-impl<V> Default for RankLink<V> {
-    fn default() -> Self {
-        RankLink {
-            me: 0,
-            rank_of: Vec::new(),
-            peers: Vec::new(),
-            head: Vec::new(),
-            data: Vec::new(),
-            out: Vec::new(),
-            inbox: Vec::new(),
-            index: Vec::new(),
-            local: InProcess::default(),
-            pending: false,
-            stats: TransportStats::default(),
-            rounds: 0,
-            rounds_step: 0,
-            seconds: 0.0,
-        }
-    }
-}
-
-impl<V> RankLink<V> {
+impl RankLink {
     /// Peers of this step's decomposition: the ranks of the own subdomains' neighbors.
-    pub(super) fn setup<D: Family<V = V>>(&mut self, subs: &[Subdomain<D>], rank_of: &[u32], me: u32) {
+    pub(super) fn setup<D: Family>(&mut self, subs: &[Subdomain<D>], rank_of: &[u32], me: u32) {
         self.me = me;
         self.rank_of.clear();
         self.rank_of.extend_from_slice(rank_of);
@@ -80,13 +60,13 @@ impl<V> RankLink<V> {
 /// The decentralized scheme's [`Transport`] across ranks: packets to subdomains of
 /// other ranks are collected per rank and sent as one message per peer when the
 /// first packet of the round is read; packets between subdomains of this rank stay
-/// in memory. A message is `[n, (from, to, copies) × n, values…]`.
-pub(super) struct RankTransport<'a, V> {
-    pub(super) link: &'a mut RankLink<V>,
+/// in memory. A message is `[n, (from, to, values) × n, values…]`.
+pub(super) struct RankTransport<'a> {
+    pub(super) link: &'a mut RankLink,
     pub(super) cl: &'a mut dyn Cluster,
 }
 
-impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankTransport<'_, V> {
+impl RankTransport<'_> {
     fn exchange(&mut self) {
         let l = &mut *self.link;
         l.pending = false;
@@ -106,7 +86,6 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankTransport<'_, V> {
             l.stats.values += o.len() as u64;
         }
         self.cl.exchange(&l.peers, &l.out, &mut l.inbox);
-        let ndof = V::default().as_ref().len();
         l.index.clear();
         for (p, m) in l.inbox.iter().enumerate() {
             let n = m.first().copied().unwrap_or(0.0) as usize;
@@ -114,7 +93,7 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankTransport<'_, V> {
             for h in m[1..1 + 3 * n].chunks_exact(3) {
                 let len = h[2] as usize;
                 l.index.push((h[1] as u32, h[0] as u32, p as u32, off as u32, len as u32));
-                off += len * ndof;
+                off += len;
             }
             assert_eq!(off, m.len(), "malformed interface message from rank {}", l.peers[p]);
         }
@@ -124,8 +103,8 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankTransport<'_, V> {
     }
 }
 
-impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> Transport<V> for RankTransport<'_, V> {
-    fn send(&mut self, from: u32, to: u32, data: &[V]) {
+impl Transport for RankTransport<'_> {
+    fn send(&mut self, from: u32, to: u32, data: &[f64]) {
         let l = &mut *self.link;
         let r = l.rank_of[to as usize];
         if r == l.me {
@@ -133,12 +112,10 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> Transport<V> for RankTrans
         }
         let p = l.peers.binary_search(&r).expect("a neighbor's rank is a peer");
         l.head[p].extend([from as f64, to as f64, data.len() as f64]);
-        for v in data {
-            l.data[p].extend_from_slice(v.as_ref());
-        }
+        l.data[p].extend_from_slice(data);
         l.pending = true;
     }
-    fn recv(&mut self, to: u32, from: u32, out: &mut Vec<V>) {
+    fn recv(&mut self, to: u32, from: u32, out: &mut Vec<f64>) {
         if self.link.pending {
             self.exchange();
         }
@@ -149,17 +126,11 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> Transport<V> for RankTrans
         out.clear();
         if let Ok(i) = l.index.binary_search_by_key(&(to, from), |e| (e.0, e.1)) {
             let (_, _, p, off, len) = l.index[i];
-            let ndof = V::default().as_ref().len();
-            let m = &l.inbox[p as usize][off as usize..off as usize + len as usize * ndof];
-            out.extend(m.chunks_exact(ndof).map(|c| {
-                let mut v = V::default();
-                v.as_mut().copy_from_slice(c);
-                v
-            }));
+            out.extend_from_slice(&l.inbox[p as usize][off as usize..off as usize + len as usize]);
         }
     }
     fn stats(&self) -> TransportStats {
         self.link.stats
     }
-    fn record(&mut self, _from: u32, _to: u32, _len: usize) {}
+    fn record(&mut self, _from: u32, _to: u32, _values: usize) {}
 }

@@ -72,23 +72,23 @@ pub struct RankTotals {
 }
 
 /// The multi-process state of an NSCDD solver.
-pub struct RankState<V> {
+pub struct RankState {
     pub cluster: Box<dyn Cluster>,
     /// Rank of each subdomain (the last repartition's).
     pub rank_of: Vec<u32>,
-    link: RankLink<V>,
-    glue: GlueBuffers<V>,
-    chain: ChainBuffers<V>,
+    link: RankLink,
+    glue: GlueBuffers,
+    chain: ChainBuffers,
     send: Vec<f64>,
     all: Vec<f64>,
     counts: Vec<usize>,
-    per_sub: Vec<Vec<V>>,
-    per_sub_out: Vec<Vec<V>>,
+    per_sub: Vec<Vec<f64>>,
+    per_sub_out: Vec<Vec<f64>>,
     parts: Vec<GluePartial>,
     pub totals: RankTotals,
 }
 
-impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
+impl RankState {
     pub fn new(cluster: Box<dyn Cluster>) -> Self {
         RankState {
             cluster,
@@ -160,14 +160,14 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
 
     /// The centralized gluing across ranks; returns the own subdomains' residual
     /// shares (subdomain order).
-    fn central<D: Family<V = V>>(&mut self, d: &mut Decomposition<D>, only_fresh: bool, own: &mut Vec<GluePartial>) {
-        let ndof = V::default().as_ref().len();
+    fn central<D: Family>(&mut self, d: &mut Decomposition<D>, only_fresh: bool, own: &mut Vec<GluePartial>) {
+        let ndof = super::subdomain::dofs::<D>();
         let (me, np, ns) = (self.cluster.rank(), self.cluster.size(), d.subs.len());
         let t0 = Instant::now();
         self.send.clear();
         for s in d.subs.iter().filter(|s| self.rank_of[s.id as usize] == me) {
             for q in 0..s.iface.len() {
-                self.send.extend_from_slice(s.interface_velocity(q).as_ref());
+                s.interface_velocity(q, &mut self.send);
             }
         }
         let at = self.counts_by(ns, |s| d.subs[s].iface.len() * ndof);
@@ -182,11 +182,7 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
             for (s, v) in self.per_sub.iter_mut().enumerate() {
                 v.clear();
                 let (pos, n) = (at[s], d.subs[s].iface.len() * ndof);
-                v.extend(self.all[pos..pos + n].chunks_exact(ndof).map(|c| {
-                    let mut x = V::default();
-                    x.as_mut().copy_from_slice(c);
-                    x
-                }));
+                v.extend_from_slice(&self.all[pos..pos + n]);
             }
             self.parts.clear();
             self.parts.resize(ns, GluePartial::default());
@@ -203,9 +199,7 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
             self.all.clear();
             for r in 0..np {
                 for s in (0..ns).filter(|&s| self.rank_of[s] == r) {
-                    for v in &self.per_sub_out[s] {
-                        self.all.extend_from_slice(v.as_ref());
-                    }
+                    self.all.extend_from_slice(&self.per_sub_out[s]);
                     let p = &self.parts[s];
                     self.all.extend([p.jump2, p.links as f64, p.v2, p.copies as f64]);
                 }
@@ -224,12 +218,10 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
         own.clear();
         for s in d.subs.iter_mut().filter(|s| self.rank_of[s.id as usize] == me) {
             for q in 0..s.iface.len() {
-                let mut dv = V::default();
-                dv.as_mut().copy_from_slice(&mine[pos..pos + ndof]);
-                pos += ndof;
                 if !only_fresh || d.iface.fresh[s.iface_ib[q] as usize] {
-                    s.glue(q, dv);
+                    s.glue(q, &mine[pos..pos + ndof]);
                 }
+                pos += ndof;
             }
             let p = &mine[pos..pos + 4];
             own.push(GluePartial {
@@ -244,7 +236,7 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
     }
 
     /// One gluing stage over the own subdomains; their residual shares in `own`.
-    fn glue<D: Family<V = V>>(&mut self, d: &mut Decomposition<D>, scheme: Scheme, only_fresh: bool, own: &mut Vec<GluePartial>) {
+    fn glue<D: Family>(&mut self, d: &mut Decomposition<D>, scheme: Scheme, only_fresh: bool, own: &mut Vec<GluePartial>) {
         match scheme {
             Scheme::Centralized => self.central(d, only_fresh, own),
             Scheme::Decentralized => {
@@ -262,7 +254,7 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
 
     /// A check stage: every subdomain's sums and residual share, on every rank, merged
     /// in subdomain order.
-    fn check<D: Family<V = V>>(&mut self, d: &Decomposition<D>, own: &[GluePartial]) -> (Sums, GluePartial) {
+    fn check<D: Family>(&mut self, d: &Decomposition<D>, own: &[GluePartial]) -> (Sums, GluePartial) {
         let me = self.cluster.rank();
         let t0 = Instant::now();
         self.send.clear();
@@ -314,8 +306,8 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
     }
 
     /// Every subdomain's impulses, copy velocities and F_Γ from its rank to all.
-    fn share_results<D: Family<V = V>>(&mut self, d: &mut Decomposition<D>) {
-        let ndof = V::default().as_ref().len();
+    fn share_results<D: Family>(&mut self, d: &mut Decomposition<D>) {
+        let ndof = super::subdomain::dofs::<D>();
         let me = self.cluster.rank();
         let t0 = Instant::now();
         // copies of other ranks' subdomains were not given starting velocities
@@ -341,7 +333,7 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
                 D::r_mut(&mut s.contacts, a).copy_from_slice(&self.all[pos..pos + D::SPACE]);
                 pos += D::SPACE;
             }
-            s.vel.resize(s.body_global.len(), V::default());
+            s.vel.resize(s.body_global.len(), D::V::default());
             for v in s.vel.iter_mut().chain(s.f_gamma.iter_mut()) {
                 v.as_mut().copy_from_slice(&self.all[pos..pos + ndof]);
                 pos += ndof;
@@ -358,7 +350,7 @@ impl<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>> RankState<V> {
 /// rank. The subdomains' ranks are those of [`RankState::assign`] at the partition.
 /// Returns the stages run and this step's exchange counts.
 pub(super) fn iterate<D: Family>(
-    st: &mut RankState<D::V>,
+    st: &mut RankState,
     d: &mut Decomposition<D>,
     scheme: Scheme,
     (per, omega): (u32, f64),
@@ -416,7 +408,7 @@ pub(super) fn iterate<D: Family>(
 /// Every rank's totals, gathered on every rank (collective), as a JSON document:
 /// per rank its gluing messages and values sent, gluing rounds, peers (the ranks it
 /// sent gluing messages to), reduction messages and values, and seconds.
-pub fn totals_json(st: &mut RankState<impl Copy + Default + AsRef<[f64]> + AsMut<[f64]>>) -> String {
+pub fn totals_json(st: &mut RankState) -> String {
     const H: usize = 10;
     let p = st.cluster.size() as usize;
     let t = &st.totals;

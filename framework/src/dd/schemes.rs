@@ -31,37 +31,19 @@ pub enum Scheme {
 }
 
 /// Buffers reused between gluing stages.
-pub struct GlueBuffers<V> {
-    packets: Vec<Vec<V>>,
-    c: ChainBuffers<V>,
-    send: Vec<V>,
-}
-
-impl<V> Default for GlueBuffers<V> {
-    fn default() -> Self {
-        GlueBuffers {
-            packets: Vec::new(),
-            c: ChainBuffers::default(),
-            send: Vec::new(),
-        }
-    }
+#[derive(Default)]
+pub struct GlueBuffers {
+    packets: Vec<Vec<f64>>,
+    c: ChainBuffers,
+    send: Vec<f64>,
 }
 
 /// Buffers of the chain solves of one subdomain's gluing ([`glue_sub`]).
-pub struct ChainBuffers<V> {
-    chain: Vec<V>,
-    dv: Vec<V>,
-    scratch: ChainScratch<V>,
-}
-
-impl<V> Default for ChainBuffers<V> {
-    fn default() -> Self {
-        ChainBuffers {
-            chain: Vec::new(),
-            dv: Vec::new(),
-            scratch: ChainScratch::default(),
-        }
-    }
+#[derive(Default)]
+pub struct ChainBuffers {
+    chain: Vec<f64>,
+    dv: Vec<f64>,
+    scratch: ChainScratch,
 }
 
 /// One gluing stage: exchange, chain solves, F_Γ and velocity updates. Returns each
@@ -72,9 +54,9 @@ pub fn glue_stage<D: Family>(
     subs: &mut [&mut Subdomain<D>],
     iface: &Interface,
     scheme: Scheme,
-    t: &mut dyn Transport<D::V>,
+    t: &mut dyn Transport,
     only_fresh: bool,
-    b: &mut GlueBuffers<D::V>,
+    b: &mut GlueBuffers,
 ) -> Vec<GluePartial> {
     match scheme {
         Scheme::Decentralized => decentralized(subs, iface, t, only_fresh, b),
@@ -85,9 +67,9 @@ pub fn glue_stage<D: Family>(
 fn decentralized<D: Family>(
     subs: &mut [&mut Subdomain<D>],
     iface: &Interface,
-    t: &mut dyn Transport<D::V>,
+    t: &mut dyn Transport,
     only_fresh: bool,
-    b: &mut GlueBuffers<D::V>,
+    b: &mut GlueBuffers,
 ) -> Vec<GluePartial> {
     for s in subs.iter() {
         for nbr in &s.neighbors {
@@ -109,7 +91,7 @@ fn decentralized<D: Family>(
 
 /// The decentralized scheme's packets of subdomain `s`: `out[ni]` its copies'
 /// velocities of the bodies shared with neighbor `ni` (what [`decentralized`] sends).
-pub fn post<D: Family>(s: &Subdomain<D>, out: &mut Vec<Vec<D::V>>) {
+pub fn post<D: Family>(s: &Subdomain<D>, out: &mut Vec<Vec<f64>>) {
     out.resize_with(s.neighbors.len(), Vec::new);
     for (o, nbr) in out.iter_mut().zip(&s.neighbors) {
         o.clear();
@@ -123,40 +105,43 @@ pub fn post<D: Family>(s: &Subdomain<D>, out: &mut Vec<Vec<D::V>>) {
 /// measured on the velocities before the update.
 pub fn glue_sub<D: Family>(
     s: &mut Subdomain<D>,
-    packets: &[Vec<D::V>],
+    packets: &[Vec<f64>],
     iface: &Interface,
     only_fresh: bool,
-    b: &mut ChainBuffers<D::V>,
+    b: &mut ChainBuffers,
 ) -> GluePartial {
     let mut part = GluePartial::default();
+    let d = s.dofs();
     for q in 0..s.iface.len() {
         let ib = s.iface_ib[q] as usize;
         let k = s.iface_k[q] as usize;
         b.chain.clear();
         for &(ni, p) in &s.chain[s.chain_start[q] as usize..s.chain_start[q + 1] as usize] {
-            b.chain.push(if ni == OWN {
-                s.interface_velocity(p as usize)
+            if ni == OWN {
+                s.interface_velocity(p as usize, &mut b.chain);
             } else {
-                packets[ni as usize][p as usize]
-            });
+                let p = p as usize * d;
+                b.chain.extend_from_slice(&packets[ni as usize][p..p + d]);
+            }
         }
-        accumulate(&mut part, &b.chain, k, D::SPACE, iface.rho2[ib]);
+        accumulate(&mut part, &b.chain, d, k, D::SPACE, iface.rho2[ib]);
         if !only_fresh || iface.fresh[ib] {
-            b.dv.resize(b.chain.len(), D::V::default());
-            chain_increments(&b.chain, &mut b.dv, &mut b.scratch);
-            s.glue(q, b.dv[k]);
+            b.dv.resize(b.chain.len(), 0.0);
+            chain_increments(&b.chain, d, &mut b.dv, &mut b.scratch);
+            s.glue(q, &b.dv[k * d..(k + 1) * d]);
         }
     }
     part
 }
 
 /// The residual share of one copy: its chain's links if it is the first copy.
-fn accumulate<V: Copy + Default + AsRef<[f64]> + AsMut<[f64]>>(part: &mut GluePartial, chain: &[V], k: usize, space: usize, rho2: f64) {
+#[inline(always)]
+fn accumulate(part: &mut GluePartial, chain: &[f64], d: usize, k: usize, space: usize, rho2: f64) {
     if k == 0 {
-        part.jump2 += link_sum(chain, space, rho2);
-        part.links += chain.len() as u64 - 1;
+        part.jump2 += link_sum(chain, d, space, rho2);
+        part.links += (chain.len() / d) as u64 - 1;
     }
-    part.v2 += norm2(&chain[k], space, rho2);
+    part.v2 += norm2(&chain[k * d..(k + 1) * d], space, rho2);
     part.copies += 1;
 }
 
@@ -168,41 +153,49 @@ const ROOT: u32 = 0;
 /// subdomain in slot order (as the decentralized scheme). `meta(s)`: subdomain s's
 /// (`iface_ib`, `iface_k`). Shared by the in-process and the multi-process schemes.
 pub(super) fn root_solve<'m, D: Family>(
-    all: &[Vec<D::V>],
-    out: &mut [Vec<D::V>],
+    all: &[Vec<f64>],
+    out: &mut [Vec<f64>],
     parts: &mut [GluePartial],
     iface: &Interface,
     meta: impl Fn(usize) -> (&'m [u32], &'m [u32]),
     only_fresh: bool,
-    c: &mut ChainBuffers<D::V>,
+    c: &mut ChainBuffers,
 ) {
+    let d = super::subdomain::dofs::<D>();
     for (o, a) in out.iter_mut().zip(all) {
         o.clear();
-        o.resize(a.len(), D::V::default());
+        o.resize(a.len(), 0.0);
     }
+    let copy = |x: usize| {
+        let at = iface.slot[x] as usize * d;
+        &all[iface.sub[x] as usize][at..at + d]
+    };
     // solve every chain once
     for ib in 0..iface.len() {
         let r = iface.copies(ib);
         c.chain.clear();
-        c.chain
-            .extend(r.clone().map(|k| all[iface.sub[k] as usize][iface.slot[k] as usize]));
+        for x in r.clone() {
+            c.chain.extend_from_slice(copy(x));
+        }
         if !only_fresh || iface.fresh[ib] {
-            c.dv.resize(c.chain.len(), D::V::default());
-            chain_increments(&c.chain, &mut c.dv, &mut c.scratch);
+            c.dv.resize(c.chain.len(), 0.0);
+            chain_increments(&c.chain, d, &mut c.dv, &mut c.scratch);
             for (k, x) in r.enumerate() {
-                out[iface.sub[x] as usize][iface.slot[x] as usize] = c.dv[k];
+                let at = iface.slot[x] as usize * d;
+                out[iface.sub[x] as usize][at..at + d].copy_from_slice(&c.dv[k * d..(k + 1) * d]);
             }
         }
     }
     // residual shares, per subdomain in slot order
     for (s, part) in parts.iter_mut().enumerate() {
         let (ibs, ks) = meta(s);
-        for q in 0..all[s].len() {
+        for q in 0..all[s].len() / d {
             let ib = ibs[q] as usize;
             c.chain.clear();
-            c.chain
-                .extend(iface.copies(ib).map(|x| all[iface.sub[x] as usize][iface.slot[x] as usize]));
-            accumulate(part, &c.chain, ks[q] as usize, D::SPACE, iface.rho2[ib]);
+            for x in iface.copies(ib) {
+                c.chain.extend_from_slice(copy(x));
+            }
+            accumulate(part, &c.chain, d, ks[q] as usize, D::SPACE, iface.rho2[ib]);
         }
     }
 }
@@ -210,16 +203,16 @@ pub(super) fn root_solve<'m, D: Family>(
 fn centralized<D: Family>(
     subs: &mut [&mut Subdomain<D>],
     iface: &Interface,
-    t: &mut dyn Transport<D::V>,
+    t: &mut dyn Transport,
     only_fresh: bool,
-    b: &mut GlueBuffers<D::V>,
+    b: &mut GlueBuffers,
 ) -> Vec<GluePartial> {
     let ns = subs.len();
     // gather
     for s in subs.iter() {
         b.send.clear();
         for q in 0..s.iface.len() {
-            b.send.push(s.interface_velocity(q));
+            s.interface_velocity(q, &mut b.send);
         }
         t.send(s.id, ROOT, &b.send);
     }
@@ -242,11 +235,12 @@ fn centralized<D: Family>(
     for (s, o) in out.iter().enumerate().take(ns) {
         t.send(ROOT, s as u32, o);
     }
+    let d = super::subdomain::dofs::<D>();
     for s in subs.iter_mut() {
         t.recv(s.id, ROOT, &mut b.send);
-        for q in 0..b.send.len() {
+        for q in 0..b.send.len() / d {
             if !only_fresh || iface.fresh[s.iface_ib[q] as usize] {
-                s.glue(q, b.send[q]);
+                s.glue(q, &b.send[q * d..(q + 1) * d]);
             }
         }
     }

@@ -62,25 +62,31 @@ pub type Subdomain2 = Subdomain<Rigid2>;
 /// A subdomain of 3D rigid bodies.
 pub type Subdomain3 = Subdomain<Rigid3>;
 
-/// What the NSCDD coordinator needs from a subdomain (DESIGN.md §3, §4).
+/// What the NSCDD coordinator needs from a subdomain (DESIGN.md §3, §4). Interface
+/// values are the `f64`s of each copy's degrees of freedom ([`Self::dofs`] of
+/// them), so that the gluing code does not depend on the body family.
 pub trait SubdomainSolver {
-    /// Generalized velocity of a copy.
-    type V;
     /// `n` NLGS sweeps with relaxation ω; the last one is a check pass when `check`
     /// (its sums are then in [`Self::sums`], else those are zero).
     fn sweeps(&mut self, n: u32, omega: f64, check: bool);
     fn sums(&self) -> &Sums;
+    /// Degrees of freedom of an interface copy.
+    fn dofs(&self) -> usize;
     /// Velocities of the interface copies given by `slots`, appended to `out`.
-    fn interface_velocities(&self, slots: &[u32], out: &mut Vec<Self::V>);
-    /// Velocity of the interface copy in `slot`.
-    fn interface_velocity(&self, slot: usize) -> Self::V;
+    fn interface_velocities(&self, slots: &[u32], out: &mut Vec<f64>);
+    /// Velocity of the interface copy in `slot`, appended to `out`.
+    fn interface_velocity(&self, slot: usize, out: &mut Vec<f64>);
     /// Gluing increment of one interface copy: ΔF_Γ = M̂_E ΔV, applied through
     /// M̂_E⁻¹ (so the copy moves by ΔV on its free degrees of freedom).
-    fn glue(&mut self, slot: usize, dv: Self::V);
+    fn glue(&mut self, slot: usize, dv: &[f64]);
+}
+
+/// Degrees of freedom of a copy of family D.
+pub fn dofs<D: Family>() -> usize {
+    D::V::default().as_ref().len()
 }
 
 impl<D: Family> SubdomainSolver for Subdomain<D> {
-    type V = D::V;
     fn sweeps(&mut self, n: u32, omega: f64, check: bool) {
         self.sums = Sums::default();
         for k in 0..n {
@@ -91,15 +97,22 @@ impl<D: Family> SubdomainSolver for Subdomain<D> {
     fn sums(&self) -> &Sums {
         &self.sums
     }
-    fn interface_velocities(&self, slots: &[u32], out: &mut Vec<D::V>) {
-        out.extend(slots.iter().map(|&q| self.vel[self.iface[q as usize] as usize]));
+    fn dofs(&self) -> usize {
+        dofs::<D>()
     }
-    fn interface_velocity(&self, slot: usize) -> D::V {
-        self.vel[self.iface[slot] as usize]
+    fn interface_velocities(&self, slots: &[u32], out: &mut Vec<f64>) {
+        for &q in slots {
+            out.extend_from_slice(self.vel[self.iface[q as usize] as usize].as_ref());
+        }
     }
-    fn glue(&mut self, slot: usize, dv: D::V) {
+    fn interface_velocity(&self, slot: usize, out: &mut Vec<f64>) {
+        out.extend_from_slice(self.vel[self.iface[slot] as usize].as_ref());
+    }
+    fn glue(&mut self, slot: usize, dv: &[f64]) {
         let l = self.iface[slot] as usize;
-        D::glue(&mut self.vel[l], &mut self.f_gamma[slot], &self.inv_mass[l], &dv);
+        let mut v = D::V::default();
+        v.as_mut().copy_from_slice(dv);
+        D::glue(&mut self.vel[l], &mut self.f_gamma[slot], &self.inv_mass[l], &v);
     }
 }
 

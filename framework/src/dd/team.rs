@@ -99,13 +99,13 @@ struct Cmd {
 }
 
 /// A subdomain's packets of one stage parity, one per neighbor (neighbor order).
-type Outbox<V> = Mutex<Vec<Vec<V>>>;
+type Outbox = Mutex<Vec<Vec<f64>>>;
 
 /// What the threads share.
 struct Shared<'a, 'b, D: Family> {
     cells: &'a [Mutex<&'b mut Subdomain<D>>],
     /// Per subdomain and parity: one packet per neighbor, neighbor order.
-    outbox: &'a [[Outbox<D::V>; 2]],
+    outbox: &'a [[Outbox; 2]],
     /// Per subdomain, per neighbor: (neighbor, index of the subdomain among its neighbors).
     back: &'a [Vec<(usize, usize)>],
     /// Per subdomain: residual share of its last gluing.
@@ -122,22 +122,14 @@ struct Shared<'a, 'b, D: Family> {
 }
 
 /// Per-thread buffers.
-struct Scratch<V> {
-    packets: Vec<Vec<V>>,
-    chain: ChainBuffers<V>,
-}
-
-impl<V> Default for Scratch<V> {
-    fn default() -> Self {
-        Scratch {
-            packets: Vec::new(),
-            chain: ChainBuffers::default(),
-        }
-    }
+#[derive(Default)]
+struct Scratch {
+    packets: Vec<Vec<f64>>,
+    chain: ChainBuffers,
 }
 
 impl<D: Family> Shared<'_, '_, D> {
-    fn run_group(&self, g: usize, c: Cmd, buf: &mut Scratch<D::V>) {
+    fn run_group(&self, g: usize, c: Cmd, buf: &mut Scratch) {
         for &k in &self.groups[g] {
             let mut s = lock(&self.cells[k]);
             if let Some(q) = c.glue_from {
@@ -188,13 +180,13 @@ impl<D: Family> Shared<'_, '_, D> {
 /// The coordinator's handle on the subdomains of a step.
 pub struct Team<'s, 'a, 'b, D: Family> {
     sh: &'s Shared<'a, 'b, D>,
-    buf: Scratch<D::V>,
+    buf: Scratch,
     phases: usize,
     /// Stage parity of the next post.
     parity: usize,
     /// Packets posted and not glued yet (their parity).
     pending: Option<usize>,
-    /// (from, to, copies) of the decentralized exchange, counted once per gluing.
+    /// (from, to, values) of the decentralized exchange, counted once per gluing.
     links: Vec<(u32, u32, usize)>,
 }
 
@@ -249,8 +241,8 @@ impl<D: Family> Team<'_, '_, '_, D> {
         omega: f64,
         check: bool,
         scheme: Scheme,
-        t: &mut dyn Transport<D::V>,
-        bufs: &mut GlueBuffers<D::V>,
+        t: &mut dyn Transport,
+        bufs: &mut GlueBuffers,
     ) -> (Sums, Vec<GluePartial>) {
         let iface = self.sh.iface;
         let parts = if scheme == Scheme::Decentralized && !iface.is_empty() {
@@ -355,7 +347,7 @@ pub fn with_team<D: Family, R>(
             s.neighbors
                 .iter()
                 .map(|nbr| {
-                    links.push((s.id, nbr.sub, nbr.slots.len()));
+                    links.push((s.id, nbr.sub, nbr.slots.len() * super::subdomain::dofs::<D>()));
                     let t = nbr.sub as usize;
                     let j = subs[t].neighbors.iter().position(|m| m.sub == s.id);
                     (t, j.expect("neighbors are mutual"))
@@ -363,7 +355,7 @@ pub fn with_team<D: Family, R>(
                 .collect()
         })
         .collect();
-    let outbox: Vec<[Outbox<D::V>; 2]> = subs.iter().map(|_| [Mutex::new(Vec::new()), Mutex::new(Vec::new())]).collect();
+    let outbox: Vec<[Outbox; 2]> = subs.iter().map(|_| [Mutex::new(Vec::new()), Mutex::new(Vec::new())]).collect();
     let partials: Vec<Mutex<GluePartial>> = subs.iter().map(|_| Default::default()).collect();
     let cells: Vec<Mutex<&mut Subdomain<D>>> = subs.iter_mut().map(Mutex::new).collect();
     let sh = Shared {

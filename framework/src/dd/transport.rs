@@ -1,7 +1,8 @@
 //! Exchange of interface data between subdomains.
 //!
-//! The gluing stage only moves short packets of copy velocities (one generalized
-//! velocity `V` per interface copy: `[f64; 3]` in 2D, `[f64; 6]` in 3D) between subdomains, addressed by subdomain id. [`Transport`] is
+//! The gluing stage only moves short packets of copy velocities (the degrees of
+//! freedom of each interface copy, as `f64`s: 3 per 2D rigid body, 6 per 3D one)
+//! between subdomains, addressed by subdomain id. [`Transport`] is
 //! that point-to-point layer: [`InProcess`] keeps one mailbox per (receiver, sender)
 //! pair for threads and tests; an MPI transport (cargo feature `mpi`, later) maps
 //! subdomains to ranks. Both schemes of [`super::schemes`] are written against it.
@@ -19,38 +20,29 @@ pub struct TransportStats {
     pub values: u64,
 }
 
-/// Point-to-point exchange of interface packets (of copy velocities `V`) between
-/// subdomains.
-pub trait Transport<V> {
+/// Point-to-point exchange of interface packets (copy velocities, as the `f64`s of
+/// their degrees of freedom) between subdomains.
+pub trait Transport {
     /// Posts `data` from subdomain `from` to subdomain `to`.
-    fn send(&mut self, from: u32, to: u32, data: &[V]);
+    fn send(&mut self, from: u32, to: u32, data: &[f64]);
     /// Takes the packet that `from` posted to `to` in this round into `out`
     /// (cleared first; left empty when none was posted).
-    fn recv(&mut self, to: u32, from: u32, out: &mut Vec<V>);
+    fn recv(&mut self, to: u32, from: u32, out: &mut Vec<f64>);
     fn stats(&self) -> TransportStats;
-    /// Counts a packet of `len` copies from `from` to `to` that went through shared
-    /// memory instead (the threads of [`super::team`]), as `send` would.
-    fn record(&mut self, from: u32, to: u32, len: usize);
+    /// Counts a packet of `values` numbers from `from` to `to` that went through
+    /// shared memory instead (the threads of [`super::team`]), as `send` would.
+    fn record(&mut self, from: u32, to: u32, values: usize);
 }
 
 /// In-process transport: one mailbox per (receiver, sender) pair, buffers reused.
-pub struct InProcess<V> {
+#[derive(Default)]
+pub struct InProcess {
     n: usize,
-    boxes: Vec<Vec<V>>,
+    boxes: Vec<Vec<f64>>,
     stats: TransportStats,
 }
 
-impl<V> Default for InProcess<V> {
-    fn default() -> Self {
-        InProcess {
-            n: 0,
-            boxes: Vec::new(),
-            stats: TransportStats::default(),
-        }
-    }
-}
-
-impl<V> InProcess<V> {
+impl InProcess {
     /// Makes room for `n` subdomains (keeps the counts).
     pub fn resize(&mut self, n: usize) {
         if n != self.n {
@@ -64,24 +56,24 @@ impl<V> InProcess<V> {
     }
 }
 
-impl<V: Copy + AsRef<[f64]> + Default> Transport<V> for InProcess<V> {
-    fn send(&mut self, from: u32, to: u32, data: &[V]) {
+impl Transport for InProcess {
+    fn send(&mut self, from: u32, to: u32, data: &[f64]) {
         let b = &mut self.boxes[to as usize * self.n + from as usize];
         b.clear();
         b.extend_from_slice(data);
         self.record(from, to, data.len());
     }
-    fn recv(&mut self, to: u32, from: u32, out: &mut Vec<V>) {
+    fn recv(&mut self, to: u32, from: u32, out: &mut Vec<f64>) {
         out.clear();
         std::mem::swap(out, &mut self.boxes[to as usize * self.n + from as usize]);
     }
     fn stats(&self) -> TransportStats {
         self.stats
     }
-    fn record(&mut self, from: u32, to: u32, len: usize) {
+    fn record(&mut self, from: u32, to: u32, values: usize) {
         if from != to {
             self.stats.messages += 1;
-            self.stats.values += (V::default().as_ref().len() * len) as u64;
+            self.stats.values += values as u64;
         }
     }
 }
