@@ -79,10 +79,15 @@ pub struct Interface {
     /// Whether some copy had no F_Γ from the previous step (glued once before the
     /// first sweep).
     pub fresh: Vec<bool>,
+    /// Degrees of freedom of the interface entity `ib` (of each of its copies).
+    pub dofs: Vec<u32>,
     /// Copies of body `ib`: `start[ib]..start[ib + 1]`.
     pub start: Vec<u32>,
     pub sub: Vec<u32>,
     pub slot: Vec<u32>,
+    /// Per copy: where its values start in its subdomain's slot-ordered interface
+    /// values ([`super::subdomain::Subdomain::iface_off`]).
+    pub off: Vec<u32>,
 }
 
 impl Interface {
@@ -304,6 +309,9 @@ fn interface<D: Family>(
     mult: &[u32],
     store: &FGammaStore<D::V>,
 ) -> Interface {
+    for sub in subs.iter_mut() {
+        sub.iface_off.push(0);
+    }
     let mut iface = Interface {
         start: vec![0],
         ..Default::default()
@@ -320,6 +328,8 @@ fn interface<D: Family>(
         let ib = iface.body.len() as u32;
         iface.body.push(g);
         iface.rho2.push(D::rho2(w, g as usize));
+        let dofs = super::subdomain::dofs::<D>() as u32;
+        iface.dofs.push(dofs);
         // F_Γ from the previous step where the same subdomain held a copy, made to sum to zero
         let mut fresh = store.count(g) != m;
         let mut f: Vec<D::V> = copies
@@ -345,6 +355,9 @@ fn interface<D: Family>(
             let sub = &mut subs[s as usize];
             iface.sub.push(s);
             iface.slot.push(sub.iface.len() as u32);
+            let off = sub.iface_off.last().copied().unwrap_or(0);
+            iface.off.push(off);
+            sub.iface_off.push(off + dofs);
             sub.iface.push(l);
             sub.iface_ib.push(ib);
             sub.iface_k.push(k as u32);
@@ -370,13 +383,18 @@ fn link_chains<D: Family>(subs: &mut [Subdomain<D>], iface: &Interface) {
                 let ni = match sub.neighbors.iter().position(|n| n.sub == t) {
                     Some(ni) => ni,
                     None => {
-                        sub.neighbors.push(Neighbor { sub: t, slots: Vec::new() });
+                        sub.neighbors.push(Neighbor {
+                            sub: t,
+                            slots: Vec::new(),
+                            values: 0,
+                        });
                         sub.neighbors.len() - 1
                     }
                 };
                 let nbr = &mut sub.neighbors[ni];
-                sub.chain.push((ni as u32, nbr.slots.len() as u32));
+                sub.chain.push((ni as u32, nbr.values));
                 nbr.slots.push(q as u32);
+                nbr.values += iface.dofs[ib];
             }
             sub.chain_start.push(sub.chain.len() as u32);
         }

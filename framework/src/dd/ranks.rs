@@ -161,8 +161,8 @@ impl RankState {
     /// The centralized gluing across ranks; returns the own subdomains' residual
     /// shares (subdomain order).
     fn central<D: Family>(&mut self, d: &mut Decomposition<D>, only_fresh: bool, own: &mut Vec<GluePartial>) {
-        let ndof = super::subdomain::dofs::<D>();
         let (me, np, ns) = (self.cluster.rank(), self.cluster.size(), d.subs.len());
+        let values = |s: &Subdomain<D>| s.iface_off.last().copied().unwrap_or(0) as usize;
         let t0 = Instant::now();
         self.send.clear();
         for s in d.subs.iter().filter(|s| self.rank_of[s.id as usize] == me) {
@@ -170,7 +170,7 @@ impl RankState {
                 s.interface_velocity(q, &mut self.send);
             }
         }
-        let at = self.counts_by(ns, |s| d.subs[s].iface.len() * ndof);
+        let at = self.counts_by(ns, |s| values(&d.subs[s]));
         if me != 0 {
             self.sent(1, self.send.len());
         }
@@ -181,7 +181,7 @@ impl RankState {
             self.per_sub_out.resize_with(ns, Vec::new);
             for (s, v) in self.per_sub.iter_mut().enumerate() {
                 v.clear();
-                let (pos, n) = (at[s], d.subs[s].iface.len() * ndof);
+                let (pos, n) = (at[s], values(&d.subs[s]));
                 v.extend_from_slice(&self.all[pos..pos + n]);
             }
             self.parts.clear();
@@ -205,7 +205,7 @@ impl RankState {
                 }
             }
         }
-        let _ = self.counts_by(ns, |s| d.subs[s].iface.len() * ndof + 4);
+        let _ = self.counts_by(ns, |s| values(&d.subs[s]) + 4);
         if me == 0 {
             // the root's scatter: everything but its own part
             self.sent(np as u64 - 1, self.all.len() - self.counts[0]);
@@ -218,10 +218,11 @@ impl RankState {
         own.clear();
         for s in d.subs.iter_mut().filter(|s| self.rank_of[s.id as usize] == me) {
             for q in 0..s.iface.len() {
+                let n = (s.iface_off[q + 1] - s.iface_off[q]) as usize;
                 if !only_fresh || d.iface.fresh[s.iface_ib[q] as usize] {
-                    s.glue(q, &mine[pos..pos + ndof]);
+                    s.glue(q, &mine[pos..pos + n]);
                 }
-                pos += ndof;
+                pos += n;
             }
             let p = &mine[pos..pos + 4];
             own.push(GluePartial {

@@ -111,16 +111,16 @@ pub fn glue_sub<D: Family>(
     b: &mut ChainBuffers,
 ) -> GluePartial {
     let mut part = GluePartial::default();
-    let d = s.dofs();
     for q in 0..s.iface.len() {
         let ib = s.iface_ib[q] as usize;
         let k = s.iface_k[q] as usize;
+        let d = iface.dofs[ib] as usize;
         b.chain.clear();
         for &(ni, p) in &s.chain[s.chain_start[q] as usize..s.chain_start[q + 1] as usize] {
             if ni == OWN {
                 s.interface_velocity(p as usize, &mut b.chain);
             } else {
-                let p = p as usize * d;
+                let p = p as usize;
                 b.chain.extend_from_slice(&packets[ni as usize][p..p + d]);
             }
         }
@@ -161,39 +161,37 @@ pub(super) fn root_solve<'m, D: Family>(
     only_fresh: bool,
     c: &mut ChainBuffers,
 ) {
-    let d = super::subdomain::dofs::<D>();
     for (o, a) in out.iter_mut().zip(all) {
         o.clear();
         o.resize(a.len(), 0.0);
     }
-    let copy = |x: usize| {
-        let at = iface.slot[x] as usize * d;
-        &all[iface.sub[x] as usize][at..at + d]
-    };
+    let at = |x: usize| (iface.sub[x] as usize, iface.off[x] as usize);
     // solve every chain once
     for ib in 0..iface.len() {
-        let r = iface.copies(ib);
+        let (r, d) = (iface.copies(ib), iface.dofs[ib] as usize);
         c.chain.clear();
         for x in r.clone() {
-            c.chain.extend_from_slice(copy(x));
+            let (s, o) = at(x);
+            c.chain.extend_from_slice(&all[s][o..o + d]);
         }
         if !only_fresh || iface.fresh[ib] {
             c.dv.resize(c.chain.len(), 0.0);
             chain_increments(&c.chain, d, &mut c.dv, &mut c.scratch);
             for (k, x) in r.enumerate() {
-                let at = iface.slot[x] as usize * d;
-                out[iface.sub[x] as usize][at..at + d].copy_from_slice(&c.dv[k * d..(k + 1) * d]);
+                let (s, o) = at(x);
+                out[s][o..o + d].copy_from_slice(&c.dv[k * d..(k + 1) * d]);
             }
         }
     }
     // residual shares, per subdomain in slot order
     for (s, part) in parts.iter_mut().enumerate() {
         let (ibs, ks) = meta(s);
-        for q in 0..all[s].len() / d {
-            let ib = ibs[q] as usize;
+        for q in 0..ibs.len() {
+            let (ib, d) = (ibs[q] as usize, iface.dofs[ibs[q] as usize] as usize);
             c.chain.clear();
             for x in iface.copies(ib) {
-                c.chain.extend_from_slice(copy(x));
+                let (t, o) = at(x);
+                c.chain.extend_from_slice(&all[t][o..o + d]);
             }
             accumulate(part, &c.chain, d, ks[q] as usize, D::SPACE, iface.rho2[ib]);
         }
@@ -235,12 +233,12 @@ fn centralized<D: Family>(
     for (s, o) in out.iter().enumerate().take(ns) {
         t.send(ROOT, s as u32, o);
     }
-    let d = super::subdomain::dofs::<D>();
     for s in subs.iter_mut() {
         t.recv(s.id, ROOT, &mut b.send);
-        for q in 0..b.send.len() / d {
+        for q in 0..s.iface.len() {
+            let (o, e) = (s.iface_off[q] as usize, s.iface_off[q + 1] as usize);
             if !only_fresh || iface.fresh[s.iface_ib[q] as usize] {
-                s.glue(q, &b.send[q * d..(q + 1) * d]);
+                s.glue(q, &b.send[o..e]);
             }
         }
     }

@@ -20,6 +20,8 @@ pub struct Neighbor {
     /// Own interface slots of the bodies shared with `sub`, in ascending body id
     /// (the same sequence on both sides: packet positions match).
     pub slots: Vec<u32>,
+    /// Values (degrees of freedom) in a packet to or from `sub`.
+    pub values: u32,
 }
 
 /// Struct-of-arrays subdomain.
@@ -45,12 +47,16 @@ pub struct Subdomain<D: Family> {
     pub iface_ib: Vec<u32>,
     /// Per slot: position of this copy in the body's chain.
     pub iface_k: Vec<u32>,
+    /// Per slot: where its values start in the slot-ordered interface values
+    /// (the sum of the earlier slots' degrees of freedom); one more entry at the end,
+    /// the total.
+    pub iface_off: Vec<u32>,
     /// Per slot: F_Γ, the net interface impulse on the copy (N·s).
     pub f_gamma: Vec<D::V>,
     pub neighbors: Vec<Neighbor>,
     /// Per slot, the body's chain: `chain[chain_start[q]..chain_start[q + 1]]` holds,
-    /// for each copy in chain order, (neighbor index, position in its packet), or
-    /// ([`OWN`], slot) for the own copy.
+    /// for each copy in chain order, (neighbor index, offset of its values in the
+    /// neighbor's packet), or ([`OWN`], slot) for the own copy.
     pub chain_start: Vec<u32>,
     pub chain: Vec<(u32, u32)>,
     /// Check-pass sums of the last check sweep.
@@ -63,15 +69,14 @@ pub type Subdomain2 = Subdomain<Rigid2>;
 pub type Subdomain3 = Subdomain<Rigid3>;
 
 /// What the NSCDD coordinator needs from a subdomain (DESIGN.md §3, §4). Interface
-/// values are the `f64`s of each copy's degrees of freedom ([`Self::dofs`] of
-/// them), so that the gluing code does not depend on the body family.
+/// values are the `f64`s of each copy's degrees of freedom (the entity's
+/// [`super::partition::Interface::dofs`]), so that the gluing code does not depend
+/// on the body family.
 pub trait SubdomainSolver {
     /// `n` NLGS sweeps with relaxation ω; the last one is a check pass when `check`
     /// (its sums are then in [`Self::sums`], else those are zero).
     fn sweeps(&mut self, n: u32, omega: f64, check: bool);
     fn sums(&self) -> &Sums;
-    /// Degrees of freedom of an interface copy.
-    fn dofs(&self) -> usize;
     /// Velocities of the interface copies given by `slots`, appended to `out`.
     fn interface_velocities(&self, slots: &[u32], out: &mut Vec<f64>);
     /// Velocity of the interface copy in `slot`, appended to `out`.
@@ -96,9 +101,6 @@ impl<D: Family> SubdomainSolver for Subdomain<D> {
     }
     fn sums(&self) -> &Sums {
         &self.sums
-    }
-    fn dofs(&self) -> usize {
-        dofs::<D>()
     }
     fn interface_velocities(&self, slots: &[u32], out: &mut Vec<f64>) {
         for &q in slots {

@@ -347,7 +347,7 @@ pub fn with_team<D: Family, R>(
             s.neighbors
                 .iter()
                 .map(|nbr| {
-                    links.push((s.id, nbr.sub, nbr.slots.len() * super::subdomain::dofs::<D>()));
+                    links.push((s.id, nbr.sub, nbr.values as usize));
                     let t = nbr.sub as usize;
                     let j = subs[t].neighbors.iter().position(|m| m.sub == s.id);
                     (t, j.expect("neighbors are mutual"))
