@@ -13,15 +13,9 @@ use nscdd::solver::nlgs;
 use nscdd::Error;
 use std::time::Instant;
 
-/// The 2D bench packing: a triangular lattice of touching disks in a box of walls.
-pub fn lattice(n: usize) -> String {
-    let nx = (n as f64).sqrt().round().max(2.0) as usize;
-    let ny = n.div_ceil(nx);
-    let r = 0.01;
-    let w = 2.0 * r * nx as f64 + r;
-    format!(
-        r#"
-[time]
+/// The settings both bench packings share: one step, the solver, one material and
+/// its law (μ = 0.3).
+const SETTINGS: &str = r#"[time]
 step = 1e-3
 steps = 1
 [solver]
@@ -33,7 +27,17 @@ density = 1000.0
 [[laws]]
 materials = ["g", "g"]
 friction = 0.3
-[[bodies]]
+"#;
+
+/// The 2D bench packing: a triangular lattice of touching disks in a box of walls.
+pub fn lattice(n: usize) -> String {
+    let nx = (n as f64).sqrt().round().max(2.0) as usize;
+    let ny = n.div_ceil(nx);
+    let r = 0.01;
+    let w = 2.0 * r * nx as f64 + r;
+    format!(
+        r#"
+{SETTINGS}[[bodies]]
 shape = "wall"
 material = "g"
 position = [{cx}, {fy}]
@@ -88,19 +92,7 @@ pub fn lattice3(n: usize) -> String {
     let h = std::f64::consts::FRAC_PI_2;
     format!(
         r#"dimension = 3
-[time]
-step = 1e-3
-steps = 1
-[solver]
-tolerance = 1e-4
-max_sweeps = 200
-[[materials]]
-name = "g"
-density = 1000.0
-[[laws]]
-materials = ["g", "g"]
-friction = 0.3
-{}{}{}{}{}
+{SETTINGS}{}{}{}{}{}
 [[generate]]
 kind = "sphere_lattice"
 material = "g"

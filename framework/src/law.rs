@@ -194,6 +194,8 @@ pub(crate) struct LawBatches {
     /// The contacts of each pair of materials, `idx[start[s]..start[s + 1]]`.
     start: Vec<u32>,
     idx: Vec<u32>,
+    /// The next free place of each pair in `idx` while it is filled.
+    next: Vec<u32>,
     /// One pair's inputs and outputs.
     g_in: Vec<LawInput>,
     g_target: Vec<Target>,
@@ -237,10 +239,11 @@ impl LawBatches {
             self.start[k + 1] += self.start[k];
         }
         self.idx.resize(n, 0);
-        let mut next = self.start.clone();
+        self.next.clear();
+        self.next.extend_from_slice(&self.start);
         for (a, &s) in self.slot.iter().enumerate() {
-            self.idx[next[s as usize] as usize] = a as u32;
-            next[s as usize] += 1;
+            self.idx[self.next[s as usize] as usize] = a as u32;
+            self.next[s as usize] += 1;
         }
         for (s, law) in laws.iter().enumerate() {
             let (Some(law), lo, hi) = (law, self.start[s] as usize, self.start[s + 1] as usize) else {
