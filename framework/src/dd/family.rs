@@ -66,9 +66,11 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     fn order(w: &Self::World) -> &[u32];
     /// Natural-map residual of the world's contact problem.
     fn residual(w: &Self::World) -> f64;
+    /// Its squared sums (‖F(r)‖², ‖q‖²), to add an attached family's.
+    fn residual_parts(w: &Self::World) -> (f64, f64);
     fn solver(w: &Self::World) -> &crate::solver::SolverSettings;
     /// One step of the world with NSCDD as its contact stage.
-    fn step_with(w: &mut Self::World, stage: &mut super::NscddOf<Self>) -> Result<StepReport, Diverged>;
+    fn step_with(w: &mut Self::World, stage: &mut super::Stage<'_, '_, Self>) -> Result<StepReport, Diverged>;
 }
 
 /// The NSCDD family of the rigid bodies of dimension D: every operation is the
@@ -168,7 +170,10 @@ impl<D: Dim> Family for Rigid<D> {
     fn solver(w: &Self::World) -> &crate::solver::SolverSettings {
         &w.solver
     }
-    fn step_with(w: &mut Self::World, stage: &mut super::NscddOf<Self>) -> Result<StepReport, Diverged> {
+    fn residual_parts(w: &Self::World) -> (f64, f64) {
+        nlgs::residual_parts(&w.contacts, &w.bodies.vel)
+    }
+    fn step_with(w: &mut Self::World, stage: &mut super::Stage<'_, '_, Self>) -> Result<StepReport, Diverged> {
         w.step_with(stage)
     }
 }

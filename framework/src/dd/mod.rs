@@ -41,6 +41,7 @@
 //! only its own data and every reduction runs in subdomain order, so the result does
 //! not depend on the number of threads.
 
+pub mod attach;
 pub mod cluster;
 pub mod family;
 pub mod gluing;
@@ -56,9 +57,10 @@ pub mod team;
 pub mod transport;
 
 use crate::model::ContactKey;
+pub use attach::{Attached, EntityInfo, LocalPart};
 pub use cluster::{Cluster, Solo};
 pub use family::{Family, Rigid, Rigid2, Rigid3};
-pub use partition::{Decomposition, FGammaStore, Grid, Interface};
+pub use partition::{Decomposition, FGammaStore, FamilyOwners, Grid, Interface};
 pub use ranks::RankState;
 pub use schemes::Scheme;
 pub use subdomain::{Subdomain, Subdomain2, Subdomain3, SubdomainSolver};
@@ -124,7 +126,9 @@ impl Default for DdConfig {
 impl DdConfig {
     /// The solver state for a run of the body family `D`.
     pub fn solver_of<D: Family>(&self) -> NscddOf<D> {
-        NscddOf::new(self.dd.clone()).with_repartition_every(self.repartition_every)
+        let mut s = NscddOf::new(self.dd.clone()).with_repartition_every(self.repartition_every);
+        s.by_model = self.by_model;
+        s
     }
 
     /// The solver state for a run.
@@ -249,6 +253,13 @@ pub struct NscddOf<D: Family> {
     pub steps: u64,
     /// The grid of the last repartition.
     pub grid: Option<Grid>,
+    /// With attached families ([`attach`]): their contacts in subdomains of their own,
+    /// family f's on the grid's cells `(f + 1) · cells ..`; else they share the
+    /// rigid contacts' subdomains.
+    pub by_model: bool,
+    /// Subdomain of each attached family's contact (this step).
+    fam_owner: Vec<Vec<u32>>,
+    fam_points: Vec<[f64; 3]>,
     /// The report of the step in progress.
     pending: DdStepReport,
     /// Owner of each contact of the last step, by key (sorted).
@@ -278,6 +289,9 @@ impl<D: Family> NscddOf<D> {
             repartition_every: 1,
             steps: 0,
             grid: None,
+            by_model: false,
+            fam_owner: Vec::new(),
+            fam_points: Vec::new(),
             pending: DdStepReport::default(),
             kept: Vec::new(),
             grid_empty: false,
@@ -354,28 +368,50 @@ impl<D: Family> NscddOf<D> {
 
     /// This step's decomposition of `w.contacts`: a new grid every
     /// `repartition_every` steps, else the kept owners.
-    fn partition(&mut self, w: &D::World, rep: &mut DdStepReport) {
+    fn partition(&mut self, w: &D::World, fams: &[&mut dyn Attached<D>], rep: &mut DdStepReport) {
         let s = &self.settings;
         let k = self.repartition_every.max(1) as u64;
         let c = D::contacts(w);
         let nc = D::len(c);
+        // the attached families' contact points, one range per family
+        self.fam_points.clear();
+        let mut ranges = Vec::with_capacity(fams.len());
+        for f in fams {
+            let a = self.fam_points.len();
+            f.points(&mut self.fam_points);
+            ranges.push(a..self.fam_points.len());
+        }
         let repart = self.grid.is_none() || self.grid_empty || self.steps.is_multiple_of(k);
         let (grid, owner) = match self.grid {
             Some(g) if !repart => (g, partition::kept_owners::<D>(c, &g, &self.kept)),
             _ => {
-                let g = Grid::over((0..nc).map(|a| D::point(c, a)), s.nx, s.ny, s.nz);
+                let pts = (0..nc).map(|a| D::point(c, a)).chain(self.fam_points.iter().copied());
+                let g = Grid::over(pts, s.nx, s.ny, s.nz);
                 (g, (0..nc).map(|a| g.cell_of(D::point(c, a))).collect())
             }
         };
+        let models = if self.by_model { 1 + fams.len() } else { 1 };
+        let ns = grid.len() * models;
+        self.fam_owner.resize_with(fams.len(), Vec::new);
+        for (f, r) in ranges.into_iter().enumerate() {
+            let base = if self.by_model { (f + 1) * grid.len() } else { 0 } as u32;
+            let o = &mut self.fam_owner[f];
+            o.clear();
+            o.extend(self.fam_points[r].iter().map(|&p| base + grid.cell_of(p)));
+        }
         let nb = D::n_bodies(w);
         let before = (repart && self.steps > 0).then(|| partition::body_sets(&self.last, nb));
         if repart {
             self.grid = Some(grid);
-            self.grid_empty = nc == 0;
+            self.grid_empty = nc + self.fam_points.len() == 0;
         }
         // several processes: each builds only the subdomains of its rank
-        let build = self.ranks.as_mut().map(|rs| rs.assign(&owner, grid.len(), repart));
-        self.last = partition::decompose_owned::<D>(w, &self.v_free, grid, owner, &self.store, build.as_deref());
+        let build = self.ranks.as_mut().map(|rs| rs.assign(&owner, ns, repart));
+        let fo = FamilyOwners {
+            fams,
+            owner: &self.fam_owner,
+        };
+        self.last = partition::decompose_owned::<D>(w, &self.v_free, grid, owner, ns, &self.store, build.as_deref(), &fo);
         rep.repartitioned = repart;
         if let Some(before) = before {
             let after = partition::body_sets(&self.last, nb);
@@ -393,8 +429,22 @@ impl<D: Family> NscddOf<D> {
 
     /// Advances `w` by one step, the contact problem solved by NSCDD.
     pub fn step(&mut self, w: &mut D::World) -> Result<DdStepReport, Diverged> {
+        self.step_families(w, &mut [])
+    }
+
+    /// Advances `w` by one step with the attached body families `fams` ([`attach`]),
+    /// the contact problem of all of them solved by NSCDD. (Not with MPI ranks: an
+    /// attached family's parts are not exchanged between processes yet.)
+    pub fn step_families(&mut self, w: &mut D::World, fams: &mut [&mut dyn Attached<D>]) -> Result<DdStepReport, Diverged> {
+        if self.ranks.is_some() && !fams.is_empty() {
+            return Err(Diverged {
+                step: 0,
+                body: 0,
+                message: "attached body families cannot run on several MPI ranks yet".into(),
+            });
+        }
         self.pending = DdStepReport::default();
-        let base = D::step_with(w, self)?;
+        let base = D::step_with(w, &mut Stage { dd: self, fams })?;
         let mut rep = std::mem::take(&mut self.pending);
         rep.solve = base.solve;
         rep.contacts = base.contacts;
@@ -403,17 +453,17 @@ impl<D: Family> NscddOf<D> {
     }
 
     /// The NSCDD iteration on `self.last`, then the write-back into `w`.
-    fn solve(&mut self, w: &mut D::World, rep: &mut DdStepReport) {
+    fn solve(&mut self, w: &mut D::World, fams: &mut [&mut dyn Attached<D>], rep: &mut DdStepReport) {
         let set = self.settings.clone();
         let sv = D::solver(w).clone();
         let d = &mut self.last;
         self.transport.resize(d.subs.len());
         self.transport.reset_stats();
-        rep.subdomains = d.subs.iter().filter(|s| D::len(&s.contacts) > 0).count();
+        rep.subdomains = d.subs.iter().filter(|s| s.n_contacts() > 0).count();
         rep.interface_bodies = d.iface.len();
         rep.links = d.iface.links();
         rep.max_multiplicity = d.mult.iter().copied().max().unwrap_or(0);
-        if D::len(D::contacts(w)) == 0 {
+        if D::len(D::contacts(w)) + self.fam_points.len() == 0 {
             rep.solve.converged = true;
             self.store.keep(&d.subs);
             return;
@@ -467,7 +517,24 @@ impl<D: Family> NscddOf<D> {
         rep.solve.sweeps = stages * per;
         write_back(d, w);
         self.store.keep(&d.subs);
-        rep.solve.residual = D::residual(w);
+        if fams.is_empty() {
+            rep.solve.residual = D::residual(w);
+            return;
+        }
+        let (mut f2, mut q2) = D::residual_parts(w);
+        for (f, fam) in fams.iter_mut().enumerate() {
+            let parts: Vec<(u32, &dyn LocalPart<D>)> = d
+                .subs
+                .iter()
+                .flat_map(|s| s.parts.0.iter().filter(|p| p.0 == f as u32).map(|p| (s.id, &*p.1)))
+                .collect();
+            fam.write_back(w, &parts);
+        }
+        for fam in fams.iter() {
+            let (a, b) = fam.residual_parts(w);
+            (f2, q2) = (f2 + a, q2 + b);
+        }
+        rep.solve.residual = if q2 == 0.0 { f2.sqrt() } else { (f2 / q2).sqrt() };
     }
 }
 
@@ -495,7 +562,7 @@ pub fn write_back<D: Family>(d: &Decomposition<D>, w: &mut D::World) {
     let ifc = &d.iface;
     let vel = D::vel_mut(w);
     let mut vc = Vec::new();
-    for ib in 0..ifc.len() {
+    for ib in 0..ifc.n_rigid {
         let r = ifc.copies(ib);
         let m = r.len() as f64;
         let mut v = D::V::default();
@@ -518,24 +585,37 @@ pub fn step(w: &mut crate::world::World2, state: &mut Nscdd) -> Result<DdStepRep
     state.step(w)
 }
 
-/// NSCDD as the contact-solve stage of the world's `step_with`: it keeps V_free,
-/// splits the contact set (timed with the Delassus stage), and runs the NSCDD
-/// iteration.
-impl<D: Family> ContactStage<D::World> for NscddOf<D> {
+/// NSCDD with the step's attached families, as the contact-solve stage of the
+/// world's `step_with`.
+pub struct Stage<'a, 'f, D: Family> {
+    dd: &'a mut NscddOf<D>,
+    fams: &'a mut [&'f mut dyn Attached<D>],
+}
+
+/// NSCDD as the contact-solve stage of the world's `step_with`: it keeps V_free
+/// (the families' after theirs), builds the families' contacts and splits all
+/// contacts (timed with the Delassus stage), and runs the NSCDD iteration.
+impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
     fn after_free_velocity(&mut self, w: &D::World) {
-        self.v_free.clear();
-        self.v_free.extend_from_slice(D::vel(w));
+        self.dd.v_free.clear();
+        self.dd.v_free.extend_from_slice(D::vel(w));
+        for f in self.fams.iter_mut() {
+            f.after_free_velocity(w);
+        }
     }
     fn prepare(&mut self, w: &mut D::World) {
-        let mut rep = std::mem::take(&mut self.pending);
-        self.partition(w, &mut rep);
-        self.pending = rep;
+        for f in self.fams.iter_mut() {
+            f.build(w);
+        }
+        let mut rep = std::mem::take(&mut self.dd.pending);
+        self.dd.partition(w, self.fams, &mut rep);
+        self.dd.pending = rep;
     }
     fn solve(&mut self, w: &mut D::World) -> SolveReport {
-        let mut rep = std::mem::take(&mut self.pending);
-        NscddOf::solve(self, w, &mut rep);
+        let mut rep = std::mem::take(&mut self.dd.pending);
+        NscddOf::solve(self.dd, w, self.fams, &mut rep);
         let s = rep.solve;
-        self.pending = rep;
+        self.dd.pending = rep;
         s
     }
 }

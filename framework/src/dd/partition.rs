@@ -8,6 +8,7 @@
 //! copied into every subdomain that needs them without gluing. Between repartitions
 //! ([`kept_owners`]) persisting contacts keep their subdomain.
 
+use super::attach::{Attached, EntityInfo};
 use super::family::Family;
 use super::subdomain::{Neighbor, Subdomain, OWN};
 use crate::model::ContactKey;
@@ -76,6 +77,13 @@ pub struct Interface {
     pub body: Vec<u32>,
     /// ρ² = I/m of the body (0 when undefined), for the gluing norm.
     pub rho2: Vec<f64>,
+    /// The entity's translational values and its norm's weight
+    /// ([`super::attach::EntityInfo`]; D::N and 1 for a rigid body).
+    pub space: Vec<u32>,
+    pub weight: Vec<f64>,
+    /// The first `n_rigid` entities are rigid bodies (`body` their world id); the
+    /// others the attached families' entities (`body`: the family's entity id).
+    pub n_rigid: usize,
     /// Whether some copy had no F_Γ from the previous step (glued once before the
     /// first sweep).
     pub fresh: Vec<bool>,
@@ -140,7 +148,8 @@ impl<V: Copy> FGammaStore<V> {
     pub fn is_empty(&self) -> bool {
         self.entries.is_empty()
     }
-    /// Replaces the store by the subdomains' current F_Γ.
+    /// Replaces the store by the subdomains' current F_Γ (rigid copies; the attached
+    /// families' start from zero at every step).
     pub fn keep<D: Family<V = V>>(&mut self, subs: &[Subdomain<D>]) {
         self.entries.clear();
         for s in subs {
@@ -153,7 +162,7 @@ impl<V: Copy> FGammaStore<V> {
 }
 
 /// One step's decomposition.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct Decomposition<D: Family> {
     pub grid: Option<Grid>,
     /// Subdomain of each global contact.
@@ -201,26 +210,36 @@ pub fn body_sets<D: Family>(d: &Decomposition<D>, nb: usize) -> Vec<Vec<u32>> {
     out
 }
 
-/// Splits the contact set of `w` over the subdomains given by `owner` (one per
-/// contact, each below `grid.len()`); copies start at V_free + M̂_E⁻¹(F_Γ + H_E r).
+/// The attached families of a step and the subdomain of each of their contacts.
+pub struct FamilyOwners<'a, 'f, D: Family> {
+    pub fams: &'a [&'f mut dyn Attached<D>],
+    pub owner: &'a [Vec<u32>],
+}
+
+/// Splits the contact set of `w` over the `ns` subdomains given by `owner` (one per
+/// contact, each below `ns`), and the attached families' contacts by theirs;
+/// copies start at V_free + M̂_E⁻¹(F_Γ + H_E r).
 /// The world's visiting order (empty: storage order) is restricted to each subdomain.
 /// With `build`, only the subdomains it marks get their copies' M̂_E⁻¹, W_αα and
 /// starting velocities (the others are swept by another process: their structure
-/// alone is kept, for the exchange of results).
+/// alone is kept, for the exchange of results; no attached family then).
+#[allow(clippy::too_many_arguments)]
 pub fn decompose_owned<D: Family>(
     w: &D::World,
     v_free: &[D::V],
     grid: Grid,
     owner: Vec<u32>,
+    ns: usize,
     store: &FGammaStore<D::V>,
     build: Option<&[bool]>,
+    fam: &FamilyOwners<'_, '_, D>,
 ) -> Decomposition<D> {
     let built = |s: u32| build.is_none_or(|b| b[s as usize]);
     let c = D::contacts(w);
     let order = D::order(w);
-    let ns = grid.len();
     let nb = D::n_bodies(w);
-    let (mut subs, mult, mut copy_of) = split_contacts::<D>(c, &owner, ns, nb);
+    let (mut subs, mut mult, mut copy_of) = split_contacts::<D>(c, &owner, ns, nb);
+    let ent_copies = split_families(w, &mut subs, &mut mult, &mut copy_of, fam);
     // copies' M̂_E⁻¹ and W_αα; the visiting order restricted to each subdomain
     let mut local_of = vec![0u32; D::len(c)];
     for sub in subs.iter_mut() {
@@ -231,6 +250,11 @@ pub fn decompose_owned<D: Family>(
                 .map(|&g| D::scale_inv(D::inv_mass(w, g as usize), mult[g as usize] as f64))
                 .collect();
             sub.copy_delassus();
+            let Subdomain { parts, inv_mass, .. } = sub;
+            for (f, p) in parts.0.iter_mut() {
+                let m: Vec<u32> = p.entities().iter().map(|&e| ent_copies[*f as usize].mult[e as usize]).collect();
+                p.prepare(inv_mass, &m);
+            }
         }
         for (la, &ga) in sub.contact_global.iter().enumerate() {
             local_of[ga as usize] = la as u32;
@@ -240,8 +264,11 @@ pub fn decompose_owned<D: Family>(
         subs[owner[a as usize] as usize].order.push(local_of[a as usize]);
     }
     // interface bodies: copies grouped by body, in subdomain order
-    copy_of.sort_by_key(|e| e.0); // stable: subdomain order kept
-    let iface = interface::<D>(w, &mut subs, &copy_of, &mult, store);
+    copy_of.sort_unstable_by_key(|e| (e.0, e.1));
+    let mut iface = interface::<D>(w, &mut subs, &copy_of, &mult, store);
+    for (f, ec) in ent_copies.iter().enumerate() {
+        entity_interface(&mut iface, &mut subs, &*fam.fams[f], ec);
+    }
     link_chains(&mut subs, &iface);
     for sub in subs.iter_mut().filter(|s| built(s.id)) {
         sub.init_velocities(v_free);
@@ -252,6 +279,99 @@ pub fn decompose_owned<D: Family>(
         mult,
         subs,
         iface,
+    }
+}
+
+/// The copies of one family's entities: multiplicity per entity and the copies as
+/// (entity, subdomain, index of the part in the subdomain, local entity).
+#[derive(Default)]
+struct EntityCopies {
+    mult: Vec<u32>,
+    copies: Vec<(u32, u32, u32, u32)>,
+}
+
+/// The attached families' parts, with copies of the world bodies their contacts
+/// touch (made where the subdomain has none yet).
+fn split_families<D: Family>(
+    w: &D::World,
+    subs: &mut [Subdomain<D>],
+    mult: &mut [u32],
+    copy_of: &mut Vec<(u32, u32, u32)>,
+    fam: &FamilyOwners<'_, '_, D>,
+) -> Vec<EntityCopies> {
+    let mut out = Vec::with_capacity(fam.fams.len());
+    if fam.fams.is_empty() {
+        return out;
+    }
+    let mut local: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+    for s in subs.iter() {
+        for (l, &g) in s.body_global.iter().enumerate() {
+            local.insert((s.id, g), l as u32);
+        }
+    }
+    for (f, a) in fam.fams.iter().enumerate() {
+        let mut copy = |s: u32, g: u32| -> u32 {
+            *local.entry((s, g)).or_insert_with(|| {
+                let sub = &mut subs[s as usize];
+                let l = sub.body_global.len() as u32;
+                sub.body_global.push(g);
+                mult[g as usize] += 1;
+                copy_of.push((g, s, l));
+                l
+            })
+        };
+        let parts = a.split(w, &fam.owner[f], &mut copy);
+        let mut ec = EntityCopies {
+            mult: vec![0; a.n_entities()],
+            copies: Vec::new(),
+        };
+        for (s, p) in parts {
+            let sub = &mut subs[s as usize];
+            let pi = sub.parts.0.len() as u32;
+            for (le, &e) in p.entities().iter().enumerate() {
+                ec.mult[e as usize] += 1;
+                ec.copies.push((e, s, pi, le as u32));
+            }
+            sub.parts.0.push((f as u32, p));
+        }
+        ec.copies.sort_unstable_by_key(|x| (x.0, x.1));
+        out.push(ec);
+    }
+    out
+}
+
+/// Appends one family's interface entities (held by ≥ 2 subdomains) to the interface
+/// and their slots to the subdomains; their F_Γ start from zero (fresh).
+fn entity_interface<D: Family>(iface: &mut Interface, subs: &mut [Subdomain<D>], fam: &dyn Attached<D>, ec: &EntityCopies) {
+    let mut p = 0;
+    while p < ec.copies.len() {
+        let e = ec.copies[p].0;
+        let m = ec.mult[e as usize] as usize;
+        let copies = &ec.copies[p..p + m];
+        p += m;
+        if m < 2 {
+            continue;
+        }
+        let EntityInfo { dofs, space, rho2, weight } = fam.entity(e);
+        let ib = iface.body.len() as u32;
+        iface.body.push(e);
+        iface.rho2.push(rho2);
+        iface.space.push(space);
+        iface.weight.push(weight);
+        iface.dofs.push(dofs);
+        iface.fresh.push(true);
+        for (k, &(_, s, pi, le)) in copies.iter().enumerate() {
+            let sub = &mut subs[s as usize];
+            iface.sub.push(s);
+            iface.slot.push(sub.slots() as u32);
+            let off = sub.iface_off.last().copied().unwrap_or(0);
+            iface.off.push(off);
+            sub.iface_off.push(off + dofs);
+            sub.iface_ent.push((pi, le));
+            sub.iface_ib.push(ib);
+            sub.iface_k.push(k as u32);
+        }
+        iface.start.push(iface.sub.len() as u32);
     }
 }
 
@@ -328,6 +448,8 @@ fn interface<D: Family>(
         let ib = iface.body.len() as u32;
         iface.body.push(g);
         iface.rho2.push(D::rho2(w, g as usize));
+        iface.space.push(D::SPACE as u32);
+        iface.weight.push(1.0);
         let dofs = super::subdomain::dofs::<D>() as u32;
         iface.dofs.push(dofs);
         // F_Γ from the previous step where the same subdomain held a copy, made to sum to zero
@@ -365,6 +487,7 @@ fn interface<D: Family>(
         }
         iface.start.push(iface.sub.len() as u32);
     }
+    iface.n_rigid = iface.body.len();
     iface
 }
 
@@ -372,7 +495,7 @@ fn interface<D: Family>(
 fn link_chains<D: Family>(subs: &mut [Subdomain<D>], iface: &Interface) {
     for sub in subs.iter_mut() {
         sub.chain_start.push(0);
-        for q in 0..sub.iface.len() {
+        for q in 0..sub.slots() {
             let ib = sub.iface_ib[q] as usize;
             for k in iface.copies(ib) {
                 let t = iface.sub[k];

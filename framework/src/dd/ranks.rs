@@ -166,7 +166,7 @@ impl RankState {
         let t0 = Instant::now();
         self.send.clear();
         for s in d.subs.iter().filter(|s| self.rank_of[s.id as usize] == me) {
-            for q in 0..s.iface.len() {
+            for q in 0..s.slots() {
                 s.interface_velocity(q, &mut self.send);
             }
         }
@@ -217,7 +217,7 @@ impl RankState {
         let mut pos = 0;
         own.clear();
         for s in d.subs.iter_mut().filter(|s| self.rank_of[s.id as usize] == me) {
-            for q in 0..s.iface.len() {
+            for q in 0..s.slots() {
                 let n = (s.iface_off[q + 1] - s.iface_off[q]) as usize;
                 if !only_fresh || d.iface.fresh[s.iface_ib[q] as usize] {
                     s.glue(q, &mine[pos..pos + n]);

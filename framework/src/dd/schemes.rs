@@ -111,7 +111,7 @@ pub fn glue_sub<D: Family>(
     b: &mut ChainBuffers,
 ) -> GluePartial {
     let mut part = GluePartial::default();
-    for q in 0..s.iface.len() {
+    for q in 0..s.slots() {
         let ib = s.iface_ib[q] as usize;
         let k = s.iface_k[q] as usize;
         let d = iface.dofs[ib] as usize;
@@ -124,7 +124,7 @@ pub fn glue_sub<D: Family>(
                 b.chain.extend_from_slice(&packets[ni as usize][p..p + d]);
             }
         }
-        accumulate(&mut part, &b.chain, d, k, D::SPACE, iface.rho2[ib]);
+        accumulate(&mut part, &b.chain, d, k, iface, ib);
         if !only_fresh || iface.fresh[ib] {
             b.dv.resize(b.chain.len(), 0.0);
             chain_increments(&b.chain, d, &mut b.dv, &mut b.scratch);
@@ -136,12 +136,13 @@ pub fn glue_sub<D: Family>(
 
 /// The residual share of one copy: its chain's links if it is the first copy.
 #[inline(always)]
-fn accumulate(part: &mut GluePartial, chain: &[f64], d: usize, k: usize, space: usize, rho2: f64) {
+fn accumulate(part: &mut GluePartial, chain: &[f64], d: usize, k: usize, iface: &Interface, ib: usize) {
+    let (space, rho2, w) = (iface.space[ib] as usize, iface.rho2[ib], iface.weight[ib]);
     if k == 0 {
-        part.jump2 += link_sum(chain, d, space, rho2);
+        part.jump2 += w * link_sum(chain, d, space, rho2);
         part.links += (chain.len() / d) as u64 - 1;
     }
-    part.v2 += norm2(&chain[k * d..(k + 1) * d], space, rho2);
+    part.v2 += w * norm2(&chain[k * d..(k + 1) * d], space, rho2);
     part.copies += 1;
 }
 
@@ -193,7 +194,7 @@ pub(super) fn root_solve<'m, D: Family>(
                 let (t, o) = at(x);
                 c.chain.extend_from_slice(&all[t][o..o + d]);
             }
-            accumulate(part, &c.chain, d, ks[q] as usize, D::SPACE, iface.rho2[ib]);
+            accumulate(part, &c.chain, d, ks[q] as usize, iface, ib);
         }
     }
 }
@@ -209,7 +210,7 @@ fn centralized<D: Family>(
     // gather
     for s in subs.iter() {
         b.send.clear();
-        for q in 0..s.iface.len() {
+        for q in 0..s.slots() {
             s.interface_velocity(q, &mut b.send);
         }
         t.send(s.id, ROOT, &b.send);
@@ -235,7 +236,7 @@ fn centralized<D: Family>(
     }
     for s in subs.iter_mut() {
         t.recv(s.id, ROOT, &mut b.send);
-        for q in 0..s.iface.len() {
+        for q in 0..s.slots() {
             let (o, e) = (s.iface_off[q] as usize, s.iface_off[q + 1] as usize);
             if !only_fresh || iface.fresh[s.iface_ib[q] as usize] {
                 s.glue(q, &b.send[o..e]);

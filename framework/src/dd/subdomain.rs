@@ -7,6 +7,7 @@
 //! glued). Its loads are F̂/m_g, so its free velocity is the body's V_free:
 //! (F̂/m)/(M̂/m) = M̂⁻¹F̂. The contacts' Delassus blocks W_αα are those of the copies.
 
+use super::attach::Parts;
 use super::family::{Family, Rigid2, Rigid3};
 use crate::norms::Sums;
 
@@ -25,7 +26,7 @@ pub struct Neighbor {
 }
 
 /// Struct-of-arrays subdomain.
-#[derive(Clone, Debug, Default)]
+#[derive(Debug, Default)]
 pub struct Subdomain<D: Family> {
     pub id: u32,
     /// The subdomain's contacts, `bodies` as local body ids; `block` with the
@@ -41,8 +42,14 @@ pub struct Subdomain<D: Family> {
     pub vel: Vec<D::V>,
     /// Copy M̂_E⁻¹ = m M̂⁻¹.
     pub inv_mass: Vec<D::InvMass>,
-    /// Local ids of the interface copies (ascending global id): the slots.
+    /// Local ids of the interface copies of rigid bodies (ascending global id): the
+    /// first slots.
     pub iface: Vec<u32>,
+    /// The attached families' parts of the subdomain ([`super::attach`]).
+    pub parts: Parts<D>,
+    /// Slots past the rigid ones: (index in `parts`, local entity), ascending
+    /// interface entity.
+    pub iface_ent: Vec<(u32, u32)>,
     /// Per slot: index of the body in [`super::partition::Interface`].
     pub iface_ib: Vec<u32>,
     /// Per slot: position of this copy in the body's chain.
@@ -51,7 +58,7 @@ pub struct Subdomain<D: Family> {
     /// (the sum of the earlier slots' degrees of freedom); one more entry at the end,
     /// the total.
     pub iface_off: Vec<u32>,
-    /// Per slot: F_Γ, the net interface impulse on the copy (N·s).
+    /// Per rigid slot: F_Γ, the net interface impulse on the copy (N·s).
     pub f_gamma: Vec<D::V>,
     pub neighbors: Vec<Neighbor>,
     /// Per slot, the body's chain: `chain[chain_start[q]..chain_start[q + 1]]` holds,
@@ -96,7 +103,27 @@ impl<D: Family> SubdomainSolver for Subdomain<D> {
         self.sums = Sums::default();
         for k in 0..n {
             let sums = if check && k + 1 == n { Some(&mut self.sums) } else { None };
-            D::sweep(&mut self.contacts, &mut self.vel, &self.inv_mass, &self.order, omega, sums);
+            match sums {
+                None => {
+                    D::sweep(&mut self.contacts, &mut self.vel, &self.inv_mass, &self.order, omega, None);
+                    for (_, p) in self.parts.0.iter_mut() {
+                        p.sweep(&mut self.vel, &self.inv_mass, omega, None);
+                    }
+                }
+                Some(sm) => {
+                    D::sweep(
+                        &mut self.contacts,
+                        &mut self.vel,
+                        &self.inv_mass,
+                        &self.order,
+                        omega,
+                        Some(&mut *sm),
+                    );
+                    for (_, p) in self.parts.0.iter_mut() {
+                        p.sweep(&mut self.vel, &self.inv_mass, omega, Some(&mut *sm));
+                    }
+                }
+            }
         }
     }
     fn sums(&self) -> &Sums {
@@ -104,14 +131,26 @@ impl<D: Family> SubdomainSolver for Subdomain<D> {
     }
     fn interface_velocities(&self, slots: &[u32], out: &mut Vec<f64>) {
         for &q in slots {
-            out.extend_from_slice(self.vel[self.iface[q as usize] as usize].as_ref());
+            self.interface_velocity(q as usize, out);
         }
     }
+    #[inline]
     fn interface_velocity(&self, slot: usize, out: &mut Vec<f64>) {
-        out.extend_from_slice(self.vel[self.iface[slot] as usize].as_ref());
+        match self.iface.get(slot) {
+            Some(&l) => out.extend_from_slice(self.vel[l as usize].as_ref()),
+            None => {
+                let (p, e) = self.iface_ent[slot - self.iface.len()];
+                self.parts.0[p as usize].1.entity_velocity(e as usize, out);
+            }
+        }
     }
     fn glue(&mut self, slot: usize, dv: &[f64]) {
-        let l = self.iface[slot] as usize;
+        let Some(&l) = self.iface.get(slot) else {
+            let (p, e) = self.iface_ent[slot - self.iface.len()];
+            self.parts.0[p as usize].1.glue_entity(e as usize, dv);
+            return;
+        };
+        let l = l as usize;
         let mut v = D::V::default();
         v.as_mut().copy_from_slice(dv);
         D::glue(&mut self.vel[l], &mut self.f_gamma[slot], &self.inv_mass[l], &v);
@@ -119,6 +158,17 @@ impl<D: Family> SubdomainSolver for Subdomain<D> {
 }
 
 impl<D: Family> Subdomain<D> {
+    /// Interface slots: the rigid copies', then the attached families' entities'.
+    #[inline]
+    pub fn slots(&self) -> usize {
+        self.iface_ib.len()
+    }
+
+    /// Contacts of the subdomain, the attached families' included.
+    pub fn n_contacts(&self) -> usize {
+        D::len(&self.contacts) + self.parts.0.iter().map(|(_, p)| p.len()).sum::<usize>()
+    }
+
     /// Appends global contact `a` of `c`, with local body ids `li`, `lj`.
     pub(crate) fn push_contact(&mut self, c: &D::Contacts, a: usize, li: u32, lj: u32) {
         D::push_contact(&mut self.contacts, c, a, li, lj);
@@ -140,5 +190,8 @@ impl<D: Family> Subdomain<D> {
             D::apply_impulse(&mut self.vel[l], &self.inv_mass[l], &self.f_gamma[q]);
         }
         D::warm_start(&self.contacts, &mut self.vel, &self.inv_mass);
+        for (_, p) in self.parts.0.iter_mut() {
+            p.warm_start(&mut self.vel, &self.inv_mass);
+        }
     }
 }

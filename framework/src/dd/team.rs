@@ -313,12 +313,12 @@ impl<D: Family> Drop for StopOnDrop<'_, '_, '_, D> {
 fn groups<D: Family>(subs: &[Subdomain<D>], threads: usize) -> Vec<Vec<usize>> {
     let n = threads.clamp(1, subs.len().max(1));
     let mut by_load: Vec<usize> = (0..subs.len()).collect();
-    by_load.sort_by_key(|&k| (std::cmp::Reverse(D::len(&subs[k].contacts)), k));
+    by_load.sort_by_key(|&k| (std::cmp::Reverse(subs[k].n_contacts()), k));
     let mut g = vec![Vec::new(); n];
     let mut load = vec![0usize; n];
     for k in by_load {
         let i = (0..n).min_by_key(|&i| (load[i], i)).unwrap_or(0);
-        load[i] += D::len(&subs[k].contacts);
+        load[i] += subs[k].n_contacts();
         g[i].push(k);
     }
     for x in g.iter_mut() {

@@ -1,0 +1,114 @@
+//! The subdomain interface of a body family attached to the world's rigid bodies
+//! (DESIGN.md §3, "model coupling"): finite-element bodies today, continuum regions
+//! and researchers' families next. The NSCDD coordinator ([`super::NscddOf`]:
+//! partition, gluing schemes, thread team) is written against these two traits and
+//! names no family.
+//!
+//! A family ([`Attached`]) owns its bodies and, each step, its contacts (with one
+//! another and with the world's rigid bodies). NSCDD gives each of its contacts a
+//! subdomain (by geometry, and by model with `by_model = true`: the family's
+//! contacts in subdomains of their own), and the family splits them into one
+//! [`LocalPart`] per subdomain: the local problem of E restricted to the family's
+//! contacts. A part works on
+//!
+//! - the subdomain's copies of the world's rigid bodies (V_E and M̂_E⁻¹ = m M̂⁻¹, the
+//!   slices the coordinator passes to every call: rigid contacts and every family's
+//!   contacts of E see the same copies), and
+//! - its own copies of the family's *entities* (for a deformable body: its contact
+//!   nodes; each entity copy in E has M̂_E = M̂/m, m the number of subdomains holding
+//!   a copy, so that Σ_E M̂_E = M̂).
+//!
+//! An entity held by m ≥ 2 subdomains is an interface entity: A_ΓE picks its
+//! [`EntityInfo::dofs`] values from the copy ([`LocalPart::entity_velocity`],
+//! A_ΓE V_E), and the one gluing code ([`super::gluing`]) solves its chain,
+//! ΔV_k = y_k − y_{k−1} with y = L⁻¹ [V], which the part applies as
+//! V_E += M̂_E⁻¹ A_ΓEᵀ ΔF_Γ = ΔV_k on the entity ([`LocalPart::glue_entity`]).
+//! Copies of equal M̂_E go to their mean, so the family never forms M̂_E itself: its
+//! F_Γ is implied (Σ_k ΔF_Γ,k = M̂_E Σ_k ΔV_k = 0) and starts from zero at every
+//! step; the end-of-step velocity V⁺ = V_free + M̂⁻¹ Σ_E H_E r_E is the family's
+//! ([`Attached::write_back`]).
+//!
+//! Calls are per step, per subdomain and sweep, never per contact: a part's
+//! [`LocalPart::sweep`] visits all its contacts in the family's own code.
+
+use super::family::Family;
+use crate::norms::Sums;
+use std::any::Any;
+
+/// The gluing norm of an interface entity: |V|² = w (Σ_{i<space} v_i² + ρ² Σ_{i≥space} v_i²),
+/// in (m/s)² (a rigid body: space = 2 or 3, ρ² = I/m, w = 1; n deformable nodes:
+/// space = dofs, ρ² = 0, w = 1/n, the mean over the nodes).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EntityInfo {
+    /// Values of one copy (A_ΓE's rows).
+    pub dofs: u32,
+    /// The first `space` values are translational velocities.
+    pub space: u32,
+    pub rho2: f64,
+    pub weight: f64,
+}
+
+/// One family's part of one subdomain (module docs). `vel`/`inv`: the subdomain's
+/// copies of the world's rigid bodies, by local id.
+pub trait LocalPart<F: Family>: Any + Send {
+    /// Contacts of the part.
+    fn len(&self) -> usize;
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    /// The family's ids of its entity copies, by local entity index.
+    fn entities(&self) -> &[u32];
+    /// Builds what depends on the multiplicities: the entity copies' M̂_E = M̂/m
+    /// (`mult` per local entity), W_αα of its contacts from them and the rigid copies'
+    /// `inv`, the entity copies' free velocities.
+    fn prepare(&mut self, inv: &[F::InvMass], mult: &[u32]);
+    /// Warm start: V_E += M̂_E⁻¹ H_E r for its contacts, on both sides (after the
+    /// rigid contacts' warm start, in the family's storage order).
+    fn warm_start(&mut self, vel: &mut [F::V], inv: &[F::InvMass]);
+    /// One NLGS sweep over its contacts; a check pass adds to `sums`.
+    fn sweep(&mut self, vel: &mut [F::V], inv: &[F::InvMass], omega: f64, sums: Option<&mut Sums>);
+    /// A_ΓE V_E of local entity `e`, appended to `out`.
+    fn entity_velocity(&self, e: usize, out: &mut Vec<f64>);
+    /// The gluing increment of local entity `e`: its copy moves by `dv`.
+    fn glue_entity(&mut self, e: usize, dv: &[f64]);
+    fn as_any(&self) -> &dyn Any;
+}
+
+/// A body family beside the world's rigid bodies, solved by the NSCDD stage (module
+/// docs). The step calls, in order: [`Self::after_free_velocity`], [`Self::build`],
+/// [`Self::points`], [`Self::split`] (then the parts' `prepare` and `warm_start`),
+/// sweeps and gluings, [`Self::write_back`], [`Self::residual_parts`].
+pub trait Attached<F: Family> {
+    /// After the world's free velocity: the family's own V_free (and detection).
+    fn after_free_velocity(&mut self, w: &F::World);
+    /// The step's contacts (frames, targets ū, μ, warm-start impulses).
+    fn build(&mut self, w: &mut F::World);
+    /// Contact points of its contacts (z = 0 in 2D), appended to `out`: the
+    /// partition's input.
+    fn points(&self, out: &mut Vec<[f64; 3]>);
+    /// Entities of the family (their ids are 0..n).
+    fn n_entities(&self) -> usize;
+    fn entity(&self, e: u32) -> EntityInfo;
+    /// One part per subdomain owning some of its contacts (`owner[a]`, one per
+    /// contact of [`Self::points`]), as (subdomain, part) in ascending subdomain order.
+    /// `copy(sub, body)` gives the local id of the subdomain's copy of world body
+    /// `body`, making it on first call.
+    fn split(&self, w: &F::World, owner: &[u32], copy: &mut dyn FnMut(u32, u32) -> u32) -> Vec<(u32, Box<dyn LocalPart<F>>)>;
+    /// After the iteration (the copies glued): the contacts' impulses from the parts
+    /// `(subdomain, part)`, and the family's V⁺.
+    fn write_back(&mut self, w: &mut F::World, parts: &[(u32, &dyn LocalPart<F>)]);
+    /// (‖F(r)‖², ‖q‖²) of its contacts for the natural-map residual, from the written-back
+    /// state and the world's velocities.
+    fn residual_parts(&self, w: &F::World) -> (f64, f64);
+}
+
+/// The parts of one subdomain, with the family index of each.
+#[derive(Default)]
+pub struct Parts<F: Family>(pub Vec<(u32, Box<dyn LocalPart<F>>)>);
+
+impl<F: Family> std::fmt::Debug for Parts<F> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let n: Vec<(u32, usize)> = self.0.iter().map(|(k, p)| (*k, p.len())).collect();
+        write!(f, "Parts(family, contacts) {n:?}")
+    }
+}
