@@ -25,16 +25,16 @@ pub fn check(scene: &Path, reg: &Registry) -> ExitCode {
                     &s.fe.bodies,
                     s.world.time.steps,
                     s.world.time.h,
-                    s.by_model.is_some(),
+                    s.decomposition.as_ref().map(describe),
                 ),
-                FeScene::D3(s) => (3, s.world.bodies.len(), &s.fe.bodies, s.world.time.steps, s.world.time.h, false),
+                FeScene::D3(s) => (3, s.world.bodies.len(), &s.fe.bodies, s.world.time.steps, s.world.time.h, None),
             };
             let nodes: usize = fe.iter().map(|b| b.mesh.n_nodes()).sum();
             println!(
                 "{}: ok — {dim}D, {rigid} rigid bodies, {} deformable bodies ({nodes} nodes), {steps} steps of {h} s{}",
                 scene.display(),
                 fe.len(),
-                if by_model { "; subdomains by model" } else { "" }
+                by_model.map(|d| format!("; {d}")).unwrap_or_default()
             );
             ExitCode::SUCCESS
         }
@@ -45,24 +45,66 @@ pub fn check(scene: &Path, reg: &Registry) -> ExitCode {
     }
 }
 
-pub fn run(scene: &Path, out: &Path, quiet: bool, reg: &Registry, unsupported: Option<&str>) -> ExitCode {
+/// The command line's flags of `nscdd run`.
+pub struct Flags<'a> {
+    pub subdomains: Option<&'a str>,
+    pub scheme: Option<&'a str>,
+    pub threads: Option<&'a str>,
+    pub restart: bool,
+}
+
+/// "subdomains by model, nx × ny cells" (what `check` says of a decomposition).
+fn describe(d: &nscdd::dd::DdConfig) -> String {
+    let by = if d.by_model { "by model and " } else { "" };
+    format!(
+        "subdomains {by}on a {} × {} grid, {} thread(s), {} scheme",
+        d.dd.nx,
+        d.dd.ny,
+        d.dd.threads,
+        match d.dd.scheme {
+            nscdd::dd::Scheme::Decentralized => "decentralized",
+            nscdd::dd::Scheme::Centralized => "centralized",
+        }
+    )
+}
+
+pub fn run(scene: &Path, out: &Path, quiet: bool, reg: &Registry, flags: Flags<'_>) -> ExitCode {
     use nscdd_fem_deformable::scene::FeScene;
-    if let Some(flag) = unsupported {
-        eprintln!(
-            "error: {flag} is not supported for scenes with deformable bodies yet (they run in one process, one thread; `[decomposition] by_model = true` splits them by model)"
-        );
-        return ExitCode::from(2);
+    let refuse = |flag: &str, why: &str| {
+        eprintln!("error: {flag} is not supported for scenes with deformable bodies yet ({why})");
+        ExitCode::from(2)
+    };
+    if flags.restart {
+        return refuse("--restart", "their state is not checkpointed");
     }
     let ranks = crate::ranks::launched_size();
     if ranks > 1 {
         eprintln!(
-            "error: started as one of {ranks} MPI ranks, but scenes with deformable bodies run in one process for now: run without mpirun"
+            "error: started as one of {ranks} MPI ranks, but scenes with deformable bodies run in one process for now (use --threads): run without mpirun"
         );
         return ExitCode::from(2);
     }
+    let dd_flag = [
+        (flags.subdomains.is_some(), "--subdomains"),
+        (flags.scheme.is_some(), "--scheme"),
+        (flags.threads.is_some(), "--threads"),
+    ]
+    .into_iter()
+    .find_map(|(given, f)| given.then_some(f));
     match nscdd_fem_deformable::scene::load_any(scene, reg) {
-        Ok(FeScene::D2(mut s)) => run_loaded(&mut s, out, quiet),
-        Ok(FeScene::D3(mut s)) => run_loaded(&mut s, out, quiet),
+        Ok(FeScene::D2(mut s)) => {
+            let movable = (0..s.world.bodies.len()).filter(|&b| s.world.bodies.movable(b)).count() + s.fe.bodies.len();
+            let d = &mut s.decomposition;
+            if let Err(m) = crate::apply_decomposition_to(d, movable, false, flags.subdomains, flags.scheme, flags.threads) {
+                eprintln!("error: {m}");
+                return ExitCode::from(2);
+            }
+            run_loaded(&mut s, out, quiet)
+        }
+        Ok(FeScene::D3(mut s)) => match dd_flag {
+            Some(f) => refuse(f, "3D scenes with deformable bodies run in one domain"),
+            None => run_loaded(&mut s, out, quiet),
+        },
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::from(2)

@@ -311,15 +311,13 @@ fn fem_dispatch(cmd: &Cmd, reg: &nscdd::registry::Registry) -> Option<ExitCode> 
             threads,
             restart,
         } if fem::has_deformable(scene) => {
-            let flag = [
-                (subdomains.is_some(), "--subdomains"),
-                (scheme.is_some(), "--scheme"),
-                (threads.is_some(), "--threads"),
-                (restart.is_some(), "--restart"),
-            ]
-            .into_iter()
-            .find_map(|(given, f)| given.then_some(f));
-            Some(fem::run(scene, out, *quiet, reg, flag))
+            let flags = fem::Flags {
+                subdomains: subdomains.as_deref(),
+                scheme: scheme.as_deref(),
+                threads: threads.as_deref(),
+                restart: restart.is_some(),
+            };
+            Some(fem::run(scene, out, *quiet, reg, flags))
         }
         _ => None,
     }

@@ -223,22 +223,22 @@ fn restart_continues_and_never_overwrites_its_own_run() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// A scene with deformable bodies refuses what it cannot run yet (NSCDD flags, a
-/// restart, MPI ranks) with exit 2 and a message naming it, before running.
+/// A scene with deformable bodies refuses what it cannot run yet (a restart, MPI
+/// ranks, NSCDD flags in 3D) with exit 2 and a message naming it, before running.
 #[cfg(feature = "fem")]
 #[test]
 fn deformable_scenes_refuse_what_they_cannot_run() {
     let dir = common::scratch("fe_refusals");
     let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/scenes/foundation.toml");
+    let scene3 = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/scenes/foundation3d.toml");
     let out = dir.join("out");
-    let cases: [(&[&str], &str, &str); 5] = [
-        (&["--threads", "2"], "", "--threads"),
-        (&["--scheme", "centralized"], "", "--scheme"),
-        (&["--subdomains", "2x1"], "", "--subdomains"),
-        (&["--restart", "x.json"], "", "--restart"),
-        (&[], "2", "MPI ranks"),
+    let cases: [(&str, &[&str], &str, &str); 4] = [
+        (scene, &["--restart", "x.json"], "", "--restart"),
+        (scene, &[], "2", "MPI ranks"),
+        (scene3, &["--threads", "2"], "", "--threads"),
+        (scene3, &["--subdomains", "2x1x1"], "", "--subdomains"),
     ];
-    for (flags, ranks, said) in cases {
+    for (scene, flags, ranks, said) in cases {
         let mut cmd = std::process::Command::new(common::BIN);
         cmd.args(["run", scene, "--quiet", "--out"]).arg(&out).args(flags);
         if !ranks.is_empty() {
@@ -250,4 +250,31 @@ fn deformable_scenes_refuse_what_they_cannot_run() {
         assert!(err.contains(said), "{flags:?}: {err}");
         assert!(!out.join("history.csv").exists(), "{flags:?} ran");
     }
+}
+
+/// A 2D scene with deformable bodies takes the NSCDD flags: `--threads 2` gives
+/// bitwise the final state of one thread, `--subdomains` and `--scheme` run.
+#[cfg(feature = "fem")]
+#[test]
+fn deformable_scenes_take_the_nscdd_flags() {
+    let dir = common::scratch("fe_flags");
+    let src = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/scenes/foundation.toml")).unwrap();
+    let scene = dir.join("foundation.toml");
+    std::fs::write(&scene, src.replace("duration = 0.5", "steps = 40")).unwrap();
+    let run = |name: &str, flags: &[&str]| {
+        let out = dir.join(name);
+        let o = std::process::Command::new(common::BIN)
+            .args(["run"])
+            .arg(&scene)
+            .args(["--quiet", "--out"])
+            .arg(&out)
+            .args(flags)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0), "{flags:?}: {}", String::from_utf8_lossy(&o.stderr));
+        std::fs::read_to_string(out.join("final.json")).unwrap()
+    };
+    let one = run("t1", &["--threads", "1"]);
+    assert_eq!(one, run("t2", &["--threads", "2"]));
+    run("grid", &["--subdomains", "2x2", "--scheme", "centralized"]);
 }

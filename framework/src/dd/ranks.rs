@@ -187,7 +187,7 @@ impl RankState {
             self.parts.clear();
             self.parts.resize(ns, GluePartial::default());
             let subs = &d.subs;
-            schemes::root_solve::<D>(
+            schemes::root_solve(
                 &self.per_sub,
                 &mut self.per_sub_out,
                 &mut self.parts,

@@ -153,7 +153,7 @@ const ROOT: u32 = 0;
 /// increments (zero where not updated) and `parts[s]` the residual shares, per
 /// subdomain in slot order (as the decentralized scheme). `meta(s)`: subdomain s's
 /// (`iface_ib`, `iface_k`). Shared by the in-process and the multi-process schemes.
-pub(super) fn root_solve<'m, D: Family>(
+pub(super) fn root_solve<'m>(
     all: &[Vec<f64>],
     out: &mut [Vec<f64>],
     parts: &mut [GluePartial],
@@ -221,7 +221,7 @@ fn centralized<D: Family>(
         t.recv(ROOT, s as u32, a);
     }
     let mut parts = vec![GluePartial::default(); ns];
-    root_solve::<D>(
+    root_solve(
         all,
         out,
         &mut parts,

@@ -3,7 +3,7 @@ pub mod bench;
 pub mod body;
 pub mod contact2;
 pub mod contact3;
-pub mod coupled;
+pub mod family2;
 pub mod mesh;
 pub mod nodes;
 pub mod python;

@@ -66,14 +66,17 @@ pub enum MeshSpec {
     File(String),
 }
 
-/// A 2D scene with deformable bodies: the rigid world, the deformable stage and
-/// the subdomains by model when asked.
+/// A 2D scene with deformable bodies: the rigid world, the deformable stage and,
+/// with a `[decomposition]`, the NSCDD stage that glues the subdomains (the
+/// deformable bodies attached to it as a family, [`crate::family2`]).
 pub struct FeScene2 {
     pub world: World2,
     pub fe: Deformables2,
     pub output: OutputSettings,
-    /// `[decomposition] by_model = true`: the grid (nx, ny) and the settings.
-    pub by_model: Option<crate::coupled::ByModel>,
+    /// The scene's `[decomposition]` (by model and/or by geometry).
+    pub decomposition: Option<nscdd::dd::DdConfig>,
+    /// The NSCDD state, made at the first step from `decomposition`.
+    pub dd: Option<nscdd::dd::Nscdd>,
 }
 
 /// Loads a 2D scene file that may hold `[[deformable]]` entries.
@@ -116,48 +119,25 @@ pub fn load_str(text: &str, file: &str, dir: &Path, registry: &Registry) -> Resu
         world.time.h,
         world.time.theta,
     )?;
-    refuse_unsupported(text, file, decomposition.as_ref(), &output)?;
+    refuse_unsupported(text, file, &output)?;
     let fe = Deformables2::new(bodies, world.alert);
-    let by_model = crate::coupled::ByModel::from_config(decomposition.as_ref());
     Ok(FeScene2 {
         world,
         fe,
         output,
-        by_model,
+        decomposition,
+        dd: None,
     })
 }
 
 /// The settings a scene with deformable bodies cannot use yet, refused (exit 2)
-/// instead of being ignored: a geometric `[decomposition]` without `by_model`, the
-/// NSCDD settings the by-model coordinator does not implement (`scheme`,
-/// `threads`, `sweeps_per_gluing`, `repartition_every` other than their
-/// defaults), and `checkpoint_every`.
-fn refuse_unsupported(text: &str, file: &str, d: Option<&nscdd::dd::DdConfig>, output: &OutputSettings) -> Result<(), InputError> {
+/// instead of being ignored: `checkpoint_every`.
+fn refuse_unsupported(text: &str, file: &str, output: &OutputSettings) -> Result<(), InputError> {
     let at = |keys: &[&str], msg: &str| err(text, file, &keys.iter().map(|k| Seg::Key(k.to_string())).collect::<Vec<_>>(), msg);
     if output.checkpoint_every > 0 {
         return Err(at(
             &["output", "checkpoint_every"],
             "checkpoints of scenes with deformable bodies are not supported yet (their state is not saved); remove it",
-        ));
-    }
-    let Some(d) = d else { return Ok(()) };
-    if !d.by_model {
-        return Err(at(
-            &["decomposition"],
-            "scenes with deformable bodies are split by model: add `by_model = true` (nx, ny then split each model by a grid)",
-        ));
-    }
-    let defaults = nscdd::dd::DdSettings::default();
-    let unsupported = [
-        ("scheme", d.dd.scheme != defaults.scheme),
-        ("threads", d.dd.threads != 1),
-        ("sweeps_per_gluing", d.dd.sweeps_per_gluing != 1),
-        ("repartition_every", d.repartition_every != 1),
-    ];
-    if let Some((key, _)) = unsupported.iter().find(|(_, set)| *set) {
-        return Err(at(
-            &["decomposition", key],
-            "subdomains by model run on one thread with the decentralized scheme, one sweep per gluing and a partition per step for now; remove this key",
         ));
     }
     Ok(())
@@ -220,7 +200,7 @@ pub fn load3_str(text: &str, file: &str, dir: &Path, registry: &Registry) -> Res
             "3D scenes with deformable bodies run in one domain for now (subdomains by model are 2D); remove [decomposition]",
         ));
     }
-    refuse_unsupported(text, file, None, &scene.output)?;
+    refuse_unsupported(text, file, &scene.output)?;
     let world = scene.world;
     let bodies = bodies_from(
         entries,
@@ -393,17 +373,20 @@ pub fn fixed_nodes(m: &Mesh, sides: &[String]) -> Result<Vec<u32>, String> {
 
 impl FeScene2 {
     /// One time step of the rigid bodies and the deformable bodies, contacts solved
-    /// in one domain or by model.
+    /// in one domain or, with a decomposition, by NSCDD.
     pub fn step(&mut self) -> Result<nscdd::engine::StepReport, nscdd::engine::Diverged> {
-        let rep = match self.by_model {
+        if self.dd.is_none() {
+            self.dd = self.decomposition.as_ref().map(|d| d.solver());
+        }
+        let rep = match self.dd.as_mut() {
             None => self.world.step_with(&mut self.fe)?,
-            Some(by) => {
-                let mut c = crate::coupled::Coupled {
-                    fe: &mut self.fe,
-                    by,
-                    egluing: 0.0,
-                };
-                self.world.step_with(&mut c)?
+            Some(dd) => {
+                let r = dd.step_families(&mut self.world, &mut [&mut self.fe])?;
+                nscdd::engine::StepReport {
+                    solve: r.solve,
+                    contacts: r.contacts,
+                    times: r.times,
+                }
             }
         };
         if let Some(e) = self.fe.error.take() {

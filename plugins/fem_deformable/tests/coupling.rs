@@ -76,7 +76,13 @@ fn by_model_subdomains_agree_with_one_domain() {
     let umax = u0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     println!("one domain: disks {p0:?}, umax {umax:e}");
     assert!(umax > 1e-5, "the block must deform: {umax}");
-    for dec in ["[decomposition]\nby_model = true", "[decomposition]\nby_model = true\nnx = 2"] {
+    for dec in [
+        "[decomposition]\nby_model = true",
+        "[decomposition]\nby_model = true\nnx = 2",
+        "[decomposition]\nnx = 2",
+        "[decomposition]\nby_model = true\nnx = 2\nscheme = \"centralized\"",
+        "[decomposition]\nby_model = true\nnx = 2\nsweeps_per_gluing = 3\nrepartition_every = 5",
+    ] {
         let mut s = scene(&foundation(dec, tol));
         let mut ifaces = 0;
         for _ in 0..60 {
@@ -180,20 +186,7 @@ fn non_convergence_is_reported() {
 /// the key, never ignored.
 #[test]
 fn unsupported_settings_are_refused() {
-    let cases = [
-        ("[decomposition]\nnx = 2", "decomposition"),
-        ("[decomposition]\nby_model = true\nthreads = 2", "decomposition.threads"),
-        ("[decomposition]\nby_model = true\nscheme = \"centralized\"", "decomposition.scheme"),
-        (
-            "[decomposition]\nby_model = true\nsweeps_per_gluing = 3",
-            "decomposition.sweeps_per_gluing",
-        ),
-        (
-            "[decomposition]\nby_model = true\nrepartition_every = 5",
-            "decomposition.repartition_every",
-        ),
-        ("[output]\ncheckpoint_every = 10", "output.checkpoint_every"),
-    ];
+    let cases = [("[output]\ncheckpoint_every = 10", "output.checkpoint_every")];
     for (extra, key) in cases {
         let text = foundation(extra, 1e-6);
         let e = match nscdd_fem_deformable::scene::load_str(&text, "t.toml", std::path::Path::new("."), &registry()) {
@@ -203,7 +196,26 @@ fn unsupported_settings_are_refused() {
         assert_eq!(e.key, key, "{e}");
         assert!(e.line.is_some(), "{e}");
     }
-    // the defaults written out are accepted
-    let ok = foundation("[decomposition]\nby_model = true\nthreads = 1\nscheme = \"decentralized\"", 1e-6);
-    assert!(nscdd_fem_deformable::scene::load_str(&ok, "t.toml", std::path::Path::new("."), &registry()).is_ok());
+}
+
+/// The coupled scene on 1 and 2 threads: bitwise the same (subdomains are swept
+/// and glued in parallel, every reduction in subdomain order).
+#[test]
+fn coupled_threads_are_bitwise_identical() {
+    let run = |threads: u32| {
+        let dec = format!("[decomposition]\nby_model = true\nnx = 2\nthreads = {threads}");
+        let mut s = scene(&foundation(&dec, 1e-8));
+        let mut sweeps = Vec::new();
+        for _ in 0..30 {
+            sweeps.push(s.step().unwrap().solve.sweeps);
+        }
+        (
+            s.world.bodies.pos.clone(),
+            s.world.bodies.vel.clone(),
+            s.fe.bodies[0].u.clone(),
+            sweeps,
+        )
+    };
+    let (a, b) = (run(1), run(2));
+    assert_eq!(a, b);
 }

@@ -1,0 +1,81 @@
+//! What an NSCDD step reports, and the per body / per contact view of its
+//! decomposition for outputs.
+
+use super::transport::TransportStats;
+use crate::engine::StageTimes;
+use crate::solver::SolveReport;
+
+/// What one NSCDD step did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DdStepReport {
+    /// `sweeps` counts NLGS sweeps (stages × sweeps_per_gluing); `converged` is both
+    /// criteria; `norms` those of the merged sums; `residual` the natural-map
+    /// residual of the written-back global solution.
+    pub solve: SolveReport,
+    pub stages: u32,
+    pub contacts: usize,
+    /// Subdomains that own at least one contact.
+    pub subdomains: usize,
+    pub interface_bodies: usize,
+    pub links: usize,
+    pub max_multiplicity: u32,
+    /// egluing of the last check (before its gluing) and egluing / QuadWR.
+    pub egluing: f64,
+    pub egluing_rel: f64,
+    /// Which criterion was met last (the one that held the iteration longest).
+    pub prevailing: Prevailing,
+    /// Whether the contact set was re-partitioned over a new grid at this step.
+    pub repartitioned: bool,
+    /// At a repartition: bodies with contacts before and after it whose set of
+    /// subdomains changed (0 between repartitions).
+    pub migrations: usize,
+    /// Messages and values exchanged during the step.
+    pub exchange: TransportStats,
+    pub times: StageTimes,
+}
+
+/// Which stopping criterion was met last in a step: `Nlgs` when the gluing residual
+/// was already below tol at the check before the converged one and the NLGS norms
+/// were not (the contact solve held the iteration), `Gluing` the other way round,
+/// `Both` when both became true at the same check (or at the first check). For a
+/// step that did not converge: the criteria still unmet. `None`: no contacts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Prevailing {
+    #[default]
+    None,
+    Nlgs,
+    Gluing,
+    Both,
+}
+
+impl Prevailing {
+    pub fn name(self) -> &'static str {
+        match self {
+            Prevailing::None => "none",
+            Prevailing::Nlgs => "nlgs",
+            Prevailing::Gluing => "gluing",
+            Prevailing::Both => "both",
+        }
+    }
+    pub(super) fn of(now: (bool, bool), before: Option<(bool, bool)>) -> Self {
+        match (now, before) {
+            ((true, true), Some((true, false))) => Prevailing::Gluing,
+            ((true, true), Some((false, true))) => Prevailing::Nlgs,
+            ((true, true), _) | ((false, false), _) => Prevailing::Both,
+            ((false, true), _) => Prevailing::Nlgs,
+            ((true, false), _) => Prevailing::Gluing,
+        }
+    }
+}
+
+/// Per body and per contact fields of the last step's decomposition, for outputs.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct DdView {
+    /// The subdomain owning most of the body's contacts (ties: the smaller id); −1
+    /// for a body without contacts.
+    pub body_subdomain: Vec<i32>,
+    /// Number of subdomains holding a copy of the body (0: no contacts).
+    pub multiplicity: Vec<u32>,
+    /// Subdomain of each contact of the world's contact set.
+    pub contact_subdomain: Vec<u32>,
+}

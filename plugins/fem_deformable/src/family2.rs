@@ -1,0 +1,181 @@
+//! The 2D deformable bodies as a body family of the NSCDD stage
+//! ([`nscdd::dd::attach`]): subdomains by model and by geometry, glued to the rigid
+//! ones through the framework's one gluing code, with its schemes and threads.
+//!
+//! An entity is a deformable body; its copy in subdomain E holds the body's contact
+//! nodes (the union over the step's contacts, the same list in every copy) with
+//! M̂_E = M̂/m: the copy's block of M̂_E⁻¹ among those nodes is m G, so that its
+//! velocity there is V_E = V_free + m G b_E with b_E = F_Γ,E + H_E r_E. A_ΓE picks
+//! the 2 n values of V_E at the n contact nodes; the gluing moves them by ΔV
+//! (V_E += m G ΔF_Γ = ΔV): the copies of a body go to their mean, and with Σ_E ΔF_Γ,E
+//! = 0 the body's V⁺ = V_free + M̂⁻¹ Σ_E H_E r_E is the one-domain formula
+//! ([`Deformables2::finish_velocities`]). A body touched by the contacts of several
+//! subdomains is thus duplicated whole (each copy solves with M̂/m), not cut into
+//! node sets.
+
+use crate::contact2::*;
+use crate::stage2::{self, Deformables2};
+use nscdd::dd::{Attached, EntityInfo, LocalPart, Rigid2};
+use nscdd::dim::coulomb2 as coulomb;
+use nscdd::dim::d2::Block2;
+use nscdd::engine::ContactStage;
+use nscdd::norms::Sums;
+use nscdd::world::World2;
+use std::any::Any;
+
+/// The deformable bodies' share of one subdomain.
+#[derive(Default)]
+pub struct FePart2 {
+    /// Deformable body of each local entity.
+    fe: Vec<u32>,
+    sets: Vec<NodeSet>,
+    contacts: FeContacts2,
+    /// Index of each local contact in the family's contact set.
+    global: Vec<u32>,
+}
+
+impl LocalPart<Rigid2> for FePart2 {
+    fn len(&self) -> usize {
+        self.contacts.len()
+    }
+    fn entities(&self) -> &[u32] {
+        &self.fe
+    }
+    fn prepare(&mut self, inv: &[[f64; 3]], mult: &[u32]) {
+        for (set, &m) in self.sets.iter_mut().zip(mult) {
+            if m > 1 {
+                let m = m as f64;
+                set.g.iter_mut().for_each(|g| *g *= m);
+            }
+        }
+        let c = &mut self.contacts;
+        for a in 0..c.len() {
+            let (cand, anta, n) = (c.cand[a], c.anta[a], c.frame[a]);
+            let mut wb = self.sets[cand.body as usize].delassus(&cand, n);
+            let wo = match anta {
+                Anta::Rigid { body, arm } => rigid_delassus(n, arm, inv[body as usize]),
+                Anta::Fe(s) => self.sets[s.body as usize].delassus(&s, n),
+            };
+            for q in 0..3 {
+                wb[q] += wo[q];
+            }
+            c.block[a] = Block2 {
+                w: wb,
+                pre: coulomb::precompute(wb, c.target[a].mu),
+            };
+        }
+    }
+    fn warm_start(&mut self, vel: &mut [[f64; 3]], inv: &[[f64; 3]]) {
+        let c = &self.contacts;
+        for a in 0..c.len() {
+            let r = c.r[a];
+            if r != [0.0, 0.0] {
+                stage2::apply(&mut self.sets, vel, inv, c.cand[a], c.anta[a], c.frame[a], r);
+            }
+        }
+    }
+    fn sweep(&mut self, vel: &mut [[f64; 3]], inv: &[[f64; 3]], omega: f64, sums: Option<&mut Sums>) {
+        stage2::sweep(&mut self.contacts, &mut self.sets, vel, inv, omega, sums);
+    }
+    fn entity_velocity(&self, e: usize, out: &mut Vec<f64>) {
+        out.extend(self.sets[e].v.iter().flatten());
+    }
+    fn glue_entity(&mut self, e: usize, dv: &[f64]) {
+        for (v, d) in self.sets[e].v.iter_mut().zip(dv.chunks_exact(2)) {
+            v[0] += d[0];
+            v[1] += d[1];
+        }
+    }
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+}
+
+impl Attached<Rigid2> for Deformables2 {
+    fn after_free_velocity(&mut self, w: &World2) {
+        ContactStage::after_free_velocity(self, w);
+    }
+    fn build(&mut self, w: &mut World2) {
+        Deformables2::build(self, w);
+    }
+    fn points(&self, out: &mut Vec<[f64; 3]>) {
+        out.extend(self.contacts.point.iter().map(|p| [p[0], p[1], 0.0]));
+    }
+    fn n_entities(&self) -> usize {
+        self.bodies.len()
+    }
+    fn entity(&self, e: u32) -> EntityInfo {
+        let n = self.sets[e as usize].len();
+        EntityInfo {
+            dofs: 2 * n as u32,
+            space: 2 * n as u32,
+            rho2: 0.0,
+            weight: 1.0 / n.max(1) as f64,
+        }
+    }
+    fn split(&self, _w: &World2, owner: &[u32], copy: &mut dyn FnMut(u32, u32) -> u32) -> Vec<(u32, Box<dyn LocalPart<Rigid2>>)> {
+        let mut by_sub: Vec<(u32, u32)> = owner.iter().enumerate().map(|(a, &s)| (s, a as u32)).collect();
+        by_sub.sort_unstable();
+        let c = &self.contacts;
+        let mut out: Vec<(u32, Box<dyn LocalPart<Rigid2>>)> = Vec::new();
+        // (subdomain, local id) of each body's last copy made
+        let mut seen = vec![(u32::MAX, 0u32); self.bodies.len()];
+        let mut p = 0;
+        while p < by_sub.len() {
+            let s = by_sub[p].0;
+            let q = p + by_sub[p..].iter().take_while(|x| x.0 == s).count();
+            let mut part = FePart2::default();
+            let mut fid = |part: &mut FePart2, b: u32| -> u32 {
+                let e = &mut seen[b as usize];
+                if e.0 == s {
+                    return e.1;
+                }
+                *e = (s, part.fe.len() as u32);
+                part.fe.push(b);
+                let body = &self.bodies[b as usize];
+                let mut set = self.sets[b as usize].clone();
+                for (kk, &nd) in set.nodes.iter().enumerate() {
+                    set.v[kk] = [body.v_free[2 * nd as usize], body.v_free[2 * nd as usize + 1]];
+                }
+                part.sets.push(set);
+                e.1
+            };
+            for &(_, a) in &by_sub[p..q] {
+                let a = a as usize;
+                let mut cand = c.cand[a];
+                cand.body = fid(&mut part, cand.body);
+                let anta = match c.anta[a] {
+                    Anta::Rigid { body, arm } => Anta::Rigid { body: copy(s, body), arm },
+                    Anta::Fe(mut side) => {
+                        side.body = fid(&mut part, side.body);
+                        Anta::Fe(side)
+                    }
+                };
+                part.contacts.push_from(c, a, cand, anta);
+                part.global.push(a as u32);
+            }
+            out.push((s, Box::new(part)));
+            p = q;
+        }
+        out
+    }
+    fn write_back(&mut self, _w: &mut World2, parts: &[(u32, &dyn LocalPart<Rigid2>)]) {
+        for (_, p) in parts {
+            let Some(p) = p.as_any().downcast_ref::<FePart2>() else { continue };
+            for (l, &g) in p.global.iter().enumerate() {
+                self.contacts.r[g as usize] = p.contacts.r[l];
+            }
+        }
+        self.finish_velocities();
+        // the one-domain sets hold V⁺ at the contact nodes (for the residual)
+        for (bi, set) in self.sets.iter_mut().enumerate() {
+            let b = &self.bodies[bi];
+            for (kk, &nd) in set.nodes.iter().enumerate() {
+                set.v[kk] = [b.v[2 * nd as usize], b.v[2 * nd as usize + 1]];
+            }
+        }
+    }
+    fn residual_parts(&self, w: &World2) -> (f64, f64) {
+        Deformables2::residual_parts(self, &w.bodies.vel)
+    }
+}
