@@ -27,7 +27,14 @@ pub fn check(scene: &Path, reg: &Registry) -> ExitCode {
                     s.world.time.h,
                     s.decomposition.as_ref().map(describe),
                 ),
-                FeScene::D3(s) => (3, s.world.bodies.len(), &s.fe.bodies, s.world.time.steps, s.world.time.h, None),
+                FeScene::D3(s) => (
+                    3,
+                    s.world.bodies.len(),
+                    &s.fe.bodies,
+                    s.world.time.steps,
+                    s.world.time.h,
+                    s.decomposition.as_ref().map(describe),
+                ),
             };
             let nodes: usize = fe.iter().map(|b| b.mesh.n_nodes()).sum();
             println!(
@@ -56,10 +63,13 @@ pub struct Flags<'a> {
 /// "subdomains by model, nx × ny cells" (what `check` says of a decomposition).
 fn describe(d: &nscdd::dd::DdConfig) -> String {
     let by = if d.by_model { "by model and " } else { "" };
+    let grid = if d.dd.nz > 1 {
+        format!("{} × {} × {}", d.dd.nx, d.dd.ny, d.dd.nz)
+    } else {
+        format!("{} × {}", d.dd.nx, d.dd.ny)
+    };
     format!(
-        "subdomains {by}on a {} × {} grid, {} thread(s), {} scheme",
-        d.dd.nx,
-        d.dd.ny,
+        "subdomains {by}on a {grid} grid, {} thread(s), {} scheme",
         d.dd.threads,
         match d.dd.scheme {
             nscdd::dd::Scheme::Decentralized => "decentralized",
@@ -84,27 +94,27 @@ pub fn run(scene: &Path, out: &Path, quiet: bool, reg: &Registry, flags: Flags<'
         );
         return ExitCode::from(2);
     }
-    let dd_flag = [
-        (flags.subdomains.is_some(), "--subdomains"),
-        (flags.scheme.is_some(), "--scheme"),
-        (flags.threads.is_some(), "--threads"),
-    ]
-    .into_iter()
-    .find_map(|(given, f)| given.then_some(f));
+    let apply = |d: &mut Option<nscdd::dd::DdConfig>, movable: usize, dim3: bool| {
+        crate::apply_decomposition_to(d, movable, dim3, flags.subdomains, flags.scheme, flags.threads).map_err(|m| {
+            eprintln!("error: {m}");
+            ExitCode::from(2)
+        })
+    };
     match nscdd_fem_deformable::scene::load_any(scene, reg) {
         Ok(FeScene::D2(mut s)) => {
             let movable = (0..s.world.bodies.len()).filter(|&b| s.world.bodies.movable(b)).count() + s.fe.bodies.len();
-            let d = &mut s.decomposition;
-            if let Err(m) = crate::apply_decomposition_to(d, movable, false, flags.subdomains, flags.scheme, flags.threads) {
-                eprintln!("error: {m}");
-                return ExitCode::from(2);
+            if let Err(code) = apply(&mut s.decomposition, movable, false) {
+                return code;
             }
             run_loaded(&mut s, out, quiet)
         }
-        Ok(FeScene::D3(mut s)) => match dd_flag {
-            Some(f) => refuse(f, "3D scenes with deformable bodies run in one domain"),
-            None => run_loaded(&mut s, out, quiet),
-        },
+        Ok(FeScene::D3(mut s)) => {
+            let movable = (0..s.world.bodies.len()).filter(|&b| s.world.bodies.movable(b)).count() + s.fe.bodies.len();
+            if let Err(code) = apply(&mut s.decomposition, movable, true) {
+                return code;
+            }
+            run_loaded(&mut s, out, quiet)
+        }
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::from(2)

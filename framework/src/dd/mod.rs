@@ -546,3 +546,16 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
         s
     }
 }
+
+/// NSCDD without attached families as a contact stage (`world.step_with(&mut dd)`).
+impl<D: Family> ContactStage<D::World> for NscddOf<D> {
+    fn after_free_velocity(&mut self, w: &D::World) {
+        Stage { dd: self, fams: &mut [] }.after_free_velocity(w);
+    }
+    fn prepare(&mut self, w: &mut D::World) {
+        Stage { dd: self, fams: &mut [] }.prepare(w);
+    }
+    fn solve(&mut self, w: &mut D::World) -> SolveReport {
+        Stage { dd: self, fams: &mut [] }.solve(w)
+    }
+}

@@ -114,50 +114,28 @@ impl Attached<Rigid2> for Deformables2 {
         }
     }
     fn split(&self, _w: &World2, owner: &[u32], copy: &mut dyn FnMut(u32, u32) -> u32) -> Vec<(u32, Box<dyn LocalPart<Rigid2>>)> {
-        let mut by_sub: Vec<(u32, u32)> = owner.iter().enumerate().map(|(a, &s)| (s, a as u32)).collect();
-        by_sub.sort_unstable();
         let c = &self.contacts;
-        let mut out: Vec<(u32, Box<dyn LocalPart<Rigid2>>)> = Vec::new();
-        // (subdomain, local id) of each body's last copy made
-        let mut seen = vec![(u32::MAX, 0u32); self.bodies.len()];
-        let mut p = 0;
-        while p < by_sub.len() {
-            let s = by_sub[p].0;
-            let q = p + by_sub[p..].iter().take_while(|x| x.0 == s).count();
-            let mut part = FePart2::default();
-            let mut fid = |part: &mut FePart2, b: u32| -> u32 {
-                let e = &mut seen[b as usize];
-                if e.0 == s {
-                    return e.1;
-                }
-                *e = (s, part.fe.len() as u32);
-                part.fe.push(b);
-                let body = &self.bodies[b as usize];
-                let mut set = self.sets[b as usize].clone();
-                for (kk, &nd) in set.nodes.iter().enumerate() {
-                    set.v[kk] = [body.v_free[2 * nd as usize], body.v_free[2 * nd as usize + 1]];
-                }
-                part.sets.push(set);
-                e.1
-            };
-            for &(_, a) in &by_sub[p..q] {
+        let make = |p: &mut FePart2, b: u32| p.push_entity(b, self);
+        let parts = split_by(owner, self.bodies.len(), make, |s, part: &mut FePart2, contacts, entity| {
+            for &a in contacts {
                 let a = a as usize;
                 let mut cand = c.cand[a];
-                cand.body = fid(&mut part, cand.body);
+                cand.body = entity(part, cand.body);
                 let anta = match c.anta[a] {
                     Anta::Rigid { body, arm } => Anta::Rigid { body: copy(s, body), arm },
                     Anta::Fe(mut side) => {
-                        side.body = fid(&mut part, side.body);
+                        side.body = entity(part, side.body);
                         Anta::Fe(side)
                     }
                 };
                 part.contacts.push_from(c, a, cand, anta);
                 part.global.push(a as u32);
             }
-            out.push((s, Box::new(part)));
-            p = q;
-        }
-        out
+        });
+        parts
+            .into_iter()
+            .map(|(s, p)| (s, Box::new(p) as Box<dyn LocalPart<Rigid2>>))
+            .collect()
     }
     fn write_back(&mut self, _w: &mut World2, parts: &[(u32, &dyn LocalPart<Rigid2>)]) {
         for (_, p) in parts {
@@ -178,4 +156,57 @@ impl Attached<Rigid2> for Deformables2 {
     fn residual_parts(&self, w: &World2) -> (f64, f64) {
         Deformables2::residual_parts(self, &w.bodies.vel)
     }
+}
+
+impl FePart2 {
+    /// A copy of body `b`: its contact nodes at their free velocity.
+    fn push_entity(&mut self, b: u32, fe: &Deformables2) {
+        self.fe.push(b);
+        let body = &fe.bodies[b as usize];
+        let mut set = fe.sets[b as usize].clone();
+        for (kk, &nd) in set.nodes.iter().enumerate() {
+            set.v[kk] = [body.v_free[2 * nd as usize], body.v_free[2 * nd as usize + 1]];
+        }
+        self.sets.push(set);
+    }
+}
+
+/// The family's contacts grouped by subdomain (ascending; storage order inside):
+/// `fill(s, part, contacts, entity)` fills subdomain s's part, `entity(part, b)`
+/// giving the local id of body b's copy in it, made by `make(part, b)` on first
+/// sight.
+pub fn split_by<P: Default>(
+    owner: &[u32],
+    n_bodies: usize,
+    make: impl Fn(&mut P, u32),
+    mut fill: impl FnMut(u32, &mut P, &[u32], &mut dyn FnMut(&mut P, u32) -> u32),
+) -> Vec<(u32, P)> {
+    let mut by_sub: Vec<(u32, u32)> = owner.iter().enumerate().map(|(a, &s)| (s, a as u32)).collect();
+    by_sub.sort_unstable();
+    let mut out = Vec::new();
+    // (subdomain, local id) of each body's last copy made
+    let mut seen = vec![(u32::MAX, 0u32); n_bodies];
+    let mut contacts = Vec::new();
+    let mut p = 0;
+    while p < by_sub.len() {
+        let s = by_sub[p].0;
+        let q = p + by_sub[p..].iter().take_while(|x| x.0 == s).count();
+        contacts.clear();
+        contacts.extend(by_sub[p..q].iter().map(|x| x.1));
+        let mut part = P::default();
+        let mut made = 0u32;
+        let mut entity = |part: &mut P, b: u32| -> u32 {
+            let e = &mut seen[b as usize];
+            if e.0 != s {
+                *e = (s, made);
+                made += 1;
+                make(part, b);
+            }
+            e.1
+        };
+        fill(s, &mut part, &contacts, &mut entity);
+        out.push((s, part));
+        p = q;
+    }
+    out
 }

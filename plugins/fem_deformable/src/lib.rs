@@ -4,6 +4,7 @@ pub mod body;
 pub mod contact2;
 pub mod contact3;
 pub mod family2;
+pub mod family3;
 pub mod mesh;
 pub mod nodes;
 pub mod python;

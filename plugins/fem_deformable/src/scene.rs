@@ -181,25 +181,21 @@ fn bodies_from(
     Ok(bodies)
 }
 
-/// A 3D scene with deformable bodies: the rigid world and the deformable stage.
+/// A 3D scene with deformable bodies: the rigid world, the deformable stage and,
+/// with a `[decomposition]`, the NSCDD stage ([`crate::family3`]).
 pub struct FeScene3 {
     pub world: World3,
     pub fe: Deformables3,
     pub output: OutputSettings,
+    /// The scene's `[decomposition]` (by model and/or by geometry).
+    pub decomposition: Option<nscdd::dd::DdConfig>,
+    /// The NSCDD state, made at the first step from `decomposition`.
+    pub dd: Option<nscdd::dd::Nscdd3>,
 }
 
 /// Loads a 3D scene (`dimension = 3`) that may hold `[[deformable]]` entries.
-/// Subdomains by model are 2D only for now: asking for them is an input error.
 pub fn load3_str(text: &str, file: &str, dir: &Path, registry: &Registry) -> Result<FeScene3, InputError> {
     let (scene, entries) = nscdd::scene::Scene3::load_str_with(text, file, registry, true)?;
-    if scene.decomposition.is_some() {
-        return Err(err(
-            text,
-            file,
-            &[Seg::Key("decomposition".into())],
-            "3D scenes with deformable bodies run in one domain for now (subdomains by model are 2D); remove [decomposition]",
-        ));
-    }
     refuse_unsupported(text, file, &scene.output)?;
     let world = scene.world;
     let bodies = bodies_from(
@@ -218,6 +214,8 @@ pub fn load3_str(text: &str, file: &str, dir: &Path, registry: &Registry) -> Res
         world,
         fe,
         output: scene.output,
+        decomposition: scene.decomposition,
+        dd: None,
     })
 }
 
@@ -402,9 +400,23 @@ impl FeScene2 {
 }
 
 impl FeScene3 {
-    /// One time step of the rigid bodies and the deformable bodies (one domain).
+    /// One time step of the rigid bodies and the deformable bodies, contacts solved
+    /// in one domain or, with a decomposition, by NSCDD.
     pub fn step(&mut self) -> Result<nscdd::engine::StepReport, nscdd::engine::Diverged> {
-        let rep = self.world.step_with(&mut self.fe)?;
+        if self.dd.is_none() {
+            self.dd = self.decomposition.as_ref().map(|d| d.solver3());
+        }
+        let rep = match self.dd.as_mut() {
+            None => self.world.step_with(&mut self.fe)?,
+            Some(dd) => {
+                let r = dd.step_families(&mut self.world, &mut [&mut self.fe])?;
+                nscdd::engine::StepReport {
+                    solve: r.solve,
+                    contacts: r.contacts,
+                    times: r.times,
+                }
+            }
+        };
         if let Some(e) = self.fe.error.take() {
             return Err(nscdd::engine::Diverged {
                 step: self.world.step,

@@ -1,0 +1,168 @@
+//! The 3D deformable bodies as a body family of the NSCDD stage: the 3D
+//! counterpart of [`crate::family2`] (same entities, copies and gluing; the
+//! contacts' frames are 3D bases and their local problem the 3D Coulomb solver).
+
+use crate::contact3::*;
+use crate::family2::split_by;
+use crate::stage3::{self, Deformables3};
+use nscdd::dd::{Attached, EntityInfo, LocalPart, Rigid3};
+use nscdd::dim::coulomb3 as coulomb;
+use nscdd::dim::d3::{Block3, InvMass3};
+use nscdd::engine::ContactStage;
+use nscdd::norms::Sums;
+use nscdd::world::World3;
+use std::any::Any;
+
+/// The deformable bodies' share of one subdomain.
+#[derive(Default)]
+pub struct FePart3 {
+    /// Deformable body of each local entity.
+    fe: Vec<u32>,
+    sets: Vec<NodeSet3>,
+    contacts: FeContacts3,
+    /// Index of each local contact in the family's contact set.
+    global: Vec<u32>,
+}
+
+impl FePart3 {
+    /// A copy of body `b`: its contact nodes at their free velocity.
+    fn push_entity(&mut self, b: u32, fe: &Deformables3) {
+        self.fe.push(b);
+        let body = &fe.bodies[b as usize];
+        let mut set = fe.sets[b as usize].clone();
+        for (kk, &nd) in set.nodes.iter().enumerate() {
+            let i = 3 * nd as usize;
+            set.v[kk] = [body.v_free[i], body.v_free[i + 1], body.v_free[i + 2]];
+        }
+        self.sets.push(set);
+    }
+}
+
+impl LocalPart<Rigid3> for FePart3 {
+    fn len(&self) -> usize {
+        self.contacts.len()
+    }
+    fn entities(&self) -> &[u32] {
+        &self.fe
+    }
+    fn prepare(&mut self, inv: &[InvMass3], mult: &[u32]) {
+        for (set, &m) in self.sets.iter_mut().zip(mult) {
+            if m > 1 {
+                let m = m as f64;
+                set.g.iter_mut().for_each(|g| *g *= m);
+            }
+        }
+        let c = &mut self.contacts;
+        for a in 0..c.len() {
+            let (cand, anta, basis) = (c.cand[a], c.anta[a], c.frame[a]);
+            let mut wb = project(&basis, &self.sets[cand.body as usize].side_block(&cand));
+            let wo = match anta {
+                Anta3::Rigid { body, d } => {
+                    let im = &inv[body as usize];
+                    rigid_delassus(&basis, d, im.m, &im.i)
+                }
+                Anta3::Fe(s) => project(&basis, &self.sets[s.body as usize].side_block(&s)),
+            };
+            for q in 0..6 {
+                wb[q] += wo[q];
+            }
+            c.block[a] = Block3 {
+                w: wb,
+                pre: coulomb::precompute(&wb),
+            };
+        }
+    }
+    fn warm_start(&mut self, vel: &mut [[f64; 6]], inv: &[InvMass3]) {
+        let c = &self.contacts;
+        for a in 0..c.len() {
+            let r = c.r[a];
+            if r != [0.0; 3] {
+                stage3::apply(&mut self.sets, vel, inv, c.cand[a], c.anta[a], &c.frame[a], r);
+            }
+        }
+    }
+    fn sweep(&mut self, vel: &mut [[f64; 6]], inv: &[InvMass3], omega: f64, sums: Option<&mut Sums>) {
+        stage3::sweep(&mut self.contacts, &mut self.sets, vel, inv, omega, sums);
+    }
+    fn entity_velocity(&self, e: usize, out: &mut Vec<f64>) {
+        out.extend(self.sets[e].v.iter().flatten());
+    }
+    fn glue_entity(&mut self, e: usize, dv: &[f64]) {
+        for (v, d) in self.sets[e].v.iter_mut().zip(dv.chunks_exact(3)) {
+            for q in 0..3 {
+                v[q] += d[q];
+            }
+        }
+    }
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+}
+
+impl Attached<Rigid3> for Deformables3 {
+    fn after_free_velocity(&mut self, w: &World3) {
+        ContactStage::after_free_velocity(self, w);
+    }
+    fn build(&mut self, w: &mut World3) {
+        Deformables3::build(self, w);
+    }
+    fn points(&self, out: &mut Vec<[f64; 3]>) {
+        out.extend_from_slice(&self.contacts.point);
+    }
+    fn n_entities(&self) -> usize {
+        self.bodies.len()
+    }
+    fn entity(&self, e: u32) -> EntityInfo {
+        let n = self.sets[e as usize].len();
+        EntityInfo {
+            dofs: 3 * n as u32,
+            space: 3 * n as u32,
+            rho2: 0.0,
+            weight: 1.0 / n.max(1) as f64,
+        }
+    }
+    fn split(&self, _w: &World3, owner: &[u32], copy: &mut dyn FnMut(u32, u32) -> u32) -> Vec<(u32, Box<dyn LocalPart<Rigid3>>)> {
+        let c = &self.contacts;
+        let make = |p: &mut FePart3, b: u32| p.push_entity(b, self);
+        let parts = split_by(owner, self.bodies.len(), make, |s, part: &mut FePart3, contacts, entity| {
+            for &a in contacts {
+                let a = a as usize;
+                let mut cand = c.cand[a];
+                cand.body = entity(part, cand.body);
+                let anta = match c.anta[a] {
+                    Anta3::Rigid { body, d } => Anta3::Rigid { body: copy(s, body), d },
+                    Anta3::Fe(mut side) => {
+                        side.body = entity(part, side.body);
+                        Anta3::Fe(side)
+                    }
+                };
+                part.contacts.push_from(c, a, cand, anta);
+                part.global.push(a as u32);
+            }
+        });
+        parts
+            .into_iter()
+            .map(|(s, p)| (s, Box::new(p) as Box<dyn LocalPart<Rigid3>>))
+            .collect()
+    }
+    fn write_back(&mut self, _w: &mut World3, parts: &[(u32, &dyn LocalPart<Rigid3>)]) {
+        for (_, p) in parts {
+            let Some(p) = p.as_any().downcast_ref::<FePart3>() else { continue };
+            for (l, &g) in p.global.iter().enumerate() {
+                self.contacts.r[g as usize] = p.contacts.r[l];
+            }
+        }
+        self.finish_velocities();
+        // the one-domain sets hold V⁺ at the contact nodes (for the residual)
+        for (bi, set) in self.sets.iter_mut().enumerate() {
+            let b = &self.bodies[bi];
+            for (kk, &nd) in set.nodes.iter().enumerate() {
+                let i = 3 * nd as usize;
+                set.v[kk] = [b.v[i], b.v[i + 1], b.v[i + 2]];
+            }
+        }
+    }
+    fn residual_parts(&self, w: &World3) -> (f64, f64) {
+        Deformables3::residual_parts(self, &w.bodies.vel)
+    }
+}
