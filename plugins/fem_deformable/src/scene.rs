@@ -29,11 +29,15 @@ use crate::mesh::Mesh;
 use crate::python;
 use crate::stage2::Deformables2;
 use crate::stage3::Deformables3;
+use nscdd::dd::{Attached, DdConfig, NscddOf, Rigid};
+use nscdd::dim::{Dim, D2, D3};
+use nscdd::engine::{ContactStage, Diverged, StepReport};
 use nscdd::error::InputError;
 use nscdd::registry::Registry;
 use nscdd::scene::locate::{locate, path_string, Seg};
 use nscdd::scene::{OutputSettings, Scene};
 use nscdd::world::Material;
+use nscdd::world::World;
 use nscdd::world::World2;
 use nscdd::world::World3;
 use serde::Deserialize;
@@ -369,62 +373,76 @@ pub fn fixed_nodes(m: &Mesh, sides: &[String]) -> Result<Vec<u32>, String> {
     Ok(out)
 }
 
-impl FeScene2 {
-    /// One time step of the rigid bodies and the deformable bodies, contacts solved
-    /// in one domain or, with a decomposition, by NSCDD.
-    pub fn step(&mut self) -> Result<nscdd::engine::StepReport, nscdd::engine::Diverged> {
-        if self.dd.is_none() {
-            self.dd = self.decomposition.as_ref().map(|d| d.solver());
-        }
-        let rep = match self.dd.as_mut() {
-            None => self.world.step_with(&mut self.fe)?,
-            Some(dd) => {
-                let r = dd.step_families(&mut self.world, &mut [&mut self.fe])?;
-                nscdd::engine::StepReport {
-                    solve: r.solve,
-                    contacts: r.contacts,
-                    times: r.times,
-                }
+/// What a time step needs of the deformable stage of either dimension
+/// ([`Deformables2`], [`Deformables3`]).
+pub trait FeStage<D: Dim>: ContactStage<World<D>> + Attached<Rigid<D>> + Sized {
+    /// A failure inside the step (a refactorization).
+    fn take_error(&mut self) -> Option<String>;
+    /// u⁺ = u⁻ + h((1 − θ)V⁻ + θV⁺).
+    fn update(&mut self, h: f64, theta: f64, step: u64) -> Result<(), Diverged>;
+}
+
+impl FeStage<D2> for Deformables2 {
+    fn take_error(&mut self) -> Option<String> {
+        self.error.take()
+    }
+    fn update(&mut self, h: f64, theta: f64, step: u64) -> Result<(), Diverged> {
+        Deformables2::update(self, h, theta, step)
+    }
+}
+
+impl FeStage<D3> for Deformables3 {
+    fn take_error(&mut self) -> Option<String> {
+        self.error.take()
+    }
+    fn update(&mut self, h: f64, theta: f64, step: u64) -> Result<(), Diverged> {
+        Deformables3::update(self, h, theta, step)
+    }
+}
+
+/// One time step of the rigid bodies and the deformable bodies, contacts solved in
+/// one domain or, with a decomposition, by NSCDD (its state made at the first step).
+pub fn step_scene<D: Dim, S: FeStage<D>>(
+    world: &mut World<D>,
+    fe: &mut S,
+    decomposition: Option<&DdConfig>,
+    dd: &mut Option<NscddOf<Rigid<D>>>,
+) -> Result<StepReport, Diverged> {
+    if dd.is_none() {
+        *dd = decomposition.map(|d| d.solver_of());
+    }
+    let rep = match dd.as_mut() {
+        None => world.step_with(fe)?,
+        Some(dd) => {
+            let r = dd.step_families(world, &mut [fe as &mut dyn Attached<Rigid<D>>])?;
+            StepReport {
+                solve: r.solve,
+                contacts: r.contacts,
+                times: r.times,
             }
-        };
-        if let Some(e) = self.fe.error.take() {
-            return Err(nscdd::engine::Diverged {
-                step: self.world.step,
-                body: 0,
-                message: e,
-            });
         }
-        self.fe.update(self.world.time.h, self.world.time.theta, self.world.step)?;
-        Ok(rep)
+    };
+    if let Some(e) = fe.take_error() {
+        return Err(Diverged {
+            step: world.step,
+            body: 0,
+            message: e,
+        });
+    }
+    fe.update(world.time.h, world.time.theta, world.step)?;
+    Ok(rep)
+}
+
+impl FeScene2 {
+    /// One time step ([`step_scene`]).
+    pub fn step(&mut self) -> Result<StepReport, Diverged> {
+        step_scene(&mut self.world, &mut self.fe, self.decomposition.as_ref(), &mut self.dd)
     }
 }
 
 impl FeScene3 {
-    /// One time step of the rigid bodies and the deformable bodies, contacts solved
-    /// in one domain or, with a decomposition, by NSCDD.
-    pub fn step(&mut self) -> Result<nscdd::engine::StepReport, nscdd::engine::Diverged> {
-        if self.dd.is_none() {
-            self.dd = self.decomposition.as_ref().map(|d| d.solver3());
-        }
-        let rep = match self.dd.as_mut() {
-            None => self.world.step_with(&mut self.fe)?,
-            Some(dd) => {
-                let r = dd.step_families(&mut self.world, &mut [&mut self.fe])?;
-                nscdd::engine::StepReport {
-                    solve: r.solve,
-                    contacts: r.contacts,
-                    times: r.times,
-                }
-            }
-        };
-        if let Some(e) = self.fe.error.take() {
-            return Err(nscdd::engine::Diverged {
-                step: self.world.step,
-                body: 0,
-                message: e,
-            });
-        }
-        self.fe.update(self.world.time.h, self.world.time.theta, self.world.step)?;
-        Ok(rep)
+    /// One time step ([`step_scene`]).
+    pub fn step(&mut self) -> Result<StepReport, Diverged> {
+        step_scene(&mut self.world, &mut self.fe, self.decomposition.as_ref(), &mut self.dd)
     }
 }
