@@ -102,15 +102,14 @@ pub fn run(scene: &Path, out: &Path, quiet: bool, reg: &Registry, flags: Flags<'
     };
     match nscdd_fem_deformable::scene::load_any(scene, reg) {
         Ok(FeScene::D2(mut s)) => {
-            let movable = (0..s.world.bodies.len()).filter(|&b| s.world.bodies.movable(b)).count() + s.fe.bodies.len();
-            if let Err(code) = apply(&mut s.decomposition, movable, false) {
+            // a deformable body may be copied into any number of subdomains: no bound
+            if let Err(code) = apply(&mut s.decomposition, usize::MAX, false) {
                 return code;
             }
             run_loaded(&mut s, out, quiet)
         }
         Ok(FeScene::D3(mut s)) => {
-            let movable = (0..s.world.bodies.len()).filter(|&b| s.world.bodies.movable(b)).count() + s.fe.bodies.len();
-            if let Err(code) = apply(&mut s.decomposition, movable, true) {
+            if let Err(code) = apply(&mut s.decomposition, usize::MAX, true) {
                 return code;
             }
             run_loaded(&mut s, out, quiet)

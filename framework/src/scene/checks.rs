@@ -165,6 +165,8 @@ pub(crate) fn decomposition(cx: &Ctx, d: &schema::DecompositionSpec, movable: us
     if let Some(s) = &d.scheme {
         c.dd.scheme = parse_scheme(s).map_err(|m| cx.err(&p("scheme"), m))?;
     }
+    // a deformable body may be copied into any number of subdomains: no bound then
+    let movable = if cx.deformable { usize::MAX } else { movable };
     c.check_capacity(movable).map_err(|(key, m)| {
         // name a key the section has
         let key = match (d.nx.is_some(), d.ny.is_some(), d.nz.is_some()) {
