@@ -461,7 +461,7 @@ impl<D: Family> NscddOf<D> {
             let (a, b) = fam.residual_parts(w);
             (f2, q2) = (f2 + a, q2 + b);
         }
-        rep.solve.residual = if q2 == 0.0 { f2.sqrt() } else { (f2 / q2).sqrt() };
+        rep.solve.residual = crate::solver::nlgs::residual_of(f2, q2);
     }
 }
 

@@ -178,6 +178,12 @@ pub fn solve<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMas
 /// shifted by the law's target (u_n − ū) and q the shifted free velocity.
 pub fn residual<D: Dim>(c: &Contacts<D>, vel: &[D::Twist]) -> f64 {
     let (f2, q2) = residual_parts(c, vel);
+    residual_of(f2, q2)
+}
+
+/// ‖F(r)‖/‖q‖ from the squared sums of [`residual_parts`] (added over the problems
+/// that make up a step): ‖F(r)‖ alone when q vanishes.
+pub fn residual_of(f2: f64, q2: f64) -> f64 {
     if q2 == 0.0 {
         f2.sqrt()
     } else {

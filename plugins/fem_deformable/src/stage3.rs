@@ -228,12 +228,7 @@ impl Deformables3 {
     pub fn residual(&self, w: &World3) -> f64 {
         let (f1, q1) = nlgs::residual_parts(&w.contacts, &w.bodies.vel);
         let (f2, q2) = self.residual_parts(&w.bodies.vel);
-        let (f, q) = (f1 + f2, q1 + q2);
-        if q == 0.0 {
-            f.sqrt()
-        } else {
-            (f / q).sqrt()
-        }
+        nlgs::residual_of(f1 + f2, q1 + q2)
     }
 
     /// (‖F(r)‖², ‖q‖²) of the deformable contacts.
