@@ -18,12 +18,16 @@ pub struct Flags<'a> {
 /// Runs a loaded scene with the command line's decomposition flags (as one of
 /// `ranks`).
 pub fn run<D: Dim>(mut s: Scene<D>, reg: &Registry, scene: &Path, out: &Path, quiet: bool, f: Flags<'_>, ranks: &Ranks) -> ExitCode {
-    let movable = (0..s.world.bodies.len()).filter(|&b| s.world.bodies.movable(b)).count();
+    // a family's body (a deformable one) may be copied into any number of subdomains
+    let movable = match s.families.is_empty() {
+        true => (0..s.world.bodies.len()).filter(|&b| s.world.bodies.movable(b)).count(),
+        false => usize::MAX,
+    };
     let flags = crate::apply_decomposition_to(&mut s.decomposition, movable, D::N == 3, f.subdomains, f.scheme, f.threads).and_then(|()| {
         match f.restart {
             Some(state) => {
                 crate::check_restart_dir(out, state)?;
-                nscdd::scene::restart(&mut s.world, state).map_err(|e| e.to_string())
+                nscdd::scene::restart_scene(&mut s, state).map_err(|e| e.to_string())
             }
             None => Ok(()),
         }

@@ -223,33 +223,99 @@ fn restart_continues_and_never_overwrites_its_own_run() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// A scene with deformable bodies refuses what it cannot run yet (a restart, MPI
-/// ranks) with exit 2 and a message naming it, before running; a bad flag too.
+/// A scene with deformable bodies refuses what it cannot do yet (export-fc: their
+/// W is not assembled in local form) and a bad flag, with exit 2 and a message
+/// naming it; a restart from a state of another scene (a rigid one) too.
 #[cfg(feature = "fem")]
 #[test]
 fn deformable_scenes_refuse_what_they_cannot_run() {
     let dir = common::scratch("fe_refusals");
     let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/scenes/foundation.toml");
     let scene3 = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/scenes/foundation3d.toml");
+    let rigid = dir.join("rigid.toml");
+    let text = "[time]\nstep = 1e-3\nsteps = 2\n[[materials]]\nname = \"m\"\ndensity = 1000.0\n[[bodies]]\nshape = \"disk\"\nmaterial = \"m\"\nradius = 0.1\nposition = [0.0, 0.0]\n";
+    std::fs::write(&rigid, text).unwrap();
     let out = dir.join("out");
-    let cases: [(&str, &[&str], &str, &str); 4] = [
-        (scene, &["--restart", "x.json"], "", "--restart"),
-        (scene, &[], "2", "MPI ranks"),
-        (scene3, &["--restart", "x.json"], "", "--restart"),
-        (scene3, &["--threads", "0"], "", "--threads"),
+    // a rigid scene's state
+    let state = dir.join("rigid");
+    let o = std::process::Command::new(common::BIN)
+        .arg("run")
+        .arg(&rigid)
+        .args(["--quiet", "--out"])
+        .arg(&state)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let state = state.join("final.json");
+    let cases: [(&str, Vec<&str>, &str); 3] = [
+        (scene3, vec!["run", scene3, "--threads", "0"], "--threads"),
+        (scene, vec!["export-fc", scene, "--steps", "1"], "export-fc"),
+        (
+            scene,
+            vec!["run", scene, "--restart", state.to_str().unwrap()],
+            "the scene that wrote it",
+        ),
     ];
-    for (scene, flags, ranks, said) in cases {
+    for (_, args, said) in cases {
         let mut cmd = std::process::Command::new(common::BIN);
-        cmd.args(["run", scene, "--quiet", "--out"]).arg(&out).args(flags);
-        if !ranks.is_empty() {
-            cmd.env("OMPI_COMM_WORLD_SIZE", ranks);
+        cmd.args(&args).arg("--out").arg(&out);
+        if args[0] == "run" {
+            cmd.arg("--quiet");
         }
         let o = cmd.output().unwrap();
         let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{flags:?}: {err}");
-        assert!(err.contains(said), "{flags:?}: {err}");
-        assert!(!out.join("history.csv").exists(), "{flags:?} ran");
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(said), "{args:?}: {err}");
+        assert!(!out.join("history.csv").exists(), "{args:?} ran");
     }
+}
+
+/// A deformable scene run by model on 2 subdomains, stopped at step 20 and restarted
+/// from its final.json (the deformable bodies' and NSCDD's states in it) to step
+/// 40: bitwise the final state of the uninterrupted run; a checkpoint too.
+#[cfg(feature = "fem")]
+#[test]
+fn deformable_scenes_restart_bitwise() {
+    let dir = common::scratch("fe_restart");
+    let src = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/scenes/foundation.toml")).unwrap();
+    let whole = dir.join("whole.toml");
+    std::fs::write(
+        &whole,
+        src.replace("duration = 0.5", "steps = 40")
+            .replace("[output]\n", "[output]\ncheckpoint_every = 20\nvtk = false\n"),
+    )
+    .unwrap();
+    let first = dir.join("first.toml");
+    std::fs::write(
+        &first,
+        src.replace("duration = 0.5", "steps = 20")
+            .replace("[output]\n", "[output]\nvtk = false\n"),
+    )
+    .unwrap();
+    let run = |scene: &std::path::Path, name: &str, flags: &[&str]| {
+        let out = dir.join(name);
+        let o = std::process::Command::new(common::BIN)
+            .arg("run")
+            .arg(scene)
+            .args(["--quiet", "--out"])
+            .arg(&out)
+            .args(flags)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0), "{flags:?}: {}", String::from_utf8_lossy(&o.stderr));
+        out
+    };
+    let a = run(&whole, "whole", &[]);
+    let b = run(&first, "first", &[]);
+    let from = b.join("final.json");
+    let c = run(&whole, "second", &["--restart", from.to_str().unwrap()]);
+    let fin = |d: &std::path::Path| std::fs::read_to_string(d.join("final.json")).unwrap();
+    assert!(fin(&a) == fin(&c), "the restarted run ends elsewhere");
+    let ck = std::fs::read_to_string(a.join("checkpoint.json")).unwrap();
+    assert!(
+        ck.contains("\"deformable\"") && ck.contains("\"nscdd\""),
+        "the checkpoint holds the family's and NSCDD's states"
+    );
 }
 
 /// A 2D scene with deformable bodies takes the NSCDD flags: `--threads 2` gives

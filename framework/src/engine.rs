@@ -79,7 +79,7 @@ impl<D: Dim> World<D> {
 
     /// Advances the scene by one step with the given contact-solve stage (NLGS or
     /// NSCDD).
-    pub fn step_with(&mut self, stage: &mut impl ContactStage<World<D>>) -> Result<StepReport, Diverged> {
+    pub fn step_with<S: ContactStage<World<D>> + ?Sized>(&mut self, stage: &mut S) -> Result<StepReport, Diverged> {
         let mut rep = StepReport::default();
         let t0 = Instant::now();
         free_velocity(self);

@@ -4,7 +4,8 @@
 //! over the dimension trait [`dim::Dim`]: bodies and contacts ([`model`]), the
 //! Moreau–Jean time step ([`engine`], [`step`]), contact detection driven by plugins' narrow phases ([`detect`],
 //! [`registry`]), contact laws ([`law`]), the NLGS solver and LMGC90's convergence
-//! norms ([`solver::nlgs`], [`norms`]), scene files ([`scene`]), outputs
+//! norms ([`solver::nlgs`], [`norms`]), body families beside the rigid bodies
+//! ([`family`], glued by [`dd`]), scene files ([`scene`]), outputs
 //! ([`output`]) and frictional-contact problems in local form ([`fc`]).
 //! It never names a plugin: shapes, detectors and generators come from plugins
 //! through the [`registry::Registry`].
@@ -29,6 +30,7 @@ pub mod dim;
 pub mod drive;
 pub mod engine;
 pub mod error;
+pub mod family;
 pub mod fc;
 pub mod law;
 pub mod model;

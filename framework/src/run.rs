@@ -4,7 +4,8 @@
 use crate::dd::{NscddOf, Rigid};
 use crate::dim::Dim;
 use crate::engine::StepReport;
-use crate::output::{final_json, history::History};
+use crate::family::SceneFamily;
+use crate::output::{final_json_with, history::History};
 use crate::registry::{Registry, Writer};
 use crate::scene::Scene;
 use crate::world::World;
@@ -140,8 +141,16 @@ pub(crate) fn write_rank_totals<D: crate::dd::Family>(dd: &mut Option<crate::dd:
     Ok(())
 }
 
-fn save_state<D: Dim>(dir: &Path, name: &str, w: &World<D>) -> Result<(), RunError> {
-    save_state_text(dir, name, &final_json(w))
+fn save_state<D: Dim>(
+    dir: &Path,
+    name: &str,
+    w: &World<D>,
+    families: &[Box<dyn SceneFamily<D>>],
+    dd: &Option<NscddOf<Rigid<D>>>,
+) -> Result<(), RunError> {
+    let states = (!families.is_empty()).then(|| crate::family::states(families));
+    let dd = dd.as_ref().and_then(|n| n.save_state());
+    save_state_text(dir, name, &final_json_with(w, states.as_ref(), dd.as_ref()))
 }
 
 /// Runs `scene` for its number of steps, writing `history.csv`, the writers' frames
@@ -178,7 +187,9 @@ fn writers<D: Dim>(scene: &Scene<D>, registry: &Registry, root: bool) -> Vec<Box
 
 /// [`run`], as one rank of a multi-process run when `cluster` is given: every rank
 /// steps the whole world and sweeps its subdomains ([`crate::dd::ranks`]); rank 0
-/// writes the outputs (the same files as one process, and `ranks.json`).
+/// writes the outputs (the same files as one process, and `ranks.json`). A scene's
+/// body families ([`crate::family`]) step with the world, add their history columns
+/// and VTK frames, and save their state in `final.json` and the checkpoints.
 pub fn run_on<D: Dim>(
     scene: &mut Scene<D>,
     registry: &Registry,
@@ -188,41 +199,61 @@ pub fn run_on<D: Dim>(
 ) -> Result<RunSummary, RunError> {
     let start = Instant::now();
     let root = cluster.as_ref().is_none_or(|c| c.rank() == 0);
-    // a decomposed run steps with NSCDD; outputs take its report and view
-    let mut dd: Option<NscddOf<Rigid<D>>> = dd_solver(scene.decomposition.as_ref(), cluster)?;
+    if !scene.families.is_empty() && cluster.as_ref().is_some_and(|c| c.size() > 1) {
+        return Err(RunError::Ranks(format!(
+            "scenes with body families (`{}`) run in one process for now: run without mpirun (use --threads)",
+            scene.families[0].section()
+        )));
+    }
+    // a decomposed run steps with NSCDD (and a scene whose families need it on one
+    // subdomain); outputs take its report and view
+    let one = crate::dd::DdConfig::default();
+    let dd_config = scene
+        .decomposition
+        .as_ref()
+        .or(crate::family::needs_nscdd(false, &mut scene.families).then_some(&one));
+    let mut dd: Option<NscddOf<Rigid<D>>> = dd_solver(dd_config, cluster)?;
+    // a restarted run of the same decomposition continues its F_Γ
+    if let (Some(n), Some(state)) = (dd.as_mut(), scene.dd_state.take()) {
+        n.load_state(&state)
+            .map_err(|m| RunError::Ranks(format!("the restart file's `nscdd` state: {m}")))?;
+    }
     let mut writers = writers(scene, registry, root);
+    let fams = &mut scene.families;
     let w = &mut scene.world;
-    let mut hist = History::with_columns(history_sink(dir, root)?, w, dd.is_some()).map_err(io(dir, "history.csv"))?;
+    let columns: Vec<String> = fams.iter().flat_map(|f| f.history_columns()).collect();
+    let mut hist = History::with_columns(history_sink(dir, root)?, w, dd.is_some(), &columns).map_err(io(dir, "history.csv"))?;
+    let vtk = scene.output.vtk && root;
     let mut frame = 0u32;
-    let write_frame =
-        |writers: &mut Vec<Box<dyn Writer<D>>>, w: &World<D>, dd: &Option<NscddOf<Rigid<D>>>, frame: u32| -> std::io::Result<()> {
-            let view = dd.as_ref().map(|n| n.view(w));
-            for wr in writers.iter_mut() {
-                match &view {
-                    Some(v) => wr.write_dd(w, v, dir, frame)?,
-                    None => wr.write(w, dir, frame)?,
-                }
+    let write_frame = |writers: &mut Vec<Box<dyn Writer<D>>>,
+                       fams: &mut [Box<dyn SceneFamily<D>>],
+                       w: &World<D>,
+                       dd: &Option<NscddOf<Rigid<D>>>,
+                       frame: u32|
+     -> std::io::Result<()> {
+        let view = dd.as_ref().map(|n| n.view(w));
+        for wr in writers.iter_mut() {
+            match &view {
+                Some(v) => wr.write_dd(w, v, dir, frame)?,
+                None => wr.write(w, dir, frame)?,
             }
-            Ok(())
-        };
-    write_frame(&mut writers, w, &dd, frame).map_err(io(dir, "the first output frame"))?;
+        }
+        if vtk {
+            for f in fams.iter_mut() {
+                f.write_frame(dir, frame, w.t)?;
+            }
+        }
+        Ok(())
+    };
+    write_frame(&mut writers, fams, w, &dd, frame).map_err(io(dir, "the first output frame"))?;
     frame += 1;
     let mut sum = RunSummary::default();
     let steps = w.time.steps;
+    let mut values = vec![];
     // a restarted world continues from its saved step
     for s in (w.step + 1)..=steps {
-        let stepped = match &mut dd {
-            Some(n) => n.step(w).map(|r| {
-                let plain = StepReport {
-                    solve: r.solve,
-                    contacts: r.contacts,
-                    times: r.times,
-                };
-                (plain, Some(r))
-            }),
-            None => w.step().map(|r| (r, None)),
-        };
-        let (rep, dd_rep) = match stepped {
+        let mut refs: Vec<&mut dyn SceneFamily<D>> = fams.iter_mut().map(|f| &mut **f).collect();
+        let (rep, dd_rep) = match crate::family::step(w, &mut refs, dd.as_mut()) {
             Ok(r) => r,
             Err(d) => {
                 let _ = hist.flush();
@@ -231,15 +262,18 @@ pub fn run_on<D: Dim>(
         };
         let t0 = Instant::now();
         if (scene.output.every > 0 && s % scene.output.every == 0) || s == steps {
-            write_frame(&mut writers, w, &dd, frame).map_err(io(dir, "an output frame"))?;
+            write_frame(&mut writers, fams, w, &dd, frame).map_err(io(dir, "an output frame"))?;
             frame += 1;
             hist.flush().map_err(io(dir, "history.csv"))?;
         }
         let t_out = t0.elapsed().as_secs_f64();
-        hist.row_dd(w, &rep, dd_rep.as_ref(), t_out).map_err(io(dir, "history.csv"))?;
+        values.clear();
+        fams.iter().for_each(|f| f.history_values(&mut values));
+        hist.row_dd(w, &rep, dd_rep.as_ref(), t_out, &values)
+            .map_err(io(dir, "history.csv"))?;
         if root && scene.output.checkpoint_every > 0 && s % scene.output.checkpoint_every == 0 && s != steps {
             hist.flush().map_err(io(dir, "history.csv"))?;
-            save_state(dir, "checkpoint.json", w)?;
+            save_state(dir, "checkpoint.json", w, fams, &dd)?;
         }
         if let Some(r) = &dd_rep {
             sum.migrations += r.migrations as u64;
@@ -251,9 +285,14 @@ pub fn run_on<D: Dim>(
     for wr in writers.iter_mut() {
         wr.finish(dir).map_err(io(dir, "the output series"))?;
     }
+    if vtk {
+        for f in fams.iter_mut() {
+            f.finish(dir).map_err(io(dir, "the output series"))?;
+        }
+    }
     write_rank_totals(&mut dd, dir)?;
     if root {
-        save_state(dir, "final.json", w)?;
+        save_state(dir, "final.json", w, fams, &dd)?;
     }
     sum.wall_seconds = start.elapsed().as_secs_f64();
     Ok(sum)

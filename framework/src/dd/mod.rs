@@ -53,6 +53,7 @@ mod rank_link;
 pub mod ranks;
 mod report;
 pub mod schemes;
+mod state;
 pub mod subdomain;
 pub mod team;
 pub mod transport;

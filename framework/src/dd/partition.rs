@@ -15,7 +15,7 @@ use crate::model::ContactKey;
 
 /// The grid of subdomains over the contact points' bounding box (nz = 1 in 2D,
 /// whose points have z = 0).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Grid {
     pub nx: u32,
     pub ny: u32,
@@ -150,6 +150,11 @@ impl<V: Copy> FGammaStore<V> {
     }
     /// Replaces the store by the subdomains' current F_Γ (rigid copies; the attached
     /// families' start from zero at every step).
+    /// A store of the entries (body, subdomain, F_Γ) in any order (a saved state).
+    pub fn from_entries(mut entries: Vec<(u32, u32, V)>) -> Self {
+        entries.sort_unstable_by_key(|e| (e.0, e.1));
+        FGammaStore { entries }
+    }
     pub fn keep<D: Family<V = V>>(&mut self, subs: &[Subdomain<D>]) {
         self.entries.clear();
         for s in subs {

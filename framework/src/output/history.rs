@@ -57,11 +57,12 @@ fn body_columns(n: usize) -> Vec<&'static str> {
 
 impl<W: Write, D: Dim> History<W, D> {
     pub fn new(out: W, w: &World<D>) -> std::io::Result<Self> {
-        Self::with_columns(out, w, false)
+        Self::with_columns(out, w, false, &[])
     }
 
-    /// With `dd`, the NSCDD columns [`DD_COLUMNS`] follow the timings.
-    pub fn with_columns(mut out: W, w: &World<D>, dd: bool) -> std::io::Result<Self> {
+    /// With `dd`, the NSCDD columns [`DD_COLUMNS`] follow the timings; `extra`
+    /// columns (the body families') come last.
+    pub fn with_columns(mut out: W, w: &World<D>, dd: bool, extra: &[String]) -> std::io::Result<Self> {
         let mut tracked: Vec<(u32, String)> = vec![];
         for b in 0..w.bodies.len() {
             let driven = w.drives.iter().any(|d| d.body as usize == b);
@@ -92,6 +93,10 @@ impl<W: Write, D: Dim> History<W, D> {
                 head.push_str(c);
             }
         }
+        for c in extra {
+            head.push(',');
+            head.push_str(c);
+        }
         writeln!(out, "{head}")?;
         let margin = 4.0 * w.max_grain_size();
         Ok(History {
@@ -105,12 +110,12 @@ impl<W: Write, D: Dim> History<W, D> {
     }
 
     pub fn row(&mut self, w: &World<D>, r: &StepReport, t_output: f64) -> std::io::Result<()> {
-        self.row_dd(w, r, None, t_output)
+        self.row_dd(w, r, None, t_output, &[])
     }
 
     /// A row; `dd` fills the NSCDD columns (empty when the history has them and
-    /// `dd` is `None`).
-    pub fn row_dd(&mut self, w: &World<D>, r: &StepReport, dd: Option<&DdStepReport>, t_output: f64) -> std::io::Result<()> {
+    /// `dd` is `None`), `extra` the extra columns.
+    pub fn row_dd(&mut self, w: &World<D>, r: &StepReport, dd: Option<&DdStepReport>, t_output: f64, extra: &[f64]) -> std::io::Result<()> {
         let (ek, ep) = w.energies();
         let mut s = solver_fields(w.step, w.t, w.bodies.len(), r, ek, ep);
         let h = w.time.h;
@@ -135,6 +140,9 @@ impl<W: Write, D: Dim> History<W, D> {
         ));
         if self.dd {
             s.push_str(&dd_fields(dd));
+        }
+        for x in extra {
+            s.push_str(&format!(",{x:e}"));
         }
         writeln!(self.out, "{s}")
     }

@@ -68,6 +68,12 @@ struct FinalOut<'a, D: Dim> {
     box_h0: Option<f64>,
     bodies: Vec<BodyOut<'a, D>>,
     contacts: Vec<ContactOut<D>>,
+    /// The body families' states, by section ([`crate::family::SceneFamily::save_state`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    families: Option<&'a serde_json::Map<String, serde_json::Value>>,
+    /// The NSCDD solver's state ([`crate::dd::NscddOf::save_state`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    nscdd: Option<&'a serde_json::Value>,
 }
 
 /// The state as `final.json`: the dimension, step, time, `box_h0` (the box height
@@ -78,6 +84,16 @@ struct FinalOut<'a, D: Dim> {
 /// `impulse` in world axes (N·s), gap (m), `bonded` for an intact joint). It is
 /// also a restart file ([`crate::scene::restart`]).
 pub fn final_json<D: Dim>(w: &World<D>) -> String {
+    final_json_with(w, None, None)
+}
+
+/// [`final_json`] with the body families' states under `families` (by section) and
+/// the NSCDD solver's under `nscdd`.
+pub fn final_json_with<D: Dim>(
+    w: &World<D>,
+    families: Option<&serde_json::Map<String, serde_json::Value>>,
+    nscdd: Option<&serde_json::Value>,
+) -> String {
     let b = &w.bodies;
     let bodies = (0..b.len())
         .map(|k| {
@@ -116,6 +132,8 @@ pub fn final_json<D: Dim>(w: &World<D>) -> String {
         box_h0: w.box_h0,
         bodies,
         contacts,
+        families,
+        nscdd,
     })
     .expect("plain data serializes");
     s.push('\n');

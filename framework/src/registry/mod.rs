@@ -2,7 +2,8 @@
 //!
 //! A [`Plugin`] registers, by name, shape kinds (each with its own struct-of-arrays
 //! store), pair detectors keyed by the pair of shape kinds, body generators, contact
-//! laws and writers. The framework names no plugin: scenes refer to these names, and
+//! laws, writers and body families ([`crate::family`]: a scene section of their own).
+//! The framework names no plugin: scenes refer to these names, and
 //! [`crate::scene`] resolves them once at load time; a pair of shape kinds that can
 //! meet in a scene but has no detector is an error then. After setup the time loop
 //! holds concrete data; detectors are called once per batch of candidate pairs, never
@@ -21,6 +22,7 @@
 //! ```
 
 use crate::dim::{Dim, D2, D3};
+use crate::family::FamilyKind;
 use crate::law::LawDef;
 pub mod builder;
 pub mod limits;
@@ -50,6 +52,7 @@ pub struct Tables<D: Dim> {
     pub(crate) detectors: BTreeMap<(&'static str, &'static str), Arc<dyn PairDetector<D>>>,
     pub(crate) generators: BTreeMap<&'static str, Box<dyn Generator<D>>>,
     pub(crate) writers: BTreeMap<&'static str, fn() -> Box<dyn Writer<D>>>,
+    pub(crate) families: BTreeMap<&'static str, Box<dyn FamilyKind<D>>>,
 }
 
 impl<D: Dim> Default for Tables<D> {
@@ -59,6 +62,7 @@ impl<D: Dim> Default for Tables<D> {
             detectors: BTreeMap::new(),
             generators: BTreeMap::new(),
             writers: BTreeMap::new(),
+            families: BTreeMap::new(),
         }
     }
 }
@@ -124,6 +128,19 @@ impl Registry {
     }
     pub fn add_writer<D: Dim>(&mut self, name: &'static str, make: fn() -> Box<dyn Writer<D>>) {
         self.tables_mut::<D>().writers.insert(name, make);
+    }
+    /// A body family ([`crate::family`]) whose entries are the scene section `section`
+    /// (`[[section]]`) of a scene of dimension D.
+    pub fn add_family<D: Dim>(&mut self, section: &'static str, kind: Box<dyn FamilyKind<D>>) {
+        self.tables_mut::<D>().families.insert(section, kind);
+    }
+    /// The body family of a scene section.
+    pub fn family<D: Dim>(&self, section: &str) -> Option<&dyn FamilyKind<D>> {
+        self.tables::<D>().families.get(section).map(|b| &**b)
+    }
+    /// The scene sections of the body families of dimension D.
+    pub fn family_sections<D: Dim>(&self) -> Vec<&'static str> {
+        self.tables::<D>().families.keys().copied().collect()
     }
     /// A writer's constructor by name.
     pub fn writer<D: Dim>(&self, name: &str) -> Option<fn() -> Box<dyn Writer<D>>> {

@@ -139,10 +139,10 @@ pub fn parse_scheme(name: &str) -> Result<crate::dd::Scheme, String> {
 }
 
 pub(crate) fn decomposition(cx: &Ctx, d: &schema::DecompositionSpec, movable: usize) -> Result<crate::dd::DdConfig, InputError> {
-    if d.by_model == Some(true) && !cx.deformable {
+    if d.by_model == Some(true) && !cx.families {
         return Err(cx.err(
             &[k("decomposition"), k("by_model")],
-            "subdomains by model need deformable bodies in the scene",
+            "subdomains by model need a body family beside the rigid bodies (a plugin's section, e.g. deformable bodies)",
         ));
     }
     let p = |key: &str| vec![k("decomposition"), k(key)];
@@ -165,8 +165,8 @@ pub(crate) fn decomposition(cx: &Ctx, d: &schema::DecompositionSpec, movable: us
     if let Some(s) = &d.scheme {
         c.dd.scheme = parse_scheme(s).map_err(|m| cx.err(&p("scheme"), m))?;
     }
-    // a deformable body may be copied into any number of subdomains: no bound then
-    let movable = if cx.deformable { usize::MAX } else { movable };
+    // a family's body (a deformable one) may be copied into any number of subdomains: no bound then
+    let movable = if cx.families { usize::MAX } else { movable };
     c.check_capacity(movable).map_err(|(key, m)| {
         // name a key the section has
         let key = match (d.nx.is_some(), d.ny.is_some(), d.nz.is_some()) {

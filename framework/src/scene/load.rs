@@ -98,6 +98,8 @@ pub(crate) fn load_parsed<D: SceneDim>(cx: &Ctx, sf: SceneFile<BodySpec<D>>, reg
             checkpoint_every: sf.output.checkpoint_every,
         },
         decomposition,
+        families: vec![],
+        dd_state: None,
     })
 }
 

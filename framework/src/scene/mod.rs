@@ -22,7 +22,7 @@ use builder::Origin;
 pub use checks::parse_scheme;
 pub(crate) use checks::*;
 use locate::{locate, path_string, Seg};
-pub use restart::restart;
+pub use restart::{restart, restart_scene};
 use schema::{BodySpec, SceneDim, SceneFile};
 
 /// Output settings of a scene.
@@ -42,6 +42,12 @@ pub struct Scene<D: Dim = D2> {
     /// NSCDD settings (`[decomposition]`); `None`: the one-domain engine.
     /// [`crate::run::run`] steps with [`crate::dd::Nscdd`] when set.
     pub decomposition: Option<crate::dd::DdConfig>,
+    /// The plugins' body families of the scene ([`crate::family`]), in the order of
+    /// their section names.
+    pub families: Vec<Box<dyn crate::family::SceneFamily<D>>>,
+    /// A restarted scene: the NSCDD state of the saved run ([`restart_scene`]),
+    /// given to the solver of the same decomposition at the first step.
+    pub dd_state: Option<serde_json::Value>,
 }
 
 /// A loaded 3D scene.
@@ -63,8 +69,8 @@ pub fn load(path: &std::path::Path, registry: &Registry) -> Result<Scene, InputE
 pub(crate) struct Ctx<'a> {
     text: &'a str,
     file: &'a str,
-    /// The scene holds deformable bodies (loaded by a plugin).
-    deformable: bool,
+    /// The scene has sections of body families ([`crate::family`]).
+    families: bool,
 }
 
 impl Ctx<'_> {
@@ -159,39 +165,19 @@ pub fn load_any_str(text: &str, file: &str, registry: &Registry) -> Result<AnySc
 
 /// Loads a 2D scene from its text ([`Scene::load_str`]); `file` names it in messages.
 pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Scene, InputError> {
-    load_str_with(text, file, registry, false).map(|(s, _)| s)
-}
-
-/// The message for a scene with deformable bodies given to a program without them.
-pub const NO_DEFORMABLE: &str =
-    "deformable bodies need the fem_deformable plugin: build nscdd with `cargo build --release --features nscdd-cli/fem` (and Python's scikit-fem, see the README)";
-
-/// [`load_str`] that also returns the scene's `[[deformable]]` entries, for a
-/// deformable-body plugin to build; with `deformable = false` a scene holding any is
-/// refused ([`NO_DEFORMABLE`]).
-pub fn load_str_with(text: &str, file: &str, registry: &Registry, deformable: bool) -> Result<(Scene, Vec<toml::Table>), InputError> {
-    Scene::<D2>::load_str_with(text, file, registry, deformable)
+    Scene::<D2>::load_str(text, file, registry)
 }
 
 impl<D: SceneDim> Scene<D> {
-    /// Loads a scene of dimension `D` from its text; `file` names it in messages.
+    /// Loads a scene of dimension `D` from its text; `file` names it in messages
+    /// (and its folder is where the files a body family's entries name are found).
     pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Self, InputError> {
-        Self::load_str_with(text, file, registry, false).map(|(s, _)| s)
-    }
-
-    /// [`Scene::load_str`] that also returns the scene's `[[deformable]]` entries,
-    /// for a deformable-body plugin to build; with `deformable = false` a scene
-    /// holding any is refused ([`NO_DEFORMABLE`]).
-    pub fn load_str_with(text: &str, file: &str, registry: &Registry, deformable: bool) -> Result<(Self, Vec<toml::Table>), InputError> {
         let mut sf: SceneFile<BodySpec<D>> = parse(text, file)?;
         let cx = Ctx {
             text,
             file,
-            deformable: !sf.deformable.is_empty(),
+            families: !sf.sections.is_empty(),
         };
-        if !deformable && cx.deformable {
-            return Err(cx.err(&[k("deformable")], NO_DEFORMABLE));
-        }
         if sf.dimension as usize != D::N {
             let msg = match sf.dimension {
                 2 | 3 => format!("a {} scene was expected here (`dimension = {}`)", D::NAME, D::N),
@@ -199,8 +185,61 @@ impl<D: SceneDim> Scene<D> {
             };
             return Err(cx.err(&[k("dimension")], msg));
         }
-        let entries = std::mem::take(&mut sf.deformable);
-        let scene = load::load_parsed(&cx, sf, registry)?;
-        Ok((scene, entries))
+        let sections = std::mem::take(&mut sf.sections);
+        for name in sections.keys() {
+            if registry.family::<D>(name).is_none() {
+                let installed = registry.family_sections::<D>();
+                let installed = if installed.is_empty() {
+                    "none".to_string()
+                } else {
+                    installed.join(", ")
+                };
+                let msg = format!(
+                    "unknown key `{name}`: not a key of {} scene files nor the section of an installed body family (installed: {installed}; a plugin may provide it)",
+                    D::NAME
+                );
+                return Err(cx.err(&[k(name)], msg));
+            }
+        }
+        let mut scene = load::load_parsed(&cx, sf, registry)?;
+        let dir = std::path::Path::new(file)
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(std::path::Path::new("."));
+        for (name, value) in sections {
+            let kind = registry.family::<D>(&name).expect("checked above");
+            let entries = family_entries(&cx, &name, value)?;
+            let fcx = crate::family::FamilyContext { world: &scene.world, dir };
+            let fam = kind.load(&entries, &fcx).map_err(|e| {
+                let mut path = vec![k(&name)];
+                path.extend(e.index.map(Seg::Index));
+                if !e.key.is_empty() {
+                    path.push(k(&e.key));
+                }
+                cx.err(&path, e.message)
+            })?;
+            scene.families.push(fam);
+        }
+        Ok(scene)
+    }
+}
+
+/// The `[[name]]` entries of a body family's section.
+fn family_entries(cx: &Ctx, name: &str, value: toml::Value) -> Result<Vec<toml::Table>, InputError> {
+    let not = || {
+        cx.err(
+            &[k(name)],
+            format!("`{name}` is a list of tables: write its entries as `[[{name}]]`"),
+        )
+    };
+    match value {
+        toml::Value::Array(a) => a
+            .into_iter()
+            .map(|v| match v {
+                toml::Value::Table(t) => Ok(t),
+                _ => Err(not()),
+            })
+            .collect(),
+        _ => Err(not()),
     }
 }

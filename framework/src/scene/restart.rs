@@ -85,6 +85,40 @@ pub fn restart<D: Dim>(w: &mut World<D>, path: &Path) -> Result<(), InputError> 
     restart_str(w, &text, &file)
 }
 
+/// [`restart`] of a scene: the world's state, then each body family's from the
+/// state's `families` (by section) and the NSCDD state (`nscdd`, used when the run
+/// has the same decomposition: then a decomposed run continues bitwise too). A
+/// state without a family of the scene, or with one the scene does not have, is
+/// another scene's: an error.
+pub fn restart_scene<D: Dim>(scene: &mut super::Scene<D>, path: &Path) -> Result<(), InputError> {
+    restart(&mut scene.world, path)?;
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).unwrap_or_default();
+    let ck = StateChecks { text: &text, file: &file };
+    let saved = serde_json::from_str::<serde_json::Value>(&text).unwrap_or_default();
+    scene.dd_state = saved.get("nscdd").cloned();
+    let states = saved.get("families").and_then(|f| f.as_object()).cloned().unwrap_or_default();
+    for (name, _) in &states {
+        if !scene.families.iter().any(|f| f.section() == name) {
+            let msg = format!("the state holds `{name}` bodies, the scene none: a restart needs the scene that wrote it");
+            return Err(ck.err(ck.line_of(name, 0), format!("families.{name}"), msg));
+        }
+    }
+    for f in scene.families.iter_mut() {
+        let key = format!("families.{}", f.section());
+        let Some(state) = states.get(f.section()) else {
+            let msg = format!(
+                "the scene has `{}` bodies, the state none: a restart needs the scene that wrote it",
+                f.section()
+            );
+            return Err(ck.err(None, key, msg));
+        };
+        f.load_state(state)
+            .map_err(|m| ck.err(ck.line_of(f.section(), 0), key.clone(), m))?;
+    }
+    Ok(())
+}
+
 /// [`restart`] from the text of a saved state; `file` names it in messages.
 pub fn restart_str<D: Dim>(w: &mut World<D>, text: &str, file: &str) -> Result<(), InputError> {
     let ck = StateChecks { text, file };

@@ -27,7 +27,7 @@ fn overlap() -> f64 {
 
 /// A scene file; `B` is the body entry of its dimension ([`BodySpec<D>`]).
 #[derive(Deserialize, Debug)]
-#[serde(deny_unknown_fields, bound(deserialize = "B: Deserialize<'de>"))]
+#[serde(bound(deserialize = "B: Deserialize<'de>"))]
 pub struct SceneFile<B = BodySpec> {
     /// 2 or 3.
     #[serde(default = "two")]
@@ -52,10 +52,12 @@ pub struct SceneFile<B = BodySpec> {
     pub output: OutputSpec,
     /// NSCDD: split the contact set over nx × ny subdomains.
     pub decomposition: Option<DecompositionSpec>,
-    /// `[[deformable]]` bodies: read by a deformable-body plugin
-    /// ([`crate::scene::load_str_with`]); the plain loaders refuse them.
-    #[serde(default)]
-    pub deformable: Vec<toml::Table>,
+    /// Every other top-level key: the sections of the plugins' body families
+    /// (`[[name]]` entries, [`crate::family`]), by name. The loader refuses a key
+    /// that no registered family owns, as an unknown key (the file's other tables
+    /// reject unknown keys themselves).
+    #[serde(flatten)]
+    pub sections: std::collections::BTreeMap<String, toml::Value>,
 }
 
 /// `[decomposition]`: signed integers so that a negative value gets its own message.
@@ -66,9 +68,9 @@ pub struct DecompositionSpec {
     pub ny: Option<i64>,
     /// 3D only.
     pub nz: Option<i64>,
-    /// Scenes with deformable bodies: contacts touching deformable bodies form
+    /// Scenes with body families ([`crate::family`]): each family's contacts form
     /// subdomains of their own (split by the same grid), glued to the rigid ones
-    /// through the bodies they share (read by the deformable-body plugin).
+    /// through the bodies they share.
     pub by_model: Option<bool>,
     /// `decentralized` (default) or `centralized`.
     pub scheme: Option<String>,

@@ -47,8 +47,9 @@ fix = ["bottom"]
 mesh = { rectangle = { origin = [0.0, 0.0], size = [2.0, 0.5], cells = [140, 70] } }
 "#;
     let mut reg = nscdd::registry::Registry::new();
+    reg.add_plugin(&nscdd_fem_deformable::FemPlugin);
     reg.add_plugin(&nscdd_rigid_disks::RigidDisks);
     let t0 = Instant::now();
-    let mut s = nscdd_fem_deformable::scene::load_str(text, "bench2d", std::path::Path::new("."), &reg).unwrap();
+    let mut s = nscdd_fem_deformable::scene::load_str(text, "bench2d", &reg).unwrap();
     nscdd_fem_deformable::bench::bench(&mut s, steps, t0.elapsed().as_secs_f64());
 }

@@ -49,8 +49,9 @@ fix = ["bottom"]
 mesh = { box = { origin = [0.0, 0.0, 0.0], size = [1.0, 1.0, 0.5], cells = [24, 24, 10] } }
 "#;
     let mut reg = nscdd::registry::Registry::new();
+    reg.add_plugin(&nscdd_fem_deformable::FemPlugin);
     reg.add_plugin(&nscdd_spheres::SpheresPlugin);
     let t0 = Instant::now();
-    let mut s = nscdd_fem_deformable::scene::load3_str(text, "bench3d", std::path::Path::new("."), &reg).unwrap();
+    let mut s = nscdd_fem_deformable::scene::load3_str(text, "bench3d", &reg).unwrap();
     nscdd_fem_deformable::bench::bench(&mut s, steps, t0.elapsed().as_secs_f64());
 }

@@ -3,8 +3,10 @@
 //! refactorization, then `steps` steps, the first one (all columns of M̂⁻¹
 //! solved) apart, and the mean time per step of each stage over the others.
 
-use crate::run::FeRunnable;
+use crate::body::FeBody;
+use crate::scene::{FeScene, FeScene2, FeScene3};
 use crate::stage2::FeTimes;
+use nscdd::engine::{Diverged, StepReport};
 use std::time::Instant;
 
 /// Prints the size of the first deformable body and the load time, then times the
@@ -57,3 +59,38 @@ pub fn bench<S: FeRunnable>(s: &mut S, steps: usize, load_seconds: f64) {
         contacts as f64 / n
     );
 }
+
+/// What the benchmark loop needs of a scene with deformable bodies (2D or 3D).
+pub trait FeRunnable {
+    fn step(&mut self) -> Result<StepReport, Diverged>;
+    fn fe_bodies(&self) -> &[FeBody];
+    fn fe_bodies_mut(&mut self) -> &mut [FeBody];
+    fn fe_contacts(&self) -> usize;
+    /// Time spent in the deformable stages during the last step.
+    fn fe_times(&self) -> FeTimes;
+}
+
+macro_rules! runnable {
+    ($scene:ty) => {
+        impl FeRunnable for $scene {
+            fn step(&mut self) -> Result<StepReport, Diverged> {
+                FeScene::step(self)
+            }
+            fn fe_bodies(&self) -> &[FeBody] {
+                &self.fe.bodies
+            }
+            fn fe_bodies_mut(&mut self) -> &mut [FeBody] {
+                &mut self.fe.bodies
+            }
+            fn fe_contacts(&self) -> usize {
+                self.fe.contacts.len()
+            }
+            fn fe_times(&self) -> FeTimes {
+                self.fe.times
+            }
+        }
+    };
+}
+
+runnable!(FeScene2);
+runnable!(FeScene3);

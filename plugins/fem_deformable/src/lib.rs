@@ -1,14 +1,36 @@
 //! # Deformable bodies: linear elastic finite elements, coupled to rigid bodies
+//!
+//! A body family of the framework ([`nscdd::family`]): [`FemPlugin`] registers the
+//! `[[deformable]]` section of 2D and 3D scenes ([`family::DeformableKind`]); the
+//! framework loads, steps (glued by the one NSCDD stage through
+//! [`nscdd::dd::Attached`], [`family2`], [`family3`]), writes and restarts it.
 pub mod bench;
 pub mod body;
 pub mod contact2;
 pub mod contact3;
+pub mod family;
 pub mod family2;
 pub mod family3;
 pub mod mesh;
 pub mod nodes;
+pub mod output;
 pub mod python;
-pub mod run;
 pub mod scene;
 pub mod stage2;
 pub mod stage3;
+
+use nscdd::dim::{D2, D3};
+use nscdd::registry::{Plugin, Registry};
+
+/// The plugin: the `[[deformable]]` section in 2D and 3D scenes.
+pub struct FemPlugin;
+
+impl Plugin for FemPlugin {
+    fn name(&self) -> &'static str {
+        "fem_deformable"
+    }
+    fn build(&self, reg: &mut Registry) {
+        reg.add_family::<D2>(family::SECTION, Box::new(family::DeformableKind));
+        reg.add_family::<D3>(family::SECTION, Box::new(family::DeformableKind));
+    }
+}

@@ -29,17 +29,15 @@ use crate::mesh::Mesh;
 use crate::python;
 use crate::stage2::Deformables2;
 use crate::stage3::Deformables3;
-use nscdd::dd::{Attached, DdConfig, NscddOf, Rigid};
+use nscdd::dd::{DdConfig, NscddOf, Rigid};
 use nscdd::dim::{Dim, D2, D3};
-use nscdd::engine::{ContactStage, Diverged, StepReport};
+use nscdd::engine::{Diverged, StepReport};
 use nscdd::error::InputError;
+use nscdd::family::{EntryError, SceneFamily};
 use nscdd::registry::Registry;
-use nscdd::scene::locate::{locate, path_string, Seg};
+use nscdd::scene::schema::SceneDim;
 use nscdd::scene::{OutputSettings, Scene};
-use nscdd::world::Material;
-use nscdd::world::World;
-use nscdd::world::World2;
-use nscdd::world::World3;
+use nscdd::world::{Material, TimeSettings, World};
 use serde::Deserialize;
 use std::path::Path;
 
@@ -70,62 +68,51 @@ pub enum MeshSpec {
     File(String),
 }
 
-/// A 2D scene with deformable bodies: the rigid world, the deformable stage and,
-/// with a `[decomposition]`, the NSCDD stage that glues the subdomains (the
-/// deformable bodies attached to it as a family, [`crate::family2`]).
-pub struct FeScene2 {
-    pub world: World2,
-    pub fe: Deformables2,
+/// A scene with deformable bodies, typed: the rigid world, the deformable stage
+/// (`S`: [`Deformables2`] or [`Deformables3`]) and, with a `[decomposition]`, the
+/// NSCDD stage that glues the subdomains. Loaded by the framework's loader
+/// ([`nscdd::scene`], the `[[deformable]]` section built by [`crate::family`]); for
+/// programs and tests that step a scene themselves (the CLI runs
+/// [`nscdd::scene::Scene`] with its families through [`nscdd::run`]).
+pub struct FeScene<D: Dim, S> {
+    pub world: World<D>,
+    pub fe: S,
     pub output: OutputSettings,
     /// The scene's `[decomposition]` (by model and/or by geometry).
-    pub decomposition: Option<nscdd::dd::DdConfig>,
+    pub decomposition: Option<DdConfig>,
     /// The NSCDD state, made at the first step from `decomposition`.
-    pub dd: Option<nscdd::dd::Nscdd>,
+    pub dd: Option<NscddOf<Rigid<D>>>,
 }
 
-/// Loads a 2D scene file that may hold `[[deformable]]` entries.
-pub fn load(path: &Path, registry: &Registry) -> Result<FeScene2, InputError> {
-    let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| InputError {
-        file: file.clone(),
-        line: None,
-        key: String::new(),
-        message: format!("cannot read the file: {e}"),
-    })?;
-    load_str(&text, &file, path.parent().unwrap_or(Path::new(".")), registry)
-}
+/// A 2D scene with deformable bodies.
+pub type FeScene2 = FeScene<D2, Deformables2>;
+/// A 3D scene with deformable bodies.
+pub type FeScene3 = FeScene<D3, Deformables3>;
 
-fn err(text: &str, file: &str, path: &[Seg], message: impl Into<String>) -> InputError {
-    InputError {
-        file: file.to_string(),
-        line: locate(text, path).map(|o| nscdd::error::line_of(text, o)),
-        key: path_string(path),
-        message: message.into(),
-    }
-}
-
-/// [`load`] from the text; mesh files are looked up relative to `dir`.
-pub fn load_str(text: &str, file: &str, dir: &Path, registry: &Registry) -> Result<FeScene2, InputError> {
-    let (scene, entries) = nscdd::scene::load_str_with(text, file, registry, true)?;
+/// The scene of `text` with its deformable family taken out, typed.
+fn typed<D: SceneDim, S: SceneFamily<D>>(text: &str, file: &str, registry: &Registry) -> Result<FeScene<D, S>, InputError> {
+    let scene = Scene::<D>::load_str(text, file, registry)?;
     let Scene {
         world,
         output,
         decomposition,
+        families,
+        ..
     } = scene;
-    let bodies = bodies_from(
-        entries,
-        text,
-        file,
-        dir,
-        &world.materials,
-        2,
-        &world.gravity,
-        world.time.h,
-        world.time.theta,
-    )?;
-    refuse_unsupported(text, file, &output)?;
-    let fe = Deformables2::new(bodies, world.alert);
-    Ok(FeScene2 {
+    let mut fe = None;
+    for f in families {
+        let any: Box<dyn std::any::Any> = f;
+        if let Ok(s) = any.downcast::<S>() {
+            fe = Some(*s);
+        }
+    }
+    let fe = fe.ok_or_else(|| InputError {
+        file: file.to_string(),
+        line: None,
+        key: crate::family::SECTION.into(),
+        message: "the scene has no [[deformable]] bodies".into(),
+    })?;
+    Ok(FeScene {
         world,
         fe,
         output,
@@ -134,119 +121,55 @@ pub fn load_str(text: &str, file: &str, dir: &Path, registry: &Registry) -> Resu
     })
 }
 
-/// The settings a scene with deformable bodies cannot use yet, refused (exit 2)
-/// instead of being ignored: `checkpoint_every`.
-fn refuse_unsupported(text: &str, file: &str, output: &OutputSettings) -> Result<(), InputError> {
-    let at = |keys: &[&str], msg: &str| err(text, file, &keys.iter().map(|k| Seg::Key(k.to_string())).collect::<Vec<_>>(), msg);
-    if output.checkpoint_every > 0 {
-        return Err(at(
-            &["output", "checkpoint_every"],
-            "checkpoints of scenes with deformable bodies are not supported yet (their state is not saved); remove it",
-        ));
-    }
-    Ok(())
+/// Loads a 2D scene with `[[deformable]]` bodies from its text (the registry must
+/// hold [`crate::FemPlugin`]); mesh files are found beside `file`.
+pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<FeScene2, InputError> {
+    typed(text, file, registry)
+}
+
+/// [`load_str`] of a 3D scene (`dimension = 3`).
+pub fn load3_str(text: &str, file: &str, registry: &Registry) -> Result<FeScene3, InputError> {
+    typed(text, file, registry)
+}
+
+/// Reads a file entry into a [`DeformableSpec`]; an error names the key serde
+/// complained about when it says which.
+fn spec_of(i: usize, e: &toml::Table) -> Result<DeformableSpec, EntryError> {
+    DeformableSpec::deserialize(toml::Value::Table(e.clone())).map_err(|x| {
+        let msg = x.message().to_string();
+        let key = msg.split('`').nth(1).filter(|k| !k.contains(' ')).unwrap_or("");
+        EntryError {
+            index: Some(i),
+            key: key.into(),
+            message: msg.clone(),
+        }
+    })
 }
 
 /// Builds the deformable bodies of a scene's `[[deformable]]` entries, factored
-/// for the scene's h and θ.
-#[allow(clippy::too_many_arguments)]
-fn bodies_from(
-    entries: Vec<toml::Table>,
-    text: &str,
-    file: &str,
+/// for the scene's h and θ; mesh files are relative to `dir`.
+pub fn bodies_from(
+    entries: &[toml::Table],
     dir: &Path,
     materials: &[Material],
     dim: usize,
     gravity: &[f64],
-    h: f64,
-    theta: f64,
-) -> Result<Vec<FeBody>, InputError> {
+    time: &TimeSettings,
+) -> Result<Vec<FeBody>, EntryError> {
     let mut bodies = Vec::new();
-    for (i, e) in entries.into_iter().enumerate() {
-        let base = vec![Seg::Key("deformable".into()), Seg::Index(i)];
-        let at = |k: &str| {
-            let mut p = base.clone();
-            if !k.is_empty() {
-                p.push(Seg::Key(k.into()));
-            }
-            p
+    for (i, e) in entries.iter().enumerate() {
+        let at = |key: &str, message: String| EntryError {
+            index: Some(i),
+            key: key.into(),
+            message,
         };
-        let spec: DeformableSpec = DeformableSpec::deserialize(toml::Value::Table(e)).map_err(|x| {
-            let msg = x.message().to_string();
-            // name the key serde complained about when it says which
-            let key = msg.split('`').nth(1).filter(|k| !k.contains(' ')).unwrap_or("");
-            err(text, file, &at(key), msg.clone())
-        })?;
-        let mut b = build(&spec, materials, dim, dir).map_err(|(k, m)| err(text, file, &at(k), m))?;
+        let spec = spec_of(i, e)?;
+        let mut b = build(&spec, materials, dim, dir).map_err(|(k, m)| at(k, m))?;
         b.set_gravity(gravity);
-        b.factorize(h, theta).map_err(|m| err(text, file, &at(""), m))?;
+        b.factorize(time.h, time.theta).map_err(|m| at("", m))?;
         bodies.push(b);
     }
     Ok(bodies)
-}
-
-/// A 3D scene with deformable bodies: the rigid world, the deformable stage and,
-/// with a `[decomposition]`, the NSCDD stage ([`crate::family3`]).
-pub struct FeScene3 {
-    pub world: World3,
-    pub fe: Deformables3,
-    pub output: OutputSettings,
-    /// The scene's `[decomposition]` (by model and/or by geometry).
-    pub decomposition: Option<nscdd::dd::DdConfig>,
-    /// The NSCDD state, made at the first step from `decomposition`.
-    pub dd: Option<nscdd::dd::Nscdd3>,
-}
-
-/// Loads a 3D scene (`dimension = 3`) that may hold `[[deformable]]` entries.
-pub fn load3_str(text: &str, file: &str, dir: &Path, registry: &Registry) -> Result<FeScene3, InputError> {
-    let (scene, entries) = nscdd::scene::Scene3::load_str_with(text, file, registry, true)?;
-    refuse_unsupported(text, file, &scene.output)?;
-    let world = scene.world;
-    let bodies = bodies_from(
-        entries,
-        text,
-        file,
-        dir,
-        &world.materials,
-        3,
-        &world.gravity,
-        world.time.h,
-        world.time.theta,
-    )?;
-    let fe = Deformables3::new(bodies, world.alert);
-    Ok(FeScene3 {
-        world,
-        fe,
-        output: scene.output,
-        decomposition: scene.decomposition,
-        dd: None,
-    })
-}
-
-/// A scene with deformable bodies of either dimension.
-pub enum FeScene {
-    D2(FeScene2),
-    D3(FeScene3),
-}
-
-/// Loads a scene file with deformable bodies of either dimension (its
-/// `dimension` key).
-pub fn load_any(path: &Path, registry: &Registry) -> Result<FeScene, InputError> {
-    let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| InputError {
-        file: file.clone(),
-        line: None,
-        key: String::new(),
-        message: format!("cannot read the file: {e}"),
-    })?;
-    let dir = path.parent().unwrap_or(Path::new("."));
-    let dim = toml::from_str::<toml::Table>(&text)
-        .ok()
-        .and_then(|t| t.get("dimension").and_then(|d| d.as_integer()));
-    match dim {
-        Some(3) => load3_str(&text, &file, dir, registry).map(FeScene::D3),
-        _ => load_str(&text, &file, dir, registry).map(FeScene::D2),
-    }
 }
 
 /// Builds one deformable body of a spec; errors name the key.
@@ -373,36 +296,10 @@ pub fn fixed_nodes(m: &Mesh, sides: &[String]) -> Result<Vec<u32>, String> {
     Ok(out)
 }
 
-/// What a time step needs of the deformable stage of either dimension
-/// ([`Deformables2`], [`Deformables3`]).
-pub trait FeStage<D: Dim>: ContactStage<World<D>> + Attached<Rigid<D>> + Sized {
-    /// A failure inside the step (a refactorization).
-    fn take_error(&mut self) -> Option<String>;
-    /// u⁺ = u⁻ + h((1 − θ)V⁻ + θV⁺).
-    fn update(&mut self, h: f64, theta: f64, step: u64) -> Result<(), Diverged>;
-}
-
-impl FeStage<D2> for Deformables2 {
-    fn take_error(&mut self) -> Option<String> {
-        self.error.take()
-    }
-    fn update(&mut self, h: f64, theta: f64, step: u64) -> Result<(), Diverged> {
-        Deformables2::update(self, h, theta, step)
-    }
-}
-
-impl FeStage<D3> for Deformables3 {
-    fn take_error(&mut self) -> Option<String> {
-        self.error.take()
-    }
-    fn update(&mut self, h: f64, theta: f64, step: u64) -> Result<(), Diverged> {
-        Deformables3::update(self, h, theta, step)
-    }
-}
-
-/// One time step of the rigid bodies and the deformable bodies, contacts solved in
-/// one domain or, with a decomposition, by NSCDD (its state made at the first step).
-pub fn step_scene<D: Dim, S: FeStage<D>>(
+/// One time step of the rigid bodies and the deformable bodies
+/// ([`nscdd::family::step`]): contacts solved in one domain or, with a
+/// decomposition, by NSCDD (its state made at the first step).
+pub fn step_scene<D: Dim, S: SceneFamily<D>>(
     world: &mut World<D>,
     fe: &mut S,
     decomposition: Option<&DdConfig>,
@@ -411,36 +308,10 @@ pub fn step_scene<D: Dim, S: FeStage<D>>(
     if dd.is_none() {
         *dd = decomposition.map(|d| d.solver_of());
     }
-    let rep = match dd.as_mut() {
-        None => world.step_with(fe)?,
-        Some(dd) => {
-            let r = dd.step_families(world, &mut [fe as &mut dyn Attached<Rigid<D>>])?;
-            StepReport {
-                solve: r.solve,
-                contacts: r.contacts,
-                times: r.times,
-            }
-        }
-    };
-    if let Some(e) = fe.take_error() {
-        return Err(Diverged {
-            step: world.step,
-            body: 0,
-            message: e,
-        });
-    }
-    fe.update(world.time.h, world.time.theta, world.step)?;
-    Ok(rep)
+    nscdd::family::step(world, &mut [fe as &mut dyn SceneFamily<D>], dd.as_mut()).map(|(r, _)| r)
 }
 
-impl FeScene2 {
-    /// One time step ([`step_scene`]).
-    pub fn step(&mut self) -> Result<StepReport, Diverged> {
-        step_scene(&mut self.world, &mut self.fe, self.decomposition.as_ref(), &mut self.dd)
-    }
-}
-
-impl FeScene3 {
+impl<D: Dim, S: SceneFamily<D>> FeScene<D, S> {
     /// One time step ([`step_scene`]).
     pub fn step(&mut self) -> Result<StepReport, Diverged> {
         step_scene(&mut self.world, &mut self.fe, self.decomposition.as_ref(), &mut self.dd)

@@ -54,6 +54,8 @@ pub struct Deformables2 {
     prev: Vec<(FeKey, [f64; 2])>,
     /// A failure inside the step (a refactorization), reported after it.
     pub error: Option<String>,
+    /// The VTK frames written, (t, frame) ([`crate::family`]).
+    pub frames: Vec<(f64, u32)>,
 }
 
 impl Deformables2 {

@@ -33,6 +33,8 @@ pub struct Deformables3 {
     prev: Vec<(FeKey, [f64; 3])>,
     /// A failure inside the step (a refactorization), reported after it.
     pub error: Option<String>,
+    /// The VTK frames written, (t, frame) ([`crate::family`]).
+    pub frames: Vec<(f64, u32)>,
 }
 
 /// The rigid bodies' M̂⁻¹ as the sweep reads them.

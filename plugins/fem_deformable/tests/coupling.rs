@@ -182,20 +182,42 @@ fn non_convergence_is_reported() {
     assert!(!conv, "one sweep cannot meet 1e-5 with a block landing on its base");
 }
 
-/// Settings a scene with deformable bodies cannot use yet are input errors naming
-/// the key, never ignored.
+/// The framework's run loop with the deformable family: a run stopped at step 20
+/// (its final.json, with the family's state) and restarted to step 40 ends bitwise
+/// where the uninterrupted run does, in one domain and by model on 2 subdomains; a
+/// checkpoint is written with the family's state.
 #[test]
-fn unsupported_settings_are_refused() {
-    let cases = [("[output]\ncheckpoint_every = 10", "output.checkpoint_every")];
-    for (extra, key) in cases {
-        let text = foundation(extra, 1e-6);
-        let e = match nscdd_fem_deformable::scene::load_str(&text, "t.toml", std::path::Path::new("."), &registry()) {
-            Err(e) => e,
-            Ok(_) => panic!("accepted: {extra}"),
+fn restart_continues_bitwise() {
+    let reg = registry();
+    let dir = std::env::temp_dir().join(format!("nscdd-fe-restart-{}", std::process::id()));
+    for (k, dec) in ["", "[decomposition]\nby_model = true\nnx = 2"].into_iter().enumerate() {
+        let text = |steps: u32, every: u32| {
+            foundation(dec, 1e-8).replace("steps = 1", &format!("steps = {steps}"))
+                + &format!("[output]\nvtk = false\ncheckpoint_every = {every}\n")
         };
-        assert_eq!(e.key, key, "{e}");
-        assert!(e.line.is_some(), "{e}");
+        let run = |t: &str, out: &str, from: Option<&std::path::Path>| {
+            let mut s = nscdd::scene::Scene::<nscdd::dim::D2>::load_str(t, "t.toml", &reg).unwrap();
+            if let Some(f) = from {
+                nscdd::scene::restart_scene(&mut s, f).unwrap();
+            }
+            nscdd::run::run(&mut s, &reg, &dir.join(format!("{k}{out}")), |_, _| {}).unwrap();
+            std::fs::read_to_string(dir.join(format!("{k}{out}")).join("final.json")).unwrap()
+        };
+        let whole = run(&text(40, 10), "whole", None);
+        assert!(whole.contains("\"families\""), "the family's state is saved");
+        let ck = std::fs::read_to_string(dir.join(format!("{k}whole")).join("checkpoint.json")).unwrap();
+        assert!(ck.contains("\"displacement\""), "the checkpoint holds the family's state");
+        run(&text(20, 0), "first", None);
+        let second = run(&text(40, 0), "second", Some(&dir.join(format!("{k}first")).join("final.json")));
+        assert!(second == whole, "restart of `{dec}` is not bitwise");
     }
+    // a state of a scene without deformable bodies: refused, naming the key
+    let mut s = nscdd::scene::Scene::<nscdd::dim::D2>::load_str(&foundation("", 1e-8), "t.toml", &reg).unwrap();
+    let rigid = dir.join("rigid.json");
+    std::fs::write(&rigid, nscdd::output::final_json(&s.world)).unwrap();
+    let e = nscdd::scene::restart_scene(&mut s, &rigid).unwrap_err();
+    assert_eq!(e.key, "families.deformable", "{e}");
+    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// The coupled scene on 1 and 2 threads: bitwise the same (subdomains are swept

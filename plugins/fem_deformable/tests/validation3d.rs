@@ -6,13 +6,14 @@ use nscdd_fem_deformable::scene::{load3_str, FeScene3};
 
 fn registry() -> Registry {
     let mut r = Registry::new();
+    r.add_plugin(&nscdd_fem_deformable::FemPlugin);
     r.add_plugin(&nscdd_spheres::SpheresPlugin);
     r.add_plugin(&nscdd_polyhedra::PolyhedraPlugin);
     r
 }
 
 fn scene(text: &str) -> FeScene3 {
-    match load3_str(text, "test.toml", std::path::Path::new("."), &registry()) {
+    match load3_str(text, "test.toml", &registry()) {
         Ok(s) => s,
         Err(e) => panic!("{e}"),
     }
@@ -395,7 +396,7 @@ poisson = 0.3
 {extra}
 "#
     );
-    match load3_str(&text, "bad.toml", std::path::Path::new("."), &registry()) {
+    match load3_str(&text, "bad.toml", &registry()) {
         Ok(_) => panic!("accepted: {extra}"),
         Err(e) => e,
     }

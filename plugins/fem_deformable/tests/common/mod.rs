@@ -4,12 +4,13 @@ use nscdd_fem_deformable::scene::{load_str, FeScene2};
 
 pub fn registry() -> Registry {
     let mut r = Registry::new();
+    r.add_plugin(&nscdd_fem_deformable::FemPlugin);
     r.add_plugin(&nscdd_rigid_disks::RigidDisks);
     r
 }
 
 pub fn scene(text: &str) -> FeScene2 {
-    match load_str(text, "test.toml", std::path::Path::new("."), &registry()) {
+    match load_str(text, "test.toml", &registry()) {
         Ok(s) => s,
         Err(e) => panic!("{e}"),
     }

@@ -1,0 +1,138 @@
+//! Body families a plugin adds to scenes: finite-element bodies today, continuum
+//! regions and researchers' families next. The framework names none of them.
+//!
+//! A plugin registers a [`FamilyKind`] under the name of a scene section
+//! ([`crate::registry::Registry::add_family`]); the loader gives it the section's
+//! `[[name]]` entries once the rigid world is built, and it returns the family
+//! ([`SceneFamily`]): its bodies beside the world's rigid ones, solved by the one
+//! NSCDD stage through the subdomain interface ([`crate::dd::Attached`]), stepped,
+//! written, saved and restarted by the framework's run loop ([`crate::run`]).
+//!
+//! ```
+//! use nscdd::family::{EntryError, FamilyContext, FamilyKind, SceneFamily};
+//! use nscdd::dim::D2;
+//! struct Nothing;
+//! impl FamilyKind<D2> for Nothing {
+//!     fn load(&self, entries: &[toml::Table], _: &FamilyContext<'_, D2>) -> Result<Box<dyn SceneFamily<D2>>, EntryError> {
+//!         Err(EntryError { index: Some(0), key: "kind".into(), message: format!("{} entries, none built", entries.len()) })
+//!     }
+//! }
+//! let mut reg = nscdd::registry::Registry::new();
+//! reg.add_family::<D2>("nothing", Box::new(Nothing));
+//! assert_eq!(reg.family_sections::<D2>(), vec!["nothing"]);
+//! ```
+
+use crate::dd::{Attached, DdStepReport, NscddOf, Rigid};
+use crate::dim::Dim;
+use crate::engine::{ContactStage, Diverged, StepReport};
+use crate::world::World;
+use std::any::Any;
+use std::path::Path;
+
+/// What a family's loader sees: the built rigid world (materials, gravity, h, θ,
+/// alert distance) and the scene file's folder (files named in entries are relative
+/// to it).
+pub struct FamilyContext<'a, D: Dim> {
+    pub world: &'a World<D>,
+    pub dir: &'a Path,
+}
+
+/// A bad entry of a family's section: `[[section]]` entry `index` (none: the section
+/// as a whole), its `key` (empty: the entry), the message. The loader adds the file
+/// and the line.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EntryError {
+    pub index: Option<usize>,
+    pub key: String,
+    pub message: String,
+}
+
+/// Builds a family from the entries of its scene section.
+pub trait FamilyKind<D: Dim>: Send + Sync {
+    fn load(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D>) -> Result<Box<dyn SceneFamily<D>>, EntryError>;
+}
+
+/// A body family of a loaded scene (module docs). Beside the subdomain interface
+/// ([`Attached`]), what the run loop needs: the step's end, outputs, saved state.
+pub trait SceneFamily<D: Dim>: Attached<Rigid<D>> + Any + Send {
+    /// The scene section the family came from (its key in `final.json`).
+    fn section(&self) -> &'static str;
+    /// One line for `nscdd check` ("2 deformable bodies, 1 200 nodes").
+    fn describe(&self) -> String;
+    /// The family's own one-domain contact stage, if it has one (the solve of all the
+    /// world's and the family's contacts together); without it, a scene without a
+    /// decomposition is solved by NSCDD on one subdomain, which is the same NLGS.
+    fn one_domain(&mut self) -> Option<&mut dyn ContactStage<World<D>>> {
+        None
+    }
+    /// The end of a step, after the world's positions: the family's own (u⁺ = u⁻ +
+    /// h((1 − θ)V⁻ + θV⁺)); a failure is a divergence naming the step.
+    fn update(&mut self, w: &World<D>) -> Result<(), Diverged>;
+    /// The family's contacts of the last step.
+    fn contacts(&self) -> usize;
+    /// Extra `history.csv` columns, and their values after a step.
+    fn history_columns(&self) -> Vec<String> {
+        vec![]
+    }
+    fn history_values(&self, _out: &mut Vec<f64>) {}
+    /// A VTK frame (with `output.vtk`) at time `t`; `finish` at the end of the run.
+    fn write_frame(&mut self, _dir: &Path, _frame: u32, _t: f64) -> std::io::Result<()> {
+        Ok(())
+    }
+    fn finish(&mut self, _dir: &Path) -> std::io::Result<()> {
+        Ok(())
+    }
+    /// The family's state: under its section in `final.json` and checkpoints, read
+    /// back by [`Self::load_state`] (every number that the next step uses, so that a
+    /// restart continues bitwise).
+    fn save_state(&self) -> serde_json::Value;
+    fn load_state(&mut self, state: &serde_json::Value) -> Result<(), String>;
+    fn as_any(&self) -> &dyn Any;
+    fn as_any_mut(&mut self) -> &mut dyn Any;
+}
+
+/// Whether a scene with `families` and the `decomposition` given needs an NSCDD
+/// solver: a decomposition, or families without one one-domain stage of their own.
+pub fn needs_nscdd<D: Dim>(decomposed: bool, families: &mut [Box<dyn SceneFamily<D>>]) -> bool {
+    decomposed
+        || match families {
+            [] => false,
+            [one] => one.one_domain().is_none(),
+            _ => true,
+        }
+}
+
+/// One time step of the world and its families: contacts solved by `dd` (NSCDD) when
+/// given, else by the single family's one-domain stage or, without families, NLGS;
+/// then the families' [`SceneFamily::update`]. The second value is NSCDD's report.
+pub fn step<D: Dim>(
+    w: &mut World<D>,
+    families: &mut [&mut dyn SceneFamily<D>],
+    dd: Option<&mut NscddOf<Rigid<D>>>,
+) -> Result<(StepReport, Option<DdStepReport>), Diverged> {
+    let stepped = match dd {
+        Some(n) => {
+            let mut fams: Vec<&mut dyn Attached<Rigid<D>>> = families.iter_mut().map(|f| &mut **f as &mut dyn Attached<Rigid<D>>).collect();
+            let r = n.step_families(w, &mut fams)?;
+            let plain = StepReport {
+                solve: r.solve,
+                contacts: r.contacts,
+                times: r.times,
+            };
+            (plain, Some(r))
+        }
+        None => match families.first_mut().and_then(|f| f.one_domain()) {
+            Some(stage) => (w.step_with(stage)?, None),
+            None => (w.step()?, None),
+        },
+    };
+    for f in families.iter_mut() {
+        f.update(w)?;
+    }
+    Ok(stepped)
+}
+
+/// The families' states, by section, for `final.json` and checkpoints.
+pub fn states<D: Dim>(families: &[Box<dyn SceneFamily<D>>]) -> serde_json::Map<String, serde_json::Value> {
+    families.iter().map(|f| (f.section().to_string(), f.save_state())).collect()
+}

@@ -1,0 +1,229 @@
+//! The deformable bodies as a body family of the framework ([`nscdd::family`]): the
+//! `[[deformable]]` section of 2D and 3D scenes ([`DeformableKind`]), stepped,
+//! written (history columns, one VTK unstructured grid per body and frame,
+//! `deformable.pvd`), saved and restarted by the framework's run loop.
+//!
+//! The saved state (`final.json` and checkpoints, under `families.deformable`): per
+//! body its displacement u and velocity V (and, to read, its name, sizes and
+//! energies), and the contacts' keys and impulses (the next step's warm start); M̂'s
+//! factors and the cached columns of M̂⁻¹ are rebuilt from the scene, so a restart
+//! continues bitwise.
+
+use crate::body::FeBody;
+use crate::nodes::{FeContacts, FeKey};
+use crate::stage2::Deformables2;
+use crate::stage3::Deformables3;
+use nscdd::dim::{Dim, D2, D3};
+use nscdd::engine::{ContactStage, Diverged};
+use nscdd::family::{EntryError, FamilyContext, FamilyKind, SceneFamily};
+use nscdd::world::World;
+use serde::{Deserialize, Serialize};
+use std::any::Any;
+use std::path::Path;
+
+/// The scene section of deformable bodies.
+pub const SECTION: &str = "deformable";
+
+/// Builds the deformable bodies of a scene's `[[deformable]]` entries
+/// ([`crate::scene`] for the keys).
+pub struct DeformableKind;
+
+impl FamilyKind<D2> for DeformableKind {
+    fn load(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D2>) -> Result<Box<dyn SceneFamily<D2>>, EntryError> {
+        let bodies = crate::scene::bodies_from(entries, cx.dir, &cx.world.materials, 2, &cx.world.gravity, &cx.world.time)?;
+        Ok(Box::new(Deformables2::new(bodies, cx.world.alert)))
+    }
+}
+
+impl FamilyKind<D3> for DeformableKind {
+    fn load(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D3>) -> Result<Box<dyn SceneFamily<D3>>, EntryError> {
+        let bodies = crate::scene::bodies_from(entries, cx.dir, &cx.world.materials, 3, &cx.world.gravity, &cx.world.time)?;
+        Ok(Box::new(Deformables3::new(bodies, cx.world.alert)))
+    }
+}
+
+#[derive(Serialize, Deserialize)]
+struct BodyState {
+    #[serde(default)]
+    name: Option<String>,
+    #[serde(default)]
+    nodes: usize,
+    #[serde(default)]
+    cells: usize,
+    #[serde(default)]
+    max_displacement: f64,
+    #[serde(default)]
+    kinetic_energy: f64,
+    #[serde(default)]
+    elastic_energy: f64,
+    displacement: Vec<f64>,
+    velocity: Vec<f64>,
+}
+
+#[derive(Serialize, Deserialize)]
+struct ContactState {
+    key: FeKey,
+    r: Vec<f64>,
+}
+
+#[derive(Serialize, Deserialize)]
+struct State {
+    bodies: Vec<BodyState>,
+    contacts: Vec<ContactState>,
+}
+
+fn save<C, A, F, B, const N: usize>(bodies: &[FeBody], c: &FeContacts<C, A, F, B, N>) -> serde_json::Value {
+    let state = State {
+        bodies: bodies
+            .iter()
+            .map(|b| BodyState {
+                name: b.name.clone(),
+                nodes: b.mesh.n_nodes(),
+                cells: b.mesh.n_cells(),
+                max_displacement: b.u.iter().fold(0.0f64, |m, x| m.max(x.abs())),
+                kinetic_energy: b.kinetic_energy(),
+                elastic_energy: b.elastic_energy(),
+                displacement: b.u.clone(),
+                velocity: b.v.clone(),
+            })
+            .collect(),
+        contacts: c
+            .key
+            .iter()
+            .zip(&c.r)
+            .map(|(k, r)| ContactState { key: *k, r: r.to_vec() })
+            .collect(),
+    };
+    serde_json::to_value(state).expect("plain data")
+}
+
+/// Puts a saved state into the bodies and the contacts' warm start (only keys and
+/// impulses: the next step's build reads nothing else).
+fn load<C: Copy, A: Copy, F: Copy, B: Copy, const N: usize>(
+    bodies: &mut [FeBody],
+    c: &mut FeContacts<C, A, F, B, N>,
+    v: &serde_json::Value,
+) -> Result<(), String> {
+    let s: State = serde_json::from_value(v.clone()).map_err(|e| format!("not a state of deformable bodies: {e}"))?;
+    if s.bodies.len() != bodies.len() {
+        return Err(format!(
+            "the state has {} deformable bodies, the scene {}: a restart needs the scene that wrote it",
+            s.bodies.len(),
+            bodies.len()
+        ));
+    }
+    for (i, (b, sb)) in bodies.iter().zip(&s.bodies).enumerate() {
+        let n = b.u.len();
+        if sb.displacement.len() != n || sb.velocity.len() != n {
+            return Err(format!(
+                "deformable body {i} has {n} degrees of freedom in the scene, {} in the state: a restart needs the scene that wrote it",
+                sb.displacement.len()
+            ));
+        }
+        if !sb.displacement.iter().chain(&sb.velocity).all(|x| x.is_finite()) {
+            return Err(format!("deformable body {i}: non-finite displacement or velocity"));
+        }
+    }
+    if let Some(k) = s.contacts.iter().position(|k| k.r.len() != N || !k.r.iter().all(|x| x.is_finite())) {
+        return Err(format!("contact {k}: the impulse must be {N} finite numbers"));
+    }
+    for (b, sb) in bodies.iter_mut().zip(s.bodies) {
+        b.u = sb.displacement;
+        b.v = sb.velocity;
+    }
+    c.clear();
+    for k in s.contacts {
+        c.key.push(k.key);
+        c.r.push(std::array::from_fn(|i| k.r[i]));
+    }
+    Ok(())
+}
+
+fn history_values(bodies: &[FeBody], contacts: usize, out: &mut Vec<f64>) {
+    out.push(contacts as f64);
+    out.push(bodies.iter().map(|b| b.kinetic_energy()).sum());
+    out.push(bodies.iter().map(|b| b.elastic_energy()).sum());
+    out.push(bodies.iter().map(|b| b.load_potential()).sum());
+}
+
+fn describe(bodies: &[FeBody]) -> String {
+    let nodes: usize = bodies.iter().map(|b| b.mesh.n_nodes()).sum();
+    format!("{} deformable bodies ({nodes} nodes)", bodies.len())
+}
+
+/// One VTK unstructured grid per body (`deformable{i}_{frame}.vtu`).
+fn write_frame(bodies: &[FeBody], frames: &mut Vec<(f64, u32)>, dir: &Path, frame: u32, t: f64) -> std::io::Result<()> {
+    for (bi, b) in bodies.iter().enumerate() {
+        std::fs::write(dir.join(format!("deformable{bi}_{frame:05}.vtu")), crate::output::vtu(b))?;
+    }
+    frames.push((t, frame));
+    Ok(())
+}
+
+macro_rules! scene_family {
+    ($stage:ty, $dim:ty) => {
+        impl SceneFamily<$dim> for $stage {
+            fn section(&self) -> &'static str {
+                SECTION
+            }
+            fn describe(&self) -> String {
+                describe(&self.bodies)
+            }
+            fn one_domain(&mut self) -> Option<&mut dyn ContactStage<World<$dim>>> {
+                Some(self)
+            }
+            fn update(&mut self, w: &World<$dim>) -> Result<(), Diverged> {
+                if let Some(e) = self.error.take() {
+                    return Err(Diverged {
+                        step: w.step,
+                        body: 0,
+                        message: e,
+                    });
+                }
+                <$stage>::update(self, w.time.h, w.time.theta, w.step)
+            }
+            fn contacts(&self) -> usize {
+                self.contacts.len()
+            }
+            fn history_columns(&self) -> Vec<String> {
+                [
+                    "deformable_contacts",
+                    "kinetic_deformable",
+                    "elastic_deformable",
+                    "load_potential_deformable",
+                ]
+                .map(String::from)
+                .to_vec()
+            }
+            fn history_values(&self, out: &mut Vec<f64>) {
+                history_values(&self.bodies, self.contacts.len(), out)
+            }
+            fn write_frame(&mut self, dir: &Path, frame: u32, t: f64) -> std::io::Result<()> {
+                write_frame(&self.bodies, &mut self.frames, dir, frame, t)
+            }
+            fn finish(&mut self, dir: &Path) -> std::io::Result<()> {
+                crate::output::write_pvd(dir, self.bodies.len(), &self.frames)
+            }
+            fn save_state(&self) -> serde_json::Value {
+                save(&self.bodies, &self.contacts)
+            }
+            fn load_state(&mut self, state: &serde_json::Value) -> Result<(), String> {
+                load(&mut self.bodies, &mut self.contacts, state)
+            }
+            fn as_any(&self) -> &dyn Any {
+                self
+            }
+            fn as_any_mut(&mut self) -> &mut dyn Any {
+                self
+            }
+        }
+    };
+}
+
+scene_family!(Deformables2, D2);
+scene_family!(Deformables3, D3);
+
+/// The deformable family of a loaded scene, if it has one.
+pub fn of<D: Dim, S: 'static>(families: &[Box<dyn SceneFamily<D>>]) -> Option<&S> {
+    families.iter().find_map(|f| f.as_any().downcast_ref::<S>())
+}
