@@ -185,6 +185,30 @@ fn writers<D: Dim>(scene: &Scene<D>, registry: &Registry, root: bool) -> Vec<Box
     out
 }
 
+/// The NSCDD solver of a scene: its decomposition's, or one subdomain where its
+/// body families need NSCDD without one; with a restart's saved state when it is
+/// of the same decomposition. Families cannot run on several ranks yet.
+fn scene_solver<D: Dim>(scene: &mut Scene<D>, cluster: Option<Box<dyn crate::dd::Cluster>>) -> Result<Option<NscddOf<Rigid<D>>>, RunError> {
+    if !scene.families.is_empty() && cluster.as_ref().is_some_and(|c| c.size() > 1) {
+        return Err(RunError::Ranks(format!(
+            "scenes with body families (`{}`) run in one process for now: run without mpirun (use --threads)",
+            scene.families[0].section()
+        )));
+    }
+    let one = crate::dd::DdConfig::default();
+    let dd_config = scene
+        .decomposition
+        .as_ref()
+        .or(crate::family::needs_nscdd(false, &mut scene.families).then_some(&one));
+    let mut dd: Option<NscddOf<Rigid<D>>> = dd_solver(dd_config, cluster)?;
+    // a restarted run of the same decomposition continues its F_Γ
+    if let (Some(n), Some(state)) = (dd.as_mut(), scene.dd_state.take()) {
+        n.load_state(&state)
+            .map_err(|m| RunError::Ranks(format!("the restart file's `nscdd` state: {m}")))?;
+    }
+    Ok(dd)
+}
+
 /// [`run`], as one rank of a multi-process run when `cluster` is given: every rank
 /// steps the whole world and sweeps its subdomains ([`crate::dd::ranks`]); rank 0
 /// writes the outputs (the same files as one process, and `ranks.json`). A scene's
@@ -199,25 +223,7 @@ pub fn run_on<D: Dim>(
 ) -> Result<RunSummary, RunError> {
     let start = Instant::now();
     let root = cluster.as_ref().is_none_or(|c| c.rank() == 0);
-    if !scene.families.is_empty() && cluster.as_ref().is_some_and(|c| c.size() > 1) {
-        return Err(RunError::Ranks(format!(
-            "scenes with body families (`{}`) run in one process for now: run without mpirun (use --threads)",
-            scene.families[0].section()
-        )));
-    }
-    // a decomposed run steps with NSCDD (and a scene whose families need it on one
-    // subdomain); outputs take its report and view
-    let one = crate::dd::DdConfig::default();
-    let dd_config = scene
-        .decomposition
-        .as_ref()
-        .or(crate::family::needs_nscdd(false, &mut scene.families).then_some(&one));
-    let mut dd: Option<NscddOf<Rigid<D>>> = dd_solver(dd_config, cluster)?;
-    // a restarted run of the same decomposition continues its F_Γ
-    if let (Some(n), Some(state)) = (dd.as_mut(), scene.dd_state.take()) {
-        n.load_state(&state)
-            .map_err(|m| RunError::Ranks(format!("the restart file's `nscdd` state: {m}")))?;
-    }
+    let mut dd = scene_solver(scene, cluster)?;
     let mut writers = writers(scene, registry, root);
     let fams = &mut scene.families;
     let w = &mut scene.world;
