@@ -344,3 +344,43 @@ fn deformable_scenes_take_the_nscdd_flags() {
     assert_eq!(one, run("t2", &["--threads", "2"]));
     run("grid", &["--subdomains", "2x2", "--scheme", "centralized"]);
 }
+
+/// A decomposed rigid run (2 × 2 subdomains) stopped at step 15 and restarted from
+/// its final.json (with NSCDD's state: F_Γ, grid, kept owners) to step 30, with 2
+/// threads: bitwise the uninterrupted run's final state.
+#[test]
+fn decomposed_restart_continues_bitwise() {
+    let dir = scratch("dd_restart");
+    let pile = format!(
+        "{}\n[[generate]]\nkind = \"square_lattice\"\nmaterial = \"grain\"\nradius = 0.01\norigin = [0.2, 0.01]\nnx = 10\nny = 6\nspacing = 0.02\n[decomposition]\nnx = 2\nny = 2\n[output]\nvtk = false\n",
+        BASE.replace("steps = 10", "steps = 30")
+    );
+    let whole = dir.join("whole.toml");
+    std::fs::write(&whole, &pile).unwrap();
+    let first = dir.join("first.toml");
+    std::fs::write(&first, pile.replace("steps = 30", "steps = 15")).unwrap();
+    let run = |scene: &PathBuf, out: &str, extra: &[&str]| {
+        let out = dir.join(out);
+        let mut a: Vec<&std::ffi::OsStr> = vec![
+            "run".as_ref(),
+            scene.as_os_str(),
+            "--out".as_ref(),
+            out.as_os_str(),
+            "--quiet".as_ref(),
+        ];
+        a.extend(extra.iter().map(|s| std::ffi::OsStr::new(*s)));
+        let o = nscdd(&a);
+        assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+        std::fs::read_to_string(out.join("final.json")).unwrap()
+    };
+    let a = run(&whole, "whole", &[]);
+    assert!(
+        a.contains("\"nscdd\"") && a.contains("\"f_gamma\": [\n      ["),
+        "the NSCDD state is saved, with F_Γ"
+    );
+    run(&first, "first", &[]);
+    let state = dir.join("first").join("final.json");
+    let b = run(&whole, "second", &["--threads", "2", "--restart", state.to_str().unwrap()]);
+    assert!(a == b, "the restarted run ends elsewhere");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -5,7 +5,10 @@
 //! that state into a world loaded from the same scene, so that the run continues to
 //! the scene's end time. Continuing is bitwise the uninterrupted one-domain run (the
 //! saved numbers round-trip exactly through JSON); a decomposed run starts its gluing
-//! multipliers F_Γ from zero and repartitions at the first step.
+//! multipliers F_Γ from zero and repartitions at the first step, unless the scene
+//! is restarted with [`restart_scene`] and the state holds the NSCDD state of the
+//! same decomposition (`nscdd`, written by a one-process run): then it continues
+//! bitwise as well; body families' states (`families`) are read back the same way.
 //!
 //! The scene may change anything that is not state: solver settings, the
 //! decomposition, outputs, the end time, drives. It may not change the bodies (their
