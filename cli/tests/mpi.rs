@@ -494,17 +494,63 @@ radius = 1e-3
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// A scene with deformable bodies under mpirun: refused by every rank with exit 2
-/// (their parts are not exchanged between processes yet), nothing written.
+/// A scene with deformable bodies by model (2 × 1 cells, 4 subdomains) on 2 and 4
+/// ranks: final.json bitwise that of one process (the deformable bodies' state
+/// included; the families' parts travel as their packed impulses), and the 3D
+/// foundation (2 × 2 cells by model) on 2 ranks; without a decomposition, refused by
+/// every rank with exit 2.
 #[cfg(feature = "fem")]
 #[test]
-fn deformable_scenes_refuse_mpi_ranks() {
+fn deformable_scenes_on_ranks_give_the_one_process_result() {
     let dir = scratch("fe_ranks");
-    let scene = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/scenes/foundation.toml"));
-    let out = dir.join("out");
-    let o = mpirun(&[(2, args(scene, &out, &[]))]);
+    let src = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/scenes/foundation.toml")).unwrap();
+    let scene = dir.join("foundation.toml");
+    std::fs::write(
+        &scene,
+        src.replace("duration = 0.5", "steps = 30")
+            .replace("[output]\n", "[output]\nvtk = false\n"),
+    )
+    .unwrap();
+    let one = dir.join("one");
+    let o = nscdd(&args(&scene, &one, &["--threads", "2"]));
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let reference = final_json(&one);
+    assert!(reference.contains("\"deformable\""));
+    for n in [2, 4] {
+        let out = dir.join(format!("ranks{n}"));
+        let o = mpirun(&[(n, args(&scene, &out, &[]))]);
+        assert!(o.status.success(), "{n} ranks: {}", text(&o.stderr));
+        assert!(final_json(&out) == reference, "{n} ranks: final.json differs from one process");
+    }
+    // 3D: 2 × 2 cells by model
+    let src3 = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/scenes/foundation3d.toml")).unwrap();
+    let scene3 = dir.join("foundation3d.toml");
+    std::fs::write(
+        &scene3,
+        src3.replace("duration = 0.4", "steps = 15")
+            .replace("[output]\n", "[output]\nvtk = false\n"),
+    )
+    .unwrap();
+    let one3 = dir.join("one3");
+    let o = nscdd(&args(&scene3, &one3, &[]));
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let out = dir.join("ranks3d");
+    let o = mpirun(&[(2, args(&scene3, &out, &[]))]);
+    assert!(o.status.success(), "3D on 2 ranks: {}", text(&o.stderr));
+    assert!(
+        final_json(&out) == final_json(&one3),
+        "3D on 2 ranks: final.json differs from one process"
+    );
+    let plain = dir.join("plain.toml");
+    let no_dd = std::fs::read_to_string(&scene).unwrap();
+    let cut = no_dd.find("[decomposition]").unwrap();
+    let rest = &no_dd[cut..];
+    let end = rest[1..].find("\n[").map_or(no_dd.len(), |e| cut + 1 + e + 1);
+    std::fs::write(&plain, format!("{}{}", &no_dd[..cut], &no_dd[end..])).unwrap();
+    let out = dir.join("plain");
+    let o = mpirun(&[(2, args(&plain, &out, &[]))]);
     let err = text(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(err.contains("one process"), "{err}");
+    assert!(err.contains("no decomposition"), "{err}");
     assert!(!out.join("final.json").exists());
 }

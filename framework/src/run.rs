@@ -187,14 +187,8 @@ fn writers<D: Dim>(scene: &Scene<D>, registry: &Registry, root: bool) -> Vec<Box
 
 /// The NSCDD solver of a scene: its decomposition's, or one subdomain where its
 /// body families need NSCDD without one; with a restart's saved state when it is
-/// of the same decomposition. Families cannot run on several ranks yet.
+/// of the same decomposition.
 fn scene_solver<D: Dim>(scene: &mut Scene<D>, cluster: Option<Box<dyn crate::dd::Cluster>>) -> Result<Option<NscddOf<Rigid<D>>>, RunError> {
-    if !scene.families.is_empty() && cluster.as_ref().is_some_and(|c| c.size() > 1) {
-        return Err(RunError::Ranks(format!(
-            "scenes with body families (`{}`) run in one process for now: run without mpirun (use --threads)",
-            scene.families[0].section()
-        )));
-    }
     let one = crate::dd::DdConfig::default();
     let dd_config = scene
         .decomposition

@@ -71,6 +71,15 @@ pub trait LocalPart<F: Family>: Any + Send {
     fn entity_velocity(&self, e: usize, out: &mut Vec<f64>);
     /// The gluing increment of local entity `e`: its copy moves by `dv`.
     fn glue_entity(&mut self, e: usize, dv: &[f64]);
+    /// The part's results after the iteration as numbers (its contacts' impulses, and
+    /// whatever else its family's [`Attached::write_back`] reads), appended to `out`:
+    /// on several MPI ranks, the rank that solved the subdomain sends them to the
+    /// others, which [`Self::unpack`] them into their own (unsolved) copy of the part.
+    fn pack(&self, out: &mut Vec<f64>);
+    /// The number of values [`Self::pack`] appends.
+    fn packed_len(&self) -> usize;
+    /// Puts results [`Self::pack`]ed by another rank's copy of the part back.
+    fn unpack(&mut self, values: &[f64]);
     fn as_any(&self) -> &dyn Any;
 }
 

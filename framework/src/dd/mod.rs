@@ -232,10 +232,12 @@ impl<D: Family> NscddOf<D> {
 
     /// Runs the subdomains over the ranks of `cluster` ([`ranks`]); every rank must
     /// step the same world with the same settings. Err: the grid has fewer
-    /// subdomains than there are ranks.
+    /// subdomains than there are ranks (by model: at least two models, the rigid
+    /// contacts and one family's, over the grid's cells).
     pub fn with_cluster(mut self, cluster: Box<dyn Cluster>) -> Result<Self, String> {
         let s = &self.settings;
-        let n = s.nx as u64 * s.ny as u64 * s.nz.max(1) as u64;
+        let models = if self.by_model { 2 } else { 1 };
+        let n = models * s.nx as u64 * s.ny as u64 * s.nz.max(1) as u64;
         if (cluster.size() as u64) > n {
             return Err(format!(
                 "{} ranks for {n} subdomains: every rank needs at least one subdomain (use at most {n} ranks or a finer [decomposition])",
@@ -361,16 +363,10 @@ impl<D: Family> NscddOf<D> {
     }
 
     /// Advances `w` by one step with the attached body families `fams` ([`attach`]),
-    /// the contact problem of all of them solved by NSCDD. (Not with MPI ranks: an
-    /// attached family's parts are not exchanged between processes yet.)
+    /// the contact problem of all of them solved by NSCDD (over the ranks of a
+    /// cluster as well: every rank holds the families too, sweeps its subdomains'
+    /// parts and receives the others' packed results, [`LocalPart::pack`]).
     pub fn step_families(&mut self, w: &mut D::World, fams: &mut [&mut dyn Attached<D>]) -> Result<DdStepReport, Diverged> {
-        if self.ranks.is_some() && !fams.is_empty() {
-            return Err(Diverged {
-                step: 0,
-                body: 0,
-                message: "attached body families cannot run on several MPI ranks yet".into(),
-            });
-        }
         self.pending = DdStepReport::default();
         let base = D::step_with(w, &mut Stage { dd: self, fams })?;
         let mut rep = std::mem::take(&mut self.pending);

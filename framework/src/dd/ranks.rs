@@ -311,8 +311,10 @@ impl RankState {
         let ndof = super::subdomain::dofs::<D>();
         let me = self.cluster.rank();
         let t0 = Instant::now();
-        // copies of other ranks' subdomains were not given starting velocities
-        let size = |s: &Subdomain<D>| D::len(&s.contacts) * D::SPACE + (s.body_global.len() + s.f_gamma.len()) * ndof;
+        // copies of other ranks' subdomains were not given starting velocities; the
+        // attached families' parts travel as their packed results, after the rigid values
+        let parts_len = |s: &Subdomain<D>| s.parts.0.iter().map(|(_, p)| p.packed_len()).sum::<usize>();
+        let size = |s: &Subdomain<D>| D::len(&s.contacts) * D::SPACE + (s.body_global.len() + s.f_gamma.len()) * ndof + parts_len(s);
         self.send.clear();
         for s in d.subs.iter().filter(|s| self.rank_of[s.id as usize] == me) {
             for a in 0..D::len(&s.contacts) {
@@ -320,6 +322,9 @@ impl RankState {
             }
             for v in s.vel.iter().chain(&s.f_gamma) {
                 self.send.extend_from_slice(v.as_ref());
+            }
+            for (_, p) in &s.parts.0 {
+                p.pack(&mut self.send);
             }
         }
         let at = self.counts_by(d.subs.len(), |k| size(&d.subs[k]));
@@ -338,6 +343,11 @@ impl RankState {
             for v in s.vel.iter_mut().chain(s.f_gamma.iter_mut()) {
                 v.as_mut().copy_from_slice(&self.all[pos..pos + ndof]);
                 pos += ndof;
+            }
+            for (_, p) in s.parts.0.iter_mut() {
+                let n = p.packed_len();
+                p.unpack(&self.all[pos..pos + n]);
+                pos += n;
             }
         }
         self.totals.reduce_seconds += t0.elapsed().as_secs_f64();

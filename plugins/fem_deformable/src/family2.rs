@@ -86,6 +86,15 @@ impl LocalPart<Rigid2> for FePart2 {
             v[1] += d[1];
         }
     }
+    fn pack(&self, out: &mut Vec<f64>) {
+        self.contacts.pack_r(out);
+    }
+    fn packed_len(&self) -> usize {
+        2 * self.contacts.len()
+    }
+    fn unpack(&mut self, values: &[f64]) {
+        self.contacts.unpack_r(values);
+    }
     fn as_any(&self) -> &dyn Any {
         self
     }

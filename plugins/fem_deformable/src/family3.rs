@@ -94,6 +94,15 @@ impl LocalPart<Rigid3> for FePart3 {
             }
         }
     }
+    fn pack(&self, out: &mut Vec<f64>) {
+        self.contacts.pack_r(out);
+    }
+    fn packed_len(&self) -> usize {
+        3 * self.contacts.len()
+    }
+    fn unpack(&mut self, values: &[f64]) {
+        self.contacts.unpack_r(values);
+    }
     fn as_any(&self) -> &dyn Any {
         self
     }

@@ -227,6 +227,16 @@ impl<C, A, F, B, const D: usize> Default for FeContacts<C, A, F, B, D> {
 }
 
 impl<C, A, F: Copy, B: Copy, const D: usize> FeContacts<C, A, F, B, D> {
+    /// The impulses, flat (a part's results between MPI ranks).
+    pub fn pack_r(&self, out: &mut Vec<f64>) {
+        out.extend(self.r.iter().flatten());
+    }
+    /// Impulses [`Self::pack_r`]ed by another rank.
+    pub fn unpack_r(&mut self, v: &[f64]) {
+        for (r, x) in self.r.iter_mut().zip(v.chunks_exact(D)) {
+            r.copy_from_slice(x);
+        }
+    }
     pub fn len(&self) -> usize {
         self.cand.len()
     }

@@ -117,6 +117,17 @@ impl LocalPart<Rigid2> for PointPart {
         self.v[e][0] += dv[0];
         self.v[e][1] += dv[1];
     }
+    fn pack(&self, out: &mut Vec<f64>) {
+        out.extend(self.contacts.iter().flat_map(|c| c.r));
+    }
+    fn packed_len(&self) -> usize {
+        2 * self.contacts.len()
+    }
+    fn unpack(&mut self, values: &[f64]) {
+        for (c, r) in self.contacts.iter_mut().zip(values.chunks_exact(2)) {
+            c.r = [r[0], r[1]];
+        }
+    }
     fn as_any(&self) -> &dyn Any {
         self
     }
