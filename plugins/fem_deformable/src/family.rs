@@ -148,7 +148,8 @@ fn history_values(bodies: &[FeBody], contacts: usize, out: &mut Vec<f64>) {
 
 fn describe(bodies: &[FeBody]) -> String {
     let nodes: usize = bodies.iter().map(|b| b.mesh.n_nodes()).sum();
-    format!("{} deformable bodies ({nodes} nodes)", bodies.len())
+    let n = bodies.len();
+    format!("{n} deformable bod{} ({nodes} nodes)", if n == 1 { "y" } else { "ies" })
 }
 
 /// One VTK unstructured grid per body (`deformable{i}_{frame}.vtu`).
