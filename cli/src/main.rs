@@ -407,45 +407,39 @@ fn solve_fc(
     ExitCode::SUCCESS
 }
 
-/// export-fc of a scene with body families: refused (their contacts' W is not
-/// assembled in local form yet), never their contacts silently left out.
-fn export_refused(what: &str) -> ExitCode {
-    input_error(format!(
-        "export-fc of a scene with {what} is not supported yet (their contacts' Delassus matrix is not assembled in local form); remove them or run the scene"
-    ))
+/// The local problem of a scene after `steps` steps, stepped as a run without a
+/// decomposition would (its body families' one-domain stage, or NSCDD on one
+/// subdomain): the world's contacts, then each family's.
+fn export_scene<D: nscdd::dim::Dim>(mut s: nscdd::scene::Scene<D>, steps: u64) -> Result<nscdd::fc::FcProblem, ExitCode> {
+    let one = nscdd::dd::DdConfig::default();
+    let mut dd = nscdd::family::needs_nscdd(false, &mut s.families).then(|| one.solver_of());
+    for _ in 0..steps {
+        let mut fams: Vec<&mut dyn nscdd::family::SceneFamily<D>> = s.families.iter_mut().map(|f| &mut **f).collect();
+        if let Err(e) = nscdd::family::step(&mut s.world, &mut fams, dd.as_mut()) {
+            eprintln!("error: {e}");
+            return Err(ExitCode::from(1));
+        }
+    }
+    let bonded = s.world.contacts.joint.iter().filter(|j| j.bonded()).count();
+    if bonded > 0 {
+        eprintln!(
+            "error: {bonded} contacts are intact mortar joints (law `mohr_coulomb`): a frictional-contact problem (FCLIB) cannot express their cohesion"
+        );
+        return Err(ExitCode::from(2));
+    }
+    nscdd::family::local_problem(&s.world, &s.families).map_err(input_error)
 }
 
 /// `nscdd export-fc`: the contact problem of a scene after `steps` steps.
 fn export_fc(scene: &std::path::Path, steps: u64, out: &std::path::Path, reg: &nscdd::registry::Registry) -> ExitCode {
     let p = match load_any(scene, reg) {
         Err(e) => return input_error(e),
-        Ok(nscdd::scene::AnyScene::D2(s)) if !s.families.is_empty() => return export_refused(&s.families[0].describe()),
-        Ok(nscdd::scene::AnyScene::D3(s)) if !s.families.is_empty() => return export_refused(&s.families[0].describe()),
-        Ok(nscdd::scene::AnyScene::D2(mut s)) => {
-            for _ in 0..steps {
-                if let Err(e) = s.world.step() {
-                    eprintln!("error: {e}");
-                    return ExitCode::from(1);
-                }
-            }
-            nscdd::fc::problem_from_world(&s.world)
-        }
-        Ok(nscdd::scene::AnyScene::D3(mut s)) => {
-            for _ in 0..steps {
-                if let Err(e) = s.world.step() {
-                    eprintln!("error: {e}");
-                    return ExitCode::from(1);
-                }
-            }
-            let bonded = s.world.contacts.joint.iter().filter(|j| j.bonded()).count();
-            if bonded > 0 {
-                eprintln!(
-                    "error: {bonded} contacts are intact mortar joints (law `mohr_coulomb`): a frictional-contact problem (FCLIB) cannot express their cohesion"
-                );
-                return ExitCode::from(2);
-            }
-            nscdd::fc::problem_from_world3(&s.world)
-        }
+        Ok(nscdd::scene::AnyScene::D2(s)) => export_scene(s, steps),
+        Ok(nscdd::scene::AnyScene::D3(s)) => export_scene(s, steps),
+    };
+    let p = match p {
+        Ok(p) => p,
+        Err(code) => return code,
     };
     match write_problem(&p, out) {
         Ok(()) => {

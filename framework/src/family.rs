@@ -86,6 +86,13 @@ pub trait SceneFamily<D: Dim>: Attached<Rigid<D>> + Any + Send {
     /// back by [`Self::load_state`] (every number that the next step uses, so that a
     /// restart continues bitwise).
     fn save_state(&self) -> serde_json::Value;
+    /// The family's share of the last step's local problem (`nscdd export-fc`):
+    /// q, μ, its contacts' H_bᵀ on the world's rigid bodies and its W blocks
+    /// ([`crate::fc::FamilyShare`]); `None`: the family cannot give it (the export
+    /// is refused).
+    fn local_problem(&self, _w: &World<D>) -> Option<crate::fc::FamilyShare> {
+        None
+    }
     fn load_state(&mut self, state: &serde_json::Value) -> Result<(), String>;
     fn as_any(&self) -> &dyn Any;
     fn as_any_mut(&mut self) -> &mut dyn Any;
@@ -130,6 +137,28 @@ pub fn step<D: Dim>(
         f.update(w)?;
     }
     Ok(stepped)
+}
+
+/// The local problem of the last step of `w` and its families (`nscdd export-fc`):
+/// the world's contacts, then each family's. Err: a family that cannot give its
+/// share (named).
+pub fn local_problem<D: Dim>(w: &World<D>, families: &[Box<dyn SceneFamily<D>>]) -> Result<crate::fc::FcProblem, String> {
+    let mut shares = vec![];
+    for f in families {
+        let share = f
+            .local_problem(w)
+            .ok_or_else(|| format!("the `{}` family cannot give its contacts' local problem", f.section()))?;
+        shares.push(share);
+    }
+    let any = w as &dyn Any;
+    match (
+        any.downcast_ref::<crate::world::World2>(),
+        any.downcast_ref::<crate::world::World3>(),
+    ) {
+        (Some(w2), _) => Ok(crate::fc::problem_with(w2, &shares)),
+        (_, Some(w3)) => Ok(crate::fc::problem_with3(w3, &shares)),
+        _ => unreachable!("Dim is sealed: D2 or D3"),
+    }
 }
 
 /// The families' states, by section, for `final.json` and checkpoints.

@@ -47,7 +47,7 @@ use serde::Serialize;
 use serde_json::{Map, Value};
 use std::io::Read;
 use std::path::Path;
-pub use world::{problem_from_world, problem_from_world3};
+pub use world::{problem_from_world, problem_from_world3, problem_with, problem_with3, FamilyShare};
 
 /// Stopping test of `solve-fc`.
 #[derive(Clone, Copy, Debug, PartialEq)]

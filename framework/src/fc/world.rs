@@ -3,13 +3,51 @@
 use super::{CooMatrix, FcProblem};
 use crate::world::World2;
 
+/// A body family's share of the step's local problem ([`crate::family::SceneFamily::local_problem`]),
+/// its contacts numbered 0.. (after the world's and the earlier families' in the
+/// problem): per contact d values of q = u_free − ū e_n and μ; each contact's H_bᵀ
+/// on the world's movable rigid bodies b (d rows of the body's dofs, row-major); and
+/// the blocks W_αβ (α ≤ β, d × d row-major) through the family's own bodies.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FamilyShare {
+    pub q: Vec<f64>,
+    pub mu: Vec<f64>,
+    /// (contact, rigid body, H_bᵀ rows).
+    pub rigid: Vec<(u32, u32, Vec<f64>)>,
+    /// (α, β, W_αβ) with α ≤ β.
+    pub own: Vec<(u32, u32, Vec<f64>)>,
+}
+
+/// The families' contact offsets, q and μ after the world's `nw` contacts.
+fn family_rows(nw: usize, d: usize, shares: &[FamilyShare]) -> (Vec<usize>, Vec<f64>, Vec<f64>) {
+    let mut off = vec![];
+    let (mut q, mut mu) = (vec![], vec![]);
+    let mut at = nw;
+    for s in shares {
+        off.push(at);
+        at += s.mu.len();
+        q.extend_from_slice(&s.q);
+        mu.extend_from_slice(&s.mu);
+    }
+    debug_assert_eq!(q.len(), d * (at - nw));
+    (off, q, mu)
+}
+
 /// The local problem of the last step of a 2D world (call it right after
 /// [`World2::step`]): W = Hᵀ M̂⁻¹ H over `w.contacts` and q = u_free − ū e_n. The
 /// impulses the world found, `w.contacts.r`, are an (approximate) solution of it.
 pub fn problem_from_world(w: &World2) -> FcProblem {
+    problem_with(w, &[])
+}
+
+/// [`problem_from_world`] with the body families' shares (their contacts after the
+/// world's).
+pub fn problem_with(w: &World2, shares: &[FamilyShare]) -> FcProblem {
     let c = &w.contacts;
     let b = &w.bodies;
-    let nc = c.len();
+    let nw = c.len();
+    let (off, fq, fmu) = family_rows(nw, 2, shares);
+    let nc = nw + fmu.len();
     // H_bᵀ (2 × 3) of contact a seen from body b, with its sign.
     let h_of = |a: usize, arm: [f64; 2], s: f64| {
         let n = c.frame[a].n;
@@ -17,7 +55,7 @@ pub fn problem_from_world(w: &World2) -> FcProblem {
     };
     // (body, contact, H_bᵀ) for the bodies impulses can move, grouped by body.
     let mut inc: Vec<(u32, u32, [[f64; 3]; 2])> = Vec::with_capacity(2 * nc);
-    for a in 0..nc {
+    for a in 0..nw {
         let [i, j] = c.bodies[a];
         if b.movable(i as usize) {
             inc.push((i, a as u32, h_of(a, c.frame[a].arm_i, 1.0)));
@@ -26,9 +64,23 @@ pub fn problem_from_world(w: &World2) -> FcProblem {
             inc.push((j, a as u32, h_of(a, c.frame[a].arm_j, -1.0)));
         }
     }
+    for (s, &o) in shares.iter().zip(&off) {
+        for (a, body, h) in &s.rigid {
+            inc.push((*body, (o + *a as usize) as u32, [[h[0], h[1], h[2]], [h[3], h[4], h[5]]]));
+        }
+    }
     inc.sort_by_key(|x| (x.0, x.1));
     // Contributions to the blocks (α ≤ β) from each shared body.
     let mut contrib: Vec<(u32, u32, [f64; 4])> = Vec::new();
+    for (s, &o) in shares.iter().zip(&off) {
+        for (x, y, blk) in &s.own {
+            let mut blk = [blk[0], blk[1], blk[2], blk[3]];
+            if x == y {
+                blk[2] = blk[1];
+            }
+            contrib.push(((o + *x as usize) as u32, (o + *y as usize) as u32, blk));
+        }
+    }
     let mut g0 = 0;
     while g0 < inc.len() {
         let body = inc[g0].0;
@@ -69,10 +121,11 @@ pub fn problem_from_world(w: &World2) -> FcProblem {
     }
     trip.sort_by_key(|x| (x.0, x.1));
     let mut q = Vec::with_capacity(2 * nc);
-    for a in 0..nc {
+    for a in 0..nw {
         q.push(c.u_free[a][0] - c.target[a].u_target);
         q.push(c.u_free[a][1]);
     }
+    q.extend(fq);
     let meta = serde_json::json!({
         "source": format!("nscdd: 2D world after step {} (t = {} s), {} bodies", w.step, w.t, b.len()),
     });
@@ -81,7 +134,7 @@ pub fn problem_from_world(w: &World2) -> FcProblem {
         nc,
         w: CooMatrix::from_triplets(2 * nc, &trip),
         q,
-        mu: c.target.iter().map(|t| t.mu).collect(),
+        mu: c.target.iter().map(|t| t.mu).chain(fmu).collect(),
         meta: Some(meta),
     }
 }
@@ -92,10 +145,18 @@ pub fn problem_from_world(w: &World2) -> FcProblem {
 /// − for the antagonist), `W_αβ = Σ_b H_bαᵀ M̂_b⁻¹ H_bβ` with `M̂_b⁻¹ = diag(m⁻¹) ⊕
 /// I_w⁻¹`, and `q_α = (u_free,n − ū, u_free,t1, u_free,t2)`.
 pub fn problem_from_world3(w: &crate::world::World3) -> FcProblem {
+    problem_with3(w, &[])
+}
+
+/// [`problem_from_world3`] with the body families' shares (their contacts after the
+/// world's).
+pub fn problem_with3(w: &crate::world::World3, shares: &[FamilyShare]) -> FcProblem {
     use crate::dim::d3::cross;
     let c = &w.contacts;
     let b = &w.bodies;
-    let nc = c.len();
+    let nw = c.len();
+    let (off, fq, fmu) = family_rows(nw, 3, shares);
+    let nc = nw + fmu.len();
     let h_of = |a: usize, d: [f64; 3], s: f64| -> [[f64; 6]; 3] {
         let f = &c.frame[a];
         std::array::from_fn(|k| {
@@ -105,7 +166,7 @@ pub fn problem_from_world3(w: &crate::world::World3) -> FcProblem {
         })
     };
     let mut inc: Vec<(u32, u32, [[f64; 6]; 3])> = Vec::with_capacity(2 * nc);
-    for a in 0..nc {
+    for a in 0..nw {
         let [i, j] = c.bodies[a];
         if b.movable(i as usize) {
             inc.push((i, a as u32, h_of(a, c.frame[a].d_i, 1.0)));
@@ -114,8 +175,26 @@ pub fn problem_from_world3(w: &crate::world::World3) -> FcProblem {
             inc.push((j, a as u32, h_of(a, c.frame[a].d_j, -1.0)));
         }
     }
+    for (s, &o) in shares.iter().zip(&off) {
+        for (a, body, h) in &s.rigid {
+            inc.push((
+                *body,
+                (o + *a as usize) as u32,
+                std::array::from_fn(|k| std::array::from_fn(|l| h[6 * k + l])),
+            ));
+        }
+    }
     inc.sort_by_key(|x| (x.0, x.1));
     let mut contrib: Vec<(u32, u32, [[f64; 3]; 3])> = Vec::new();
+    for (s, &o) in shares.iter().zip(&off) {
+        for (x, y, blk) in &s.own {
+            contrib.push((
+                (o + *x as usize) as u32,
+                (o + *y as usize) as u32,
+                std::array::from_fn(|p| std::array::from_fn(|q| blk[3 * p + q])),
+            ));
+        }
+    }
     let mut g0 = 0;
     while g0 < inc.len() {
         let body = inc[g0].0 as usize;
@@ -164,11 +243,12 @@ pub fn problem_from_world3(w: &crate::world::World3) -> FcProblem {
     }
     trip.sort_by_key(|x| (x.0, x.1));
     let mut q = Vec::with_capacity(3 * nc);
-    for a in 0..nc {
+    for a in 0..nw {
         q.push(c.u_free[a][0] - c.target[a].u_target);
         q.push(c.u_free[a][1]);
         q.push(c.u_free[a][2]);
     }
+    q.extend(fq);
     let meta = serde_json::json!({
         "source": format!("nscdd: 3D world after step {} (t = {} s), {} bodies", w.step, w.t, b.len()),
     });
@@ -177,7 +257,7 @@ pub fn problem_from_world3(w: &crate::world::World3) -> FcProblem {
         nc,
         w: CooMatrix::from_triplets(3 * nc, &trip),
         q,
-        mu: c.target.iter().map(|t| t.mu).collect(),
+        mu: c.target.iter().map(|t| t.mu).chain(fmu).collect(),
         meta: Some(meta),
     }
 }

@@ -162,7 +162,7 @@ fn write_frame(bodies: &[FeBody], frames: &mut Vec<(f64, u32)>, dir: &Path, fram
 }
 
 macro_rules! scene_family {
-    ($stage:ty, $dim:ty) => {
+    ($stage:ty, $dim:ty, $share:path) => {
         impl SceneFamily<$dim> for $stage {
             fn section(&self) -> &'static str {
                 SECTION
@@ -211,6 +211,9 @@ macro_rules! scene_family {
             fn load_state(&mut self, state: &serde_json::Value) -> Result<(), String> {
                 load(&mut self.bodies, &mut self.contacts, state)
             }
+            fn local_problem(&self, w: &World<$dim>) -> Option<nscdd::fc::FamilyShare> {
+                Some($share(self, w))
+            }
             fn as_any(&self) -> &dyn Any {
                 self
             }
@@ -221,8 +224,8 @@ macro_rules! scene_family {
     };
 }
 
-scene_family!(Deformables2, D2);
-scene_family!(Deformables3, D3);
+scene_family!(Deformables2, D2, crate::problem::share2);
+scene_family!(Deformables3, D3, crate::problem::share3);
 
 /// The deformable family of a loaded scene, if it has one.
 pub fn of<D: Dim, S: 'static>(families: &[Box<dyn SceneFamily<D>>]) -> Option<&S> {

@@ -14,6 +14,7 @@ pub mod family3;
 pub mod mesh;
 pub mod nodes;
 pub mod output;
+pub mod problem;
 pub mod python;
 pub mod scene;
 pub mod stage2;

@@ -54,6 +54,9 @@ pub struct Deformables2 {
     prev: Vec<(FeKey, [f64; 2])>,
     /// A failure inside the step (a refactorization), reported after it.
     pub error: Option<String>,
+    /// V_free of the rigid antagonists of the step's contacts, by body (sorted): the
+    /// world's warm start moves the bodies before the contacts are built.
+    rigid_free: Vec<(u32, [f64; 3])>,
     /// The VTK frames written, (t, frame) ([`crate::family`]).
     pub frames: Vec<(f64, u32)>,
 }
@@ -74,6 +77,14 @@ impl Deformables2 {
         self.times = free_velocities(&mut self.bodies, w.time.h, w.time.theta)?;
         let t = Instant::now();
         detect(w, &self.bodies, self.alert, &mut self.raw);
+        self.rigid_free.clear();
+        for rc in &self.raw {
+            if let RawAnta::Rigid(j) = rc.anta {
+                self.rigid_free.push((j, w.bodies.vel[j as usize]));
+            }
+        }
+        self.rigid_free.sort_unstable_by_key(|x| x.0);
+        self.rigid_free.dedup_by_key(|x| x.0);
         self.times.detect = t.elapsed().as_secs_f64();
         Ok(())
     }
@@ -135,7 +146,7 @@ impl Deformables2 {
                     (
                         Anta::Rigid { body: j, arm },
                         rigid_local(n, arm, v_begin[ju]),
-                        rigid_local(n, arm, w.bodies.vel[ju]),
+                        rigid_local(n, arm, free_of(&self.rigid_free, j)),
                         w.bodies.material[ju],
                         j,
                         0,
@@ -431,4 +442,10 @@ impl ContactStage<World2> for Deformables2 {
         self.times.update = t1.elapsed().as_secs_f64();
         report
     }
+}
+
+/// V_free of rigid body `j` among the step's antagonists (`free`: sorted by body).
+fn free_of(free: &[(u32, [f64; 3])], j: u32) -> [f64; 3] {
+    let k = free.binary_search_by_key(&j, |x| x.0);
+    k.map_or([0.0; 3], |k| free[k].1)
 }

@@ -33,6 +33,9 @@ pub struct Deformables3 {
     prev: Vec<(FeKey, [f64; 3])>,
     /// A failure inside the step (a refactorization), reported after it.
     pub error: Option<String>,
+    /// V_free of the rigid antagonists of the step's contacts, by body (sorted): the
+    /// world's warm start moves the bodies before the contacts are built.
+    rigid_free: Vec<(u32, [f64; 6])>,
     /// The VTK frames written, (t, frame) ([`crate::family`]).
     pub frames: Vec<(f64, u32)>,
 }
@@ -56,6 +59,14 @@ impl Deformables3 {
         self.times = free_velocities(&mut self.bodies, w.time.h, w.time.theta)?;
         let t = Instant::now();
         detect(w, &self.bodies, self.alert, &mut self.raw);
+        self.rigid_free.clear();
+        for rc in &self.raw {
+            if let RawAnta3::Rigid(j) = rc.anta {
+                self.rigid_free.push((j, w.bodies.vel[j as usize]));
+            }
+        }
+        self.rigid_free.sort_unstable_by_key(|x| x.0);
+        self.rigid_free.dedup_by_key(|x| x.0);
         self.times.detect = t.elapsed().as_secs_f64();
         Ok(())
     }
@@ -129,7 +140,7 @@ impl Deformables3 {
                     (
                         Anta3::Rigid { body: j, d },
                         rigid_local(&basis, d, &v_begin[ju]),
-                        rigid_local(&basis, d, &w.bodies.vel[ju]),
+                        rigid_local(&basis, d, &free_of(&self.rigid_free, j)),
                         w.bodies.material[ju],
                         j,
                         0,
@@ -337,4 +348,10 @@ impl ContactStage<World3> for Deformables3 {
         self.times.update = t1.elapsed().as_secs_f64();
         report
     }
+}
+
+/// V_free of rigid body `j` among the step's antagonists (`free`: sorted by body).
+fn free_of(free: &[(u32, [f64; 6])], j: u32) -> [f64; 6] {
+    let k = free.binary_search_by_key(&j, |x| x.0);
+    k.map_or([0.0; 6], |k| free[k].1)
 }

@@ -241,3 +241,61 @@ fn coupled_threads_are_bitwise_identical() {
     let (a, b) = (run(1), run(2));
     assert_eq!(a, b);
 }
+
+/// The local problem of a coupled step (`nscdd export-fc`): the world's contacts and
+/// the deformable ones, W = Hᵀ M̂⁻¹ H with the blocks G among the soil's contact
+/// nodes and the couplings through the disks they share. At the impulses the step
+/// found, its natural-map residual is the step's own (the same W and q the solve
+/// used), W is symmetric, and the deformable contacts' diagonal blocks are the
+/// solve's W_αα.
+#[test]
+fn exported_coupled_problem_is_the_solved_one() {
+    let reg = registry();
+    let mut s = nscdd::scene::Scene::<nscdd::dim::D2>::load_str(&foundation("", 1e-10), "t.toml", &reg).unwrap();
+    let mut res = 0.0;
+    for _ in 0..5 {
+        let mut fams: Vec<&mut dyn nscdd::family::SceneFamily<nscdd::dim::D2>> = s.families.iter_mut().map(|f| &mut **f).collect();
+        let (r, _) = nscdd::family::step(&mut s.world, &mut fams, None).unwrap();
+        res = r.solve.residual;
+    }
+    let p = nscdd::family::local_problem(&s.world, &s.families).unwrap();
+    let fe = nscdd_fem_deformable::family::of::<nscdd::dim::D2, nscdd_fem_deformable::stage2::Deformables2>(&s.families).unwrap();
+    let (nw, nf) = (s.world.contacts.len(), fe.contacts.len());
+    assert!(nw > 0 && nf > 0, "rigid {nw} and deformable {nf} contacts");
+    assert_eq!(p.nc, nw + nf);
+    let r: Vec<f64> = s
+        .world
+        .contacts
+        .r
+        .iter()
+        .flatten()
+        .chain(fe.contacts.r.iter().flatten())
+        .copied()
+        .collect();
+    let got = p.natural_residual(&r);
+    println!("{nw} rigid and {nf} deformable contacts; residual of the exported problem {got:e}, of the step {res:e}");
+    assert!(
+        (got - res).abs() < 1e-9 + 1e-6 * res,
+        "exported problem's residual {got:e}, the step's {res:e}"
+    );
+    // symmetric, and the deformable diagonal blocks are the solve's
+    let mut w = std::collections::BTreeMap::new();
+    for k in 0..p.w.rows.len() {
+        *w.entry((p.w.rows[k], p.w.cols[k])).or_insert(0.0) += p.w.vals[k];
+    }
+    for (&(i, j), v) in &w {
+        let t = w.get(&(j, i)).copied().unwrap_or(0.0);
+        assert!((v - t).abs() <= 1e-12 * v.abs().max(1.0), "W[{i},{j}] = {v}, W[{j},{i}] = {t}");
+    }
+    for a in 0..nf {
+        let k = 2 * (nw + a);
+        let b = fe.contacts.block[a].w;
+        let e = [w[&(k, k)], w[&(k, k + 1)], w[&(k + 1, k + 1)]];
+        for q in 0..3 {
+            assert!(
+                (e[q] - b[q]).abs() <= 1e-12 * b[0].abs(),
+                "contact {a}: W_αα {e:?}, the solve's {b:?}"
+            );
+        }
+    }
+}

@@ -494,3 +494,69 @@ fn coupled_3d_subdomains_agree_with_one_domain() {
     let two = run("[decomposition]\nby_model = true\nnx = 2\nthreads = 2", 20);
     assert_eq!(one, two);
 }
+
+/// The local problem of a coupled 3D step (`nscdd export-fc`): the spheres' contacts
+/// and the block's, W with the block's G blocks and the couplings through the
+/// spheres. At the impulses the step found, its natural-map residual is the step's.
+#[test]
+fn exported_coupled_3d_problem_is_the_solved_one() {
+    let reg = registry();
+    let mut s = nscdd::scene::Scene::<nscdd::dim::D3>::load_str(&stacks(""), "t.toml", &reg).unwrap();
+    let mut res = 0.0;
+    for _ in 0..10 {
+        let mut fams: Vec<&mut dyn nscdd::family::SceneFamily<nscdd::dim::D3>> = s.families.iter_mut().map(|f| &mut **f).collect();
+        res = nscdd::family::step(&mut s.world, &mut fams, None).unwrap().0.solve.residual;
+    }
+    let p = nscdd::family::local_problem(&s.world, &s.families).unwrap();
+    let fe = nscdd_fem_deformable::family::of::<nscdd::dim::D3, nscdd_fem_deformable::stage3::Deformables3>(&s.families).unwrap();
+    let (nw, nf) = (s.world.contacts.len(), fe.contacts.len());
+    assert!(
+        nw > 0 && nf > 0 && p.nc == nw + nf,
+        "rigid {nw}, deformable {nf}, exported {}",
+        p.nc
+    );
+    let r: Vec<f64> = s
+        .world
+        .contacts
+        .r
+        .iter()
+        .flatten()
+        .chain(fe.contacts.r.iter().flatten())
+        .copied()
+        .collect();
+    let got = p.natural_residual(&r);
+    println!("{nw} rigid and {nf} deformable contacts; residual of the exported problem {got:e}, of the step {res:e}");
+    if std::env::var("DEBUG_FC").is_ok() {
+        let u = p.velocity(&r);
+        for a in 0..nf {
+            let k = 3 * (nw + a);
+            let act = nscdd_fem_deformable::stage3::local_velocity(
+                &fe.sets,
+                &s.world.bodies.vel,
+                fe.contacts.cand[a],
+                fe.contacts.anta[a],
+                &fe.contacts.frame[a],
+            );
+            println!(
+                "fe {a}: exported u {:?} actual {:?} r {:?} q {:?}",
+                &u[k..k + 3],
+                act,
+                fe.contacts.r[a],
+                &p.q[k..k + 3]
+            );
+            println!("   block {:?}", fe.contacts.block[a].w);
+        }
+        for a in 0..nw {
+            println!("rigid {a}: exported u {:?} r {:?}", &u[3 * a..3 * a + 3], s.world.contacts.r[a]);
+        }
+        let mut w = std::collections::BTreeMap::new();
+        for k in 0..p.w.rows.len() {
+            *w.entry((p.w.rows[k], p.w.cols[k])).or_insert(0.0) += p.w.vals[k];
+        }
+        println!("{w:?}");
+    }
+    assert!(
+        (got - res).abs() < 1e-9 + 1e-6 * res,
+        "exported problem's residual {got:e}, the step's {res:e}"
+    );
+}

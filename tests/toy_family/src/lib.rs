@@ -101,7 +101,9 @@ pub struct PointContact {
     pub gap: f64,
     pub u_target: f64,
     pub mu: f64,
-    /// u_free (local frame) and the impulse r (normal first).
+    /// The body's V_free (taken at detection: the world's warm start moves it
+    /// before the contacts are built), u_free (local frame) and the impulse r.
+    pub body_free: [f64; 3],
     pub u_free: [f64; 2],
     pub r: [f64; 2],
 }
@@ -156,6 +158,7 @@ impl PointMasses {
                     arm,
                     at: pc.point,
                     gap: pc.gap,
+                    body_free: w.bodies.vel[rb],
                     ..Default::default()
                 });
             }
@@ -185,7 +188,7 @@ impl Attached<Rigid2> for PointMasses {
                 let (l, r) = (local(c.n, vp), rigid_local(c.n, c.arm, vb));
                 [l[0] - r[0], l[1] - r[1]]
             };
-            c.u_free = rel(self.v_free[p], w.bodies.vel[b]);
+            c.u_free = rel(self.v_free[p], c.body_free);
             let input = LawInput {
                 gap: c.gap,
                 un_begin: rel(self.v_begin[p], v_begin[b])[0],
