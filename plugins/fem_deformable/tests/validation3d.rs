@@ -526,35 +526,6 @@ fn exported_coupled_3d_problem_is_the_solved_one() {
         .collect();
     let got = p.natural_residual(&r);
     println!("{nw} rigid and {nf} deformable contacts; residual of the exported problem {got:e}, of the step {res:e}");
-    if std::env::var("DEBUG_FC").is_ok() {
-        let u = p.velocity(&r);
-        for a in 0..nf {
-            let k = 3 * (nw + a);
-            let act = nscdd_fem_deformable::stage3::local_velocity(
-                &fe.sets,
-                &s.world.bodies.vel,
-                fe.contacts.cand[a],
-                fe.contacts.anta[a],
-                &fe.contacts.frame[a],
-            );
-            println!(
-                "fe {a}: exported u {:?} actual {:?} r {:?} q {:?}",
-                &u[k..k + 3],
-                act,
-                fe.contacts.r[a],
-                &p.q[k..k + 3]
-            );
-            println!("   block {:?}", fe.contacts.block[a].w);
-        }
-        for a in 0..nw {
-            println!("rigid {a}: exported u {:?} r {:?}", &u[3 * a..3 * a + 3], s.world.contacts.r[a]);
-        }
-        let mut w = std::collections::BTreeMap::new();
-        for k in 0..p.w.rows.len() {
-            *w.entry((p.w.rows[k], p.w.cols[k])).or_insert(0.0) += p.w.vals[k];
-        }
-        println!("{w:?}");
-    }
     assert!(
         (got - res).abs() < 1e-9 + 1e-6 * res,
         "exported problem's residual {got:e}, the step's {res:e}"
