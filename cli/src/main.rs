@@ -244,6 +244,9 @@ fn main() -> ExitCode {
                 Err(e) => return input_error(e),
             };
             let quiet = quiet || !ranks.root();
+            if ranks.size() == 1 {
+                stop_on_signals();
+            }
             let flags = run::Flags {
                 subdomains: subdomains.as_deref(),
                 scheme: scheme.as_deref(),
@@ -291,6 +294,20 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
     }
+}
+
+/// SIGINT/SIGTERM stop a run at the end of its current step with a checkpoint
+/// (`nscdd::run::request_stop`); a second one ends the process at once. (One
+/// process only: MPI ranks keep the default behaviour.)
+fn stop_on_signals() {
+    static SEEN: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+    let _ = ctrlc::set_handler(|| {
+        if SEEN.swap(true, std::sync::atomic::Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+        eprintln!("\nstopping at the end of this step (a checkpoint is written); a second signal ends the run at once");
+        nscdd::run::request_stop();
+    });
 }
 
 /// Loads a scene of either dimension; a scene with deformable bodies given to a

@@ -57,6 +57,15 @@ pub fn finish(res: Result<RunSummary, RunError>, norm: &str, dd: impl Fn(&RunSum
             );
             ExitCode::SUCCESS
         }
+        Err(RunError::Interrupted(step)) => {
+            let ck = out.join("checkpoint.json");
+            eprintln!(
+                "stopped on request at the end of step {step}; its state is in {} (continue with `--restart {}` and another --out)",
+                ck.display(),
+                ck.display()
+            );
+            ExitCode::from(130)
+        }
         Err(e) => {
             eprintln!("error: {e}; the outputs written so far are kept in {}", out.display());
             ExitCode::from(1)

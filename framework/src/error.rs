@@ -99,6 +99,9 @@ pub enum Error {
     /// A multi-process run that cannot start: ranks against the decomposition
     /// (exit 2).
     Ranks(String),
+    /// Stopped on request (SIGINT/SIGTERM, [`crate::run::request_stop`]) at the end
+    /// of this step, a checkpoint written (exit 130).
+    Interrupted(u64),
 }
 
 impl Error {
@@ -107,6 +110,7 @@ impl Error {
         match self {
             Error::Input(_) | Error::Param(_) | Error::Ranks(_) => 2,
             Error::Diverged(_) | Error::Io(_) => 1,
+            Error::Interrupted(_) => 130,
         }
     }
 }
@@ -118,6 +122,10 @@ impl std::fmt::Display for Error {
             Error::Param(e) => write!(f, "{e}"),
             Error::Diverged(d) => write!(f, "{d}"),
             Error::Io(m) | Error::Ranks(m) => write!(f, "{m}"),
+            Error::Interrupted(step) => write!(
+                f,
+                "stopped on request at the end of step {step}; checkpoint.json holds that state (continue with --restart)"
+            ),
         }
     }
 }

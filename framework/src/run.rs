@@ -104,8 +104,23 @@ pub(crate) fn history_sink(dir: &Path, root: bool) -> Result<Box<dyn Write>, Run
         return Ok(Box::new(std::io::sink()));
     }
     std::fs::create_dir_all(dir).map_err(io(dir, "the output directory"))?;
+    // unbuffered: each row is one write (whole lines after a kill)
     let file = std::fs::File::create(dir.join("history.csv")).map_err(io(dir, "history.csv"))?;
-    Ok(Box::new(std::io::BufWriter::new(file)))
+    Ok(Box::new(file))
+}
+
+static STOP: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Asks the running [`run_on`] to stop at the end of its current step, after
+/// writing `checkpoint.json` (a signal handler's call: SIGINT, SIGTERM). It then
+/// returns [`RunError::Interrupted`]. One process only: several ranks would have
+/// to agree on the step.
+pub fn request_stop() {
+    STOP.store(true, std::sync::atomic::Ordering::SeqCst);
+}
+
+fn stop_requested() -> bool {
+    STOP.load(std::sync::atomic::Ordering::SeqCst)
 }
 
 /// The NSCDD solver of a decomposed scene, over the ranks of `cluster` when given.
@@ -183,6 +198,24 @@ fn writers<D: Dim>(scene: &Scene<D>, registry: &Registry, root: bool) -> Vec<Box
     // the loader checked every name
     out.extend(names.filter_map(|n| registry.writer::<D>(n)).map(|make| make()));
     out
+}
+
+/// The end of the writers' and the families' series (`.pvd`).
+fn finish_outputs<D: Dim>(
+    writers: &mut [Box<dyn Writer<D>>],
+    fams: &mut [Box<dyn SceneFamily<D>>],
+    vtk: bool,
+    dir: &Path,
+) -> Result<(), RunError> {
+    for wr in writers.iter_mut() {
+        wr.finish(dir).map_err(io(dir, "the output series"))?;
+    }
+    if vtk {
+        for f in fams.iter_mut() {
+            f.finish(dir).map_err(io(dir, "the output series"))?;
+        }
+    }
+    Ok(())
 }
 
 /// The NSCDD solver of a scene: its decomposition's, or one subdomain where its
@@ -280,16 +313,17 @@ pub fn run_on<D: Dim>(
         }
         sum.record(&rep.solve, w.step, w.solver.tolerance);
         on_step(w, &rep);
-    }
-    hist.flush().map_err(io(dir, "history.csv"))?;
-    for wr in writers.iter_mut() {
-        wr.finish(dir).map_err(io(dir, "the output series"))?;
-    }
-    if vtk {
-        for f in fams.iter_mut() {
-            f.finish(dir).map_err(io(dir, "the output series"))?;
+        if s != steps && stop_requested() {
+            hist.flush().map_err(io(dir, "history.csv"))?;
+            if root {
+                save_state(dir, "checkpoint.json", w, fams, &dd)?;
+            }
+            finish_outputs(&mut writers, fams, vtk, dir)?;
+            return Err(RunError::Interrupted(s));
         }
     }
+    hist.flush().map_err(io(dir, "history.csv"))?;
+    finish_outputs(&mut writers, fams, vtk, dir)?;
     write_rank_totals(&mut dd, dir)?;
     if root {
         save_state(dir, "final.json", w, fams, &dd)?;

@@ -7,7 +7,9 @@ use crate::engine::StepReport;
 use crate::world::{World, World3};
 use std::io::Write;
 
-/// Writes the history rows; the columns are fixed when the run starts:
+/// Writes the history rows, each with one `write_all` (over an unbuffered file, a
+/// run killed at any moment leaves whole lines); the columns are fixed when the run
+/// starts:
 ///
 /// - [`SOLVER_COLUMNS`]: the step, its solve and the energies;
 /// - per named or driven body `_x, _y[, _z]`, its rotation (`_rot` in 2D, the
@@ -97,7 +99,8 @@ impl<W: Write, D: Dim> History<W, D> {
             head.push(',');
             head.push_str(c);
         }
-        writeln!(out, "{head}")?;
+        head.push('\n');
+        out.write_all(head.as_bytes())?;
         let margin = 4.0 * w.max_grain_size();
         Ok(History {
             out,
@@ -144,7 +147,9 @@ impl<W: Write, D: Dim> History<W, D> {
         for x in extra {
             s.push_str(&format!(",{x:e}"));
         }
-        writeln!(self.out, "{s}")
+        // one write per row: an unbuffered sink never holds half a line
+        s.push('\n');
+        self.out.write_all(s.as_bytes())
     }
 
     pub fn flush(&mut self) -> std::io::Result<()> {

@@ -4,6 +4,21 @@
 pub mod history;
 pub mod vtk;
 
+/// Writes a file atomically: `write` fills a temporary file beside `path` (its name
+/// keeps the extension: `.name.part.ext`), renamed onto `path` once complete, so
+/// that a run killed at any moment leaves either the previous file or the new one,
+/// never a part of it.
+pub fn write_atomic(path: &std::path::Path, write: impl FnOnce(&std::path::Path) -> std::io::Result<()>) -> std::io::Result<()> {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let tmp_name = match name.rsplit_once('.') {
+        Some((stem, ext)) => format!(".{stem}.part.{ext}"),
+        None => format!(".{name}.part"),
+    };
+    let tmp = path.with_file_name(tmp_name);
+    write(&tmp)?;
+    std::fs::rename(&tmp, path)
+}
+
 use crate::dim::Dim;
 use crate::world::World;
 use serde::Serialize;

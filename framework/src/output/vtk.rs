@@ -74,9 +74,12 @@ fn runs(n: usize, per: u64) -> Option<VertexNumbers> {
     cells((0..per * n as u64).collect(), (1..=n as u64).map(|x| per * x).collect())
 }
 
+/// Writes a VTK file atomically ([`super::write_atomic`]).
 fn export(v: Vtk, path: &Path) -> std::io::Result<()> {
-    v.export(path)
-        .map_err(|e| std::io::Error::other(format!("writing {}: {e}", path.display())))
+    super::write_atomic(path, |tmp| {
+        v.export(tmp)
+            .map_err(|e| std::io::Error::other(format!("writing {}: {e}", path.display())))
+    })
 }
 
 /// A point or vector of either dimension as three coordinates (z = 0 in 2D).
@@ -114,7 +117,11 @@ fn polygons<D: Dim>(g: Glyph<D>) -> Vec<Vec<D::Point>> {
 
 impl VtkWriter {
     fn write_pvd(&self, dir: &Path, name: &str) -> std::io::Result<()> {
-        let mut f = std::io::BufWriter::new(std::fs::File::create(dir.join(format!("{name}.pvd")))?);
+        super::write_atomic(&dir.join(format!("{name}.pvd")), |tmp| self.write_pvd_to(tmp, name))
+    }
+
+    fn write_pvd_to(&self, path: &Path, name: &str) -> std::io::Result<()> {
+        let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
         writeln!(
             f,
             "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>"

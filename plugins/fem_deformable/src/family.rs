@@ -155,7 +155,8 @@ fn describe(bodies: &[FeBody]) -> String {
 /// One VTK unstructured grid per body (`deformable{i}_{frame}.vtu`).
 fn write_frame(bodies: &[FeBody], frames: &mut Vec<(f64, u32)>, dir: &Path, frame: u32, t: f64) -> std::io::Result<()> {
     for (bi, b) in bodies.iter().enumerate() {
-        std::fs::write(dir.join(format!("deformable{bi}_{frame:05}.vtu")), crate::output::vtu(b))?;
+        let path = dir.join(format!("deformable{bi}_{frame:05}.vtu"));
+        nscdd::output::write_atomic(&path, |tmp| std::fs::write(tmp, crate::output::vtu(b)))?;
     }
     frames.push((t, frame));
     Ok(())

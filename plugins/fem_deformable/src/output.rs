@@ -15,7 +15,7 @@ pub fn write_pvd(dir: &Path, bodies: usize, frames: &[(f64, u32)]) -> std::io::R
         }
     }
     pvd.push_str("</Collection>\n</VTKFile>\n");
-    std::fs::write(dir.join("deformable.pvd"), pvd)
+    nscdd::output::write_atomic(&dir.join("deformable.pvd"), |tmp| std::fs::write(tmp, pvd))
 }
 
 /// One deformable body as a VTK XML unstructured grid (ASCII): current node
