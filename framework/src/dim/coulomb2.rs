@@ -109,6 +109,14 @@ pub fn solve_pre(w: [f64; 3], p: &[f64; 5], u0: [f64; 2], u_target: f64, mu: f64
     fallback(w, u0, u_target, mu)
 }
 
+/// x clamped to [−b, b]; never panics (`f64::clamp` does on a NaN bound, which
+/// overflowing input can produce): a NaN bound leaves x, which the caller's
+/// residual then reports.
+#[inline]
+fn clamp_sym(x: f64, b: f64) -> f64 {
+    x.max(-b).min(b)
+}
+
 /// Projected fixed point `r ← P_K(r − ρ (u(r) − ū e_n))` for degenerate blocks.
 #[cold]
 fn fallback(w: [f64; 3], u0: [f64; 2], u_target: f64, mu: f64) -> [f64; 2] {
@@ -119,7 +127,7 @@ fn fallback(w: [f64; 3], u0: [f64; 2], u_target: f64, mu: f64) -> [f64; 2] {
         let un = wnn * r[0] + wnt * r[1] + u0[0] - u_target;
         let ut = wnt * r[0] + wtt * r[1] + u0[1];
         let rn = (r[0] - rho * un).max(0.0);
-        let rt = (r[1] - rho * ut).clamp(-mu * rn, mu * rn);
+        let rt = clamp_sym(r[1] - rho * ut, mu * rn);
         let change = (rn - r[0]).abs() + (rt - r[1]).abs();
         r = [rn, rt];
         if change <= 1e-14 * (rn.abs() + rt.abs()) {
@@ -145,7 +153,7 @@ pub fn project_joint(z: [f64; 2], mu: f64, j: &Joint) -> [f64; 2] {
         return [p[0] - j.shift, p[1]];
     }
     let rad = mu * (j.shift - j.tension);
-    [-j.tension, z[1].clamp(-rad, rad)]
+    [-j.tension, clamp_sym(z[1], rad)]
 }
 
 /// Whether r lies in K_c up to `tol` relative to the strength scale s + |r_n|.
@@ -175,7 +183,7 @@ pub fn solve_joint(w: [f64; 3], p: &[f64; 5], u0: [f64; 2], u_target: f64, mu: f
     let b = u0[1] + w[1] * rn;
     if w[2] > 0.0 {
         let rad = mu * (s - j.tension);
-        let rt = (-b / w[2]).clamp(-rad, rad);
+        let rt = clamp_sym(-b / w[2], rad);
         let un = w[0] * rn + w[1] * rt + u0[0];
         if un >= u_target - 1e-12 * (u_target.abs() + u0[0].abs()) {
             return [rn, rt];
