@@ -282,3 +282,26 @@ fn a_diverging_run_stops_and_keeps_its_history() {
 }
 
 // ---- [decomposition] and the NSCDD flags (issue 3) ----
+
+/// A step longer than the duration (the scene would run no step) and a step so
+/// short that the run would take more than 10¹² steps (it used to run 0 steps, and
+/// `as u64` saturated to 1.8e19 steps): refused, naming time.duration.
+#[test]
+fn a_duration_of_no_step_or_of_too_many() {
+    for (name, step) in [("no_step", "1e308"), ("too_many", "1e-300")] {
+        let scene = edit(BASE, "steps = 10", "duration = 0.2").replace("step = 1e-3", &format!("step = {step}"));
+        check_bad(&Case {
+            name,
+            scene,
+            key: "time.duration",
+            marker: "duration",
+        });
+    }
+    let scene = edit(BASE, "steps = 10", "steps = 9000000000000000000");
+    check_bad(&Case {
+        name: "steps_too_many",
+        scene,
+        key: "time.steps",
+        marker: "steps = 9",
+    });
+}

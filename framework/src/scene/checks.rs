@@ -179,6 +179,9 @@ pub(crate) fn decomposition(cx: &Ctx, d: &schema::DecompositionSpec, movable: us
     Ok(c)
 }
 
+/// The most steps a scene may ask for (10¹²: eleven days at a microsecond a step).
+const MAX_STEPS: f64 = 1e12;
+
 pub(crate) fn time_settings<B>(cx: &Ctx, sf: &SceneFile<B>) -> Result<TimeSettings, InputError> {
     let t = &sf.time;
     if !(t.step > 0.0 && t.step.is_finite()) {
@@ -191,11 +194,27 @@ pub(crate) fn time_settings<B>(cx: &Ctx, sf: &SceneFile<B>) -> Result<TimeSettin
         return Err(cx.err(&[k("time"), k("theta")], format!("θ must lie in [0.5, 1], got {}", t.theta)));
     }
     let steps = match (t.steps, t.duration) {
-        (Some(n), None) => n,
-        (None, Some(d)) if d >= 0.0 && d.is_finite() => (d / t.step).round() as u64,
+        (Some(n), None) => n as f64,
+        (None, Some(d)) if d >= 0.0 && d.is_finite() => {
+            let n = (d / t.step).round();
+            if d > 0.0 && n < 1.0 {
+                let msg = format!(
+                    "{d} s is less than half a step (time.step = {:e} s): the scene would run no step",
+                    t.step
+                );
+                return Err(cx.err(&[k("time"), k("duration")], msg));
+            }
+            n
+        }
         (None, Some(d)) => return Err(cx.err(&[k("time"), k("duration")], format!("must be ≥ 0, got {d}"))),
         _ => return Err(cx.err(&[k("time")], "give exactly one of `steps` or `duration`")),
     };
+    if steps > MAX_STEPS {
+        let key = if t.steps.is_some() { "steps" } else { "duration" };
+        let msg = format!("{steps:e} steps: more than a run can take (at most {MAX_STEPS:e}); lengthen time.step or shorten the run");
+        return Err(cx.err(&[k("time"), k(key)], msg));
+    }
+    let steps = steps as u64;
     Ok(TimeSettings {
         h: t.step,
         theta: t.theta,
