@@ -18,6 +18,55 @@ pub struct FamilyShare {
     pub own: Vec<(u32, u32, Vec<f64>)>,
 }
 
+/// The families' contacts' H_bᵀ rows, as (body, contact, rows) in the problem's
+/// numbering (`off`: each family's first contact), and their own blocks as
+/// (α, β, block); `rows`/`block` turn the flat values into the dimension's arrays.
+fn family_parts<H, B>(
+    shares: &[FamilyShare],
+    off: &[usize],
+    rows: impl Fn(&[f64]) -> H,
+    block: impl Fn(&[f64]) -> B,
+) -> (Vec<(u32, u32, H)>, Vec<(u32, u32, B)>) {
+    let (mut inc, mut own) = (vec![], vec![]);
+    for (s, &o) in shares.iter().zip(off) {
+        let at = |a: u32| (o + a as usize) as u32;
+        inc.extend(s.rigid.iter().map(|(a, body, h)| (*body, at(*a), rows(h))));
+        own.extend(s.own.iter().map(|(x, y, b)| (at(*x), at(*y), block(b))));
+    }
+    (inc, own)
+}
+
+/// The 3 × 3 block contributions (α ≤ β) summed per pair and written as the
+/// symmetric matrix's triplets, sorted.
+fn triplets3(mut contrib: Vec<(u32, u32, [[f64; 3]; 3])>) -> Vec<(usize, usize, f64)> {
+    contrib.sort_by_key(|x| (x.0, x.1));
+    let mut trip: Vec<(usize, usize, f64)> = Vec::with_capacity(9 * contrib.len());
+    let mut k = 0;
+    while k < contrib.len() {
+        let (ca, cb, mut blk) = contrib[k];
+        k += 1;
+        while k < contrib.len() && (contrib[k].0, contrib[k].1) == (ca, cb) {
+            for p in 0..3 {
+                for q in 0..3 {
+                    blk[p][q] += contrib[k].2[p][q];
+                }
+            }
+            k += 1;
+        }
+        let (ra, rb) = (3 * ca as usize, 3 * cb as usize);
+        for p in 0..3 {
+            for q in 0..3 {
+                trip.push((ra + p, rb + q, blk[p][q]));
+                if ca != cb {
+                    trip.push((rb + q, ra + p, blk[p][q]));
+                }
+            }
+        }
+    }
+    trip.sort_by_key(|x| (x.0, x.1));
+    trip
+}
+
 /// The families' contact offsets, q and μ after the world's `nw` contacts.
 fn family_rows(nw: usize, d: usize, shares: &[FamilyShare]) -> (Vec<usize>, Vec<f64>, Vec<f64>) {
     let mut off = vec![];
@@ -64,22 +113,17 @@ pub fn problem_with(w: &World2, shares: &[FamilyShare]) -> FcProblem {
             inc.push((j, a as u32, h_of(a, c.frame[a].arm_j, -1.0)));
         }
     }
-    for (s, &o) in shares.iter().zip(&off) {
-        for (a, body, h) in &s.rigid {
-            inc.push((*body, (o + *a as usize) as u32, [[h[0], h[1], h[2]], [h[3], h[4], h[5]]]));
-        }
-    }
+    let (finc, mut contrib) = family_parts(
+        shares,
+        &off,
+        |h| [[h[0], h[1], h[2]], [h[3], h[4], h[5]]],
+        |b| [b[0], b[1], b[2], b[3]],
+    );
+    inc.extend(finc);
     inc.sort_by_key(|x| (x.0, x.1));
-    // Contributions to the blocks (α ≤ β) from each shared body.
-    let mut contrib: Vec<(u32, u32, [f64; 4])> = Vec::new();
-    for (s, &o) in shares.iter().zip(&off) {
-        for (x, y, blk) in &s.own {
-            let mut blk = [blk[0], blk[1], blk[2], blk[3]];
-            if x == y {
-                blk[2] = blk[1];
-            }
-            contrib.push(((o + *x as usize) as u32, (o + *y as usize) as u32, blk));
-        }
+    // Contributions to the blocks (α ≤ β) from each shared body (and the families' own).
+    for c in contrib.iter_mut().filter(|c| c.0 == c.1) {
+        c.2[2] = c.2[1];
     }
     let mut g0 = 0;
     while g0 < inc.len() {
@@ -175,26 +219,11 @@ pub fn problem_with3(w: &crate::world::World3, shares: &[FamilyShare]) -> FcProb
             inc.push((j, a as u32, h_of(a, c.frame[a].d_j, -1.0)));
         }
     }
-    for (s, &o) in shares.iter().zip(&off) {
-        for (a, body, h) in &s.rigid {
-            inc.push((
-                *body,
-                (o + *a as usize) as u32,
-                std::array::from_fn(|k| std::array::from_fn(|l| h[6 * k + l])),
-            ));
-        }
-    }
+    let rows = |h: &[f64]| -> [[f64; 6]; 3] { std::array::from_fn(|k| std::array::from_fn(|l| h[6 * k + l])) };
+    let block = |v: &[f64]| -> [[f64; 3]; 3] { std::array::from_fn(|p| std::array::from_fn(|q| v[3 * p + q])) };
+    let (finc, mut contrib) = family_parts(shares, &off, rows, block);
+    inc.extend(finc);
     inc.sort_by_key(|x| (x.0, x.1));
-    let mut contrib: Vec<(u32, u32, [[f64; 3]; 3])> = Vec::new();
-    for (s, &o) in shares.iter().zip(&off) {
-        for (x, y, blk) in &s.own {
-            contrib.push((
-                (o + *x as usize) as u32,
-                (o + *y as usize) as u32,
-                std::array::from_fn(|p| std::array::from_fn(|q| blk[3 * p + q])),
-            ));
-        }
-    }
     let mut g0 = 0;
     while g0 < inc.len() {
         let body = inc[g0].0 as usize;
@@ -217,31 +246,7 @@ pub fn problem_with3(w: &crate::world::World3, shares: &[FamilyShare]) -> FcProb
         }
         g0 = g1;
     }
-    contrib.sort_by_key(|x| (x.0, x.1));
-    let mut trip: Vec<(usize, usize, f64)> = Vec::with_capacity(9 * contrib.len());
-    let mut k = 0;
-    while k < contrib.len() {
-        let (ca, cb, mut blk) = contrib[k];
-        k += 1;
-        while k < contrib.len() && (contrib[k].0, contrib[k].1) == (ca, cb) {
-            for p in 0..3 {
-                for q in 0..3 {
-                    blk[p][q] += contrib[k].2[p][q];
-                }
-            }
-            k += 1;
-        }
-        let (ra, rb) = (3 * ca as usize, 3 * cb as usize);
-        for p in 0..3 {
-            for q in 0..3 {
-                trip.push((ra + p, rb + q, blk[p][q]));
-                if ca != cb {
-                    trip.push((rb + q, ra + p, blk[p][q]));
-                }
-            }
-        }
-    }
-    trip.sort_by_key(|x| (x.0, x.1));
+    let trip = triplets3(contrib);
     let mut q = Vec::with_capacity(3 * nc);
     for a in 0..nw {
         q.push(c.u_free[a][0] - c.target[a].u_target);
