@@ -45,7 +45,7 @@ impl<D: Family> NscddOf<D> {
     /// first step). `Ok(false)`: the state is of another decomposition and is left
     /// out (F_Γ starts from zero); an error: a malformed state.
     pub fn load_state(&mut self, state: &serde_json::Value) -> Result<bool, String> {
-        let s: Saved = serde_json::from_value(state.clone()).map_err(|e| format!("not an NSCDD state: {e}"))?;
+        let s: Saved = Saved::deserialize(state).map_err(|e| format!("not an NSCDD state: {e}"))?;
         if s.grid_of != [self.settings.nx, self.settings.ny, self.settings.nz] || s.by_model != self.by_model || self.ranks.is_some() {
             return Ok(false);
         }

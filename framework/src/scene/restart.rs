@@ -78,6 +78,12 @@ struct Saved<D: Dim> {
 /// Loads the saved state in `path` into `w` (a world loaded from the scene that
 /// wrote it). Errors name the file, the line and the key.
 pub fn restart<D: Dim>(w: &mut World<D>, path: &Path) -> Result<(), InputError> {
+    let (text, file) = read_state(path)?;
+    restart_str(w, &text, &file)
+}
+
+/// The text of a saved state and its name for messages.
+fn read_state(path: &Path) -> Result<(String, String), InputError> {
     let file = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|e| InputError {
         file: file.clone(),
@@ -85,7 +91,7 @@ pub fn restart<D: Dim>(w: &mut World<D>, path: &Path) -> Result<(), InputError> 
         key: String::new(),
         message: format!("cannot read the restart file: {e}"),
     })?;
-    restart_str(w, &text, &file)
+    Ok((text, file))
 }
 
 /// [`restart`] of a scene: the world's state, then each body family's from the
@@ -94,9 +100,8 @@ pub fn restart<D: Dim>(w: &mut World<D>, path: &Path) -> Result<(), InputError> 
 /// state without a family of the scene, or with one the scene does not have, is
 /// another scene's: an error.
 pub fn restart_scene<D: Dim>(scene: &mut super::Scene<D>, path: &Path) -> Result<(), InputError> {
-    restart(&mut scene.world, path)?;
-    let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).unwrap_or_default();
+    let (text, file) = read_state(path)?;
+    restart_str(&mut scene.world, &text, &file)?;
     let ck = StateChecks { text: &text, file: &file };
     let saved = serde_json::from_str::<serde_json::Value>(&text).unwrap_or_default();
     scene.dd_state = saved.get("nscdd").cloned();

@@ -104,7 +104,7 @@ fn load<C: Copy, A: Copy, F: Copy, B: Copy, const N: usize>(
     c: &mut FeContacts<C, A, F, B, N>,
     v: &serde_json::Value,
 ) -> Result<(), String> {
-    let s: State = serde_json::from_value(v.clone()).map_err(|e| format!("not a state of deformable bodies: {e}"))?;
+    let s: State = State::deserialize(v).map_err(|e| format!("not a state of deformable bodies: {e}"))?;
     if s.bodies.len() != bodies.len() {
         return Err(format!(
             "the state has {} deformable bodies, the scene {}: a restart needs the scene that wrote it",

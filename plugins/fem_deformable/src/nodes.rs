@@ -101,15 +101,20 @@ impl<const D: usize> NodeSet<D> {
     }
     /// Σ_kl w_k w_l G_kl: the side's share of the Delassus block (global frame).
     pub fn side_block(&self, s: &FeSide<D>) -> [[f64; D]; D] {
+        self.cross_block(s, s)
+    }
+    /// Σ_kl w_k w'_l G_kl of two sides `a`, `b` of this body (global frame): their
+    /// coupling through M̂⁻¹ (`a = b`: [`Self::side_block`]).
+    pub fn cross_block(&self, a: &FeSide<D>, b: &FeSide<D>) -> [[f64; D]; D] {
         let mut g = [[0.0; D]; D];
         for p in 0..D {
             for q in 0..D {
-                let ww = s.w[p] * s.w[q];
+                let ww = a.w[p] * b.w[q];
                 if ww != 0.0 {
-                    let b = self.block(s.k[p] as usize, s.k[q] as usize);
+                    let blk = self.block(a.k[p] as usize, b.k[q] as usize);
                     for c in 0..D {
                         for d in 0..D {
-                            g[c][d] += ww * b[c][d];
+                            g[c][d] += ww * blk[c][d];
                         }
                     }
                 }

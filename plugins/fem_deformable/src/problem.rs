@@ -34,25 +34,6 @@ fn sandwich<const D: usize>(ra: &[[f64; D]; D], m: &[[f64; D]; D], rb: &[[f64; D
     out
 }
 
-/// Σ_kl w_k w'_l G_kl of two sides of one body (global frame).
-fn cross_block<const D: usize>(set: &NodeSet<D>, a: &FeSide<D>, b: &FeSide<D>) -> [[f64; D]; D] {
-    let mut g = [[0.0; D]; D];
-    for p in 0..D {
-        for q in 0..D {
-            let ww = a.w[p] * b.w[q];
-            if ww != 0.0 {
-                let blk = set.block(a.k[p] as usize, b.k[q] as usize);
-                for c in 0..D {
-                    for d in 0..D {
-                        g[c][d] += ww * blk[c][d];
-                    }
-                }
-            }
-        }
-    }
-    g
-}
-
 /// What the share needs of one dimension's contacts.
 pub struct Dims<'a, A, F, const D: usize> {
     /// The local frame rows of a contact.
@@ -101,7 +82,7 @@ pub fn share<A: Copy, F: Copy, B: Copy, const D: usize>(
                     if sa.body != sb.body {
                         continue;
                     }
-                    let g = cross_block(&sets[sa.body as usize], sa, sb);
+                    let g = sets[sa.body as usize].cross_block(sa, sb);
                     for p in 0..D {
                         for q in 0..D {
                             m[p][q] += ga * gb * g[p][q];

@@ -311,7 +311,7 @@ impl SceneFamily<D2> for PointMasses {
         .expect("plain data")
     }
     fn load_state(&mut self, state: &serde_json::Value) -> Result<(), String> {
-        let s: State = serde_json::from_value(state.clone()).map_err(|e| e.to_string())?;
+        let s: State = State::deserialize(state).map_err(|e| e.to_string())?;
         if s.x.len() != self.x.len() || s.v.len() != self.v.len() {
             return Err(format!("{} point masses saved, {} in the scene", s.x.len(), self.x.len()));
         }
