@@ -24,9 +24,19 @@
 //! ΔV_k = y_k − y_{k−1} with y = L⁻¹ [V], which the part applies as
 //! V_E += M̂_E⁻¹ A_ΓEᵀ ΔF_Γ = ΔV_k on the entity ([`LocalPart::glue_entity`]).
 //! Copies of equal M̂_E go to their mean, so the family never forms M̂_E itself: its
-//! F_Γ is implied (Σ_k ΔF_Γ,k = M̂_E Σ_k ΔV_k = 0) and starts from zero at every
-//! step; the end-of-step velocity V⁺ = V_free + M̂⁻¹ Σ_E H_E r_E is the family's
-//! ([`Attached::write_back`]).
+//! F_Γ is implied (Σ_k ΔF_Γ,k = M̂_E Σ_k ΔV_k = 0); the end-of-step velocity
+//! V⁺ = V_free + M̂⁻¹ Σ_E H_E r_E is the family's ([`Attached::write_back`]).
+//!
+//! *Warm start of F_Γ.* Every interface entity is glued once before the first sweep
+//! of a step (it is `fresh`): its copies start at their mean, V_free + M̂⁻¹ Σ_E H_E r_E
+//! with the warm-start impulses, i.e. with F_Γ,E = (1/m) Σ_E' H_E' r_E' − H_E r_E. A
+//! kept F_Γ (the rigid copies' [`super::FGammaStore`]) starts the copies at
+//! V_free + M̂_E⁻¹ (F_Γ,E + H_E r_E), the same point up to the last step's gluing
+//! residual when the contacts persist: with copies of equal M̂_E the two are the same
+//! warm start, and the glued one also holds when contacts appear, vanish or change
+//! subdomain. Keeping a deformable copy's F_Γ itself would need a solve with its
+//! block G per copy and step (F_Γ = (m G)⁻¹ A_ΓE (V_E − V_free) − H_E r_E, on a node
+//! set that changes every step) for no gain; measured in docs/PERFORMANCE.md.
 //!
 //! Calls are per step, per subdomain and sweep, never per contact: a part's
 //! [`LocalPart::sweep`] visits all its contacts in the family's own code.

@@ -148,13 +148,14 @@ impl<V: Copy> FGammaStore<V> {
     pub fn is_empty(&self) -> bool {
         self.entries.is_empty()
     }
-    /// Replaces the store by the subdomains' current F_Γ (rigid copies; the attached
-    /// families' start from zero at every step).
     /// A store of the entries (body, subdomain, F_Γ) in any order (a saved state).
     pub fn from_entries(mut entries: Vec<(u32, u32, V)>) -> Self {
         entries.sort_unstable_by_key(|e| (e.0, e.1));
         FGammaStore { entries }
     }
+    /// Replaces the store by the subdomains' current F_Γ (rigid copies; the attached
+    /// families' entities are glued at the start of every step instead, the same warm
+    /// start: [`super::attach`]).
     pub fn keep<D: Family<V = V>>(&mut self, subs: &[Subdomain<D>]) {
         self.entries.clear();
         for s in subs {
@@ -308,22 +309,30 @@ fn split_families<D: Family>(
     if fam.fams.is_empty() {
         return out;
     }
-    let mut local: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
-    for s in subs.iter() {
-        for (l, &g) in s.body_global.iter().enumerate() {
-            local.insert((s.id, g), l as u32);
-        }
-    }
+    // the local id of each body's copy in the subdomain `cur` (a family's parts come
+    // in ascending subdomain order: one refill per subdomain)
+    let nb = mult.len();
+    let (mut stamp, mut local) = (vec![u32::MAX; nb], vec![0u32; nb]);
+    let mut cur = u32::MAX;
     for (f, a) in fam.fams.iter().enumerate() {
         let mut copy = |s: u32, g: u32| -> u32 {
-            *local.entry((s, g)).or_insert_with(|| {
-                let sub = &mut subs[s as usize];
-                let l = sub.body_global.len() as u32;
+            let sub = &mut subs[s as usize];
+            if s != cur {
+                cur = s;
+                for (l, &b) in sub.body_global.iter().enumerate() {
+                    stamp[b as usize] = s;
+                    local[b as usize] = l as u32;
+                }
+            }
+            let gi = g as usize;
+            if stamp[gi] != s {
+                stamp[gi] = s;
+                local[gi] = sub.body_global.len() as u32;
                 sub.body_global.push(g);
-                mult[g as usize] += 1;
-                copy_of.push((g, s, l));
-                l
-            })
+                mult[gi] += 1;
+                copy_of.push((g, s, local[gi]));
+            }
+            local[gi]
         };
         let parts = a.split(w, &fam.owner[f], &mut copy);
         let mut ec = EntityCopies {
@@ -346,7 +355,8 @@ fn split_families<D: Family>(
 }
 
 /// Appends one family's interface entities (held by ≥ 2 subdomains) to the interface
-/// and their slots to the subdomains; their F_Γ start from zero (fresh).
+/// and their slots to the subdomains; they are fresh: glued once before the first
+/// sweep, their warm start ([`super::attach`]).
 fn entity_interface<D: Family>(iface: &mut Interface, subs: &mut [Subdomain<D>], fam: &dyn Attached<D>, ec: &EntityCopies) {
     let mut p = 0;
     while p < ec.copies.len() {
