@@ -320,31 +320,38 @@ pub fn detect(w: &World3, fe: &[FeBody], alert: f64, out: &mut Vec<RawFe3>) {
                 }
             }
         }
-        for (ob, other) in fe.iter().enumerate().skip(fb + 1) {
-            let o = boxes[ob];
-            if !overlap(&o, &bb, alert) || w.law(body.material, other.material).is_none() {
+        fe_pairs(w, fe, &boxes, fb, alert, out);
+    }
+}
+
+/// Node contacts of deformable body `fb`'s boundary nodes with the boundary faces of
+/// the deformable bodies after it whose boxes meet its own.
+fn fe_pairs(w: &World3, fe: &[FeBody], boxes: &[Bounds], fb: usize, alert: f64, out: &mut Vec<RawFe3>) {
+    let (body, bb) = (&fe[fb], boxes[fb]);
+    for (ob, other) in fe.iter().enumerate().skip(fb + 1) {
+        let o = boxes[ob];
+        if !overlap(&o, &bb, alert) || w.law(body.material, other.material).is_none() {
+            continue;
+        }
+        for &k in &body.mesh.boundary {
+            let p = body.position(k as usize);
+            if !inside(p, &o, alert) {
                 continue;
             }
-            for &k in &body.mesh.boundary {
-                let p = body.position(k as usize);
-                if !inside(p, &o, alert) {
-                    continue;
-                }
-                if let Some((face, nodes, wts, n, gap, q)) = nearest_face(other, p, alert) {
-                    out.push(RawFe3 {
-                        body: fb as u32,
-                        cand: RawCand3::Node(k),
-                        anta: RawAnta3::Face {
-                            body: ob as u32,
-                            face,
-                            nodes,
-                            w: wts,
-                        },
-                        n,
-                        gap,
-                        point: q,
-                    });
-                }
+            if let Some((face, nodes, wts, n, gap, q)) = nearest_face(other, p, alert) {
+                out.push(RawFe3 {
+                    body: fb as u32,
+                    cand: RawCand3::Node(k),
+                    anta: RawAnta3::Face {
+                        body: ob as u32,
+                        face,
+                        nodes,
+                        w: wts,
+                    },
+                    n,
+                    gap,
+                    point: q,
+                });
             }
         }
     }

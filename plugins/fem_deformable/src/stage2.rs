@@ -23,6 +23,10 @@ use nscdd::solver::SolveReport;
 use nscdd::world::World2;
 use std::time::Instant;
 
+/// An antagonist side: the side, its local velocities at the beginning of the step
+/// and free, its material, its key and its feature.
+type AntaSide = (Anta, [f64; 2], [f64; 2], u16, u32, u32);
+
 /// Seconds per stage of the deformable part of the last step (the benchmark's
 /// split).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
@@ -94,29 +98,14 @@ impl Deformables2 {
     pub fn build(&mut self, w: &mut World2) {
         let t0 = Instant::now();
         let solves0: u64 = self.bodies.iter().map(|b| b.solves).sum();
-        // contact nodes per body (sorted, unique)
-        let mut nodes: Vec<Vec<u32>> = vec![vec![]; self.bodies.len()];
-        for rc in &self.raw {
-            nodes[rc.body as usize].push(rc.node);
-            if let RawAnta::Segment { body, a, b, .. } = rc.anta {
-                nodes[body as usize].extend([a, b]);
-            }
-        }
-        for (bi, ns) in nodes.iter_mut().enumerate() {
-            ns.sort_unstable();
-            ns.dedup();
-            let body = &mut self.bodies[bi];
-            body.retain_columns(ns);
-            let set = &mut self.sets[bi];
-            fill_set(set, body, ns, 1.0);
-        }
+        self.fill_sets();
         let t1 = Instant::now();
         let (h, theta) = (w.time.h, w.time.theta);
         self.prev.clear();
         self.prev
             .extend(self.contacts.key.iter().copied().zip(self.contacts.r.iter().copied()));
         self.prev.sort_unstable_by_key(|x| x.0);
-        let c = &mut self.contacts;
+        let mut c = std::mem::take(&mut self.contacts);
         c.clear();
         let v_begin = w.velocity_begin();
         for rc in &self.raw {
@@ -133,52 +122,7 @@ impl Deformables2 {
             let vb_i = local(n, [body.v_begin[2 * rc.node as usize], body.v_begin[2 * rc.node as usize + 1]]);
             let vf_i = local(n, set.v[k as usize]);
             let mut wb = set.delassus(&cand, n);
-            let (anta, ub_j, uf_j, mat_j, key_j, feature) = match rc.anta {
-                RawAnta::Rigid(j) => {
-                    let ju = j as usize;
-                    let t = [-n[1], n[0]];
-                    let dd = [rc.point[0] - w.bodies.pos[ju][0], rc.point[1] - w.bodies.pos[ju][1]];
-                    let arm = [dd[0] * n[1] - dd[1] * n[0], dd[0] * t[1] - dd[1] * t[0]];
-                    let wr = rigid_delassus(n, arm, w.bodies.inv_mass[ju]);
-                    for q in 0..3 {
-                        wb[q] += wr[q];
-                    }
-                    (
-                        Anta::Rigid { body: j, arm },
-                        rigid_local(n, arm, v_begin[ju]),
-                        rigid_local(n, arm, free_of(&self.rigid_free, j)),
-                        w.bodies.material[ju],
-                        j,
-                        0,
-                    )
-                }
-                RawAnta::Segment { body: ob, seg, a, b, xi } => {
-                    let os = &self.sets[ob as usize];
-                    let ka = os.nodes.binary_search(&a).unwrap() as u32;
-                    let kb = os.nodes.binary_search(&b).unwrap() as u32;
-                    let side = FeSide {
-                        body: ob,
-                        k: [ka, kb],
-                        w: [1.0 - xi, xi],
-                    };
-                    let wo = os.delassus(&side, n);
-                    for q in 0..3 {
-                        wb[q] += wo[q];
-                    }
-                    let other = &self.bodies[ob as usize];
-                    let vb = |x: u32| [other.v_begin[2 * x as usize], other.v_begin[2 * x as usize + 1]];
-                    let (va, vbb) = (vb(a), vb(b));
-                    let vbeg = [(1.0 - xi) * va[0] + xi * vbb[0], (1.0 - xi) * va[1] + xi * vbb[1]];
-                    (
-                        Anta::Fe(side),
-                        local(n, vbeg),
-                        local(n, os.side_velocity(&side)),
-                        other.material,
-                        1 << 31 | ob,
-                        seg,
-                    )
-                }
-            };
+            let (anta, ub_j, uf_j, mat_j, key_j, feature) = self.antagonist(w, rc, n, &v_begin, &mut wb);
             if !(wb[0] > 0.0) {
                 continue;
             }
@@ -208,7 +152,88 @@ impl Deformables2 {
             c.point.push(rc.point);
             c.key.push(key);
         }
-        // warm start
+        self.contacts = c;
+        self.warm_start(w);
+        let solves1: u64 = self.bodies.iter().map(|b| b.solves).sum();
+        self.times.solves = solves1.saturating_sub(solves0);
+        self.times.columns = (t1 - t0).as_secs_f64();
+    }
+
+    /// The contact nodes of each body (sorted, unique) and their node sets (G blocks,
+    /// free velocities).
+    fn fill_sets(&mut self) {
+        let mut nodes: Vec<Vec<u32>> = vec![vec![]; self.bodies.len()];
+        for rc in &self.raw {
+            nodes[rc.body as usize].push(rc.node);
+            if let RawAnta::Segment { body, a, b, .. } = rc.anta {
+                nodes[body as usize].extend([a, b]);
+            }
+        }
+        for (bi, ns) in nodes.iter_mut().enumerate() {
+            ns.sort_unstable();
+            ns.dedup();
+            let body = &mut self.bodies[bi];
+            body.retain_columns(ns);
+            let set = &mut self.sets[bi];
+            fill_set(set, body, ns, 1.0);
+        }
+    }
+
+    /// The antagonist side of a raw contact: the side, its local velocities at the
+    /// beginning of the step and free, its material, its key and feature; adds its
+    /// share of W_αα to `wb`.
+    fn antagonist(&self, w: &World2, rc: &RawFe, n: [f64; 2], v_begin: &[[f64; 3]], wb: &mut [f64; 3]) -> AntaSide {
+        match rc.anta {
+            RawAnta::Rigid(j) => {
+                let ju = j as usize;
+                let t = [-n[1], n[0]];
+                let dd = [rc.point[0] - w.bodies.pos[ju][0], rc.point[1] - w.bodies.pos[ju][1]];
+                let arm = [dd[0] * n[1] - dd[1] * n[0], dd[0] * t[1] - dd[1] * t[0]];
+                let wr = rigid_delassus(n, arm, w.bodies.inv_mass[ju]);
+                for q in 0..3 {
+                    wb[q] += wr[q];
+                }
+                (
+                    Anta::Rigid { body: j, arm },
+                    rigid_local(n, arm, v_begin[ju]),
+                    rigid_local(n, arm, free_of(&self.rigid_free, j)),
+                    w.bodies.material[ju],
+                    j,
+                    0,
+                )
+            }
+            RawAnta::Segment { body: ob, seg, a, b, xi } => {
+                let os = &self.sets[ob as usize];
+                let ka = os.nodes.binary_search(&a).unwrap() as u32;
+                let kb = os.nodes.binary_search(&b).unwrap() as u32;
+                let side = FeSide {
+                    body: ob,
+                    k: [ka, kb],
+                    w: [1.0 - xi, xi],
+                };
+                let wo = os.delassus(&side, n);
+                for q in 0..3 {
+                    wb[q] += wo[q];
+                }
+                let other = &self.bodies[ob as usize];
+                let vb = |x: u32| [other.v_begin[2 * x as usize], other.v_begin[2 * x as usize + 1]];
+                let (va, vbb) = (vb(a), vb(b));
+                let vbeg = [(1.0 - xi) * va[0] + xi * vbb[0], (1.0 - xi) * va[1] + xi * vbb[1]];
+                (
+                    Anta::Fe(side),
+                    local(n, vbeg),
+                    local(n, os.side_velocity(&side)),
+                    other.material,
+                    1 << 31 | ob,
+                    seg,
+                )
+            }
+        }
+    }
+
+    /// Warm start: the kept impulses applied to the node sets and rigid bodies.
+    fn warm_start(&mut self, w: &mut World2) {
+        let c = &self.contacts;
         for a in 0..c.len() {
             let r = c.r[a];
             if r != [0.0, 0.0] {
@@ -223,9 +248,6 @@ impl Deformables2 {
                 );
             }
         }
-        let solves1: u64 = self.bodies.iter().map(|b| b.solves).sum();
-        self.times.solves = solves1.saturating_sub(solves0);
-        self.times.columns = (t1 - t0).as_secs_f64();
     }
 
     /// V⁺ of the deformable bodies from their free velocity and the impulses.

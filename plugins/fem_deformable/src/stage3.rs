@@ -21,6 +21,15 @@ use nscdd::solver::SolveReport;
 use nscdd::world::World3;
 use std::time::Instant;
 
+/// Node k's velocity at the beginning of the step.
+fn vb3(b: &FeBody, k: u32) -> [f64; 3] {
+    std::array::from_fn(|q| b.v_begin[3 * k as usize + q])
+}
+
+/// An antagonist side: the side, its local velocities at the beginning of the step
+/// and free, its material, its key and its feature.
+type AntaSide3 = (Anta3, [f64; 3], [f64; 3], u16, u32, u32);
+
 /// The deformable bodies of a 3D scene and their contacts.
 #[derive(Default)]
 pub struct Deformables3 {
@@ -76,32 +85,15 @@ impl Deformables3 {
     pub fn build(&mut self, w: &mut World3) {
         let t0 = Instant::now();
         let solves0: u64 = self.bodies.iter().map(|b| b.solves).sum();
-        let mut nodes: Vec<Vec<u32>> = vec![vec![]; self.bodies.len()];
-        for rc in &self.raw {
-            match rc.cand {
-                RawCand3::Node(k) => nodes[rc.body as usize].push(k),
-                RawCand3::Face { nodes: f, .. } => nodes[rc.body as usize].extend(f),
-            }
-            if let RawAnta3::Face { body, nodes: f, .. } = rc.anta {
-                nodes[body as usize].extend(f);
-            }
-        }
-        for (bi, ns) in nodes.iter_mut().enumerate() {
-            ns.sort_unstable();
-            ns.dedup();
-            let body = &mut self.bodies[bi];
-            body.retain_columns(ns);
-            fill_set(&mut self.sets[bi], body, ns, 1.0);
-        }
+        self.fill_sets();
         let (h, theta) = (w.time.h, w.time.theta);
         self.prev.clear();
         self.prev
             .extend(self.contacts.key.iter().copied().zip(self.contacts.r.iter().copied()));
         self.prev.sort_unstable_by_key(|x| x.0);
-        let c = &mut self.contacts;
+        let mut c = std::mem::take(&mut self.contacts);
         c.clear();
         let v_begin = w.velocity_begin();
-        let vb3 = |b: &FeBody, k: u32| -> [f64; 3] { std::array::from_fn(|q| b.v_begin[3 * k as usize + q]) };
         for rc in &self.raw {
             let bi = rc.body as usize;
             let set = &self.sets[bi];
@@ -128,55 +120,7 @@ impl Deformables3 {
             let ub_i = local(&basis, vbi);
             let uf_i = local(&basis, set.side_velocity(&cand));
             let mut wb = project(&basis, &set.side_block(&cand));
-            let (anta, ub_j, uf_j, mat_j, key_j, feature) = match rc.anta {
-                RawAnta3::Rigid(j) => {
-                    let ju = j as usize;
-                    let x = w.bodies.pos[ju];
-                    let d = [rc.point[0] - x[0], rc.point[1] - x[1], rc.point[2] - x[2]];
-                    let wr = rigid_delassus(&basis, d, w.bodies.inv_mass[ju].m, &w.bodies.inv_mass[ju].i);
-                    for q in 0..6 {
-                        wb[q] += wr[q];
-                    }
-                    (
-                        Anta3::Rigid { body: j, d },
-                        rigid_local(&basis, d, &v_begin[ju]),
-                        rigid_local(&basis, d, &free_of(&self.rigid_free, j)),
-                        w.bodies.material[ju],
-                        j,
-                        0,
-                    )
-                }
-                RawAnta3::Face {
-                    body: ob,
-                    face,
-                    nodes: f,
-                    w: wts,
-                } => {
-                    let os = &self.sets[ob as usize];
-                    let kk = f.map(|x| os.nodes.binary_search(&x).unwrap() as u32);
-                    let side = FeSide3 { body: ob, k: kk, w: wts };
-                    let wo = project(&basis, &os.side_block(&side));
-                    for q in 0..6 {
-                        wb[q] += wo[q];
-                    }
-                    let other = &self.bodies[ob as usize];
-                    let mut vbeg = [0.0; 3];
-                    for (q, &node) in f.iter().enumerate() {
-                        let v = vb3(other, node);
-                        for c in 0..3 {
-                            vbeg[c] += wts[q] * v[c];
-                        }
-                    }
-                    (
-                        Anta3::Fe(side),
-                        local(&basis, vbeg),
-                        local(&basis, os.side_velocity(&side)),
-                        other.material,
-                        1 << 31 | ob,
-                        face,
-                    )
-                }
-            };
+            let (anta, ub_j, uf_j, mat_j, key_j, feature) = self.antagonist(w, rc, &basis, &v_begin, &mut wb);
             if !(wb[0] > 0.0) {
                 continue;
             }
@@ -206,6 +150,94 @@ impl Deformables3 {
             c.point.push(rc.point);
             c.key.push(key);
         }
+        self.contacts = c;
+        self.warm_start(w);
+        let solves1: u64 = self.bodies.iter().map(|b| b.solves).sum();
+        self.times.solves = solves1.saturating_sub(solves0);
+        self.times.columns = t0.elapsed().as_secs_f64();
+    }
+
+    /// The contact nodes of each body (sorted, unique) and their node sets (G blocks,
+    /// free velocities).
+    fn fill_sets(&mut self) {
+        let mut nodes: Vec<Vec<u32>> = vec![vec![]; self.bodies.len()];
+        for rc in &self.raw {
+            match rc.cand {
+                RawCand3::Node(k) => nodes[rc.body as usize].push(k),
+                RawCand3::Face { nodes: f, .. } => nodes[rc.body as usize].extend(f),
+            }
+            if let RawAnta3::Face { body, nodes: f, .. } = rc.anta {
+                nodes[body as usize].extend(f);
+            }
+        }
+        for (bi, ns) in nodes.iter_mut().enumerate() {
+            ns.sort_unstable();
+            ns.dedup();
+            let body = &mut self.bodies[bi];
+            body.retain_columns(ns);
+            fill_set(&mut self.sets[bi], body, ns, 1.0);
+        }
+    }
+
+    /// The antagonist side of a raw contact: the side, its local velocities at the
+    /// beginning of the step and free, its material, its key and feature; adds its
+    /// share of W_αα to `wb`.
+    fn antagonist(&self, w: &World3, rc: &RawFe3, basis: &Basis, v_begin: &[[f64; 6]], wb: &mut [f64; 6]) -> AntaSide3 {
+        let basis = *basis;
+        match rc.anta {
+            RawAnta3::Rigid(j) => {
+                let ju = j as usize;
+                let x = w.bodies.pos[ju];
+                let d = [rc.point[0] - x[0], rc.point[1] - x[1], rc.point[2] - x[2]];
+                let wr = rigid_delassus(&basis, d, w.bodies.inv_mass[ju].m, &w.bodies.inv_mass[ju].i);
+                for q in 0..6 {
+                    wb[q] += wr[q];
+                }
+                (
+                    Anta3::Rigid { body: j, d },
+                    rigid_local(&basis, d, &v_begin[ju]),
+                    rigid_local(&basis, d, &free_of(&self.rigid_free, j)),
+                    w.bodies.material[ju],
+                    j,
+                    0,
+                )
+            }
+            RawAnta3::Face {
+                body: ob,
+                face,
+                nodes: f,
+                w: wts,
+            } => {
+                let os = &self.sets[ob as usize];
+                let kk = f.map(|x| os.nodes.binary_search(&x).unwrap() as u32);
+                let side = FeSide3 { body: ob, k: kk, w: wts };
+                let wo = project(&basis, &os.side_block(&side));
+                for q in 0..6 {
+                    wb[q] += wo[q];
+                }
+                let other = &self.bodies[ob as usize];
+                let mut vbeg = [0.0; 3];
+                for (q, &node) in f.iter().enumerate() {
+                    let v = vb3(other, node);
+                    for c in 0..3 {
+                        vbeg[c] += wts[q] * v[c];
+                    }
+                }
+                (
+                    Anta3::Fe(side),
+                    local(&basis, vbeg),
+                    local(&basis, os.side_velocity(&side)),
+                    other.material,
+                    1 << 31 | ob,
+                    face,
+                )
+            }
+        }
+    }
+
+    /// Warm start: the kept impulses applied to the node sets and rigid bodies.
+    fn warm_start(&mut self, w: &mut World3) {
+        let c = &self.contacts;
         let inv: RigidInv<'_> = &w.bodies.inv_mass;
         for a in 0..c.len() {
             let r = c.r[a];
@@ -213,9 +245,6 @@ impl Deformables3 {
                 apply(&mut self.sets, &mut w.bodies.vel, inv, c.cand[a], c.anta[a], &c.frame[a], r);
             }
         }
-        let solves1: u64 = self.bodies.iter().map(|b| b.solves).sum();
-        self.times.solves = solves1.saturating_sub(solves0);
-        self.times.columns = t0.elapsed().as_secs_f64();
     }
 
     /// V⁺ of the deformable bodies from their free velocity and the impulses.
