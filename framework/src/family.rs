@@ -35,6 +35,28 @@ use std::path::Path;
 pub struct FamilyContext<'a, D: Dim> {
     pub world: &'a World<D>,
     pub dir: &'a Path,
+    /// The registry's memory limit (`--max-memory`; None: the machine's), for
+    /// [`Self::check_memory`].
+    pub max_memory: Option<f64>,
+}
+
+impl<D: Dim> FamilyContext<'_, D> {
+    /// Checks, before the family allocates, that `bytes` (its estimate of what it will
+    /// hold, `what` says of what) fit beside the rigid world in the memory limit
+    /// ([`crate::registry::limits`]); Err: the message with the estimate and the limit.
+    pub fn check_memory(&self, bytes: f64, what: &str) -> Result<(), String> {
+        use crate::registry::limits::{bytes_per_body, human, memory_limit};
+        let need = bytes.max(0.0) + self.world.bodies.len() as f64 * bytes_per_body::<D>();
+        let (limit, source) = memory_limit(self.max_memory);
+        if need.is_finite() && need <= limit {
+            return Ok(());
+        }
+        Err(format!(
+            "needs ≈ {} ({what}), more than {} ({source}); make it smaller",
+            human(need),
+            human(limit)
+        ))
+    }
 }
 
 /// A bad entry of a family's section: `[[section]]` entry `index` (none: the section

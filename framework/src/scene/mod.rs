@@ -209,7 +209,11 @@ impl<D: SceneDim> Scene<D> {
         for (name, value) in sections {
             let kind = registry.family::<D>(&name).expect("checked above");
             let entries = family_entries(&cx, &name, value)?;
-            let fcx = crate::family::FamilyContext { world: &scene.world, dir };
+            let fcx = crate::family::FamilyContext {
+                world: &scene.world,
+                dir,
+                max_memory: registry.max_memory(),
+            };
             let fam = kind.load(&entries, &fcx).map_err(|e| {
                 let mut path = vec![k(&name)];
                 path.extend(e.index.map(Seg::Index));

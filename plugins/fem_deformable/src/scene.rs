@@ -155,8 +155,11 @@ pub fn bodies_from(
     dim: usize,
     gravity: &[f64],
     time: &TimeSettings,
+    memory: &dyn Fn(f64, &str) -> Result<(), String>,
 ) -> Result<Vec<FeBody>, EntryError> {
     let mut bodies = Vec::new();
+    // bytes of the bodies before entry i
+    let mut held = 0.0;
     for (i, e) in entries.iter().enumerate() {
         let at = |key: &str, message: String| EntryError {
             index: Some(i),
@@ -164,7 +167,15 @@ pub fn bodies_from(
             message,
         };
         let spec = spec_of(i, e)?;
-        let mut b = build(&spec, materials, dim, dir).map_err(|(k, m)| at(k, m))?;
+        let mut check = |nodes: f64| {
+            let bytes = mesh_bytes(dim, nodes);
+            let what = match i {
+                0 => format!("a deformable body of about {nodes:.0} nodes"),
+                _ => format!("{} deformable bodies, the last of about {nodes:.0} nodes", i + 1),
+            };
+            memory(held + bytes, &what).map(|()| held += bytes)
+        };
+        let mut b = build(&spec, materials, dim, dir, &mut check).map_err(|(k, m)| at(k, m))?;
         b.set_gravity(gravity);
         b.factorize(time.h, time.theta).map_err(|m| at("", m))?;
         bodies.push(b);
@@ -172,8 +183,41 @@ pub fn bodies_from(
     Ok(bodies)
 }
 
-/// Builds one deformable body of a spec; errors name the key.
-pub fn build(s: &DeformableSpec, materials: &[Material], dim: usize, dir: &Path) -> Result<FeBody, (&'static str, String)> {
+/// Bytes a deformable body of `nodes` nodes holds while it is built and run (its
+/// mesh, M, K, the factor of M̂ and Python's assembly arrays): measured with
+/// `nscdd check` (peak memory of a rectangle of 100² and 300² cells, 2.6 kB per
+/// degree of freedom; of a box of 20³ and 30³ cells, 18 and 17 kB per degree of
+/// freedom, growing as the factor's fill-in), rounded up. An order of magnitude.
+pub fn mesh_bytes(dim: usize, nodes: f64) -> f64 {
+    let dofs = dim as f64 * nodes.max(0.0);
+    if dim == 2 {
+        3000.0 * dofs
+    } else {
+        500.0 * dofs * dofs.cbrt()
+    }
+}
+
+/// The number of nodes of a generated mesh (None: a file, counted once read).
+fn mesh_nodes(m: &MeshSpec) -> Option<f64> {
+    let c = |x: i64| x.max(0) as f64 + 1.0;
+    match m {
+        MeshSpec::Box { cells, .. } => Some(c(cells[0]) * c(cells[1]) * c(cells[2])),
+        MeshSpec::Rectangle { cells, .. } => Some(c(cells[0]) * c(cells[1])),
+        MeshSpec::Disk { refine, .. } => Some(2.0 * 4f64.powi((*refine).clamp(0, 64) as i32) + 5.0),
+        MeshSpec::File(_) => None,
+    }
+}
+
+/// Builds one deformable body of a spec; errors name the key. `memory(nodes)` is
+/// asked before the mesh is made (a file: once read) whether a body of that many
+/// nodes fits ([`mesh_bytes`]).
+pub fn build(
+    s: &DeformableSpec,
+    materials: &[Material],
+    dim: usize,
+    dir: &Path,
+    memory: &mut dyn FnMut(f64) -> Result<(), String>,
+) -> Result<FeBody, (&'static str, String)> {
     let mat = materials
         .iter()
         .position(|m| m.name == s.material)
@@ -194,6 +238,7 @@ pub fn build(s: &DeformableSpec, materials: &[Material], dim: usize, dir: &Path)
         (2, Some(o)) => return Err(("plane", format!("`{o}`: `strain` or `stress`"))),
         _ => return Err(("plane", "`plane` (strain or stress) is for 2D scenes only".into())),
     };
+    let mut fits = || mesh_nodes(&s.mesh).map_or(Ok(()), |n| memory(n).map_err(|m| ("mesh", m)));
     let raw = match &s.mesh {
         MeshSpec::Rectangle { .. } | MeshSpec::Disk { .. } if dim == 3 => {
             return Err(("mesh", "rectangles and disks are 2D meshes; in 3D use `box` or `file`".into()))
@@ -203,18 +248,21 @@ pub fn build(s: &DeformableSpec, materials: &[Material], dim: usize, dir: &Path)
             if !size.iter().all(|&x| x > 0.0) || cells.iter().any(|&c| c < 1) {
                 return Err(("mesh", "a box needs a positive size and at least 1 cell per side".into()));
             }
+            fits()?;
             python::cuboid(*origin, *size, [cells[0] as usize, cells[1] as usize, cells[2] as usize])
         }
         MeshSpec::Rectangle { origin, size, cells } => {
             if !(size[0] > 0.0 && size[1] > 0.0) || cells.iter().any(|&c| c < 1) {
                 return Err(("mesh", "a rectangle needs a positive size and at least 1 cell per side".into()));
             }
+            fits()?;
             python::rectangle(*origin, *size, [cells[0] as usize, cells[1] as usize])
         }
         MeshSpec::Disk { centre, radius, refine } => {
             if !(*radius > 0.0) || !(0..=8).contains(refine) {
                 return Err(("mesh", "a disk needs radius > 0 and refine in 0..=8".into()));
             }
+            fits()?;
             python::disk(*centre, *radius, *refine as usize)
         }
         MeshSpec::File(f) => {
@@ -227,6 +275,9 @@ pub fn build(s: &DeformableSpec, materials: &[Material], dim: usize, dir: &Path)
     }
     .map_err(|e| ("mesh", e.0))?;
     let mesh = Mesh::new(raw).map_err(|e| ("mesh", e.0))?;
+    if mesh_nodes(&s.mesh).is_none() {
+        memory(mesh.n_nodes() as f64).map_err(|m| ("mesh", m))?;
+    }
     let el = Elastic {
         young: s.young,
         poisson: s.poisson,
