@@ -40,7 +40,7 @@ export PYO3_PYTHON="$PWD/venv/bin/python" NSCDD_PYTHON_ENV="$PWD/venv"
 # OpenMPI refuses to run as root unless told; the MPI tests also set these.
 # Containers often forbid the cross-memory attach OpenMPI uses for large messages.
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_btl_vader_single_copy_mechanism=none
-cargo test --workspace --release --no-fail-fast --features nscdd-cli/hdf5,nscdd-tests/hdf5,nscdd-cli/mpi,nscdd-cli/fem
+cargo test --workspace --release --no-fail-fast --features nscdd-cli/hdf5,nscdd-tests/hdf5,nscdd-cli/mpi,nscdd-cli/fem,nscdd-fuzz/fem,nscdd-fuzz/hdf5
 # Fuzzing, bounded (docs/RELIABILITY.md): every target 20 s on mutants of its corpus
 # (tests/fuzz/corpus); a panic or a hang fails the run, its input saved in
 # target/fuzz-failures/. The binary was built by the tests above.

@@ -116,10 +116,20 @@ fn huge_meshes_are_refused_before_python_builds_them() {
         "needs ≈ 60 TB (a deformable body of about 10000200001 nodes)",
     );
     // 2.3 × 10⁵ nodes in 3D: minutes of assembly and factorization, tens of GB
-    let (code, err) = check_mutant("foundation3d.toml", "cells = [10, 10, 3]", "cells = [60, 60, 60]", &["--max-memory", "1G"]);
+    let (code, err) = check_mutant(
+        "foundation3d.toml",
+        "cells = [10, 10, 3]",
+        "cells = [60, 60, 60]",
+        &["--max-memory", "1G"],
+    );
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("key `deformable[0].mesh`") && err.contains("--max-memory"), "{err}");
     // the example itself fits in 1 GiB
-    let (code, err) = check_mutant("foundation3d.toml", "cells = [10, 10, 3]", "cells = [10, 10, 3]", &["--max-memory", "1G"]);
+    let (code, err) = check_mutant(
+        "foundation3d.toml",
+        "cells = [10, 10, 3]",
+        "cells = [10, 10, 3]",
+        &["--max-memory", "1G"],
+    );
     assert_eq!(code, Some(0), "{err}");
 }

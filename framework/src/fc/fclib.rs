@@ -154,6 +154,18 @@ fn local(f: &hdf5::File) -> R<FcProblem> {
         return Err(("/fclib_local/W".into(), format!("W is {} × {}: expected square", w.m, w.n)));
     }
     let nc = mu.len();
+    // before W is made: its size comes from the file
+    if w.n != dim * nc || q.len() != w.n {
+        return Err((
+            "/fclib_local".into(),
+            format!(
+                "sizes disagree: {nc} contacts in {dim}D need W of {0} × {0} and q of {0}; W is {1} × {1}, q {2}",
+                dim * nc,
+                w.n,
+                q.len()
+            ),
+        ));
+    }
     Ok(FcProblem {
         dim,
         nc,
@@ -179,6 +191,19 @@ fn global(f: &hdf5::File) -> R<FcProblem> {
         return Err((
             base.into(),
             format!("sizes disagree: M {} × {}, H {} × {}, f {}", m.m, m.n, h.m, h.n, fv.len()),
+        ));
+    }
+    if h.n != dim * mu.len() || w.len() != h.n {
+        return Err((
+            base.into(),
+            format!(
+                "sizes disagree: {} contacts in {dim}D need H with {} columns and w of {}; H has {}, w {}",
+                mu.len(),
+                dim * mu.len(),
+                dim * mu.len(),
+                h.n,
+                w.len()
+            ),
         ));
     }
     let (wm, q) = condense(&m, &h, &fv, &w).map_err(|e| (format!("{base}/M"), e))?;

@@ -28,7 +28,8 @@ pub(crate) fn load_parsed<D: SceneDim>(cx: &Ctx, sf: SceneFile<BodySpec<D>>, reg
     add_bodies(cx, &sf, &mut b, &mut drives)?;
     generate(cx, &sf, registry, &mut b)?;
     drives.append(&mut b.drives);
-    if b.bodies.is_empty() {
+    // a scene of a body family's bodies alone (deformable bodies) has no rigid ones
+    if b.bodies.is_empty() && !cx.families {
         return Err(cx.err(&[], "the scene has no bodies"));
     }
     let nm = b.materials.len();

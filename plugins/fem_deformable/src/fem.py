@@ -4,11 +4,17 @@ Meshes: linear triangles (2D) and linear tetrahedra (3D). Degrees of freedom are
 node-major (dof = dim * node + component), the order nscdd uses. Arrays go back to
 Rust as little-endian bytes (float64 / int64) so that no numpy binding is needed.
 """
+import warnings
+
 import numpy as np
 import skfem
 from skfem import Basis, BilinearForm, ElementTetP1, ElementTriP1, ElementVector, MeshTet, MeshTri, asm
 from skfem.helpers import dot
 from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+# an overflow or a NaN in a mesh or its matrices is an error (naming the scene's key),
+# not a warning on stderr
+warnings.simplefilter("error", RuntimeWarning)
 
 
 def _mesh_out(points, cells):

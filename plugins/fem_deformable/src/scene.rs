@@ -245,22 +245,31 @@ pub fn build(
         }
         MeshSpec::Box { .. } if dim == 2 => return Err(("mesh", "a box is a 3D mesh; in 2D use `rectangle`, `disk` or `file`".into())),
         MeshSpec::Box { origin, size, cells } => {
-            if !size.iter().all(|&x| x > 0.0) || cells.iter().any(|&c| c < 1) {
-                return Err(("mesh", "a box needs a positive size and at least 1 cell per side".into()));
+            if !size.iter().chain(origin).all(|x| x.is_finite()) || !size.iter().all(|&x| x > 0.0) || cells.iter().any(|&c| c < 1) {
+                return Err((
+                    "mesh",
+                    "a box needs a finite origin, a finite positive size and at least 1 cell per side".into(),
+                ));
             }
             fits()?;
             python::cuboid(*origin, *size, [cells[0] as usize, cells[1] as usize, cells[2] as usize])
         }
         MeshSpec::Rectangle { origin, size, cells } => {
-            if !(size[0] > 0.0 && size[1] > 0.0) || cells.iter().any(|&c| c < 1) {
-                return Err(("mesh", "a rectangle needs a positive size and at least 1 cell per side".into()));
+            if !size.iter().chain(origin).all(|x| x.is_finite()) || !(size[0] > 0.0 && size[1] > 0.0) || cells.iter().any(|&c| c < 1) {
+                return Err((
+                    "mesh",
+                    "a rectangle needs a finite origin, a finite positive size and at least 1 cell per side".into(),
+                ));
             }
             fits()?;
             python::rectangle(*origin, *size, [cells[0] as usize, cells[1] as usize])
         }
         MeshSpec::Disk { centre, radius, refine } => {
-            if !(*radius > 0.0) || !(0..=8).contains(refine) {
-                return Err(("mesh", "a disk needs radius > 0 and refine in 0..=8".into()));
+            if !(*radius > 0.0 && radius.is_finite() && centre.iter().all(|x| x.is_finite())) || !(0..=8).contains(refine) {
+                return Err((
+                    "mesh",
+                    "a disk needs a finite centre, a finite radius > 0 and refine in 0..=8".into(),
+                ));
             }
             fits()?;
             python::disk(*centre, *radius, *refine as usize)

@@ -14,6 +14,8 @@
 //! A panic or a hang (an input running longer than the limit) is saved under
 //! `target/fuzz-failures/` and the run exits 1.
 
+#[cfg(feature = "hdf5")]
+pub mod fclib;
 pub mod mutate;
 
 use nscdd::dim::{D2, D3};
@@ -64,12 +66,12 @@ pub fn restart(data: &[u8]) {
 pub fn fc_json(data: &[u8]) {
     if let Ok(t) = std::str::from_utf8(data) {
         if let Ok(p) = FcProblem::parse(t, "fuzz.json") {
-            solve(&p);
+            solve_problem(&p);
         }
     }
 }
 
-fn solve(p: &FcProblem) {
+pub(crate) fn solve_problem(p: &FcProblem) {
     let _ = p.solve(&FcOptions {
         tol: 1e-8,
         max_sweeps: 50,
@@ -113,17 +115,62 @@ pub fn solve_fc(data: &[u8]) {
         meta: None,
     };
     if p.validate().is_ok() {
-        solve(&p);
+        solve_problem(&p);
     }
 }
 
-/// The fuzz targets by name.
+/// Memory a fuzzed deformable scene may use: a mesh of about 10⁴ nodes in 2D, 3·10³
+/// in 3D (each built in well under a second).
+#[cfg(feature = "fem")]
+const MAX_FE_MEMORY: f64 = 1e8;
+
+/// A scene with `[[deformable]]` bodies (2D or 3D: loaded as both), meshes built by
+/// Python's scikit-fem and factored; a scene that loads is stepped twice.
+#[cfg(feature = "fem")]
+pub fn deformable(data: &[u8]) {
+    let Ok(t) = std::str::from_utf8(data) else { return };
+    let mut r = registry();
+    r.add_plugin(&nscdd_fem_deformable::FemPlugin);
+    r.set_max_memory(MAX_FE_MEMORY);
+    if let Ok(mut s) = Scene::<D2>::load_str(t, "fuzz.toml", &r) {
+        step_twice(&mut s);
+    }
+    if let Ok(mut s) = Scene::<D3>::load_str(t, "fuzz.toml", &r) {
+        step_twice(&mut s);
+    }
+}
+
+/// Two steps of a scene with its families (as the run loop makes its solver).
+#[cfg(feature = "fem")]
+fn step_twice<D: nscdd::dim::Dim>(s: &mut Scene<D>) {
+    let decomposed = s.decomposition.is_some();
+    let cfg = s
+        .decomposition
+        .clone()
+        .or_else(|| nscdd::family::needs_nscdd(decomposed, &mut s.families).then(nscdd::dd::DdConfig::default));
+    let mut dd = cfg.map(|c| c.solver_of());
+    for _ in 0..2 {
+        let mut fams: Vec<&mut dyn nscdd::family::SceneFamily<D>> = s.families.iter_mut().map(|f| &mut **f).collect();
+        if nscdd::family::step(&mut s.world, &mut fams, dd.as_mut()).is_err() {
+            break;
+        }
+    }
+}
+
+/// The fuzz targets by name (`deformable` with the `fem` feature, `fclib` with
+/// `hdf5`), with the executions the corpus test gives each.
 pub fn targets() -> Vec<(&'static str, fn(&[u8]))> {
-    vec![
+    #[allow(unused_mut)]
+    let mut t: Vec<(&'static str, fn(&[u8]))> = vec![
         ("scene2", scene2),
         ("scene3", scene3),
         ("restart", restart),
         ("fc_json", fc_json),
         ("solve_fc", solve_fc),
-    ]
+    ];
+    #[cfg(feature = "fem")]
+    t.push(("deformable", deformable));
+    #[cfg(feature = "hdf5")]
+    t.push(("fclib", fclib::fclib));
+    t
 }
