@@ -244,9 +244,7 @@ fn main() -> ExitCode {
                 Err(e) => return input_error(e),
             };
             let quiet = quiet || !ranks.root();
-            if ranks.size() == 1 {
-                stop_on_signals();
-            }
+            stop_on_signals();
             let flags = run::Flags {
                 subdomains: subdomains.as_deref(),
                 scheme: scheme.as_deref(),
@@ -297,8 +295,8 @@ fn main() -> ExitCode {
 }
 
 /// SIGINT/SIGTERM stop a run at the end of its current step with a checkpoint
-/// (`nscdd::run::request_stop`); a second one ends the process at once. (One
-/// process only: MPI ranks keep the default behaviour.)
+/// (`nscdd::run::request_stop`); a second one ends the process at once. On MPI
+/// ranks, a signal on any rank stops every rank after the same step.
 fn stop_on_signals() {
     static SEEN: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
     let _ = ctrlc::set_handler(|| {

@@ -113,14 +113,25 @@ static STOP: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(
 
 /// Asks the running [`run_on`] to stop at the end of its current step, after
 /// writing `checkpoint.json` (a signal handler's call: SIGINT, SIGTERM). It then
-/// returns [`RunError::Interrupted`]. One process only: several ranks would have
-/// to agree on the step.
+/// returns [`RunError::Interrupted`]. On several ranks, the ranks agree at the end of
+/// every step ([`stop_agreed`]): a request on any rank stops all of them after the
+/// same step.
 pub fn request_stop() {
     STOP.store(true, std::sync::atomic::Ordering::SeqCst);
 }
 
 fn stop_requested() -> bool {
     STOP.load(std::sync::atomic::Ordering::SeqCst)
+}
+
+/// Whether the run stops after this step: a request on this process or, on several
+/// ranks, on any of them (one collective reduction per step, every rank calls it).
+fn stop_agreed<D: Dim>(dd: &mut Option<NscddOf<Rigid<D>>>) -> bool {
+    let mine = stop_requested();
+    match dd.as_mut().and_then(|n| n.ranks_mut()) {
+        Some(rs) => rs.cluster.min_max(mine as u64).1 > 0,
+        None => mine,
+    }
 }
 
 /// The NSCDD solver of a decomposed scene, over the ranks of `cluster` when given.
@@ -313,7 +324,7 @@ pub fn run_on<D: Dim>(
         }
         sum.record(&rep.solve, w.step, w.solver.tolerance);
         on_step(w, &rep);
-        if s != steps && stop_requested() {
+        if s != steps && stop_agreed(&mut dd) {
             hist.flush().map_err(io(dir, "history.csv"))?;
             if root {
                 save_state(dir, "checkpoint.json", w, fams, &dd)?;
