@@ -133,3 +133,62 @@ fn huge_meshes_are_refused_before_python_builds_them() {
     );
     assert_eq!(code, Some(0), "{err}");
 }
+
+/// Mutants whose accepted runs hung in the campaign with runs (issue 17).
+#[test]
+fn an_alert_distance_that_makes_every_pair_a_contact_is_refused() {
+    // 2000 disks with alert = 2 m: 2·10⁶ contacts per step, minutes per step
+    refused(
+        "biaxial.toml",
+        "alert = 5e-4",
+        "alert = 2.0",
+        "detection.alert",
+        "contact candidates",
+    );
+}
+
+#[test]
+fn densities_in_the_subnormal_range_are_refused() {
+    // ρ = 1e308: inverse masses of 10⁻³⁰⁸, 20 000 sweeps per step on subnormal numbers
+    refused(
+        "aqueduct.toml",
+        "density = 2200.0",
+        "density = 1e308",
+        "materials[0].density",
+        "[1e-20, 1e20]",
+    );
+    refused(
+        "aqueduct.toml",
+        "density = 2200.0",
+        "density = 1e-300",
+        "materials[0].density",
+        "[1e-20, 1e20]",
+    );
+}
+
+#[test]
+fn an_overflowing_run_stops_at_its_first_step_naming_the_body() {
+    // g = 1e308: velocities of 10³⁰⁵ after one step; the solver swept on infinities
+    // for a minute per step before its sums were checked
+    let dir = scratch("overflow");
+    let text = std::fs::read_to_string(format!("{}/../examples/scenes/aqueduct.toml", env!("CARGO_MANIFEST_DIR"))).unwrap();
+    let path = dir.join("aqueduct.toml");
+    std::fs::write(
+        &path,
+        text.replacen("gravity = [0.0, 0.0, -9.81]", "gravity = [0.0, 1e308, -9.81]", 1),
+    )
+    .unwrap();
+    let t0 = std::time::Instant::now();
+    let o = nscdd(&[
+        "run".as_ref(),
+        path.as_os_str(),
+        "--out".as_ref(),
+        dir.join("out").as_os_str(),
+        "--quiet".as_ref(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("diverged at step 1") && err.contains("body"), "{err}");
+    assert!(t0.elapsed().as_secs() < 10, "took {:?}", t0.elapsed());
+    assert!(dir.join("out/history.csv").exists());
+}

@@ -79,6 +79,22 @@ pub struct Sums {
 }
 
 impl Sums {
+    /// Whether every sum is finite: an overflow (impulses or velocities near 10³⁰⁸, a
+    /// diverging scene) makes the norms meaningless, and the solve stops there
+    /// unconverged rather than sweeping on infinities.
+    pub fn is_finite(&self) -> bool {
+        [
+            self.sum_dvdv,
+            self.sum_wrwr,
+            self.sum_wrr,
+            self.sum_dvdvrr,
+            self.sum_dvor,
+            self.max_dvdv,
+            self.max_dvdvrr,
+        ]
+        .iter()
+        .all(|x| x.is_finite())
+    }
     /// Adds one contact. `r_old`, `r`: impulses before and after solving; `du = u − u'`;
     /// `wr_old = W_αα r'`, `wr = W_αα r`.
     #[inline]

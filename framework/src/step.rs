@@ -18,18 +18,25 @@ impl Diverged {
         Diverged {
             step,
             body: k as u32,
-            message: format!("{label} has a non-finite state (position {:?}, velocity {:?})", b.pos[k], b.vel[k]),
+            message: format!(
+                "{label} has a non-finite or diverging state (position {:?}, velocity {:?})",
+                b.pos[k], b.vel[k]
+            ),
         }
     }
 }
 
+/// A position (m) or velocity (m/s, rad/s) beyond this has diverged: no scene of the
+/// field comes near it, and its squares (energies, norms) would overflow.
+pub const DIVERGED: f64 = 1e100;
+
 /// The θ-method's position update of every body from V⁻ (`v_begin`) and V⁺ (the
-/// bodies' velocities). Stops at the first body whose state is not finite and
-/// returns its id (the bodies before it are updated).
+/// bodies' velocities). Stops at the first body whose state is not finite (or
+/// beyond [`DIVERGED`]) and returns its id (the bodies before it are updated).
 pub fn integrate<D: Dim>(b: &mut Bodies<D>, v_begin: &[D::Twist], h: f64, theta: f64) -> Result<(), usize> {
     for k in 0..b.len() {
         D::integrate(&mut b.pos[k], &mut b.rot[k], &v_begin[k], &b.vel[k], h, theta);
-        let finite = b.pos[k].as_ref().iter().chain(b.vel[k].as_ref()).all(|x| x.is_finite()) && D::rot_finite(&b.rot[k]);
+        let finite = b.pos[k].as_ref().iter().chain(b.vel[k].as_ref()).all(|x| x.abs() < DIVERGED) && D::rot_finite(&b.rot[k]);
         if !finite {
             return Err(k);
         }

@@ -409,7 +409,8 @@ impl<D: Family> NscddOf<D> {
             rep.prevailing = Prevailing::of(now, before);
             before = Some(now);
             rep.solve.converged = now == (true, true);
-            rep.solve.converged
+            // an overflow stops the stages, unconverged
+            rep.solve.converged || !sums.is_finite()
         };
         let stages = if let Some(rs) = self.ranks.as_mut() {
             let (stages, stats) = ranks::iterate(rs, d, set.scheme, (per, sv.relaxation), max_stages, k, |s, g| converged(s, g, rep));

@@ -86,6 +86,46 @@ pub(crate) fn alert_distance(cx: &Ctx, d: &schema::DetectionSpec, sizes: &[f64])
     }
 }
 
+/// Refuses an alert distance that makes every step detect and solve a number of
+/// contact candidates no packing has: with the movable bodies' centres `pts` (z = 0
+/// in 2D, `dim` coordinates used) spread evenly over their bounding box, a body sees
+/// the others within alert + the median size; more than max(10⁶, 64 N) pairs over
+/// the sample (a packing has fewer than 6 per body) is an input error naming
+/// `detection.alert` (an alert of 10⁸ m on 2000 disks made 2·10⁶ contacts per step,
+/// a run of minutes per step).
+pub(crate) fn check_alert_work(cx: &Ctx, alert: f64, pts: &[[f64; 3]], sizes: &[f64], dim: usize) -> Result<(), InputError> {
+    let n = pts.len() as f64;
+    if n < 2.0 {
+        return Ok(());
+    }
+    let mut s: Vec<f64> = sizes.iter().copied().filter(|x| x.is_finite() && *x > 0.0).collect();
+    s.sort_by(|a, c| a.total_cmp(c));
+    let size = s.get(s.len() / 2).copied().unwrap_or(0.0);
+    let reach = 2.0 * (alert + size);
+    let mut share = 1.0;
+    for d in 0..dim {
+        let (lo, hi) = pts
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p[d]), b.max(p[d])));
+        let extent = (hi - lo).max(size);
+        if extent > 0.0 && extent.is_finite() {
+            share *= (reach / extent).min(1.0);
+        }
+    }
+    let per_body = ((n - 1.0) * share).min(n - 1.0);
+    let pairs = 0.5 * n * per_body;
+    if pairs <= (64.0 * n).max(1e6) {
+        return Ok(());
+    }
+    Err(cx.err(
+        &[k("detection"), k("alert")],
+        format!(
+            "{alert} makes about {pairs:.1e} contact candidates ({per_body:.0} per body; a packing has fewer than 12), each step would detect and solve them all: use a fraction of the bodies' size (the default is 0.1 × the median size, {:.3e})",
+            0.1 * size
+        ),
+    ))
+}
+
 /// Initial interpenetrations beyond `detection.overlap_tolerance` × the smaller
 /// shape size, among the detected `(i, j, gap)` of materials that interact.
 #[allow(clippy::too_many_arguments)]
@@ -242,10 +282,13 @@ pub(crate) fn validate_solver(cx: &Ctx, s: &crate::solver::SolverSettings) -> Re
 pub(crate) fn materials<B>(cx: &Ctx, sf: &SceneFile<B>) -> Result<Vec<Material>, InputError> {
     let mut out: Vec<Material> = vec![];
     for (i, m) in sf.materials.iter().enumerate() {
-        if !(m.density > 0.0 && m.density.is_finite()) {
+        // beyond 10²⁰ kg/m³ (a neutron star's 10¹⁷) or below 10⁻²⁰, inverse masses,
+        // Delassus blocks or impulses fall among the subnormal numbers, where
+        // arithmetic crawls
+        if !(1e-20..=1e20).contains(&m.density) {
             return Err(cx.err(
                 &[k("materials"), Seg::Index(i), k("density")],
-                format!("density must be > 0, got {}", m.density),
+                format!("density must lie in [1e-20, 1e20] kg/m³, got {:e}", m.density),
             ));
         }
         if out.iter().any(|o| o.name == m.name) {

@@ -55,6 +55,17 @@ pub(crate) fn load_parsed<D: SceneDim>(cx: &Ctx, sf: SceneFile<BodySpec<D>>, reg
         .map(|i| b.shapes[b.bodies.shape[i].kind as usize].size(b.bodies.shape[i].index))
         .collect();
     let alert = super::alert_distance(cx, &sf.detection, &sizes)?;
+    let centres: Vec<[f64; 3]> = (0..n)
+        .filter(|&i| b.bodies.movable(i))
+        .map(|i| {
+            let mut p = [0.0; 3];
+            for (x, y) in p.iter_mut().zip(b.bodies.pos[i].as_ref()) {
+                *x = *y;
+            }
+            p
+        })
+        .collect();
+    super::checks::check_alert_work(cx, alert, &centres, &sizes, D::N)?;
     // initial interpenetrations beyond the tolerance
     let mut raw = vec![];
     Detector::default().detect(&b.bodies, &b.shapes, &table, 0.0, &mut raw);

@@ -56,6 +56,7 @@ impl SolverSettings {
     /// residual is left to the caller.
     pub fn run_sweeps(&self, mut sweep: impl FnMut(Option<&mut Sums>)) -> SolveReport {
         let mut report = SolveReport::default();
+        let mut overflow = false;
         (report.sweeps, report.converged) = check_loop(self.max_sweeps, self.check_every, |check| {
             if !check {
                 sweep(None);
@@ -64,8 +65,11 @@ impl SolverSettings {
             let mut sums = Sums::default();
             sweep(Some(&mut sums));
             report.norms = Norms::from_sums(&sums, self.tolerance);
-            report.norms.converged(self.norm)
+            // an overflow stops the sweeps, unconverged
+            overflow = !sums.is_finite();
+            overflow || report.norms.converged(self.norm)
         });
+        report.converged &= !overflow;
         report
     }
 }
