@@ -4,6 +4,7 @@
 //! 2 bad input (the message names the file, the line and the key).
 
 mod bench;
+mod plugins;
 mod ranks;
 mod report;
 mod run;
@@ -24,6 +25,10 @@ struct Cli {
     /// machine): a generator asked for more bodies is refused before it allocates.
     #[arg(long, global = true)]
     max_memory: Option<String>,
+    /// A plugin library to load (repeatable; docs/PLUGINS.md). Scenes may also name
+    /// theirs in `[[plugins]] library = "…"`.
+    #[arg(long, global = true, value_name = "PATH")]
+    plugin: Vec<PathBuf>,
 }
 
 #[derive(Subcommand)]
@@ -53,6 +58,8 @@ enum Cmd {
     },
     /// Validate a scene without running it.
     Check { scene: PathBuf },
+    /// List the plugins (built in, and loaded with --plugin) and what each registers.
+    Plugins,
     /// Solve one frictional contact problem (JSON exchange format) and print JSON.
     SolveFc {
         problem: PathBuf,
@@ -209,6 +216,12 @@ fn write_problem(p: &nscdd::fc::FcProblem, path: &std::path::Path) -> Result<(),
 }
 
 fn main() -> ExitCode {
+    plugins::install_panic_hook();
+    // a panic (in a plugin's code or ours) stops the command with its message
+    std::panic::catch_unwind(command).unwrap_or_else(plugins::report)
+}
+
+fn command() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {
@@ -228,7 +241,22 @@ fn main() -> ExitCode {
             Err(e) => return input_error(e),
         }
     }
+    if let Err(e) = plugins::load_cli(&cli.plugin, &mut reg) {
+        return input_error(e);
+    }
+    // the plugins a scene names, loaded before it is read
+    let scene_of = match &cli.cmd {
+        Cmd::Check { scene } | Cmd::Run { scene, .. } | Cmd::ExportFc { scene, .. } => Some(scene.clone()),
+        _ => None,
+    };
+    if let Some(scene) = scene_of {
+        if let Err(e) = plugins::load_for_scene(&scene, &mut reg) {
+            return input_error(e);
+        }
+    }
+    let reg = reg;
     match cli.cmd {
+        Cmd::Plugins => plugins::list(&reg),
         Cmd::Check { scene } => check(&scene, &reg),
         Cmd::Run {
             scene,

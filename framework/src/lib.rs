@@ -37,6 +37,7 @@ pub mod model;
 pub mod norms;
 pub mod output;
 pub mod params;
+pub mod plugin;
 pub mod registry;
 pub mod run;
 pub mod scene;

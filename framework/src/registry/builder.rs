@@ -83,7 +83,7 @@ impl<'r, D: Dim> SceneBuilder<'r, D> {
         }
         let (&static_name, def) = self.registry.tables::<D>().shapes.get_key_value(name)?;
         let id = self.shapes.len() as u16;
-        self.shapes.push((def.new_store)());
+        self.shapes.push(def());
         self.kind_ids.insert(static_name, id);
         Some(id)
     }

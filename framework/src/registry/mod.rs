@@ -25,6 +25,7 @@ use crate::dim::{Dim, D2, D3};
 use crate::family::FamilyKind;
 use crate::law::LawDef;
 pub mod builder;
+pub mod guard;
 pub mod limits;
 
 pub use crate::output::Writer;
@@ -47,8 +48,12 @@ pub trait Plugin {
 
 /// What plugins provide for one dimension: shape kinds, pair detectors keyed by
 /// the pair of kinds, generators.
+/// Makes a shape kind's empty store (its plugin's code: guarded when the plugin was
+/// loaded at run time, [`guard`]).
+pub type NewStore<D> = Arc<dyn Fn() -> Box<dyn ShapeStore<D>> + Send + Sync>;
+
 pub struct Tables<D: Dim> {
-    pub(crate) shapes: BTreeMap<&'static str, ShapeKindDef<D>>,
+    pub(crate) shapes: BTreeMap<&'static str, NewStore<D>>,
     pub(crate) detectors: BTreeMap<(&'static str, &'static str), Arc<dyn PairDetector<D>>>,
     pub(crate) generators: BTreeMap<&'static str, Box<dyn Generator<D>>>,
     pub(crate) writers: BTreeMap<&'static str, fn() -> Box<dyn Writer<D>>>,
@@ -71,11 +76,16 @@ impl<D: Dim> Default for Tables<D> {
 #[derive(Default)]
 pub struct Registry {
     plugins: Vec<&'static str>,
+    /// What each plugin added ([`Self::contents`] after less before), by plugin.
+    added: Vec<Vec<String>>,
     pub(crate) laws: BTreeMap<&'static str, LawDef>,
     t2: Tables<D2>,
     t3: Tables<D3>,
     /// Memory a scene may use (bytes); `None`: the machine's available memory.
     max_memory: Option<f64>,
+    /// Set by the plugin loader while a run-time plugin registers: what it adds is
+    /// wrapped in this guard ([`guard`]).
+    pub(crate) guard: Option<guard::Guard>,
 }
 
 impl Registry {
@@ -98,12 +108,35 @@ impl Registry {
         self.max_memory
     }
     pub fn add_plugin(&mut self, p: &dyn Plugin) -> &mut Self {
+        let before = self.contents();
         self.plugins.push(p.name());
         p.build(self);
+        let after = self.contents();
+        self.added.push(after.into_iter().filter(|x| !before.contains(x)).collect());
         self
     }
     pub fn plugins(&self) -> Vec<&'static str> {
         self.plugins.clone()
+    }
+    /// Each plugin with what it registered (`shape 2D polygon`, `detector 2D
+    /// polygon–disk`, `law mohr_coulomb`, …), in the order they were added.
+    pub fn plugin_contents(&self) -> Vec<(&'static str, Vec<String>)> {
+        self.plugins.iter().copied().zip(self.added.iter().cloned()).collect()
+    }
+    /// Everything registered, one line per item (`nscdd plugins`).
+    pub fn contents(&self) -> Vec<String> {
+        let mut out: Vec<String> = self.laws.keys().map(|l| format!("law {l}")).collect();
+        fn of<D: Dim>(t: &Tables<D>, out: &mut Vec<String>) {
+            let d = D::NAME;
+            out.extend(t.shapes.keys().map(|k| format!("shape {d} {k}")));
+            out.extend(t.detectors.keys().map(|(a, b)| format!("detector {d} {a}–{b}")));
+            out.extend(t.generators.keys().map(|k| format!("generator {d} {k}")));
+            out.extend(t.writers.keys().map(|k| format!("writer {d} {k}")));
+            out.extend(t.families.keys().map(|k| format!("body family {d} [[{k}]]")));
+        }
+        of(&self.t2, &mut out);
+        of(&self.t3, &mut out);
+        out
     }
     /// The tables of dimension D.
     pub fn tables<D: Dim>(&self) -> &Tables<D> {
@@ -115,12 +148,31 @@ impl Registry {
         t.downcast_mut().expect("Dim is sealed: D2 or D3")
     }
     pub fn add_shape<D: Dim>(&mut self, def: ShapeKindDef<D>) {
-        self.tables_mut::<D>().shapes.insert(def.name, def);
+        let new_store = def.new_store;
+        let make: NewStore<D> = match self.guard.clone() {
+            None => Arc::new(new_store),
+            Some(guard) => Arc::new(move || {
+                let inner = guard.call(new_store);
+                Box::new(guard::GuardedStore {
+                    inner,
+                    guard: guard.clone(),
+                }) as Box<dyn ShapeStore<D>>
+            }),
+        };
+        self.tables_mut::<D>().shapes.insert(def.name, make);
     }
     pub fn add_detector<D: Dim>(&mut self, a: &'static str, b: &'static str, d: Arc<dyn PairDetector<D>>) {
+        let d = match self.guard.clone() {
+            None => d,
+            Some(guard) => Arc::new(guard::GuardedDetector { inner: d, guard }),
+        };
         self.tables_mut::<D>().detectors.insert((a, b), d);
     }
     pub fn add_generator<D: Dim>(&mut self, name: &'static str, g: Box<dyn Generator<D>>) {
+        let g = match self.guard.clone() {
+            None => g,
+            Some(guard) => Box::new(guard::GuardedGenerator { inner: g, guard }),
+        };
         self.tables_mut::<D>().generators.insert(name, g);
     }
     pub fn add_law(&mut self, def: LawDef) {

@@ -52,6 +52,10 @@ pub struct SceneFile<B = BodySpec> {
     pub output: OutputSpec,
     /// NSCDD: split the contact set over nx × ny subdomains.
     pub decomposition: Option<DecompositionSpec>,
+    /// `[[plugins]] library = "…"`: plugin libraries the scene needs, relative to the
+    /// scene (loaded before the scene is read: [`super::load_plugins`]).
+    #[serde(default)]
+    pub plugins: Vec<PluginSpec>,
     /// Every other top-level key: the sections of the plugins' body families
     /// (`[[name]]` entries, [`crate::family`]), by name. The loader refuses a key
     /// that no registered family owns, as an unknown key (the file's other tables
@@ -309,4 +313,11 @@ pub struct BoxSpec3 {
     /// ε1 (along z) is measured from the height at this time (s).
     #[serde(default)]
     pub strain_from: f64,
+}
+
+/// One `[[plugins]]` entry of a scene.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PluginSpec {
+    pub library: String,
 }

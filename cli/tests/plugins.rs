@@ -1,0 +1,179 @@
+//! Plugins loaded at run time (issue 18): the template's library loaded with
+//! `--plugin` and by a scene's `[[plugins]]`, listed by `nscdd plugins`; libraries of
+//! another interface version, corrupt, missing or not plugins refused with exit 2;
+//! a plugin's panic reported as `plugin NAME: …` with the outputs kept.
+//!
+//! The libraries are the workspace members `templates/plugin`, `tests/plugin_bad_abi`
+//! and `tests/plugin_panics`, built by the same cargo command as this test (the
+//! README's test command builds the whole workspace): a plugin must be built with
+//! the same framework build as the program that loads it.
+mod common;
+use common::*;
+use std::path::{Path, PathBuf};
+
+/// The library of workspace member `name` (crate name with underscores).
+fn library(name: &str) -> PathBuf {
+    let dir = Path::new(BIN).parent().unwrap();
+    let file = format!("{}{name}{}", std::env::consts::DLL_PREFIX, std::env::consts::DLL_SUFFIX);
+    [dir.join("deps").join(&file), dir.join(&file)]
+        .into_iter()
+        .find(|p| p.exists())
+        .unwrap_or_else(|| {
+            panic!(
+                "{file} is not built: run the tests of the whole workspace (cargo test --workspace --release …), which builds it with nscdd's features"
+            )
+        })
+}
+
+const BEAD: &str = r#"[time]
+step = 1e-3
+steps = 300
+[[materials]]
+name = "m"
+density = 1000.0
+[[laws]]
+materials = ["m", "m"]
+friction = 0.3
+[[bodies]]
+shape = "halfplane"
+material = "m"
+position = [0.0, 0.0]
+fixed = true
+[[bodies]]
+shape = "bead"
+material = "m"
+radius = 0.05
+position = [0.0, 0.1]
+[[bodies]]
+shape = "disk"
+material = "m"
+radius = 0.05
+position = [0.0, 0.25]
+"#;
+
+fn os(s: &str) -> &std::ffi::OsStr {
+    std::ffi::OsStr::new(s)
+}
+
+#[test]
+fn the_template_plugin_is_listed_and_runs_a_scene() {
+    let lib = library("nscdd_plugin_template");
+    let o = nscdd(&[os("plugins"), os("--plugin"), lib.as_os_str()]);
+    let out = text(&o.stdout);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(
+        out.contains("nscdd_plugin_template (loaded from") && out.contains("shape 2D bead"),
+        "{out}"
+    );
+    assert!(
+        out.contains("detector 2D bead–halfplane") && out.contains("rigid_disks (built in)"),
+        "{out}"
+    );
+    // a scene naming the library, relative to the scene's folder
+    let dir = scratch("plugin-scene");
+    std::fs::copy(&lib, dir.join("libbead.so")).unwrap();
+    let scene = dir.join("bead.toml");
+    std::fs::write(&scene, format!("[[plugins]]\nlibrary = \"libbead.so\"\n{BEAD}")).unwrap();
+    let o = nscdd(&[
+        os("run"),
+        scene.as_os_str(),
+        os("--out"),
+        dir.join("out").as_os_str(),
+        os("--quiet"),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let fin: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("out/final.json")).unwrap()).unwrap();
+    // the bead rests on the floor and the disk on the bead (y = r and 3r)
+    let y = |k: usize| fin["bodies"][k]["position"][1].as_f64().unwrap();
+    assert!((y(1) - 0.05).abs() < 1e-3 && (y(2) - 0.15).abs() < 2e-3, "{} {}", y(1), y(2));
+    // the same with --plugin instead of [[plugins]]
+    std::fs::write(&scene, BEAD).unwrap();
+    let o = nscdd(&[os("check"), scene.as_os_str()]);
+    assert_eq!(o.status.code(), Some(2), "without the plugin `bead` is unknown");
+    let o = nscdd(&[os("check"), scene.as_os_str(), os("--plugin"), lib.as_os_str()]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[track_caller]
+fn refused(args: &[&std::ffi::OsStr], said: &[&str]) {
+    let o = nscdd(args);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert_eq!(err.lines().count(), 1, "one message: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    for s in said {
+        assert!(err.contains(s), "`{s}` not in: {err}");
+    }
+}
+
+#[test]
+fn libraries_of_another_interface_corrupt_missing_or_foreign_are_refused() {
+    let dir = scratch("plugin-bad");
+    let scene = dir.join("s.toml");
+    std::fs::write(&scene, BEAD).unwrap();
+    let bad = library("nscdd_plugin_bad_abi");
+    let v = format!("interface version {}", nscdd::plugin::ABI_VERSION + 1);
+    refused(
+        &[os("check"), scene.as_os_str(), os("--plugin"), bad.as_os_str()],
+        &["--plugin", "nscdd_plugin_bad_abi", &v, "rebuild"],
+    );
+    let junk = dir.join("libjunk.so");
+    std::fs::write(&junk, b"\x7fELF this is not a library").unwrap();
+    refused(
+        &[os("check"), scene.as_os_str(), os("--plugin"), junk.as_os_str()],
+        &["libjunk.so", "cannot load it"],
+    );
+    refused(
+        &[os("plugins"), os("--plugin"), dir.join("nowhere.so").as_os_str()],
+        &["nowhere.so"],
+    );
+    // a scene naming a missing library: its file, line and key
+    std::fs::write(&scene, format!("[[plugins]]\nlibrary = \"libnone.so\"\n{BEAD}")).unwrap();
+    refused(&[os("check"), scene.as_os_str()], &["s.toml:2", "plugins[0].library", "libnone.so"]);
+    // a library that is not a plugin: the C library
+    let foreign = [
+        "/lib/x86_64-linux-gnu/libm.so.6",
+        "/usr/lib/x86_64-linux-gnu/libm.so.6",
+        "/lib64/libm.so.6",
+    ]
+    .into_iter()
+    .find(|p| Path::new(p).exists());
+    if let Some(f) = foreign {
+        refused(&[os("plugins"), os("--plugin"), os(f)], &["not an nscdd plugin"]);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_panic_in_a_plugin_is_reported_and_the_outputs_are_kept() {
+    let lib = library("nscdd_plugin_panics");
+    let dir = scratch("plugin-panics");
+    let scene = dir.join("fragile.toml");
+    let text_ = BEAD.replace("shape = \"bead\"", "shape = \"fragile\"\npanic_below = 0.02").replace(
+        "[[bodies]]\nshape = \"disk\"\nmaterial = \"m\"\nradius = 0.05\nposition = [0.0, 0.25]\n",
+        "",
+    );
+    std::fs::write(&scene, text_).unwrap();
+    let out = dir.join("out");
+    let o = nscdd(&[
+        os("run"),
+        scene.as_os_str(),
+        os("--out"),
+        out.as_os_str(),
+        os("--quiet"),
+        os("--plugin"),
+        lib.as_os_str(),
+    ]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("plugin nscdd_plugin_panics") && err.contains("the fragile bead broke"),
+        "{err}"
+    );
+    assert!(!err.contains("panicked at"), "no raw panic message: {err}");
+    // it fell for a while: the rows written before are kept, whole
+    let hist = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    assert!(hist.lines().count() > 10 && hist.ends_with('\n'), "{hist}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
