@@ -19,7 +19,7 @@ pub fn load_cli(paths: &[std::path::PathBuf], reg: &mut Registry) -> Result<(), 
 /// is read. A file that cannot be read is left to the scene's loader.
 pub fn load_for_scene(scene: &Path, reg: &mut Registry) -> Result<(), nscdd::error::InputError> {
     let Ok(text) = std::fs::read_to_string(scene) else { return Ok(()) };
-    nscdd::scene::load_plugins(&text, &scene.display().to_string(), reg).map(|_| ())
+    nscdd::plugin::load_for_scene(&text, &scene.display().to_string(), reg).map(|_| ())
 }
 
 /// `nscdd plugins`: every plugin, built in or loaded, with what it registers.

@@ -192,3 +192,32 @@ fn an_overflowing_run_stops_at_its_first_step_naming_the_body() {
     assert!(t0.elapsed().as_secs() < 10, "took {:?}", t0.elapsed());
     assert!(dir.join("out/history.csv").exists());
 }
+
+#[test]
+fn bodies_too_small_to_have_a_mass_are_refused() {
+    // a disk of 1e-200 m (a sphere of 1e-308 m in the deformable fuzz target): a mass
+    // of 0, an infinite inverse mass, NaN at the first step
+    let dir = scratch("massless");
+    let path = dir.join("s.toml");
+    std::fs::write(&path, edit(BASE, "radius = 0.1", "radius = 1e-200")).unwrap();
+    let o = nscdd(&["check".as_ref(), path.as_os_str()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("key `bodies[1].shape`") && err.contains("mass (0)"), "{err}");
+    // the same made by a generator
+    let lattice = "[[generate]]\nkind = \"square_lattice\"\nmaterial = \"grain\"\nradius = 1e-200\norigin = [1.0, 1.0]\nnx = 2\nny = 2\nspacing = 0.5\n";
+    std::fs::write(&path, format!("{BASE}{lattice}")).unwrap();
+    let o = nscdd(&["check".as_ref(), path.as_os_str()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("key `generate[0]`") && err.contains("mass 0e0"), "{err}");
+    // and a generator's grid of such disks is refused by its size, in scientific notation
+    let (code, err) = check_mutant(
+        "deposit.toml",
+        "radius_min = 0.008\nradius_max = 0.012",
+        "radius_min = 1e-200\nradius_max = 1e-200",
+        &["--max-memory", "16G"],
+    );
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("e201 B"), "{err}");
+}

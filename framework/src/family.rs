@@ -45,7 +45,7 @@ impl<D: Dim> FamilyContext<'_, D> {
     /// hold, `what` says of what) fit beside the rigid world in the memory limit
     /// ([`crate::registry::limits`]); Err: the message with the estimate and the limit.
     pub fn check_memory(&self, bytes: f64, what: &str) -> Result<(), String> {
-        use crate::registry::limits::{bytes_per_body, human, memory_limit};
+        use crate::limits::{bytes_per_body, human, memory_limit};
         let need = bytes.max(0.0) + self.world.bodies.len() as f64 * bytes_per_body::<D>();
         let (limit, source) = memory_limit(self.max_memory);
         if need.is_finite() && need <= limit {

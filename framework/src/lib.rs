@@ -33,6 +33,7 @@ pub mod error;
 pub mod family;
 pub mod fc;
 pub mod law;
+pub mod limits;
 pub mod model;
 pub mod norms;
 pub mod output;

@@ -110,6 +110,7 @@ pub fn interface_hash() -> u64 {
         TypeId::of::<dyn crate::family::SceneFamily<D2>>(),
         TypeId::of::<dyn crate::family::SceneFamily<D3>>(),
         TypeId::of::<crate::scene::Scene<D2>>(),
+        TypeId::of::<crate::scene::Scene<D3>>(),
     ] {
         t.hash(&mut h);
     }
@@ -154,13 +155,7 @@ pub unsafe fn register(reg: *mut c_void, plugin: &dyn Plugin) -> *const c_char {
     }
 }
 
-/// The message of a panic's payload.
-pub fn panic_text(e: &(dyn std::any::Any + Send)) -> String {
-    e.downcast_ref::<&str>()
-        .map(|s| s.to_string())
-        .or_else(|| e.downcast_ref::<String>().cloned())
-        .unwrap_or_else(|| "a panic".into())
-}
+pub use crate::registry::guard::panic_text;
 
 /// Exports a plugin from a `cdylib` crate: `nscdd::export_plugin!(MyPlugin);` with
 /// `MyPlugin` a unit value implementing [`Plugin`] (module docs).
@@ -277,4 +272,12 @@ pub fn load(path: &Path, reg: &mut Registry) -> Result<Loaded, String> {
         std::mem::forget(lib);
     }
     Ok(l)
+}
+
+/// The plugins a scene's text names (`[[plugins]]`, relative to the scene's folder),
+/// loaded into `reg` ([`crate::scene::load_plugins`]); errors name the entry's line.
+pub fn load_for_scene(text: &str, file: &str, reg: &mut Registry) -> Result<Vec<Loaded>, crate::error::InputError> {
+    let mut out = vec![];
+    crate::scene::load_plugins(text, file, |p| load(p, reg).map(|l| out.push(l)))?;
+    Ok(out)
 }

@@ -54,10 +54,18 @@ impl Guard {
             Ok(r) => r,
             Err(e) => {
                 let at = WHERE.lock().ok().and_then(|mut w| w.take()).unwrap_or_default();
-                (self.raise)(format!("plugin {}: {}{at}", self.plugin, crate::plugin::panic_text(&*e)))
+                (self.raise)(format!("plugin {}: {}{at}", self.plugin, panic_text(&*e)))
             }
         }
     }
+}
+
+/// The message of a panic's payload.
+pub fn panic_text(e: &(dyn Any + Send)) -> String {
+    e.downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| e.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "a panic".into())
 }
 
 /// The host's [`Guard::raise`].

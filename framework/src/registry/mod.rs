@@ -26,7 +26,7 @@ use crate::family::FamilyKind;
 use crate::law::LawDef;
 pub mod builder;
 pub mod guard;
-pub mod limits;
+pub use crate::limits;
 
 pub use crate::output::Writer;
 pub use crate::shape::*;

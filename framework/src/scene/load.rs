@@ -32,6 +32,16 @@ pub(crate) fn load_parsed<D: SceneDim>(cx: &Ctx, sf: SceneFile<BodySpec<D>>, reg
     if b.bodies.is_empty() && !cx.families {
         return Err(cx.err(&[], "the scene has no bodies"));
     }
+    // a movable body needs a mass (a shape of 1e-308 m has none left)
+    if let Some(i) = (0..b.bodies.len()).find(|&i| b.bodies.movable(i) && !(b.bodies.mass[i] > 0.0 && b.bodies.mass[i].is_finite())) {
+        return Err(cx.err(
+            &super::origin_path(b.origins[i], "shape"),
+            format!(
+                "a movable body of mass {:e} kg (its shape's volume times its density): make the shape larger or the body fixed",
+                b.bodies.mass[i]
+            ),
+        ));
+    }
     let nm = b.materials.len();
     let (laws, declared) = super::laws(cx, &sf, registry, nm, &b.materials, D::N as u8)?;
     // every pair of materials that can touch needs a law; every pair of kinds a detector

@@ -163,11 +163,11 @@ pub fn load_any_str(text: &str, file: &str, registry: &Registry) -> Result<AnySc
     }
 }
 
-/// Loads the plugin libraries a scene names (`[[plugins]] library = "…"`, relative to
-/// the scene's folder) into `registry`, before the scene is read: its shapes,
-/// laws, generators and families may come from them ([`crate::plugin`]). An error
-/// names the entry's line and key.
-pub fn load_plugins(text: &str, file: &str, registry: &mut Registry) -> Result<Vec<crate::plugin::Loaded>, InputError> {
+/// The plugin libraries a scene names (`[[plugins]] library = "…"`, relative to the
+/// scene's folder), each given to `load` in order before the scene is read (its
+/// shapes, laws, generators and families may come from them:
+/// [`crate::plugin::load_for_scene`]). An error names the entry's line and key.
+pub fn load_plugins(text: &str, file: &str, mut load: impl FnMut(&std::path::Path) -> Result<(), String>) -> Result<(), InputError> {
     let cx = Ctx {
         text,
         file,
@@ -175,23 +175,22 @@ pub fn load_plugins(text: &str, file: &str, registry: &mut Registry) -> Result<V
     };
     // a text that does not parse is reported by the scene's loader
     let Ok(t) = toml::from_str::<toml::Table>(text) else {
-        return Ok(vec![]);
+        return Ok(());
     };
-    let Some(list) = t.get("plugins") else { return Ok(vec![]) };
+    let Some(list) = t.get("plugins") else { return Ok(()) };
     let Some(list) = list.as_array() else {
         return Err(cx.err(&[k("plugins")], "expected [[plugins]] entries with `library = \"path\"`"));
     };
     let dir = std::path::Path::new(file).parent().filter(|p| !p.as_os_str().is_empty());
-    let mut out = vec![];
     for (i, e) in list.iter().enumerate() {
         let at = [k("plugins"), Seg::Index(i), k("library")];
         let Some(lib) = e.get("library").and_then(|v| v.as_str()) else {
             return Err(cx.err(&at, "the path of a plugin library (a string) is required"));
         };
         let path = dir.map_or_else(|| std::path::PathBuf::from(lib), |d| d.join(lib));
-        out.push(crate::plugin::load(&path, registry).map_err(|m| cx.err(&at, m))?);
+        load(&path).map_err(|m| cx.err(&at, m))?;
     }
-    Ok(out)
+    Ok(())
 }
 
 /// Loads a 2D scene from its text ([`Scene::load_str`]); `file` names it in messages.

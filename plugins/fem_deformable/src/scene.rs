@@ -238,8 +238,57 @@ pub fn build(
         (2, Some(o)) => return Err(("plane", format!("`{o}`: `strain` or `stress`"))),
         _ => return Err(("plane", "`plane` (strain or stress) is for 2D scenes only".into())),
     };
-    let mut fits = || mesh_nodes(&s.mesh).map_or(Ok(()), |n| memory(n).map_err(|m| ("mesh", m)));
-    let raw = match &s.mesh {
+    let raw = raw_mesh(&s.mesh, dim, dir, memory)?;
+    let mesh = Mesh::new(raw).map_err(|e| ("mesh", e.0))?;
+    if mesh_nodes(&s.mesh).is_none() {
+        memory(mesh.n_nodes() as f64).map_err(|m| ("mesh", m))?;
+    }
+    let el = Elastic {
+        young: s.young,
+        poisson: s.poisson,
+        density,
+        plane_stress,
+        rayleigh: s.rayleigh,
+    };
+    let a = python::assemble(
+        &crate::python::RawMesh {
+            dim,
+            points: mesh.x0.clone(),
+            cells: mesh.cells.clone(),
+        },
+        el.young,
+        el.poisson,
+        el.density,
+        plane_stress,
+    )
+    .map_err(|e| ("mesh", e.0))?;
+    let mut body = FeBody::new(s.name.clone(), mesh, el, mat as u16, &a.m, &a.k, a.skfem_version).map_err(|m| ("mesh", m))?;
+    let fix: Vec<u32> = fixed_nodes(&body.mesh, &s.fix).map_err(|m| ("fix", m))?;
+    body.fix_nodes(&fix);
+    match s.velocity.len() {
+        0 => {}
+        n if n == dim => {
+            for (i, v) in body.v.iter_mut().enumerate() {
+                if !body.fixed[i] {
+                    *v = s.velocity[i % dim];
+                }
+            }
+        }
+        _ => return Err(("velocity", format!("{dim} numbers in {dim}D"))),
+    }
+    Ok(body)
+}
+
+/// The mesh of a spec, made by Python (checked against the memory limit first); a
+/// file's, read.
+fn raw_mesh(
+    mesh: &MeshSpec,
+    dim: usize,
+    dir: &Path,
+    memory: &mut dyn FnMut(f64) -> Result<(), String>,
+) -> Result<crate::python::RawMesh, (&'static str, String)> {
+    let mut fits = || mesh_nodes(mesh).map_or(Ok(()), |n| memory(n).map_err(|m| ("mesh", m)));
+    match mesh {
         MeshSpec::Rectangle { .. } | MeshSpec::Disk { .. } if dim == 3 => {
             return Err(("mesh", "rectangles and disks are 2D meshes; in 3D use `box` or `file`".into()))
         }
@@ -282,45 +331,7 @@ pub fn build(
             python::read(&p, dim)
         }
     }
-    .map_err(|e| ("mesh", e.0))?;
-    let mesh = Mesh::new(raw).map_err(|e| ("mesh", e.0))?;
-    if mesh_nodes(&s.mesh).is_none() {
-        memory(mesh.n_nodes() as f64).map_err(|m| ("mesh", m))?;
-    }
-    let el = Elastic {
-        young: s.young,
-        poisson: s.poisson,
-        density,
-        plane_stress,
-        rayleigh: s.rayleigh,
-    };
-    let a = python::assemble(
-        &crate::python::RawMesh {
-            dim,
-            points: mesh.x0.clone(),
-            cells: mesh.cells.clone(),
-        },
-        el.young,
-        el.poisson,
-        el.density,
-        plane_stress,
-    )
-    .map_err(|e| ("mesh", e.0))?;
-    let mut body = FeBody::new(s.name.clone(), mesh, el, mat as u16, &a.m, &a.k, a.skfem_version).map_err(|m| ("mesh", m))?;
-    let fix: Vec<u32> = fixed_nodes(&body.mesh, &s.fix).map_err(|m| ("fix", m))?;
-    body.fix_nodes(&fix);
-    match s.velocity.len() {
-        0 => {}
-        n if n == dim => {
-            for (i, v) in body.v.iter_mut().enumerate() {
-                if !body.fixed[i] {
-                    *v = s.velocity[i % dim];
-                }
-            }
-        }
-        _ => return Err(("velocity", format!("{dim} numbers in {dim}D"))),
-    }
-    Ok(body)
+    .map_err(|e| ("mesh", e.0))
 }
 
 /// Nodes on the named sides of the mesh's box: `bottom`, `top` (the last axis:

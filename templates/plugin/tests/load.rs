@@ -50,7 +50,7 @@ position = [0.0, 0.1]
     );
     // the floor's half-plane is the built-in disks plugin's; the bead is ours
     let mut reg = nscdd_rigid_disks::registry();
-    nscdd::scene::load_plugins(&scene, "bead.toml", &mut reg).unwrap();
+    nscdd::plugin::load_for_scene(&scene, "bead.toml", &mut reg).unwrap();
     assert!(reg.shape_kinds::<nscdd::dim::D2>().contains(&"bead"));
     let mut s = nscdd::scene::Scene::<nscdd::dim::D2>::load_str(&scene, "bead.toml", &reg).unwrap();
     for _ in 0..300 {

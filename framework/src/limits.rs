@@ -76,6 +76,9 @@ pub fn human(bytes: f64) -> String {
     if !x.is_finite() {
         return "an unbounded amount".into();
     }
+    if x >= 1000.0 {
+        return format!("{bytes:.1e} B");
+    }
     format!("{} {}", if x < 10.0 { format!("{x:.1}") } else { format!("{x:.0}") }, units[u])
 }
 
