@@ -41,11 +41,23 @@ fn run_limited(mut c: Command) -> Output {
     child.wait_with_output().expect("output")
 }
 
+/// A session directory of its own for each `mpirun`: OpenMPI's default one
+/// (`/tmp/ompi.HOST.UID`) is made by every job, and two jobs started at the same
+/// moment by parallel tests can fail on it (`mkdir … File exists`).
+fn session_dir() -> PathBuf {
+    static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let k = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let d = std::env::temp_dir().join(format!("nscdd-ompi-{}-{k}", std::process::id()));
+    std::fs::create_dir_all(&d).expect("session dir");
+    d
+}
+
 /// `mpirun` with the settings a root container needs; `apps` are the programs of an
 /// MPMD launch (`-n k nscdd ARGS` each), all run as one job.
 fn mpirun(apps: &[(u32, Vec<String>)]) -> Output {
     let mut c = Command::new("mpirun");
-    c.env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+    c.env("OMPI_MCA_orte_tmpdir_base", session_dir())
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
         .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
         .env("OMPI_MCA_rmaps_base_oversubscribe", "1")
         // shared memory between the ranks of one machine, no network probing

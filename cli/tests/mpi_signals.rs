@@ -94,7 +94,11 @@ fn sigint_to_mpirun_stops_every_rank_after_the_same_step_with_a_checkpoint() {
     std::fs::write(&scene, format!("{pile}\n[decomposition]\nnx = 2\n")).unwrap();
     let out = dir.join("out");
     let mut c = Command::new("mpirun");
-    c.env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+    // a session directory of its own (as cli/tests/mpi.rs)
+    let session = dir.join("ompi");
+    std::fs::create_dir_all(&session).unwrap();
+    c.env("OMPI_MCA_orte_tmpdir_base", &session)
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
         .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
         .env("OMPI_MCA_btl", "self,vader")
         .env("OMPI_MCA_btl_vader_single_copy_mechanism", "none")
