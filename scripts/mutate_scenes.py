@@ -22,7 +22,10 @@ VALUES = ['0', '-1', '1e308', '-1e308', 'nan', 'inf', '1e12', '1e9', '3', '0.0',
 num = re.compile(r'(?<![\w.])-?\d+(\.\d+)?([eE][-+]?\d+)?(?![\w.])')
 out = ROOT / 'target/mutants'; out.mkdir(parents=True, exist_ok=True)
 bad = 0
+runs = 0
 for k in range(N):
+    if k and k % 1000 == 0:
+        print(f'{k} mutants, {runs} runs, {bad} bad', flush=True)
     p, t = random.choice(texts)
     lines = t.splitlines()
     for _ in range(random.randint(1, 3)):
@@ -51,6 +54,7 @@ for k in range(N):
         elif RUN and r.returncode == 0:
             short = re.sub(r'(?m)^(steps|duration) = .*$', 'steps = 20', text)
             f.write_text(short)
+            runs += 1
             outdir = f'/tmp/fuzz_out_{os.getpid()}'
             try:
                 r = subprocess.run([BIN, 'run', str(f), '--quiet', '--out', outdir], capture_output=True, text=True, timeout=20, cwd=str(p.parent))
@@ -66,4 +70,4 @@ for k in range(N):
         dst = out / f'{kind}_{seed}_{k}_{p.stem}.toml'; dst.write_text(text)
         msg = next((l for l in r.stderr.splitlines() if 'panicked' in l or 'alloc' in l or 'overflow' in l), (r.stderr.strip().splitlines() or [''])[0])[:200] if r else ''
         print(kind, dst.name, msg, flush=True)
-print(f'{bad} bad of {N}')
+print(f'{bad} bad of {N} mutants ({runs} accepted and run)')

@@ -5,6 +5,13 @@
 fn the_shared_library_is_built() {
     let exe = std::env::current_exe().unwrap();
     let deps = exe.parent().unwrap();
-    let name = format!("{}nscdd_plugin_bad_abi{}", std::env::consts::DLL_PREFIX, std::env::consts::DLL_SUFFIX);
-    assert!(deps.join(&name).exists() || deps.parent().unwrap().join(&name).exists(), "{name} not built");
+    let name = format!(
+        "{}nscdd_plugin_bad_abi{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_SUFFIX
+    );
+    assert!(
+        deps.join(&name).exists() || deps.parent().unwrap().join(&name).exists(),
+        "{name} not built"
+    );
 }
