@@ -31,10 +31,16 @@ pub fn list(reg: &Registry) -> ExitCode {
         nscdd::plugin::NSCDD_VERSION,
         nscdd::plugin::RUSTC_VERSION
     );
+    // the framework's own laws and writers: registered before any plugin
+    let by_plugins: Vec<String> = reg.plugin_contents().into_iter().flat_map(|(_, i)| i).collect();
+    println!("framework (built in)");
+    for i in reg.contents().into_iter().filter(|i| !by_plugins.contains(i)) {
+        println!("  {i}");
+    }
     for (name, items) in reg.plugin_contents() {
         let from = loaded
             .iter()
-            .find(|l| l.crate_name == name || l.crate_name == name.replace('-', "_"))
+            .find(|l| l.plugins.iter().any(|p| p == name))
             .map(|l| format!(" (loaded from {})", l.library.display()))
             .unwrap_or_else(|| " (built in)".into());
         println!("{name}{from}");

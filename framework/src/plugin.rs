@@ -180,6 +180,8 @@ pub struct Loaded {
     /// The plugin's crate name.
     pub crate_name: String,
     pub library: PathBuf,
+    /// The names of the plugins it registered (`Plugin::name`).
+    pub plugins: Vec<String>,
 }
 
 /// The libraries loaded so far (never unloaded) and their plugins.
@@ -255,6 +257,7 @@ pub fn load(path: &Path, reg: &mut Registry) -> Result<Loaded, String> {
         plugin: name.clone(),
         raise: crate::registry::guard::raise_in_host,
     });
+    let before = reg.plugins().len();
     // SAFETY: the fingerprint matched: the plugin's Registry is ours
     let err = unsafe { (e.register)(reg as *mut Registry as *mut c_void) };
     reg.guard = None;
@@ -264,6 +267,7 @@ pub fn load(path: &Path, reg: &mut Registry) -> Result<Loaded, String> {
     let l = Loaded {
         crate_name: name,
         library: full,
+        plugins: reg.plugins()[before..].iter().map(|p| p.to_string()).collect(),
     };
     if let Ok(mut all) = LOADED.lock() {
         all.push((l.clone(), lib));
