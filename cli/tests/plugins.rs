@@ -6,7 +6,11 @@
 //! The libraries are the workspace members `templates/plugin`, `tests/plugin_bad_abi`
 //! and `tests/plugin_panics`, built by the same cargo command as this test (the
 //! README's test command builds the whole workspace): a plugin must be built with
-//! the same framework build as the program that loads it.
+//! the same framework build as the program that loads it. To run these tests alone,
+//! build the four packages in one command first (`cargo test --release -p nscdd-cli
+//! -p nscdd-plugin-template -p nscdd-plugin-panics -p nscdd-plugin-bad-abi [--features
+//! …] --no-run`, then the same with `--test plugins`): `--test plugins` alone builds
+//! no library of the plugin crates.
 mod common;
 use common::*;
 use std::path::{Path, PathBuf};
