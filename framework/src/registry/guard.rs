@@ -9,8 +9,9 @@
 //! the plugin), which the host's program reports (`plugin NAME: …`). Built-in
 //! plugins are not wrapped (the registry's guard is unset for them).
 //!
-//! Wrapped today: pair detectors, generators and shape stores (every method,
-//! defaults included, so that the store's own overrides still answer).
+//! Wrapped: pair detectors, generators, shape stores (every method, defaults
+//! included, so that the store's own overrides still answer), contact laws and
+//! writers. (Body families of run-time plugins are not wrapped yet.)
 
 use super::{Generator, ParamError, SceneBuilder};
 use crate::dim::Dim;
@@ -149,5 +150,65 @@ impl<D: Dim> ShapeStore<D> for GuardedStore<D> {
     }
     fn face_contact(&self, s: u32, pos: D::Point, rot: D::Rot, facet: &[D::Point]) -> Option<FaceContact<D>> {
         self.guard.call(|| self.inner.face_contact(s, pos, rot, facet))
+    }
+}
+
+#[derive(Debug)]
+pub(crate) struct GuardedLaw {
+    pub inner: std::sync::Arc<dyn crate::law::Law>,
+    pub guard: GuardDebug,
+}
+
+/// A [`Guard`] inside a `Debug` type.
+#[derive(Clone)]
+pub(crate) struct GuardDebug(pub Guard);
+
+impl std::fmt::Debug for GuardDebug {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "guard of plugin {}", self.0.plugin)
+    }
+}
+
+impl crate::law::Law for GuardedLaw {
+    fn contacts(
+        &self,
+        step: &crate::law::LawStep,
+        inputs: &[crate::law::LawInput],
+        target: &mut [crate::model::Target],
+        joint: &mut [crate::dim::joint::Joint],
+    ) {
+        self.guard.0.call(|| self.inner.contacts(step, inputs, target, joint))
+    }
+    fn contact(&self, step: &crate::law::LawStep, input: &crate::law::LawInput) -> crate::law::LawOutput {
+        self.guard.0.call(|| self.inner.contact(step, input))
+    }
+    fn bonds(&self) -> bool {
+        self.guard.0.call(|| self.inner.bonds())
+    }
+}
+
+pub(crate) struct GuardedWriter<D: Dim> {
+    pub inner: Box<dyn crate::output::Writer<D>>,
+    pub guard: Guard,
+}
+
+impl<D: Dim> crate::output::Writer<D> for GuardedWriter<D> {
+    fn write(&mut self, world: &crate::world::World<D>, dir: &std::path::Path, frame: u32) -> std::io::Result<()> {
+        let inner = &mut self.inner;
+        self.guard.call(|| inner.write(world, dir, frame))
+    }
+    fn write_dd(
+        &mut self,
+        world: &crate::world::World<D>,
+        dd: &crate::dd::DdView,
+        dir: &std::path::Path,
+        frame: u32,
+    ) -> std::io::Result<()> {
+        let inner = &mut self.inner;
+        self.guard.call(|| inner.write_dd(world, dd, dir, frame))
+    }
+    fn finish(&mut self, dir: &std::path::Path) -> std::io::Result<()> {
+        let inner = &mut self.inner;
+        self.guard.call(|| inner.finish(dir))
     }
 }

@@ -52,11 +52,21 @@ pub trait Plugin {
 /// loaded at run time, [`guard`]).
 pub type NewStore<D> = Arc<dyn Fn() -> Box<dyn ShapeStore<D>> + Send + Sync>;
 
+/// Makes a writer (its plugin's code: guarded when loaded at run time).
+pub type NewWriter<D> = Arc<dyn Fn() -> Box<dyn Writer<D>> + Send + Sync>;
+
+/// A law kind as registered: its definition and its parser (guarded when its plugin
+/// was loaded at run time, [`guard`]).
+pub struct LawKind {
+    pub def: LawDef,
+    pub parse: Arc<dyn Fn(&toml::Table) -> Result<Arc<dyn crate::law::Law>, ParamError> + Send + Sync>,
+}
+
 pub struct Tables<D: Dim> {
     pub(crate) shapes: BTreeMap<&'static str, NewStore<D>>,
     pub(crate) detectors: BTreeMap<(&'static str, &'static str), Arc<dyn PairDetector<D>>>,
     pub(crate) generators: BTreeMap<&'static str, Box<dyn Generator<D>>>,
-    pub(crate) writers: BTreeMap<&'static str, fn() -> Box<dyn Writer<D>>>,
+    pub(crate) writers: BTreeMap<&'static str, NewWriter<D>>,
     pub(crate) families: BTreeMap<&'static str, Box<dyn FamilyKind<D>>>,
 }
 
@@ -78,7 +88,7 @@ pub struct Registry {
     plugins: Vec<&'static str>,
     /// What each plugin added ([`Self::contents`] after less before), by plugin.
     added: Vec<Vec<String>>,
-    pub(crate) laws: BTreeMap<&'static str, LawDef>,
+    pub(crate) laws: BTreeMap<&'static str, LawKind>,
     t2: Tables<D2>,
     t3: Tables<D3>,
     /// Memory a scene may use (bytes); `None`: the machine's available memory.
@@ -176,9 +186,30 @@ impl Registry {
         self.tables_mut::<D>().generators.insert(name, g);
     }
     pub fn add_law(&mut self, def: LawDef) {
-        self.laws.insert(def.name, def);
+        let p = def.parse;
+        let parse: Arc<dyn Fn(&toml::Table) -> Result<Arc<dyn crate::law::Law>, ParamError> + Send + Sync> = match self.guard.clone() {
+            None => Arc::new(p),
+            Some(guard) => Arc::new(move |t: &toml::Table| {
+                let inner = guard.call(|| p(t))?;
+                Ok(Arc::new(guard::GuardedLaw {
+                    inner,
+                    guard: guard::GuardDebug(guard.clone()),
+                }) as Arc<dyn crate::law::Law>)
+            }),
+        };
+        self.laws.insert(def.name, LawKind { def, parse });
     }
     pub fn add_writer<D: Dim>(&mut self, name: &'static str, make: fn() -> Box<dyn Writer<D>>) {
+        let make: NewWriter<D> = match self.guard.clone() {
+            None => Arc::new(make),
+            Some(guard) => Arc::new(move || {
+                let inner = guard.call(make);
+                Box::new(guard::GuardedWriter {
+                    inner,
+                    guard: guard.clone(),
+                }) as Box<dyn Writer<D>>
+            }),
+        };
         self.tables_mut::<D>().writers.insert(name, make);
     }
     /// A body family ([`crate::family`]) whose entries are the scene section `section`
@@ -195,8 +226,8 @@ impl Registry {
         self.tables::<D>().families.keys().copied().collect()
     }
     /// A writer's constructor by name.
-    pub fn writer<D: Dim>(&self, name: &str) -> Option<fn() -> Box<dyn Writer<D>>> {
-        self.tables::<D>().writers.get(name).copied()
+    pub fn writer<D: Dim>(&self, name: &str) -> Option<NewWriter<D>> {
+        self.tables::<D>().writers.get(name).cloned()
     }
     /// The shape kinds of dimension D.
     pub fn shape_kinds<D: Dim>(&self) -> Vec<&'static str> {
