@@ -179,5 +179,28 @@ fn a_panic_in_a_plugin_is_reported_and_the_outputs_are_kept() {
     // it fell for a while: the rows written before are kept, whole
     let hist = std::fs::read_to_string(out.join("history.csv")).unwrap();
     assert!(hist.lines().count() > 10 && hist.ends_with('\n'), "{hist}");
+    // a plugin's law that panics when the bead lands
+    let brittle = std::fs::read_to_string(&scene)
+        .unwrap()
+        .replace("panic_below = 0.02", "panic_below = -1.0")
+        .replace("friction = 0.3", "law = \"brittle\"");
+    std::fs::write(&scene, brittle).unwrap();
+    let out2 = dir.join("out2");
+    let o = nscdd(&[
+        os("run"),
+        scene.as_os_str(),
+        os("--out"),
+        out2.as_os_str(),
+        os("--quiet"),
+        os("--plugin"),
+        lib.as_os_str(),
+    ]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("plugin nscdd_plugin_panics") && err.contains("the brittle law broke"),
+        "{err}"
+    );
+    assert!(std::fs::read_to_string(out2.join("history.csv")).unwrap().lines().count() > 10);
     let _ = std::fs::remove_dir_all(&dir);
 }

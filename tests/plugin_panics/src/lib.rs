@@ -1,6 +1,7 @@
 //! A plugin with a `fragile` 2D shape (a disk of `radius`) whose detector against
-//! half-planes panics once its bead comes within `panic_below` of the floor: nscdd
-//! must report `plugin nscdd_plugin_panics: …` and stop, keeping what was written.
+//! half-planes panics once its bead comes within `panic_below` of the floor, and a
+//! `brittle` law that panics at its first contact: nscdd must report `plugin
+//! nscdd_plugin_panics: …` and stop, keeping what was written.
 
 use nscdd::dim::D2;
 use nscdd::params::{number, only_keys, positive};
@@ -93,6 +94,23 @@ impl PairDetector<D2> for Never {
     fn detect(&self, _cx: &DetectCtx<'_, D2>, _pairs: &[[u32; 2]], _out: &mut Vec<RawContact2>) {}
 }
 
+/// A law that breaks at the first contact it is given.
+#[derive(Debug)]
+struct Brittle;
+impl nscdd::law::Law for Brittle {
+    fn contacts(
+        &self,
+        _step: &nscdd::law::LawStep,
+        inputs: &[nscdd::law::LawInput],
+        _t: &mut [nscdd::model::Target],
+        _j: &mut [nscdd::dim::joint::Joint],
+    ) {
+        if !inputs.is_empty() {
+            panic!("the brittle law broke on {} contacts", inputs.len());
+        }
+    }
+}
+
 struct Panics;
 impl Plugin for Panics {
     fn name(&self) -> &'static str {
@@ -105,6 +123,13 @@ impl Plugin for Panics {
         });
         reg.add_detector::<D2>("fragile", "halfplane", Arc::new(FragileHalfPlane));
         reg.add_detector::<D2>("fragile", "fragile", Arc::new(Never));
+        reg.add_law(nscdd::law::LawDef {
+            name: "brittle",
+            parse: |t| {
+                nscdd::params::only_keys(t, &[])?;
+                Ok(Arc::new(Brittle))
+            },
+        });
     }
 }
 
