@@ -45,17 +45,8 @@ impl<D: Dim> FamilyContext<'_, D> {
     /// hold, `what` says of what) fit beside the rigid world in the memory limit
     /// ([`crate::registry::limits`]); Err: the message with the estimate and the limit.
     pub fn check_memory(&self, bytes: f64, what: &str) -> Result<(), String> {
-        use crate::limits::{bytes_per_body, human, memory_limit};
-        let need = bytes.max(0.0) + self.world.bodies.len() as f64 * bytes_per_body::<D>();
-        let (limit, source) = memory_limit(self.max_memory);
-        if need.is_finite() && need <= limit {
-            return Ok(());
-        }
-        Err(format!(
-            "needs ≈ {} ({what}), more than {} ({source}); make it smaller",
-            human(need),
-            human(limit)
-        ))
+        let need = bytes.max(0.0) + self.world.bodies.len() as f64 * crate::limits::bytes_per_body::<D>();
+        crate::limits::check(need, self.max_memory, what).map_err(|m| format!("{m}; make it smaller"))
     }
 }
 

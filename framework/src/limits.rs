@@ -55,6 +55,23 @@ pub fn memory_limit(limit: Option<f64>) -> (f64, &'static str) {
     }
 }
 
+/// Ok when `need` bytes fit in the memory limit (`max_memory`, else the machine's:
+/// [`memory_limit`]); Err: [`refusal`].
+pub fn check(need: f64, max_memory: Option<f64>, what: &str) -> Result<(), String> {
+    let (limit, _) = memory_limit(max_memory);
+    if need.is_finite() && need <= limit {
+        return Ok(());
+    }
+    Err(refusal(need, max_memory, what))
+}
+
+/// "needs ≈ … (`what` the bytes are for), more than … (the limit's source)", for the
+/// caller to complete with what to do.
+pub fn refusal(need: f64, max_memory: Option<f64>, what: &str) -> String {
+    let (limit, source) = memory_limit(max_memory);
+    format!("needs ≈ {} ({what}), more than {} ({source})", human(need), human(limit))
+}
+
 const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
 
 fn available_memory() -> Option<f64> {

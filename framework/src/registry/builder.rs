@@ -109,24 +109,18 @@ impl<'r, D: Dim> SceneBuilder<'r, D> {
     pub fn reserve(&self, key: &str, count: f64, extra: f64) -> Result<(), ParamError> {
         let per = super::limits::bytes_per_body::<D>();
         let need = (self.bodies.len() as f64 + count.max(0.0)) * per + extra.max(0.0);
-        let (limit, what) = super::limits::memory_limit(self.registry.max_memory());
-        if need.is_finite() && need <= limit && count <= u32::MAX as f64 / 2.0 {
+        let what = match (count > 0.0, extra > count * per) {
+            (false, _) => "the generator's grid".to_string(),
+            (true, false) => format!("{count} bodies"),
+            (true, true) => format!("{count} bodies and the generator's grid"),
+        };
+        // beyond u32::MAX / 2 bodies the dense u32 ids run out, whatever the memory
+        let max = self.registry.max_memory();
+        if count <= u32::MAX as f64 / 2.0 && super::limits::check(need, max, &what).is_ok() {
             return Ok(());
         }
-        Err(ParamError::new(
-            key,
-            format!(
-                "needs ≈ {} ({}), more than {} ({}); make the sample smaller",
-                super::limits::human(need),
-                match (count > 0.0, extra > count * per) {
-                    (false, _) => "the generator's grid".to_string(),
-                    (true, false) => format!("{count} bodies"),
-                    (true, true) => format!("{count} bodies and the generator's grid"),
-                },
-                super::limits::human(limit),
-                what
-            ),
-        ))
+        let msg = super::limits::refusal(need, max, &what);
+        Err(ParamError::new(key, format!("{msg}; make the sample smaller")))
     }
 
     pub fn add_body(&mut self, shape: ShapeRef, material: u16, pos: D::Point, rot: D::RotVec, vel: D::Twist) -> u32 {

@@ -73,16 +73,19 @@ pub(crate) fn laws_and_detectors<T>(
     Ok(table)
 }
 
+/// The median of the finite positive shape sizes (None: there is none).
+fn median_size(sizes: &[f64]) -> Option<f64> {
+    let mut s: Vec<f64> = sizes.iter().copied().filter(|x| x.is_finite() && *x > 0.0).collect();
+    s.sort_by(|a, c| a.total_cmp(c));
+    s.get(s.len() / 2).copied()
+}
+
 /// The alert distance: `detection.alert`, or 0.1 × the median shape size.
 pub(crate) fn alert_distance(cx: &Ctx, d: &schema::DetectionSpec, sizes: &[f64]) -> Result<f64, InputError> {
     match d.alert {
         Some(a) if !(a >= 0.0 && a.is_finite()) => Err(cx.err(&[k("detection"), k("alert")], format!("must be ≥ 0, got {a}"))),
         Some(a) => Ok(a),
-        None => {
-            let mut s: Vec<f64> = sizes.iter().copied().filter(|x| x.is_finite() && *x > 0.0).collect();
-            s.sort_by(|a, c| a.total_cmp(c));
-            Ok(0.1 * s.get(s.len() / 2).copied().unwrap_or(1.0))
-        }
+        None => Ok(0.1 * median_size(sizes).unwrap_or(1.0)),
     }
 }
 
@@ -98,9 +101,7 @@ pub(crate) fn check_alert_work(cx: &Ctx, alert: f64, pts: &[[f64; 3]], sizes: &[
     if n < 2.0 {
         return Ok(());
     }
-    let mut s: Vec<f64> = sizes.iter().copied().filter(|x| x.is_finite() && *x > 0.0).collect();
-    s.sort_by(|a, c| a.total_cmp(c));
-    let size = s.get(s.len() / 2).copied().unwrap_or(0.0);
+    let size = median_size(sizes).unwrap_or(0.0);
     let reach = 2.0 * (alert + size);
     let mut share = 1.0;
     for d in 0..dim {
