@@ -7,7 +7,7 @@ use super::locate::Seg;
 use super::schema::{BodySpec, SceneDim, SceneFile};
 use super::{at, k, BodyInfo, Ctx, OutputSettings, Scene};
 use crate::detect::{Detector, DetectorTable};
-use crate::dim::{Coords, Vector};
+use crate::dim::{Coords, Dim, Vector};
 use crate::drive::BodyDrive;
 use crate::error::InputError;
 use crate::model::ShapeRef;
@@ -32,16 +32,7 @@ pub(crate) fn load_parsed<D: SceneDim>(cx: &Ctx, sf: SceneFile<BodySpec<D>>, reg
     if b.bodies.is_empty() && !cx.families {
         return Err(cx.err(&[], "the scene has no bodies"));
     }
-    // a movable body needs a mass (a shape of 1e-308 m has none left)
-    if let Some(i) = (0..b.bodies.len()).find(|&i| b.bodies.movable(i) && !(b.bodies.mass[i] > 0.0 && b.bodies.mass[i].is_finite())) {
-        return Err(cx.err(
-            &super::origin_path(b.origins[i], "shape"),
-            format!(
-                "a movable body of mass {:e} kg (its shape's volume times its density): make the shape larger or the body fixed",
-                b.bodies.mass[i]
-            ),
-        ));
-    }
+    check_masses(cx, &b)?;
     let nm = b.materials.len();
     let (laws, declared) = super::laws(cx, &sf, registry, nm, &b.materials, D::N as u8)?;
     // every pair of materials that can touch needs a law; every pair of kinds a detector
@@ -65,17 +56,7 @@ pub(crate) fn load_parsed<D: SceneDim>(cx: &Ctx, sf: SceneFile<BodySpec<D>>, reg
         .map(|i| b.shapes[b.bodies.shape[i].kind as usize].size(b.bodies.shape[i].index))
         .collect();
     let alert = super::alert_distance(cx, &sf.detection, &sizes)?;
-    let centres: Vec<[f64; 3]> = (0..n)
-        .filter(|&i| b.bodies.movable(i))
-        .map(|i| {
-            let mut p = [0.0; 3];
-            for (x, y) in p.iter_mut().zip(b.bodies.pos[i].as_ref()) {
-                *x = *y;
-            }
-            p
-        })
-        .collect();
-    super::checks::check_alert_work(cx, alert, &centres, &sizes, D::N)?;
+    super::checks::check_alert_work(cx, alert, &movable_centres(&b), &sizes, D::N)?;
     // initial interpenetrations beyond the tolerance
     let mut raw = vec![];
     Detector::default().detect(&b.bodies, &b.shapes, &table, 0.0, &mut raw);
@@ -258,4 +239,33 @@ fn add_bodies<D: SceneDim>(
         }
     }
     Ok(())
+}
+
+/// A movable body needs a mass (a shape of 1e-308 m has none left).
+fn check_masses<D: Dim>(cx: &Ctx, b: &SceneBuilder<'_, D>) -> Result<(), InputError> {
+    let m = &b.bodies.mass;
+    match (0..b.bodies.len()).find(|&i| b.bodies.movable(i) && !(m[i] > 0.0 && m[i].is_finite())) {
+        None => Ok(()),
+        Some(i) => Err(cx.err(
+            &super::origin_path(b.origins[i], "shape"),
+            format!(
+                "a movable body of mass {:e} kg (its shape's volume times its density): make the shape larger or the body fixed",
+                m[i]
+            ),
+        )),
+    }
+}
+
+/// The movable bodies' centres (z = 0 in 2D).
+fn movable_centres<D: Dim>(b: &SceneBuilder<'_, D>) -> Vec<[f64; 3]> {
+    (0..b.bodies.len())
+        .filter(|&i| b.bodies.movable(i))
+        .map(|i| {
+            let mut p = [0.0; 3];
+            for (x, y) in p.iter_mut().zip(b.bodies.pos[i].as_ref()) {
+                *x = *y;
+            }
+            p
+        })
+        .collect()
 }
