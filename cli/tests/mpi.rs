@@ -11,17 +11,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-const BIN: &str = env!("CARGO_BIN_EXE_nscdd");
-
-/// No test may take longer: a failure must never hang the ranks.
-const LIMIT: Duration = Duration::from_secs(120);
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("nscdd-mpi-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("scratch dir");
-    d
-}
+mod mpi_common;
+use mpi_common::*;
 
 /// Runs a command to its end or kills it after [`LIMIT`] (then fails the test).
 fn run_limited(mut c: Command) -> Output {
@@ -41,59 +32,15 @@ fn run_limited(mut c: Command) -> Output {
     child.wait_with_output().expect("output")
 }
 
-/// A session directory of its own for each `mpirun`: OpenMPI's default one
-/// (`/tmp/ompi.HOST.UID`) is made by every job, and two jobs started at the same
-/// moment by parallel tests can fail on it (`mkdir … File exists`).
-fn session_dir() -> PathBuf {
-    static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let k = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let d = std::env::temp_dir().join(format!("nscdd-ompi-{}-{k}", std::process::id()));
-    std::fs::create_dir_all(&d).expect("session dir");
-    d
-}
-
-/// `mpirun` with the settings a root container needs; `apps` are the programs of an
-/// MPMD launch (`-n k nscdd ARGS` each), all run as one job.
+/// `mpirun` of `apps` ([`mpirun_command`]), run to its end within [`LIMIT`].
 fn mpirun(apps: &[(u32, Vec<String>)]) -> Output {
-    let mut c = Command::new("mpirun");
-    c.env("OMPI_MCA_orte_tmpdir_base", session_dir())
-        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-        .env("OMPI_MCA_rmaps_base_oversubscribe", "1")
-        // shared memory between the ranks of one machine, no network probing
-        .env("OMPI_MCA_btl", "self,vader")
-        // containers often forbid the cross-memory attach of large messages
-        .env("OMPI_MCA_btl_vader_single_copy_mechanism", "none")
-        .arg("--oversubscribe");
-    for (i, (n, args)) in apps.iter().enumerate() {
-        if i > 0 {
-            c.arg(":");
-        }
-        c.arg("-n").arg(n.to_string()).arg(BIN).args(args);
-    }
-    run_limited(c)
+    run_limited(mpirun_command(apps))
 }
 
 fn nscdd(args: &[String]) -> Output {
     let mut c = Command::new(BIN);
     c.args(args);
     run_limited(c)
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
-
-fn args(scene: &Path, out: &Path, extra: &[&str]) -> Vec<String> {
-    let mut v = vec![
-        "run".to_string(),
-        scene.display().to_string(),
-        "--out".into(),
-        out.display().to_string(),
-        "--quiet".into(),
-    ];
-    v.extend(extra.iter().map(|s| s.to_string()));
-    v
 }
 
 fn ok(o: &Output, what: &str) {
@@ -105,58 +52,6 @@ fn ok(o: &Output, what: &str) {
         text(&o.stderr)
     );
 }
-
-/// 64 disks of a triangular lattice, 16 wide, on a floor between two walls: a pile
-/// wide enough for four strips whose interface bodies are shared by adjacent strips
-/// only.
-const PILE2D: &str = r#"
-[time]
-step = 1e-3
-steps = 15
-[solver]
-tolerance = 1e-5
-norm = "QM/16"
-max_sweeps = 3000
-check_every = 5
-[output]
-every = 5
-[[materials]]
-name = "m"
-density = 1000.0
-[[laws]]
-materials = ["m", "m"]
-friction = 0.3
-[[bodies]]
-shape = "wall"
-material = "m"
-position = [0.16, -0.005]
-length = 0.4
-thickness = 0.01
-fixed = true
-[[bodies]]
-shape = "wall"
-material = "m"
-position = [-0.005, 0.05]
-rotation = 1.5707963267948966
-length = 0.2
-thickness = 0.01
-fixed = true
-[[bodies]]
-shape = "wall"
-material = "m"
-position = [0.335, 0.05]
-rotation = 1.5707963267948966
-length = 0.2
-thickness = 0.01
-fixed = true
-[[generate]]
-kind = "triangular_lattice"
-material = "m"
-nx = 16
-ny = 4
-radius = 0.01
-origin = [0.01, 0.01]
-"#;
 
 /// A 5 × 5 × 3 lattice of spheres, jostled by a tilted gravity, settling on a floor
 /// plane between box walls.

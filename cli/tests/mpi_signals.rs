@@ -3,83 +3,10 @@
 //! installs it).
 #![cfg(feature = "mpi")]
 
-use std::path::{Path, PathBuf};
+mod mpi_common;
+use mpi_common::*;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
-
-const BIN: &str = env!("CARGO_BIN_EXE_nscdd");
-const LIMIT: Duration = Duration::from_secs(120);
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
-
-/// 64 disks of a triangular lattice on a floor between two walls.
-const PILE2D: &str = r#"
-[time]
-step = 1e-3
-steps = 15
-[solver]
-tolerance = 1e-5
-norm = "QM/16"
-max_sweeps = 3000
-check_every = 5
-[output]
-every = 5
-[[materials]]
-name = "m"
-density = 1000.0
-[[laws]]
-materials = ["m", "m"]
-friction = 0.3
-[[bodies]]
-shape = "wall"
-material = "m"
-position = [0.16, -0.005]
-length = 0.4
-thickness = 0.01
-fixed = true
-[[bodies]]
-shape = "wall"
-material = "m"
-position = [-0.005, 0.05]
-rotation = 1.5707963267948966
-length = 0.2
-thickness = 0.01
-fixed = true
-[[bodies]]
-shape = "wall"
-material = "m"
-position = [0.335, 0.05]
-rotation = 1.5707963267948966
-length = 0.2
-thickness = 0.01
-fixed = true
-[[generate]]
-kind = "triangular_lattice"
-material = "m"
-nx = 16
-ny = 4
-radius = 0.01
-origin = [0.01, 0.01]
-"#;
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("nscdd-mpi-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("scratch dir");
-    d
-}
-
-fn args(scene: &Path, out: &Path) -> Vec<String> {
-    vec![
-        "run".to_string(),
-        scene.display().to_string(),
-        "--out".into(),
-        out.display().to_string(),
-        "--quiet".into(),
-    ]
-}
 
 /// SIGINT to `mpirun` (Ctrl-C; a batch system's SIGTERM goes the same way): mpirun
 /// passes it to the ranks, which agree on the step to stop after, write the
@@ -93,17 +20,7 @@ fn sigint_to_mpirun_stops_every_rank_after_the_same_step_with_a_checkpoint() {
     let scene = dir.join("pile.toml");
     std::fs::write(&scene, format!("{pile}\n[decomposition]\nnx = 2\n")).unwrap();
     let out = dir.join("out");
-    let mut c = Command::new("mpirun");
-    // a session directory of its own (as cli/tests/mpi.rs)
-    let session = dir.join("ompi");
-    std::fs::create_dir_all(&session).unwrap();
-    c.env("OMPI_MCA_orte_tmpdir_base", &session)
-        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-        .env("OMPI_MCA_btl", "self,vader")
-        .env("OMPI_MCA_btl_vader_single_copy_mechanism", "none")
-        .args(["--oversubscribe", "-n", "2", BIN])
-        .args(args(&scene, &out));
+    let mut c = mpirun_command(&[(2, args(&scene, &out, &[]))]);
     let mut child = c.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("mpirun");
     // a few hundred steps in, then SIGINT to mpirun
     let t0 = Instant::now();
