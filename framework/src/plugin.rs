@@ -185,7 +185,14 @@ pub struct Loaded {
 }
 
 /// The libraries loaded so far (never unloaded) and their plugins.
-static LOADED: Mutex<Vec<(Loaded, libloading::Library)>> = Mutex::new(Vec::new());
+/// A checked entry of a library that stays loaded (never unloaded: `'static`).
+#[derive(Clone, Copy)]
+struct Checked(&'static PluginEntry);
+// SAFETY: the entry is immutable data and `extern "C"` functions of a library that
+// is never unloaded
+unsafe impl Send for Checked {}
+
+static LOADED: Mutex<Vec<(Loaded, libloading::Library, Checked)>> = Mutex::new(Vec::new());
 
 /// The plugins loaded so far.
 pub fn loaded() -> Vec<Loaded> {
@@ -207,8 +214,15 @@ fn c_str(p: *const c_char) -> String {
 pub fn load(path: &Path, reg: &mut Registry) -> Result<Loaded, String> {
     let shown = path.display();
     let full = std::fs::canonicalize(path).map_err(|e| format!("plugin library {shown}: {e}"))?;
-    if let Some(p) = loaded().into_iter().find(|p| p.library == full) {
-        return Ok(p);
+    let known = LOADED.lock().ok().and_then(|all| all.iter().find(|p| p.0.library == full).map(|p| (p.0.clone(), p.2)));
+    if let Some((l, checked)) = known {
+        // loaded before (another registry, or named twice): register into this
+        // registry unless it holds the plugin already
+        if l.plugins.iter().all(|p| reg.plugins().contains(&p.as_str())) {
+            return Ok(l);
+        }
+        register_into(checked.0, &l.crate_name, reg).map_err(|m| format!("plugin {} ({shown}): {m}", l.crate_name))?;
+        return Ok(l);
     }
     // SAFETY: loading runs the library's initializers; an nscdd plugin has none of
     // its own (Rust runs no code before main), and a foreign library is refused below
@@ -252,30 +266,36 @@ pub fn load(path: &Path, reg: &mut Registry) -> Result<Loaded, String> {
         ));
     }
     let name = c_str(e.name);
-    // what the plugin registers is guarded (registry::guard)
-    reg.guard = Some(crate::registry::guard::Guard {
-        plugin: name.clone(),
-        raise: crate::registry::guard::raise_in_host,
-    });
     let before = reg.plugins().len();
-    // SAFETY: the fingerprint matched: the plugin's Registry is ours
-    let err = unsafe { (e.register)(reg as *mut Registry as *mut c_void) };
-    reg.guard = None;
-    if !err.is_null() {
-        return Err(format!("plugin {name} ({shown}): panicked while registering: {}", c_str(err)));
-    }
+    register_into(e, &name, reg).map_err(|m| format!("plugin {name} ({shown}): {m}"))?;
     let l = Loaded {
         crate_name: name,
         library: full,
         plugins: reg.plugins()[before..].iter().map(|p| p.to_string()).collect(),
     };
     if let Ok(mut all) = LOADED.lock() {
-        all.push((l.clone(), lib));
+        all.push((l.clone(), lib, Checked(e)));
     } else {
         // never unloaded, even when the list is poisoned
         std::mem::forget(lib);
     }
     Ok(l)
+}
+
+/// Runs a checked plugin's registration into `reg`, guarded
+/// ([`crate::registry::guard`]).
+fn register_into(e: &PluginEntry, name: &str, reg: &mut Registry) -> Result<(), String> {
+    reg.guard = Some(crate::registry::guard::Guard {
+        plugin: name.to_string(),
+        raise: crate::registry::guard::raise_in_host,
+    });
+    // SAFETY: the fingerprint matched: the plugin's Registry is ours
+    let err = unsafe { (e.register)(reg as *mut Registry as *mut c_void) };
+    reg.guard = None;
+    if !err.is_null() {
+        return Err(format!("panicked while registering: {}", c_str(err)));
+    }
+    Ok(())
 }
 
 /// The plugins a scene's text names (`[[plugins]]`, relative to the scene's folder),
