@@ -120,37 +120,35 @@ pub(crate) fn closest_boundary(v: &[P], n: &[P], q: P) -> (f64, P, P) {
     (d, [u[0] / d, u[1] / d], c)
 }
 
-/// Clips segment [p0, p1] to the slab between the lines through w0 and w1
-/// perpendicular to w1 − w0: the kept part's ends (the first from p0's side), or
-/// `None`. A point (p0 = p1) is kept if it lies in the slab.
-fn clip(p0: P, p1: P, w0: P, w1: P) -> Option<[P; 2]> {
-    let t = sub(w1, w0);
-    let (lo, hi) = (0.0, dot(t, t));
-    let (s0, s1) = (dot(sub(p0, w0), t), dot(sub(p1, w0), t));
-    let at = |s: f64| {
-        let u = (s - s0) / (s1 - s0);
-        [p0[0] + u * (p1[0] - p0[0]), p0[1] + u * (p1[1] - p0[1])]
-    };
-    let mut a = p0;
-    if s0 < lo {
-        if s1 < lo {
-            return None;
-        }
-        a = at(lo);
-    } else if s0 > hi {
-        if s1 > hi {
-            return None;
-        }
-        a = at(hi);
+/// Where each end of the overlap of an incident edge [i0, i1] with a reference
+/// edge [r0, r1] lies, along the reference edge: `Incident(k)` (the incident
+/// edge's vertex k lies in the reference edge's slab) or `Reference(q)` (the
+/// incident edge passes beyond the reference edge's vertex q there), or `None` when
+/// they do not overlap. A point (i0 = i1) gives `Incident(0)` twice if it lies in
+/// the slab.
+fn overlap(i0: P, i1: P, r0: P, r1: P) -> Option<[End; 2]> {
+    let t = sub(r1, r0);
+    let hi = dot(t, t);
+    let (s0, s1) = (dot(sub(i0, r0), t), dot(sub(i1, r0), t));
+    if (s0 < 0.0 && s1 < 0.0) || (s0 > hi && s1 > hi) {
+        return None;
     }
-    let b = if s1 < lo {
-        at(lo)
-    } else if s1 > hi {
-        at(hi)
-    } else {
-        p1
+    let end = |s: f64, k: usize| {
+        if s < 0.0 {
+            End::Reference(0)
+        } else if s > hi {
+            End::Reference(1)
+        } else {
+            End::Incident(k)
+        }
     };
-    Some([a, b])
+    Some([end(s0, 0), end(s1, 1)])
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum End {
+    Incident(usize),
+    Reference(usize),
 }
 
 /// The edge of `side` most anti-parallel to `m`.
@@ -248,65 +246,88 @@ pub fn collide(i: u32, j: u32, a: &Side, b: &Side, r: f64, alert: f64, size: f64
     }
 }
 
-/// The contact points of one axis (none if clipping leaves nothing).
+/// A vertex against an edge line (a point on it `e0`, the outward normal `m` of the
+/// edge's shape): a contact whose gap is (V − e0)·m − r. Both are material (a
+/// vertex, an edge of the other body), so the gap's rate is the normal relative
+/// velocity at the point, which is what the solver constrains: the point stays
+/// put on the vertex while the bodies slide and turn. `vertex_of_a`: the vertex is
+/// the candidate's (the normal from B to A is then m, else −m).
+#[allow(clippy::too_many_arguments)]
+fn vertex_edge(i: u32, j: u32, feature: u32, v: P, e0: P, m: P, r: f64, vertex_of_a: bool, alert: f64, out: &mut Vec<RawContact2>) {
+    let gap = dot(sub(v, e0), m) - r;
+    if gap > alert {
+        return;
+    }
+    let (h, normal) = if vertex_of_a {
+        (0.5 * gap, m)
+    } else {
+        (r + 0.5 * gap, [-m[0], -m[1]])
+    };
+    out.push(RawContact2 {
+        i,
+        j,
+        feature,
+        point: [v[0] - h * m[0], v[1] - h * m[1]],
+        normal,
+        gap,
+        area: 0.0,
+    });
+}
+
+/// The contact points of one axis (none if the edges do not overlap). For an edge
+/// axis, each end of the overlap of the incident edge with the reference edge is
+/// a vertex against an edge: an incident vertex in the reference edge's slab
+/// against the reference edge, or, where the incident edge passes beyond the
+/// reference edge, the reference vertex there against the incident edge.
 #[allow(clippy::too_many_arguments)]
 fn points(i: u32, j: u32, a: &Side, b: &Side, r: f64, alert: f64, axis: Axis, out: &mut Vec<RawContact2>) {
-    let push = |out: &mut Vec<RawContact2>, feature: u32, point: P, normal: P, gap: f64| {
-        out.push(RawContact2 {
-            i,
-            j,
-            feature,
-            point,
-            normal,
-            gap,
-            area: 0.0,
-        })
-    };
     let before = out.len();
+    let next = |s: &Side, k: usize| (k + 1) % s.v.len();
     match axis {
-        Axis::EdgeB(k) => {
-            let m = b.n[k];
-            let (w0, w1) = (b.v[k], b.v[(k + 1) % b.v.len()]);
-            let e = incident(a, m);
-            let Some(ends) = clip(a.v[e], a.v[(e + 1) % a.v.len()], w0, w1) else {
-                return;
-            };
-            for (end, p) in ends.into_iter().enumerate() {
-                let sep = dot(sub(p, w0), m) - r;
-                if sep <= alert {
-                    let f = 1 << 28 | (k as u32) << 18 | (e as u32) << 8 | end as u32;
-                    push(out, f, [p[0] - 0.5 * sep * m[0], p[1] - 0.5 * sep * m[1]], m, sep);
+        Axis::EdgeB(k) | Axis::EdgeA(k) => {
+            let ref_is_b = matches!(axis, Axis::EdgeB(_));
+            let (rs, is) = if ref_is_b { (b, a) } else { (a, b) };
+            let m = rs.n[k];
+            let (r0, r1) = (rs.v[k], rs.v[next(rs, k)]);
+            // the incident edge (a disk's centre: a point)
+            let (e, i0, i1) = match is.n.is_empty() {
+                true => (0, is.v[0], is.v[0]),
+                false => {
+                    let e = incident(is, m);
+                    (e, is.v[e], is.v[next(is, e)])
                 }
-            }
-        }
-        Axis::EdgeA(e) => {
-            let n = a.n[e];
-            let (v0, v1) = (a.v[e], a.v[(e + 1) % a.v.len()]);
-            let (k, w0, w1) = if b.n.is_empty() {
-                (0, b.v[0], b.v[0])
-            } else {
-                let k = incident(b, n);
-                (k, b.v[k], b.v[(k + 1) % b.v.len()])
             };
-            let Some(ends) = clip(w0, w1, v0, v1) else {
+            let Some(ends) = overlap(i0, i1, r0, r1) else {
                 return;
             };
-            let single = w0 == w1;
-            for (end, w) in ends.into_iter().enumerate().take(if single { 1 } else { 2 }) {
-                let sep = dot(sub(w, v0), n) - r;
-                if sep <= alert {
-                    let f = 2 << 28 | (e as u32) << 18 | (k as u32) << 8 | end as u32;
-                    let h = r + 0.5 * sep;
-                    push(out, f, [w[0] - h * n[0], w[1] - h * n[1]], [-n[0], -n[1]], sep);
+            let kind = if ref_is_b { 1u32 } else { 2 };
+            let single = i0 == i1;
+            for (slot, end) in ends.into_iter().enumerate().take(if single { 1 } else { 2 }) {
+                let f = kind << 28 | (k as u32) << 18 | (e as u32) << 8 | slot as u32;
+                match end {
+                    // the incident vertex against the reference edge
+                    End::Incident(q) => vertex_edge(i, j, f, [i0, i1][q], r0, m, r, ref_is_b, alert, out),
+                    // the reference vertex against the incident edge
+                    End::Reference(q) => {
+                        let mi = is.n[e];
+                        vertex_edge(i, j, f | 2, [r0, r1][q], i0, mi, r, !ref_is_b, alert, out)
+                    }
                 }
             }
         }
         Axis::VertexB(k, u) => {
             let lo_a = a.v.iter().map(|v| dot(*v, u)).fold(f64::INFINITY, f64::min);
-            let s = lo_a - dot(b.v[k], u) - r;
-            let p = b.v[k];
-            let h = r + 0.5 * s;
-            push(out, 3 << 28 | k as u32, [p[0] + h * u[0], p[1] + h * u[1]], u, s);
+            let gap = lo_a - dot(b.v[k], u) - r;
+            let (p, h) = (b.v[k], r + 0.5 * gap);
+            out.push(RawContact2 {
+                i,
+                j,
+                feature: 3 << 28 | k as u32,
+                point: [p[0] + h * u[0], p[1] + h * u[1]],
+                normal: u,
+                gap,
+                area: 0.0,
+            });
         }
     }
     share_length(&mut out[before..]);
@@ -430,7 +451,12 @@ mod tests {
         s
     }
     fn square(c: P, h: f64) -> Side {
-        side(vec![[c[0] - h, c[1] - h], [c[0] + h, c[1] - h], [c[0] + h, c[1] + h], [c[0] - h, c[1] + h]])
+        side(vec![
+            [c[0] - h, c[1] - h],
+            [c[0] + h, c[1] - h],
+            [c[0] + h, c[1] + h],
+            [c[0] - h, c[1] + h],
+        ])
     }
 
     #[test]
@@ -506,10 +532,13 @@ mod tests {
     }
 
     #[test]
-    fn clipping_keeps_the_part_in_the_slab() {
-        assert_eq!(clip([-1.0, 1.0], [2.0, 1.0], [0.0, 0.0], [1.0, 0.0]), Some([[0.0, 1.0], [1.0, 1.0]]));
-        assert_eq!(clip([2.0, 1.0], [3.0, 1.0], [0.0, 0.0], [1.0, 0.0]), None);
-        assert_eq!(clip([0.5, 1.0], [0.5, 1.0], [0.0, 0.0], [1.0, 0.0]), Some([[0.5, 1.0]; 2]));
+    fn overlap_ends_are_incident_or_reference_vertices() {
+        let (r0, r1) = ([0.0, 0.0], [1.0, 0.0]);
+        use End::*;
+        assert_eq!(overlap([-1.0, 1.0], [2.0, 1.0], r0, r1), Some([Reference(0), Reference(1)]));
+        assert_eq!(overlap([0.5, 1.0], [2.0, 1.0], r0, r1), Some([Incident(0), Reference(1)]));
+        assert_eq!(overlap([2.0, 1.0], [3.0, 1.0], r0, r1), None);
+        assert_eq!(overlap([0.5, 1.0], [0.5, 1.0], r0, r1), Some([Incident(0), Incident(1)]));
     }
 
     #[test]

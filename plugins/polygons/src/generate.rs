@@ -97,7 +97,11 @@ impl Generator<D2> for PolygonDeposit {
         let cols = cols as usize;
         for k in 0..n {
             let r = if rmax > rmin { rng.random_range(rmin..rmax) } else { rmin };
-            let m = if sides_max > sides { rng.random_range(sides..=sides_max) } else { sides };
+            let m = if sides_max > sides {
+                rng.random_range(sides..=sides_max)
+            } else {
+                sides
+            };
             let phase = rng.random_range(0.0..2.0 * PI);
             let mut v = regular(m, r, phase);
             if irr > 0.0 {

@@ -191,7 +191,12 @@ fn points_of(p: &toml::Table) -> Result<Vec<[f64; 2]>, ParamError> {
         if !(w > 0.0 && h > 0.0 && w.is_finite() && h.is_finite()) {
             return Err(ParamError::new("size", "2 positive sizes [w, h]"));
         }
-        return Ok(vec![[-0.5 * w, -0.5 * h], [0.5 * w, -0.5 * h], [0.5 * w, 0.5 * h], [-0.5 * w, 0.5 * h]]);
+        return Ok(vec![
+            [-0.5 * w, -0.5 * h],
+            [0.5 * w, -0.5 * h],
+            [0.5 * w, 0.5 * h],
+            [-0.5 * w, 0.5 * h],
+        ]);
     }
     let bad = || ParamError::new("vertices", "a list of at least 3 points [x, y]");
     let arr = p.get("vertices").and_then(|v| v.as_array()).ok_or_else(bad)?;

@@ -33,7 +33,11 @@ fn a_block_slides_down_an_incline_with_a_equal_g_sin_minus_mu_cos() {
     let v = w.bodies.vel[1];
     let along = v[0] * down[0] + v[1] * down[1];
     let a = G * (alpha.sin() - mu * alpha.cos());
-    println!("α = 30°, μ = 0.3: v = {along:.9} m/s after {t} s, a t = {:.9}; ω = {:.2e}", a * t, v[2]);
+    println!(
+        "α = 30°, μ = 0.3: v = {along:.9} m/s after {t} s, a t = {:.9}; ω = {:.2e}",
+        a * t,
+        v[2]
+    );
     assert!((along - a * t).abs() < 1e-6 * a * t, "sliding velocity {along} vs a t = {}", a * t);
     assert!(v[2].abs() < 1e-6, "the block does not turn: ω = {}", v[2]);
     let (_, points) = carried(w, 1, 0);
@@ -56,7 +60,11 @@ fn a_slender_block_overturns_at_atan_b_over_h_before_it_can_slide() {
     };
     let (below, vb) = turned(star - 1f64.to_radians());
     let (above, va) = turned(star + 1f64.to_radians());
-    println!("α* = {:.2}°: 1° below turned {below:.2e} rad, 1° above {above:.2e} rad (ω {:.3})", star.to_degrees(), va[2]);
+    println!(
+        "α* = {:.2}°: 1° below turned {below:.2e} rad, 1° above {above:.2e} rad (ω {:.3})",
+        star.to_degrees(),
+        va[2]
+    );
     assert!(below.abs() < 1e-6 && vb[2].abs() < 1e-6, "stands 1° below α*: {below}");
     assert!(above.abs() > 0.05, "overturns 1° above α*: {above}");
     // it tips downhill: the slope rises to the right, so about its lower left
@@ -83,7 +91,10 @@ fn a_stack_of_bricks_carries_k_m_g_at_each_joint() {
     for k in 0..n {
         let (f, points) = carried(&s.world, k, k + 1);
         let above = (n - k) as f64;
-        println!("joint under brick {k}: {points} points carry {f:.9} N (exact {:.9} N)", above * weight);
+        println!(
+            "joint under brick {k}: {points} points carry {f:.9} N (exact {:.9} N)",
+            above * weight
+        );
         assert_eq!(points, 2, "a face-to-face joint has 2 points");
         assert!((f - above * weight).abs() < 1e-6 * above * weight, "{f} vs {}", above * weight);
     }
@@ -102,7 +113,9 @@ fn arch(t_over_r: f64, steps: usize) -> f64 {
         s.world.step().unwrap();
     }
     let w = &s.world;
-    (0..24).map(|b| ((w.bodies.pos[b][0] - x0[b][0]).powi(2) + (w.bodies.pos[b][1] - x0[b][1]).powi(2)).sqrt()).fold(0.0, f64::max)
+    (0..24)
+        .map(|b| ((w.bodies.pos[b][0] - x0[b][0]).powi(2) + (w.bodies.pos[b][1] - x0[b][1]).powi(2)).sqrt())
+        .fold(0.0, f64::max)
 }
 
 /// Heyman's minimum thickness of a semicircular arch with radial joints is
