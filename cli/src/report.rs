@@ -44,6 +44,8 @@ pub fn input_error_in(out: &Path, e: impl std::fmt::Display) -> ExitCode {
 pub fn finish(res: Result<RunSummary, RunError>, norm: &str, dd: impl Fn(&RunSummary) -> String, out: &Path) -> ExitCode {
     match res {
         Ok(sum) => {
+            // a refused earlier run in the same folder left its message: not this run's
+            let _ = std::fs::remove_file(out.join("error.txt"));
             for line in sum.warnings(norm) {
                 eprintln!("{line}");
             }

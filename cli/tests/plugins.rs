@@ -3,13 +3,13 @@
 //! another interface version, corrupt, missing or not plugins refused with exit 2;
 //! a plugin's panic reported as `plugin NAME: …` with the outputs kept.
 //!
-//! The libraries are the workspace members `templates/plugin`, `tests/plugin_bad_abi`
-//! and `tests/plugin_panics`, built by the same cargo command as this test (the
+//! The libraries are the workspace members `templates/plugin`, `plugins/polygons`,
+//! `tests/plugin_bad_abi` and `tests/plugin_panics`, built by the same cargo command as this test (the
 //! README's test command builds the whole workspace): a plugin must be built with
 //! the same framework build as the program that loads it. To run these tests alone,
-//! build the four packages in one command first (`cargo test --release -p nscdd-cli
-//! -p nscdd-plugin-template -p nscdd-plugin-panics -p nscdd-plugin-bad-abi [--features
-//! …] --no-run`, then the same with `--test plugins`): `--test plugins` alone builds
+//! build the five packages in one command first (`cargo test --release -p nscdd-cli
+//! -p nscdd-plugin-template -p nscdd-polygons -p nscdd-plugin-panics -p
+//! nscdd-plugin-bad-abi [--features …] --no-run`, then the same with `--test plugins`): `--test plugins` alone builds
 //! no library of the plugin crates.
 mod common;
 use common::*;
@@ -96,6 +96,53 @@ fn the_template_plugin_is_listed_and_runs_a_scene() {
     assert_eq!(o.status.code(), Some(2), "without the plugin `bead` is unknown");
     let o = nscdd(&[os("check"), scene.as_os_str(), os("--plugin"), lib.as_os_str()]);
     assert!(o.status.success(), "{}", text(&o.stderr));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The polygons plugin (`plugins/polygons`), the worked example: listed, and its
+/// three example scenes run by `nscdd run` with their `[[plugins]]` line pointing at
+/// the library built with this test; the polygons drawn as polygons in VTK.
+#[test]
+fn the_polygons_plugin_runs_its_example_scenes() {
+    let lib = library("nscdd_polygons");
+    let o = nscdd(&[os("plugins"), os("--plugin"), lib.as_os_str()]);
+    let out = text(&o.stdout);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    for what in [
+        "polygons (loaded from",
+        "shape 2D polygon",
+        "detector 2D polygon–polygon",
+        "detector 2D polygon–disk",
+        "detector 2D polygon–wall",
+        "detector 2D polygon–halfplane",
+        "generator 2D polygon_deposit",
+        "generator 2D brick_wall_2d",
+        "generator 2D arch_2d",
+    ] {
+        assert!(out.contains(what), "{what}: {out}");
+    }
+    let dir = scratch("polygon-scenes");
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../plugins/polygons/scenes");
+    for (name, polys) in [("arch", 26), ("brick_wall", 53), ("deposit", 703)] {
+        let given = std::fs::read_to_string(scenes.join(format!("{name}.toml"))).unwrap();
+        let text_ = given
+            .replace("../../../target/release/libnscdd_polygons.so", &lib.display().to_string())
+            .replace("duration = 1.5", "duration = 0.02");
+        assert!(text_ != given, "{name}.toml names the library as the test expects");
+        let scene = dir.join(format!("{name}.toml"));
+        std::fs::write(&scene, text_).unwrap();
+        let out = dir.join(name);
+        let o = nscdd(&[os("run"), scene.as_os_str(), os("--out"), out.as_os_str(), os("--quiet")]);
+        assert!(o.status.success(), "{name}: {}", text(&o.stderr));
+        let last = std::fs::read_dir(out.join("vtk"))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.file_name().unwrap().to_string_lossy().starts_with("walls_"))
+            .max()
+            .unwrap();
+        let vtp = std::fs::read_to_string(&last).unwrap();
+        assert!(vtp.contains(&format!("NumberOfPolys=\"{polys}\"")), "{name}: {}", &vtp[..200]);
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -214,7 +214,10 @@ fn c_str(p: *const c_char) -> String {
 pub fn load(path: &Path, reg: &mut Registry) -> Result<Loaded, String> {
     let shown = path.display();
     let full = std::fs::canonicalize(path).map_err(|e| format!("plugin library {shown}: {e}"))?;
-    let known = LOADED.lock().ok().and_then(|all| all.iter().find(|p| p.0.library == full).map(|p| (p.0.clone(), p.2)));
+    let known = LOADED
+        .lock()
+        .ok()
+        .and_then(|all| all.iter().find(|p| p.0.library == full).map(|p| (p.0.clone(), p.2)));
     if let Some((l, checked)) = known {
         // loaded before (another registry, or named twice): register into this
         // registry unless it holds the plugin already
