@@ -13,18 +13,29 @@
 //! choice does not flicker between steps when two edges face each other:
 //!
 //! - an edge axis: that edge is the reference edge and the most anti-parallel edge
-//!   of the other shape the incident edge; the incident edge is clipped to the
-//!   slab of the reference edge, and each clipped end within `alert` of the
-//!   reference line is a contact point, halfway across its gap. This gives up to
-//!   **two points per pair**: edge–edge overlaps keep both ends of the overlap,
-//!   vertex–edge contacts one (the other end lies beyond alert);
+//!   of the other shape the incident edge. Each end of their overlap (along the
+//!   reference edge) is a contact point, kept within `alert`: an incident vertex
+//!   lying in the reference edge's slab, against the reference edge; or, where the
+//!   incident edge reaches past the reference edge, the reference vertex there,
+//!   against the incident edge. This gives up to **two points per pair**
+//!   (edge–edge overlaps both ends, vertex–edge contacts one: the other end lies
+//!   beyond alert). Every point is a *vertex against an edge*, both material: the
+//!   rate of its gap is the relative normal velocity the solver constrains. (The
+//!   clipping of game engines puts a point where the incident edge crosses the
+//!   reference edge's end: that point slides along the incident edge as the bodies
+//!   move, so its gap changes at first order with the sliding velocity while the
+//!   solver sees none, and a velocity-level scheme without position correction
+//!   lets that drift accumulate. What remains is of second order, h² ω u_t:
+//!   measured 6 µm a step between frictionless pentagons of 10 mm spinning at
+//!   20 rad/s with h = 1 ms.)
 //! - a vertex axis (round antagonists): one point.
 //!
 //! **Feature ids** (the warm start matches contacts by bodies and feature from step
-//! to step) name the reference edge, the incident edge and the clipped end:
+//! to step) name the reference edge, the incident edge and the overlap end:
 //! `kind << 28 | reference << 18 | incident << 8 | end` (kind 1: B's edge,
-//! 2: A's edge, 3: B's core vertex), stable while the same edges touch. A point of
-//! a two-point contact stands for half the overlap length (`area`, what bonded
+//! 2: A's edge, 3: B's core vertex; end: bit 0 the end, bit 1 set when it is the
+//! reference vertex), stable while the same features touch. A point of a
+//! two-point contact stands for half the overlap length (`area`, what bonded
 //! joints use).
 //!
 //! **Half-planes** ([`PolyHalfPlane`]): the incident edge of the polygon (the most
