@@ -249,5 +249,15 @@ fn a_panic_in_a_plugin_is_reported_and_the_outputs_are_kept() {
         "{err}"
     );
     assert!(std::fs::read_to_string(out2.join("history.csv")).unwrap().lines().count() > 10);
+    // a plugin's body family that panics while the scene loads
+    let floor_only = &BEAD[..BEAD.find("[[bodies]]\nshape = \"bead\"").unwrap()];
+    std::fs::write(&scene, format!("{floor_only}[[fragile_family]]\nsize = 1\n")).unwrap();
+    let o = nscdd(&[os("check"), scene.as_os_str(), os("--plugin"), lib.as_os_str()]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("plugin nscdd_plugin_panics") && err.contains("the fragile family broke loading 1 entries"),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -10,8 +10,8 @@
 //! plugins are not wrapped (the registry's guard is unset for them).
 //!
 //! Wrapped: pair detectors, generators, shape stores (every method, defaults
-//! included, so that the store's own overrides still answer), contact laws and
-//! writers. (Body families of run-time plugins are not wrapped yet.)
+//! included, so that the store's own overrides still answer), contact laws,
+//! writers, and body families ([`super::guard_family`]).
 
 use super::{Generator, ParamError, SceneBuilder};
 use crate::dim::Dim;

@@ -26,6 +26,7 @@ use crate::family::FamilyKind;
 use crate::law::LawDef;
 pub mod builder;
 pub mod guard;
+mod guard_family;
 pub use crate::limits;
 
 pub use crate::output::Writer;
@@ -215,6 +216,10 @@ impl Registry {
     /// A body family ([`crate::family`]) whose entries are the scene section `section`
     /// (`[[section]]`) of a scene of dimension D.
     pub fn add_family<D: Dim>(&mut self, section: &'static str, kind: Box<dyn FamilyKind<D>>) {
+        let kind: Box<dyn FamilyKind<D>> = match self.guard.clone() {
+            None => kind,
+            Some(guard) => Box::new(guard_family::GuardedFamilyKind { inner: kind, guard }),
+        };
         self.tables_mut::<D>().families.insert(section, kind);
     }
     /// The body family of a scene section.

@@ -50,7 +50,11 @@ fn main() {
     let rounds: usize = args.get(2).and_then(|a| a.parse().ok()).unwrap_or(2);
     let lib = args.get(3).map(PathBuf::from).unwrap_or_else(library);
     let scene = include_str!("../scenes/deposit.toml");
-    let text: String = scene.lines().filter(|l| !l.starts_with("[[plugins]]") && !l.starts_with("library")).collect::<Vec<_>>().join("\n");
+    let text: String = scene
+        .lines()
+        .filter(|l| !l.starts_with("[[plugins]]") && !l.starts_with("library"))
+        .collect::<Vec<_>>()
+        .join("\n");
 
     let mut linked = nscdd_rigid_disks::registry();
     linked.add_plugin(&nscdd_polygons::PolygonsPlugin);
@@ -65,7 +69,11 @@ fn main() {
     for r in 0..rounds {
         for (name, reg) in [("linked", &linked), ("loaded", &loaded)] {
             let (d, n, sweeps, bits) = run(&text, reg, steps);
-            println!("round {r} {name}: detection {:.1} µs/step, NLGS {:.1} µs/step ({sweeps} sweeps)", d * 1e6, n * 1e6);
+            println!(
+                "round {r} {name}: detection {:.1} µs/step, NLGS {:.1} µs/step ({sweeps} sweeps)",
+                d * 1e6,
+                n * 1e6
+            );
             let best = if name == "linked" { &mut best_s } else { &mut best_d };
             *best = (best.0.min(d), best.1.min(n));
             match &reference {

@@ -1,6 +1,7 @@
 //! A plugin with a `fragile` 2D shape (a disk of `radius`) whose detector against
 //! half-planes panics once its bead comes within `panic_below` of the floor, and a
-//! `brittle` law that panics at its first contact: nscdd must report `plugin
+//! `brittle` law that panics at its first contact, and a body family
+//! (`[[fragile_family]]`) that panics while it loads: nscdd must report `plugin
 //! nscdd_plugin_panics: …` and stop, keeping what was written.
 
 use nscdd::dim::D2;
@@ -111,6 +112,18 @@ impl nscdd::law::Law for Brittle {
     }
 }
 
+/// A body family (`[[fragile_family]]`) that breaks while its scene loads.
+struct FragileFamily;
+impl nscdd::family::FamilyKind<D2> for FragileFamily {
+    fn load(
+        &self,
+        entries: &[toml::Table],
+        _cx: &nscdd::family::FamilyContext<'_, D2>,
+    ) -> Result<Box<dyn nscdd::family::SceneFamily<D2>>, nscdd::family::EntryError> {
+        panic!("the fragile family broke loading {} entries", entries.len())
+    }
+}
+
 struct Panics;
 impl Plugin for Panics {
     fn name(&self) -> &'static str {
@@ -130,6 +143,7 @@ impl Plugin for Panics {
                 Ok(Arc::new(Brittle))
             },
         });
+        reg.add_family::<D2>("fragile_family", Box::new(FragileFamily));
     }
 }
 

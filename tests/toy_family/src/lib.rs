@@ -46,6 +46,9 @@ impl Plugin for PointMassesPlugin {
     }
 }
 
+// The entry point of the library loaded at run time (tests/loaded.rs).
+nscdd::export_plugin!(PointMassesPlugin);
+
 struct PointMassesKind;
 
 #[derive(Deserialize)]

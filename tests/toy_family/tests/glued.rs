@@ -7,61 +7,12 @@
 //! (m_d + m_p) g: impulses m_p g h and (m_d + m_p) g h per step.
 
 use nscdd::dim::D2;
-use nscdd::registry::Registry;
 use nscdd::scene::Scene;
-use nscdd_toy_family::{PointMasses, PointMassesPlugin};
-use std::path::{Path, PathBuf};
+use nscdd_toy_family::PointMasses;
+use std::path::Path;
 
-const H: f64 = 1e-3;
-const G: f64 = 9.81;
-const MP: f64 = 0.5;
-
-fn registry() -> Registry {
-    let mut r = nscdd_rigid_disks::registry();
-    r.add_plugin(&PointMassesPlugin);
-    r
-}
-
-/// `n` stacks 0.5 m apart; `extra`: more keys (a decomposition, outputs).
-fn scene(n: usize, steps: u32, extra: &str) -> String {
-    let mut s = format!(
-        r#"
-[time]
-step = {H}
-steps = {steps}
-[solver]
-tolerance = 1e-10
-max_sweeps = 100000
-[[materials]]
-name = "m"
-density = 1000.0
-[[laws]]
-materials = ["m", "m"]
-friction = 0.5
-[[bodies]]
-shape = "wall"
-material = "m"
-position = [1.0, -0.005]
-length = 4.0
-thickness = 0.01
-fixed = true
-"#
-    );
-    for k in 0..n {
-        let x = 0.5 * k as f64;
-        s += &format!(
-            "[[bodies]]\nshape = \"disk\"\nmaterial = \"m\"\nradius = 0.1\nposition = [{x}, 0.1]\n\
-             [[point_masses]]\nmaterial = \"m\"\nmass = {MP}\nposition = [{x}, 0.2]\n"
-        );
-    }
-    s + extra
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("nscdd-toy-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
-}
+mod common;
+use common::*;
 
 /// Runs the scene with the framework's run loop; its final.json.
 fn run(text: &str, out: &Path, restart: Option<&Path>) -> String {
