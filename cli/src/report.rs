@@ -68,6 +68,9 @@ pub fn finish(res: Result<RunSummary, RunError>, norm: &str, dd: impl Fn(&RunSum
             );
             ExitCode::from(130)
         }
+        // bad input found when the run starts (ranks against the decomposition, a
+        // setting the solver cannot use): nothing was run
+        Err(e) if e.exit_code() == 2 => input_error_in(out, e),
         Err(e) => {
             eprintln!("error: {e}; the outputs written so far are kept in {}", out.display());
             ExitCode::from(1)

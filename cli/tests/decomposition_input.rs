@@ -404,3 +404,11 @@ fn decomposed_restart_continues_bitwise() {
     assert!(a == b, "the restarted run ends elsewhere");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// LMGC90's quick scramble re-permutes the one-domain NLGS between check blocks;
+/// NSCDD sweeps its subdomains in one order a step: refused, not ignored.
+#[test]
+fn scrambled_order_with_subdomains() {
+    let scene = edit(BASE, "[time]", "[solver]\nordering = \"scrambled\"\n[time]");
+    check_bad_flags("flag_scrambled", &scene, &["--subdomains", "1x1"], "solver.ordering");
+}

@@ -67,7 +67,13 @@ pub struct Nlgs;
 
 impl<D: Dim> ContactStage<World<D>> for Nlgs {
     fn solve(&mut self, w: &mut World<D>) -> SolveReport {
-        nlgs::solve(&mut w.contacts, &mut w.bodies.vel, &w.bodies.inv_mass, &w.scratch.order, &w.solver)
+        nlgs::solve(
+            &mut w.contacts,
+            &mut w.bodies.vel,
+            &w.bodies.inv_mass,
+            &mut w.scratch.order,
+            &w.solver,
+        )
     }
 }
 

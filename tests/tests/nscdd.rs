@@ -285,9 +285,10 @@ fn loaded_pile_velocities_match_one_domain_and_corners_are_glued() {
 /// impulses are unique and known, r_n below disk k = (30 − k) m g h, r_t = 0. NSCDD
 /// over 1 × 4 subdomains (3 interface bodies) and the one-domain engine both approach
 /// them as tol decreases. The LMGC90 norms bound the change per sweep, not the
-/// error: on this 30-contact chain NLGS stops about 200 tol from the exact impulses
-/// (relative to the largest). Bounds: NSCDD's error below 2 × the one-domain error
-/// and below 500 tol, for tol = 1e-5 and 1e-7.
+/// error: on this 30-contact chain NLGS stops about 470 tol from the exact impulses
+/// (relative to the largest) with LMGC90's non-updating check pass (200 tol with the
+/// former updating one). Bounds: NSCDD's error below 2 × the one-domain error and
+/// below 1000 tol, for tol = 1e-5 and 1e-7.
 #[test]
 fn stack_split_1x4_approaches_the_unique_impulses() {
     let text = pile_text()
@@ -322,7 +323,7 @@ fn stack_split_1x4_approaches_the_unique_impulses() {
         let (gmax, grms) = impulse_gap(&a, &b);
         println!("stack 1×4, tol {tol:e}: {} interface bodies, {} sweeps (one domain {}), max |r − exact| / max r: NSCDD {ed:.3e}, one domain {ea:.3e}; NSCDD vs one domain (max, RMS) {gmax:.3e} {grms:.3e}", rb.interface_bodies, rb.solve.sweeps, ra.solve.sweeps);
         assert_eq!(rb.interface_bodies, 3);
-        assert!(ed < 2.0 * ea && ed < 500.0 * tol, "NSCDD error {ed:e}, one domain {ea:e}");
+        assert!(ed < 2.0 * ea && ed < 1000.0 * tol, "NSCDD error {ed:e}, one domain {ea:e}");
     }
 }
 

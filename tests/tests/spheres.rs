@@ -260,7 +260,8 @@ dimension = 3
 step = 1e-3
 steps = 3
 [solver]
-tolerance = 1e-8
+# (1e-8 before LMGC90's non-updating check pass, which stops earlier)
+tolerance = 1e-9
 norm = "Quad"
 max_sweeps = 100000
 {dec}

@@ -125,8 +125,13 @@ impl<D: Dim> Family for Rigid<D> {
     fn warm_start(c: &Self::Contacts, vel: &mut [Self::V], inv: &[Self::InvMass]) {
         c.apply_all(vel, inv);
     }
+    /// A sweep, then with `sums` LMGC90's non-updating check pass (as the
+    /// one-domain NLGS: one subdomain is the plain engine, bitwise).
     fn sweep(c: &mut Self::Contacts, vel: &mut [Self::V], inv: &[Self::InvMass], order: &[u32], omega: f64, sums: Option<&mut Sums>) {
-        nlgs::sweep(c, vel, inv, order, omega, sums);
+        nlgs::sweep(c, vel, inv, order, omega, None);
+        if let Some(s) = sums {
+            nlgs::check_pass(c, vel, inv, order, omega, s);
+        }
     }
     fn scale_inv(im: Self::InvMass, m: f64) -> Self::InvMass {
         D::scale_inv(&im, m)

@@ -16,6 +16,9 @@ pub enum Ordering {
     Reversed,
     /// A random permutation drawn once per step from `seed` and the step number.
     Shuffled,
+    /// LMGC90's "quick scramble": a new random permutation before every block of
+    /// `check_every` sweeps (one-domain NLGS).
+    Scrambled,
 }
 
 /// NLGS settings (scene section `[solver]`).

@@ -80,7 +80,7 @@ fn area_in(poly: &[[f64; 2]], win: [f64; 4]) -> f64 {
 
 #[test]
 fn a_frictionless_pentagon_deposit_is_dense_and_isostatic() {
-    let (n, h, steps) = (400, 1e-3, 3000);
+    let (n, h, steps) = (400, 1e-3, 4000);
     let mut s = scene(&deposit(n, 0.0, h, steps));
     for _ in 0..steps {
         s.world.step().unwrap();
