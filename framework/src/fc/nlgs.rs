@@ -166,6 +166,28 @@ impl<const D: usize> Blocks<D> {
     }
 }
 
+impl<const D: usize> Blocks<D> {
+    /// LMGC90's check pass: the sums of every contact's local solution with the
+    /// others as they are; `r` is not changed.
+    pub fn check(&self, q: &[[f64; D]], mu: &[f64], r: &[[f64; D]], sums: &mut Sums) {
+        for a in 0..q.len() {
+            let u0 = self.off_sum(a, q[a], r);
+            let ro = r[a];
+            let rn = self.local(a, u0, mu[a], ro);
+            let w = &self.diag[a];
+            let (mut wr_old, mut wr, mut du) = ([0.0; D], [0.0; D], [0.0; D]);
+            for x in 0..D {
+                for y in 0..D {
+                    wr_old[x] += w[x][y] * ro[y];
+                    wr[x] += w[x][y] * rn[y];
+                }
+                du[x] = wr[x] - wr_old[x];
+            }
+            sums.add(&ro, &rn, &du, &wr_old, &wr);
+        }
+    }
+}
+
 fn residual<const D: usize>(u: &[[f64; D]], r: &[[f64; D]], mu: &[f64], qs: f64) -> f64 {
     let f2: f64 = (0..r.len()).map(|a| natural_map_sq(&r[a], &u[a], mu[a])).sum();
     f2.sqrt() / qs
@@ -199,8 +221,10 @@ pub fn solve<const D: usize>(p: &FcProblem, opts: &FcOptions) -> FcSolution {
                 }
             }
             FcNorm::Lmgc(c) if check => {
+                // a sweep, then LMGC90's non-updating check pass (as the engine's NLGS)
                 let mut sums = Sums::default();
-                b.sweep(&q, &p.mu, &mut r, Some(&mut sums));
+                b.sweep(&q, &p.mu, &mut r, None);
+                b.check(&q, &p.mu, &r, &mut sums);
                 Norms::from_sums(&sums, opts.tol).converged(c)
             }
             FcNorm::Lmgc(_) => {
