@@ -142,26 +142,12 @@ impl<const D: usize> Blocks<D> {
         out
     }
 
-    /// One NLGS sweep in storage order; accumulates LMGC90's sums when asked.
+    /// One NLGS sweep in storage order.
     #[inline(never)]
-    pub fn sweep(&self, q: &[[f64; D]], mu: &[f64], r: &mut [[f64; D]], mut sums: Option<&mut Sums>) {
+    pub fn sweep(&self, q: &[[f64; D]], mu: &[f64], r: &mut [[f64; D]]) {
         for a in 0..q.len() {
             let u0 = self.off_sum(a, q[a], r);
-            let ro = r[a];
-            let rn = self.local(a, u0, mu[a], ro);
-            if let Some(s) = sums.as_deref_mut() {
-                let w = &self.diag[a];
-                let (mut wr_old, mut wr, mut du) = ([0.0; D], [0.0; D], [0.0; D]);
-                for x in 0..D {
-                    for y in 0..D {
-                        wr_old[x] += w[x][y] * ro[y];
-                        wr[x] += w[x][y] * rn[y];
-                    }
-                    du[x] = wr[x] - wr_old[x];
-                }
-                s.add(&ro, &rn, &du, &wr_old, &wr);
-            }
-            r[a] = rn;
+            r[a] = self.local(a, u0, mu[a], r[a]);
         }
     }
 }
@@ -214,7 +200,7 @@ pub fn solve<const D: usize>(p: &FcProblem, opts: &FcOptions) -> FcSolution {
     } else {
         crate::solver::check_loop(opts.max_sweeps, opts.check_every, |check| match opts.norm {
             FcNorm::Natural => {
-                b.sweep(&q, &p.mu, &mut r, None);
+                b.sweep(&q, &p.mu, &mut r);
                 check && {
                     b.velocity(&q, &r, &mut u);
                     residual(&u, &r, &p.mu, qs) < opts.tol
@@ -223,12 +209,12 @@ pub fn solve<const D: usize>(p: &FcProblem, opts: &FcOptions) -> FcSolution {
             FcNorm::Lmgc(c) if check => {
                 // a sweep, then LMGC90's non-updating check pass (as the engine's NLGS)
                 let mut sums = Sums::default();
-                b.sweep(&q, &p.mu, &mut r, None);
+                b.sweep(&q, &p.mu, &mut r);
                 b.check(&q, &p.mu, &r, &mut sums);
                 Norms::from_sums(&sums, opts.tol).converged(c)
             }
             FcNorm::Lmgc(_) => {
-                b.sweep(&q, &p.mu, &mut r, None);
+                b.sweep(&q, &p.mu, &mut r);
                 false
             }
         })
