@@ -184,32 +184,36 @@ enum Axis {
     VertexB(usize, P),
 }
 
+/// The smallest projection of the points `v` on `u`.
+fn min_along(v: &[P], u: P) -> f64 {
+    v.iter().map(|x| dot(*x, u)).fold(f64::INFINITY, f64::min)
+}
+
+/// The edge of `side` whose outward normal separates it most from `other` (swept
+/// by r): (separation, edge; −∞ without edges), or `None` when one separates them
+/// by more than `alert`.
+fn best_edge(side: &Side, other: &Side, r: f64, alert: f64) -> Option<(f64, usize)> {
+    let mut best = (f64::NEG_INFINITY, 0);
+    for e in 0..side.n.len() {
+        let n = side.n[e];
+        let s = min_along(&other.v, n) - dot(side.v[e], n) - r;
+        if s > alert {
+            return None;
+        }
+        if s > best.0 {
+            best = (s, e);
+        }
+    }
+    Some(best)
+}
+
 /// The largest separation of A and B (radius r) over an axis family, or `None`
 /// when some axis separates them by more than `alert`.
 fn best_axes(a: &Side, b: &Side, r: f64, alert: f64) -> Option<[(f64, Axis); 3]> {
     let ninf = f64::NEG_INFINITY;
-    let mut ea = (ninf, Axis::EdgeA(0));
-    for e in 0..a.v.len() {
-        let n = a.n[e];
-        let s = b.v.iter().map(|w| dot(*w, n)).fold(f64::INFINITY, f64::min) - dot(a.v[e], n) - r;
-        if s > alert {
-            return None;
-        }
-        if s > ea.0 {
-            ea = (s, Axis::EdgeA(e));
-        }
-    }
-    let mut eb = (ninf, Axis::EdgeB(0));
-    for k in 0..b.n.len() {
-        let m = b.n[k];
-        let s = a.v.iter().map(|v| dot(*v, m)).fold(f64::INFINITY, f64::min) - dot(b.v[k], m) - r;
-        if s > alert {
-            return None;
-        }
-        if s > eb.0 {
-            eb = (s, Axis::EdgeB(k));
-        }
-    }
+    let (sa, e) = best_edge(a, b, r, alert)?;
+    let (sb, k) = best_edge(b, a, r, alert)?;
+    let (ea, eb) = ((sa, Axis::EdgeA(e)), (sb, Axis::EdgeB(k)));
     let mut vb = (ninf, Axis::VertexB(0, [0.0; 2]));
     if r > 0.0 {
         for (k, p) in b.v.iter().enumerate() {
@@ -218,9 +222,7 @@ fn best_axes(a: &Side, b: &Side, r: f64, alert: f64) -> Option<[(f64, Axis); 3]>
                 continue; // the core vertex is inside A: the edge axes decide
             }
             let u = [-out[0], -out[1]];
-            let lo_a = a.v.iter().map(|v| dot(*v, u)).fold(f64::INFINITY, f64::min);
-            let hi_b = b.v.iter().map(|w| dot(*w, u)).fold(f64::NEG_INFINITY, f64::max);
-            let s = lo_a - hi_b - r;
+            let s = min_along(&a.v, u) + min_along(&b.v, [-u[0], -u[1]]) - r;
             if s > alert {
                 return None;
             }
@@ -327,8 +329,7 @@ fn points(i: u32, j: u32, a: &Side, b: &Side, r: f64, alert: f64, axis: Axis, ou
             }
         }
         Axis::VertexB(k, u) => {
-            let lo_a = a.v.iter().map(|v| dot(*v, u)).fold(f64::INFINITY, f64::min);
-            let gap = lo_a - dot(b.v[k], u) - r;
+            let gap = min_along(&a.v, u) - dot(b.v[k], u) - r;
             let (p, h) = (b.v[k], r + 0.5 * gap);
             out.push(RawContact2 {
                 i,
