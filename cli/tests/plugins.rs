@@ -17,16 +17,11 @@ use std::path::{Path, PathBuf};
 
 /// The library of workspace member `name` (crate name with underscores).
 fn library(name: &str) -> PathBuf {
-    let dir = Path::new(BIN).parent().unwrap();
-    let file = format!("{}{name}{}", std::env::consts::DLL_PREFIX, std::env::consts::DLL_SUFFIX);
-    [dir.join("deps").join(&file), dir.join(&file)]
-        .into_iter()
-        .find(|p| p.exists())
-        .unwrap_or_else(|| {
-            panic!(
-                "{file} is not built: run the tests of the whole workspace (cargo test --workspace --release …), which builds it with nscdd's features"
-            )
-        })
+    nscdd::plugin::built_library(name).unwrap_or_else(|| {
+        panic!(
+            "lib{name} is not built: run the tests of the whole workspace (cargo test --workspace --release …), which builds it with nscdd's features"
+        )
+    })
 }
 
 const BEAD: &str = r#"[time]
@@ -59,6 +54,15 @@ fn os(s: &str) -> &std::ffi::OsStr {
     std::ffi::OsStr::new(s)
 }
 
+/// `nscdd run SCENE --out OUT --quiet [--plugin LIB]`.
+fn run(scene: &Path, out: &Path, plugin: Option<&Path>) -> std::process::Output {
+    let mut args = vec![os("run"), scene.as_os_str(), os("--out"), out.as_os_str(), os("--quiet")];
+    if let Some(lib) = plugin {
+        args.extend([os("--plugin"), lib.as_os_str()]);
+    }
+    nscdd(&args)
+}
+
 #[test]
 fn the_template_plugin_is_listed_and_runs_a_scene() {
     let lib = library("nscdd_plugin_template");
@@ -78,13 +82,7 @@ fn the_template_plugin_is_listed_and_runs_a_scene() {
     std::fs::copy(&lib, dir.join("libbead.so")).unwrap();
     let scene = dir.join("bead.toml");
     std::fs::write(&scene, format!("[[plugins]]\nlibrary = \"libbead.so\"\n{BEAD}")).unwrap();
-    let o = nscdd(&[
-        os("run"),
-        scene.as_os_str(),
-        os("--out"),
-        dir.join("out").as_os_str(),
-        os("--quiet"),
-    ]);
+    let o = run(&scene, &dir.join("out"), None);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let fin: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("out/final.json")).unwrap()).unwrap();
     // the bead rests on the floor and the disk on the bead (y = r and 3r)
@@ -132,7 +130,7 @@ fn the_polygons_plugin_runs_its_example_scenes() {
         let scene = dir.join(format!("{name}.toml"));
         std::fs::write(&scene, text_).unwrap();
         let out = dir.join(name);
-        let o = nscdd(&[os("run"), scene.as_os_str(), os("--out"), out.as_os_str(), os("--quiet")]);
+        let o = run(&scene, &out, None);
         assert!(o.status.success(), "{name}: {}", text(&o.stderr));
         let last = std::fs::read_dir(out.join("vtk"))
             .unwrap()
@@ -207,15 +205,7 @@ fn a_panic_in_a_plugin_is_reported_and_the_outputs_are_kept() {
     );
     std::fs::write(&scene, text_).unwrap();
     let out = dir.join("out");
-    let o = nscdd(&[
-        os("run"),
-        scene.as_os_str(),
-        os("--out"),
-        out.as_os_str(),
-        os("--quiet"),
-        os("--plugin"),
-        lib.as_os_str(),
-    ]);
+    let o = run(&scene, &out, Some(&lib));
     let err = text(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(
@@ -233,15 +223,7 @@ fn a_panic_in_a_plugin_is_reported_and_the_outputs_are_kept() {
         .replace("friction = 0.3", "law = \"brittle\"");
     std::fs::write(&scene, brittle).unwrap();
     let out2 = dir.join("out2");
-    let o = nscdd(&[
-        os("run"),
-        scene.as_os_str(),
-        os("--out"),
-        out2.as_os_str(),
-        os("--quiet"),
-        os("--plugin"),
-        lib.as_os_str(),
-    ]);
+    let o = run(&scene, &out2, Some(&lib));
     let err = text(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(

@@ -308,3 +308,19 @@ pub fn load_for_scene(text: &str, file: &str, reg: &mut Registry) -> Result<Vec<
     crate::scene::load_plugins(text, file, |p| load(p, reg).map(|l| out.push(l)))?;
     Ok(out)
 }
+
+/// The shared library cargo built for crate `crate_name` (its `[lib]` name, with
+/// underscores) beside the running program — for a plugin's own tests, examples and
+/// benchmarks: in the program's folder, its parent, or their `deps/` (a test runs
+/// from target/PROFILE/deps, an example from target/PROFILE/examples). `None` when
+/// it is not built.
+pub fn built_library(crate_name: &str) -> Option<PathBuf> {
+    let exe = std::env::current_exe().ok()?;
+    let dir = exe.parent()?;
+    let name = format!("{}{crate_name}{}", std::env::consts::DLL_PREFIX, std::env::consts::DLL_SUFFIX);
+    let mut places = vec![dir.join("deps"), dir.to_path_buf()];
+    if let Some(up) = dir.parent() {
+        places.extend([up.join("deps"), up.to_path_buf()]);
+    }
+    places.into_iter().map(|d| d.join(&name)).find(|p| p.exists())
+}

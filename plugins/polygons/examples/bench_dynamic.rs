@@ -16,16 +16,6 @@ use nscdd::registry::Registry;
 use nscdd::scene::Scene;
 use std::path::PathBuf;
 
-fn library() -> PathBuf {
-    let exe = std::env::current_exe().expect("the example's path");
-    let dir = exe.parent().and_then(|d| d.parent()).expect("target/PROFILE");
-    let name = format!("{}nscdd_polygons{}", std::env::consts::DLL_PREFIX, std::env::consts::DLL_SUFFIX);
-    [dir.join("deps").join(&name), dir.join(&name)]
-        .into_iter()
-        .find(|p| p.exists())
-        .unwrap_or_else(|| dir.join(name))
-}
-
 /// Runs the scene: (mean detection time, mean NLGS time per step over the second
 /// half, sweeps there, the bodies' final positions as bits).
 fn run(text: &str, reg: &Registry, steps: usize) -> (f64, f64, u64, Vec<[u64; 2]>) {
@@ -48,7 +38,14 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let steps: usize = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(2000);
     let rounds: usize = args.get(2).and_then(|a| a.parse().ok()).unwrap_or(2);
-    let lib = args.get(3).map(PathBuf::from).unwrap_or_else(library);
+    let Some(lib) = args
+        .get(3)
+        .map(PathBuf::from)
+        .or_else(|| nscdd::plugin::built_library("nscdd_polygons"))
+    else {
+        eprintln!("libnscdd_polygons is not built: cargo build --release -p nscdd-polygons --examples");
+        std::process::exit(2);
+    };
     let scene = include_str!("../scenes/deposit.toml");
     let text: String = scene
         .lines()

@@ -1,28 +1,10 @@
 //! The template as nscdd uses it: the shared library loaded at run time by the
 //! framework's loader, a scene that names it, and a bead resting on a floor.
 
-use std::path::PathBuf;
-
-/// The library cargo built beside this test (target/PROFILE/deps/, or target/PROFILE/
-/// after `cargo build`).
-fn library() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let deps = exe.parent().unwrap();
-    let name = format!(
-        "{}nscdd_plugin_template{}",
-        std::env::consts::DLL_PREFIX,
-        std::env::consts::DLL_SUFFIX
-    );
-    [deps.join(&name), deps.parent().unwrap().join(&name)]
-        .into_iter()
-        .find(|p| p.exists())
-        .unwrap_or_else(|| deps.join(&name))
-}
-
 #[test]
 fn the_library_loads_and_a_bead_rests_on_a_floor() {
-    let lib = library();
-    assert!(lib.exists(), "{} not built", lib.display());
+    // the library cargo built beside this test
+    let lib = nscdd::plugin::built_library("nscdd_plugin_template").expect("libnscdd_plugin_template not built");
     let scene = format!(
         r#"[time]
 step = 1e-3

@@ -8,17 +8,6 @@ use common::*;
 use nscdd::dim::D2;
 use nscdd::registry::Registry;
 use nscdd::scene::Scene;
-use std::path::PathBuf;
-
-fn library() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let deps = exe.parent().unwrap();
-    let name = format!("{}nscdd_toy_family{}", std::env::consts::DLL_PREFIX, std::env::consts::DLL_SUFFIX);
-    [deps.join(&name), deps.parent().unwrap().join(&name)]
-        .into_iter()
-        .find(|p| p.exists())
-        .unwrap_or_else(|| deps.join(&name))
-}
 
 fn final_json(reg: &Registry, name: &str) -> String {
     let text = scene(
@@ -38,7 +27,8 @@ fn final_json(reg: &Registry, name: &str) -> String {
 #[test]
 fn the_family_loaded_at_run_time_gives_the_linked_result_bitwise() {
     let mut loaded = nscdd_rigid_disks::registry();
-    let l = nscdd::plugin::load(&library(), &mut loaded).unwrap_or_else(|e| panic!("{e}"));
+    let l = nscdd::plugin::load(&nscdd::plugin::built_library("nscdd_toy_family").expect("built"), &mut loaded)
+        .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(l.plugins, vec!["toy_point_masses".to_string()]);
     assert!(loaded
         .plugin_contents()

@@ -8,15 +8,9 @@ use nscdd::registry::Registry;
 use nscdd::scene::Scene;
 use std::path::PathBuf;
 
-/// The library cargo built beside this test (target/PROFILE/deps/, or target/PROFILE/).
+/// The library cargo built beside this test.
 pub fn library() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let deps = exe.parent().unwrap();
-    let name = format!("{}nscdd_polygons{}", std::env::consts::DLL_PREFIX, std::env::consts::DLL_SUFFIX);
-    [deps.join(&name), deps.parent().unwrap().join(&name)]
-        .into_iter()
-        .find(|p| p.exists())
-        .unwrap_or_else(|| deps.join(&name))
+    nscdd::plugin::built_library("nscdd_polygons").expect("libnscdd_polygons not built")
 }
 
 /// The disks plugin's registry with the polygons library loaded at run time.
