@@ -12,10 +12,10 @@
 //! pass that updates — a sweep that also sums, [`sweep`] with sums — measures the
 //! Gauss–Seidel increments instead: on LMGC90's 2000-disk biaxial test its norms
 //! read 1.4–1.5× the non-updating ones and NLGS needed 214 sweeps a step instead
-//! of 102 over the first 3000 steps, docs/PERFORMANCE.md.) The loop holds only slices of plain data: no allocation
-//! and no dynamic dispatch per contact; one monomorphized loop per (check pass,
-//! relaxation, joints) case, so that the plain sweep carries no code it does not
-//! run (fewer live values, no spills).
+//! of 102 over the first 3000 steps, docs/PERFORMANCE.md.) The loop holds only
+//! slices of plain data: no allocation and no dynamic dispatch per contact; one
+//! monomorphized loop per (check pass, update, relaxation, joints) case, so that
+//! the plain sweep carries no code it does not run (fewer live values, no spills).
 //!
 //! ```
 //! use nscdd::dim::{Dim, D2};

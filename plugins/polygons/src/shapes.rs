@@ -38,8 +38,9 @@ pub fn convex_hull(points: &[[f64; 2]]) -> Vec<[f64; 2]> {
     let mut h: Vec<[f64; 2]> = Vec::with_capacity(2 * p.len());
     for pass in 0..2 {
         let start = h.len();
-        let pts: Box<dyn Iterator<Item = &[f64; 2]>> = if pass == 0 { Box::new(p.iter()) } else { Box::new(p.iter().rev()) };
-        for &q in pts {
+        // the lower chain left to right, then the upper chain right to left
+        for k in 0..p.len() {
+            let q = if pass == 0 { p[k] } else { p[p.len() - 1 - k] };
             while h.len() >= start + 2 && cross(sub(h[h.len() - 1], h[h.len() - 2]), sub(q, h[h.len() - 2])) <= 0.0 {
                 h.pop();
             }
