@@ -68,6 +68,9 @@ enum Cmd {
         tol: f64,
         #[arg(long, default_value_t = 10000)]
         max_sweeps: u32,
+        /// `nlgs`, `anderson` (Anderson-accelerated NLGS) or `newton` (semismooth Newton, Alart–Curnier)
+        #[arg(long, default_value = "nlgs")]
+        method: String,
         /// `natural` (‖F(r)‖/‖q‖ < tol), `Quad`, `Maxm` or `QM/16`.
         #[arg(long, default_value = "natural")]
         norm: String,
@@ -290,36 +293,40 @@ fn command() -> ExitCode {
             problem,
             tol,
             max_sweeps,
+            method,
             norm,
             check_every,
             export_json,
-        } => solve_fc(&problem, tol, max_sweeps, &norm, check_every, export_json.as_deref()),
+        } => solve_fc(&problem, tol, max_sweeps, &method, &norm, check_every, export_json.as_deref()),
         Cmd::ExportFc { scene, steps, out } => export_fc(&scene, steps, &out, &reg),
         Cmd::Bench {
             which,
             disks,
             repeat,
             subdomains,
-        } => {
-            let done = match which.as_str() {
-                "nlgs" => bench::nlgs::<D2>(&reg, "nlgs", &bench::lattice(disks.unwrap_or(10000)), repeat.unwrap_or(200)),
-                "nlgs3" => bench::nlgs::<D3>(&reg, "nlgs3", &bench::lattice3(disks.unwrap_or(10648)), repeat.unwrap_or(200)),
-                "deposit" => bench::deposit(&reg, disks.unwrap_or(10000), repeat.unwrap_or(200)),
-                _ => {
-                    let list: Result<Vec<_>, _> = subdomains.split(',').map(parse_subdomains).collect();
-                    match list {
-                        Ok(list) => bench::nscdd(&reg, disks.unwrap_or(2000), repeat.unwrap_or(20), &list),
-                        Err(e) => return input_error(e),
-                    }
-                }
-            };
-            if let Err(e) = done {
-                eprintln!("error: {e}");
-                return ExitCode::from(e.exit_code());
-            }
-            ExitCode::SUCCESS
-        }
+        } => bench_command(&reg, &which, disks, repeat, &subdomains),
     }
+}
+
+/// `nscdd bench WHICH`: the benchmark named, its figures on stdout.
+fn bench_command(reg: &nscdd::registry::Registry, which: &str, disks: Option<usize>, repeat: Option<usize>, subdomains: &str) -> ExitCode {
+    let done = match which {
+        "nlgs" => bench::nlgs::<D2>(reg, "nlgs", &bench::lattice(disks.unwrap_or(10000)), repeat.unwrap_or(200)),
+        "nlgs3" => bench::nlgs::<D3>(reg, "nlgs3", &bench::lattice3(disks.unwrap_or(10648)), repeat.unwrap_or(200)),
+        "deposit" => bench::deposit(reg, disks.unwrap_or(10000), repeat.unwrap_or(200)),
+        _ => {
+            let list: Result<Vec<_>, _> = subdomains.split(',').map(parse_subdomains).collect();
+            match list {
+                Ok(list) => bench::nscdd(reg, disks.unwrap_or(2000), repeat.unwrap_or(20), &list),
+                Err(e) => return input_error(e),
+            }
+        }
+    };
+    if let Err(e) = done {
+        eprintln!("error: {e}");
+        return ExitCode::from(e.exit_code());
+    }
+    ExitCode::SUCCESS
 }
 
 /// SIGINT/SIGTERM stop a run at the end of its current step with a checkpoint
@@ -413,10 +420,14 @@ fn solve_fc(
     problem: &std::path::Path,
     tol: f64,
     max_sweeps: u32,
+    method: &str,
     norm: &str,
     check_every: u32,
     export_json: Option<&std::path::Path>,
 ) -> ExitCode {
+    let Some(method) = nscdd::solver::Method::parse(method) else {
+        return input_error(format!("--method: unknown method `{method}`; expected nlgs, anderson or newton"));
+    };
     let norm = match norm {
         "natural" => FcNorm::Natural,
         other => match Criterion::parse(other) {
@@ -442,10 +453,14 @@ fn solve_fc(
         max_sweeps,
         check_every,
         norm,
+        method,
     });
     println!("{}", serde_json::to_string(&sol).expect("plain data"));
     if !sol.converged {
-        eprintln!("warning: not converged after {} sweeps (residual {:e})", sol.sweeps, sol.residual);
+        eprintln!(
+            "warning: not converged after {} iterations (residual {:e})",
+            sol.sweeps, sol.residual
+        );
     }
     ExitCode::SUCCESS
 }

@@ -62,11 +62,16 @@ pub trait ContactStage<W> {
     fn solve(&mut self, w: &mut W) -> SolveReport;
 }
 
-/// The one-domain NLGS stage.
+/// The one-domain stage: NLGS, or the method of `[solver] method` over the
+/// assembled Delassus operator ([`crate::fc::solve_world`]).
 pub struct Nlgs;
 
 impl<D: Dim> ContactStage<World<D>> for Nlgs {
     fn solve(&mut self, w: &mut World<D>) -> SolveReport {
+        if w.solver.method != crate::solver::Method::Nlgs {
+            // Anderson or Newton over the assembled W
+            return crate::fc::solve_world(w);
+        }
         nlgs::solve(
             &mut w.contacts,
             &mut w.bodies.vel,

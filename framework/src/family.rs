@@ -163,15 +163,7 @@ pub fn local_problem<D: Dim>(w: &World<D>, families: &[Box<dyn SceneFamily<D>>])
             .ok_or_else(|| format!("the `{}` family cannot give its contacts' local problem", f.section()))?;
         shares.push(share);
     }
-    let any = w as &dyn Any;
-    match (
-        any.downcast_ref::<crate::world::World2>(),
-        any.downcast_ref::<crate::world::World3>(),
-    ) {
-        (Some(w2), _) => Ok(crate::fc::problem_with(w2, &shares)),
-        (_, Some(w3)) => Ok(crate::fc::problem_with3(w3, &shares)),
-        _ => unreachable!("Dim is sealed: D2 or D3"),
-    }
+    Ok(crate::fc::problem_of(w, &shares))
 }
 
 /// The families' states, by section, for `final.json` and checkpoints.

@@ -246,6 +246,17 @@ fn scene_solver<D: Dim>(scene: &mut Scene<D>, cluster: Option<Box<dyn crate::dd:
              NSCDD's subdomains (a decomposition, or body families) sweep in one order a step: use `shuffled`",
         )));
     }
+    let method = scene.world.solver.method;
+    if dd.is_some() && method != crate::solver::Method::Nlgs {
+        return Err(RunError::Param(crate::error::ParamError::new(
+            "solver.method",
+            format!(
+                "`{}` solves the one-domain problem over the assembled W; NSCDD's subdomains (a decomposition, \
+                 or body families) are swept by NLGS: use method = \"nlgs\"",
+                method.name()
+            ),
+        )));
+    }
     // a restarted run of the same decomposition continues its F_Γ
     if let (Some(n), Some(state)) = (dd.as_mut(), scene.dd_state.take()) {
         n.load_state(&state)

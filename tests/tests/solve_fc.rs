@@ -42,10 +42,8 @@ impl Drop for TempFile {
 
 fn natural(tol: f64) -> FcOptions {
     FcOptions {
-        tol,
         max_sweeps: 200_000,
-        check_every: 1,
-        norm: FcNorm::Natural,
+        ..FcOptions::natural(tol)
     }
 }
 
@@ -332,6 +330,7 @@ fn generated(label: &str, toml: &str, steps: usize, at_rest: bool) -> (usize, u3
             max_sweeps: 200_000,
             check_every: 10,
             norm: FcNorm::Lmgc(Criterion::QuadMax16),
+            method: nscdd::solver::Method::Nlgs,
         },
     )
     .unwrap();
@@ -444,6 +443,7 @@ fn two_stacked_blocks() {
             max_sweeps: 1000,
             check_every: 3,
             norm: FcNorm::Lmgc(Criterion::Quad),
+            method: nscdd::solver::Method::Nlgs,
         },
     )
     .unwrap();
@@ -457,6 +457,7 @@ fn two_stacked_blocks() {
             max_sweeps: 3,
             check_every: 1,
             norm: FcNorm::Natural,
+            method: nscdd::solver::Method::Nlgs,
         },
     )
     .unwrap();
@@ -533,6 +534,7 @@ fn fclib_files_reach_the_requested_residual() {
             max_sweeps: 100_000,
             check_every: 10,
             norm: FcNorm::Natural,
+            method: nscdd::solver::Method::Nlgs,
         };
         let s = p.solve(&opts);
         println!(

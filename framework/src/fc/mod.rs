@@ -36,18 +36,22 @@
 //! and `q_α = (u_free,n − ū, u_free,t)`, ū being the law's target normal velocity.
 
 use crate::error::InputError;
+pub mod anderson;
+pub mod newton;
 pub mod nlgs;
+mod solve;
 mod world;
 
 #[cfg(feature = "hdf5")]
 pub mod fclib;
 
-use crate::norms::{natural_map_sq, Criterion};
+use crate::norms::{natural_map_sq, Criterion, Norms};
+use crate::solver::Method;
 use serde::Serialize;
 use serde_json::{Map, Value};
 use std::io::Read;
 use std::path::Path;
-pub use world::{problem_from_world, problem_from_world3, problem_with, problem_with3, FamilyShare};
+pub use world::{problem_from_world, problem_from_world3, problem_of, problem_with, problem_with3, solve_world, FamilyShare};
 
 /// Stopping test of `solve-fc`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -62,9 +66,26 @@ pub enum FcNorm {
 #[derive(Clone, Debug, PartialEq)]
 pub struct FcOptions {
     pub tol: f64,
+    /// At most this many iterations: NLGS or Anderson sweeps, Newton steps.
     pub max_sweeps: u32,
+    /// The stopping test every k iterations (Newton: every step).
     pub check_every: u32,
     pub norm: FcNorm,
+    pub method: Method,
+}
+
+impl FcOptions {
+    /// NLGS to the natural-map residual `tol`, checked every sweep, at most 10⁵
+    /// sweeps.
+    pub fn natural(tol: f64) -> Self {
+        FcOptions {
+            tol,
+            max_sweeps: 100_000,
+            check_every: 1,
+            norm: FcNorm::Natural,
+            method: Method::Nlgs,
+        }
+    }
 }
 
 /// Result of `solve-fc`.
@@ -72,10 +93,13 @@ pub struct FcOptions {
 pub struct FcSolution {
     pub r: Vec<f64>,
     pub u: Vec<f64>,
+    /// Iterations: sweeps (NLGS, Anderson) or Newton steps.
     pub sweeps: u32,
     pub converged: bool,
     /// ‖F(r)‖/‖q‖ at the end.
     pub residual: f64,
+    /// LMGC90's norms of the final r (a non-updating check pass, tolerance `tol`).
+    pub norms: Norms,
     pub solve_seconds: f64,
 }
 
@@ -360,18 +384,28 @@ impl FcProblem {
         f2.sqrt() / q_scale(&self.q)
     }
 
-    /// Solves the problem by NLGS from r = 0.
+    /// Solves the problem by `opts.method` from r = 0.
     ///
     /// # Panics
     /// If the problem is invalid ([`FcProblem::validate`]); [`FcProblem::read`] and
     /// [`FcProblem::parse`] only return valid ones.
     pub fn solve(&self, opts: &FcOptions) -> FcSolution {
+        self.solve_from(None, opts)
+    }
+
+    /// Solves the problem by `opts.method` from `r0` (warm start, dim·nc values)
+    /// or r = 0.
+    ///
+    /// # Panics
+    /// If the problem is invalid or `r0` has the wrong length.
+    pub fn solve_from(&self, r0: Option<&[f64]>, opts: &FcOptions) -> FcSolution {
         if let Err((k, m)) = self.validate() {
             panic!("FcProblem::solve on an invalid problem: `{k}`: {m}");
         }
+        assert!(r0.is_none_or(|r| r.len() == self.q.len()), "r0 must have dim·nc values");
         match self.dim {
-            2 => nlgs::solve::<2>(self, opts),
-            _ => nlgs::solve::<3>(self, opts),
+            2 => solve::solve::<2>(self, r0, opts),
+            _ => solve::solve::<3>(self, r0, opts),
         }
     }
 }
@@ -415,10 +449,9 @@ mod tests {
 
     fn opts(norm: FcNorm, tol: f64) -> FcOptions {
         FcOptions {
-            tol,
             max_sweeps: 10_000,
-            check_every: 1,
             norm,
+            ..FcOptions::natural(tol)
         }
     }
 

@@ -7,11 +7,10 @@
 //! [`crate::dim::coulomb2`], or [`crate::dim::coulomb3`] whose block data are
 //! precomputed once).
 
-use super::{q_scale, FcNorm, FcOptions, FcProblem, FcSolution};
+use super::FcProblem;
 use crate::dim::coulomb2 as c2;
 use crate::dim::coulomb3 as c3;
-use crate::norms::{natural_map_sq, Norms, Sums};
-use std::time::Instant;
+use crate::norms::Sums;
 
 /// W in block form.
 pub struct Blocks<const D: usize> {
@@ -94,7 +93,7 @@ impl<const D: usize> Blocks<D> {
 
     /// `q_α + Σ_{β≠α} W_αβ r_β`.
     #[inline(always)]
-    fn off_sum(&self, a: usize, q: [f64; D], r: &[[f64; D]]) -> [f64; D] {
+    pub(crate) fn off_sum(&self, a: usize, q: [f64; D], r: &[[f64; D]]) -> [f64; D] {
         let mut u = q;
         for k in self.ptr[a]..self.ptr[a + 1] {
             let (m, rb) = (&self.blk[k], &r[self.col[k] as usize]);
@@ -171,66 +170,5 @@ impl<const D: usize> Blocks<D> {
             }
             sums.add(&ro, &rn, &du, &wr_old, &wr);
         }
-    }
-}
-
-fn residual<const D: usize>(u: &[[f64; D]], r: &[[f64; D]], mu: &[f64], qs: f64) -> f64 {
-    let f2: f64 = (0..r.len()).map(|a| natural_map_sq(&r[a], &u[a], mu[a])).sum();
-    f2.sqrt() / qs
-}
-
-/// NLGS from r = 0 on a validated problem of dimension D.
-pub fn solve<const D: usize>(p: &FcProblem, opts: &FcOptions) -> FcSolution {
-    let t0 = Instant::now();
-    let nc = p.nc;
-    let b = Blocks::<D>::assemble(p);
-    let q: Vec<[f64; D]> =
-        p.q.chunks_exact(D)
-            .map(|c| {
-                let mut v = [0.0; D];
-                v.copy_from_slice(c);
-                v
-            })
-            .collect();
-    let qs = q_scale(&p.q);
-    let mut r = vec![[0.0; D]; nc];
-    let mut u = vec![[0.0; D]; nc];
-    let (sweeps, mut converged) = if nc == 0 {
-        (0, true)
-    } else {
-        crate::solver::check_loop(opts.max_sweeps, opts.check_every, |check| match opts.norm {
-            FcNorm::Natural => {
-                b.sweep(&q, &p.mu, &mut r);
-                check && {
-                    b.velocity(&q, &r, &mut u);
-                    residual(&u, &r, &p.mu, qs) < opts.tol
-                }
-            }
-            FcNorm::Lmgc(c) if check => {
-                // a sweep, then LMGC90's non-updating check pass (as the engine's NLGS)
-                let mut sums = Sums::default();
-                b.sweep(&q, &p.mu, &mut r);
-                b.check(&q, &p.mu, &r, &mut sums);
-                Norms::from_sums(&sums, opts.tol).converged(c)
-            }
-            FcNorm::Lmgc(_) => {
-                b.sweep(&q, &p.mu, &mut r);
-                false
-            }
-        })
-    };
-    b.velocity(&q, &r, &mut u);
-    let residual = residual(&u, &r, &p.mu, qs);
-    if opts.max_sweeps == 0 && opts.norm == FcNorm::Natural {
-        converged |= residual < opts.tol;
-    }
-    let solve_seconds = t0.elapsed().as_secs_f64();
-    FcSolution {
-        r: r.concat(),
-        u: u.concat(),
-        sweeps,
-        converged,
-        residual,
-        solve_seconds,
     }
 }

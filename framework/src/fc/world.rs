@@ -266,3 +266,51 @@ pub fn problem_with3(w: &crate::world::World3, shares: &[FamilyShare]) -> FcProb
         meta: Some(meta),
     }
 }
+
+/// The local problem of the current step of a world of either dimension, the
+/// families' shares after the world's contacts.
+pub fn problem_of<D: crate::dim::Dim>(w: &crate::world::World<D>, shares: &[FamilyShare]) -> FcProblem {
+    let any = w as &dyn std::any::Any;
+    match (
+        any.downcast_ref::<crate::world::World2>(),
+        any.downcast_ref::<crate::world::World3>(),
+    ) {
+        (Some(w2), _) => problem_with(w2, shares),
+        (_, Some(w3)) => problem_with3(w3, shares),
+        _ => unreachable!("Dim is sealed: D2 or D3"),
+    }
+}
+
+/// The contact stage of `[solver] method = "anderson"` or `"newton"`: W of the
+/// step's contacts assembled from their frames and the bodies' M̂⁻¹
+/// ([`problem_of`]), solved from the warm start (the contacts' r, already applied
+/// to the bodies) with the scene's norm, tolerance, iteration limit and check
+/// period; then V += M̂⁻¹ H (r − r_warm) contact by contact.
+pub fn solve_world<D: crate::dim::Dim>(w: &mut crate::world::World<D>) -> crate::solver::SolveReport {
+    use crate::dim::Vector;
+    let p = problem_of(w, &[]);
+    let s = &w.solver;
+    let opts = super::FcOptions {
+        tol: s.tolerance,
+        max_sweeps: s.max_sweeps,
+        check_every: s.check_every,
+        norm: super::FcNorm::Lmgc(s.norm),
+        method: s.method,
+    };
+    let c = &mut w.contacts;
+    let r0: Vec<f64> = c.r.iter().flat_map(|r| r.as_ref().iter().copied()).collect();
+    let sol = p.solve_from(Some(&r0), &opts);
+    let d = <D::Local as Vector>::LEN;
+    for a in 0..c.len() {
+        let r = <D::Local as Vector>::from_fn(|k| sol.r[d * a + k]);
+        let dr = r.sub(&c.r[a]);
+        c.apply(a, &dr, &mut w.bodies.vel, &w.bodies.inv_mass);
+        c.r[a] = r;
+    }
+    crate::solver::SolveReport {
+        sweeps: sol.sweeps,
+        converged: sol.converged,
+        norms: sol.norms,
+        residual: sol.residual,
+    }
+}

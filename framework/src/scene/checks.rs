@@ -285,6 +285,19 @@ pub(crate) fn validate_solver(cx: &Ctx, s: &crate::solver::SolverSettings) -> Re
     if !(s.relaxation > 0.0 && s.relaxation <= 1.0) {
         return Err(cx.err(&p("relaxation"), format!("ω must lie in (0, 1], got {}", s.relaxation)));
     }
+    // Anderson and Newton sweep the assembled W in storage order, unrelaxed
+    let m = s.method.name();
+    if s.method != crate::solver::Method::Nlgs {
+        if s.ordering != crate::solver::Ordering::Stored {
+            let msg =
+                format!("`{m}` visits the contacts in storage order; `ordering` is an NLGS setting (remove it or use method = \"nlgs\")");
+            return Err(cx.err(&p("ordering"), msg));
+        }
+        if s.relaxation != 1.0 {
+            let msg = format!("`{m}` takes unrelaxed sweeps; `relaxation` is an NLGS setting (remove it or use method = \"nlgs\")");
+            return Err(cx.err(&p("relaxation"), msg));
+        }
+    }
     Ok(())
 }
 

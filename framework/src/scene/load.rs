@@ -35,6 +35,13 @@ pub(crate) fn load_parsed<D: SceneDim>(cx: &Ctx, sf: SceneFile<BodySpec<D>>, reg
     check_masses(cx, &b)?;
     let nm = b.materials.len();
     let (laws, declared) = super::laws(cx, &sf, registry, nm, &b.materials, D::N as u8)?;
+    if sf.solver.method != crate::solver::Method::Nlgs && laws.iter().flatten().any(|l| l.bonds()) {
+        let msg = format!(
+            "`{}` solves the unilateral contact problem only; the scene's bonded joints (mortar) need method = \"nlgs\"",
+            sf.solver.method.name()
+        );
+        return Err(cx.err(&[k("solver"), k("method")], msg));
+    }
     // every pair of materials that can touch needs a law; every pair of kinds a detector
     let n = b.bodies.len();
     let info: Vec<BodyInfo> = (0..n)

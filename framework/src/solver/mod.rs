@@ -21,7 +21,39 @@ pub enum Ordering {
     Scrambled,
 }
 
-/// NLGS settings (scene section `[solver]`).
+/// The contact solver of a step (`[solver] method`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// Non-linear Gauss–Seidel over the bodies ([`nlgs`]): LMGC90's solver.
+    #[default]
+    Nlgs,
+    /// NLGS sweeps accelerated by Anderson mixing over the assembled Delassus
+    /// operator W ([`crate::fc::anderson`]).
+    Anderson,
+    /// Semismooth Newton on the Alart–Curnier function over the assembled W,
+    /// regularized by a proximal term, with a line search and NLGS sweeps where a
+    /// step fails ([`crate::fc::newton`]): fast local convergence, for tight
+    /// tolerances.
+    Newton,
+}
+
+impl Method {
+    /// The method named `s` (as in `[solver] method`).
+    pub fn parse(s: &str) -> Option<Self> {
+        [Method::Nlgs, Method::Anderson, Method::Newton].into_iter().find(|m| m.name() == s)
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Nlgs => "nlgs",
+            Method::Anderson => "anderson",
+            Method::Newton => "newton",
+        }
+    }
+}
+
+/// Contact solver settings (scene section `[solver]`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SolverSettings {
@@ -36,6 +68,8 @@ pub struct SolverSettings {
     pub relaxation: f64,
     pub ordering: Ordering,
     pub seed: u64,
+    /// `nlgs` (default), `anderson` or `newton`.
+    pub method: Method,
 }
 
 impl Default for SolverSettings {
@@ -48,6 +82,7 @@ impl Default for SolverSettings {
             relaxation: 1.0,
             ordering: Ordering::Stored,
             seed: 0,
+            method: Method::Nlgs,
         }
     }
 }

@@ -381,12 +381,7 @@ fn stack_exports_a_frictional_contact_problem_that_solve_fc_solves() {
     // the engine's impulses solve the exported problem (to the engine's tolerance)
     let r_world: Vec<f64> = w.contacts.r.iter().flatten().copied().collect();
     let res_world = p.natural_residual(&r_world);
-    let sol = p.solve(&nscdd::fc::FcOptions {
-        tol: 1e-6,
-        max_sweeps: 100_000,
-        check_every: 1,
-        norm: nscdd::fc::FcNorm::Natural,
-    });
+    let sol = p.solve(&nscdd::fc::FcOptions::natural(1e-6));
     println!(
         "world r: residual {res_world:.1e}; solve-fc: {} sweeps, residual {:.1e}",
         sol.sweeps, sol.residual

@@ -22,6 +22,7 @@ use nscdd::dim::{D2, D3};
 use nscdd::fc::{CooMatrix, FcNorm, FcOptions, FcProblem};
 use nscdd::registry::Registry;
 use nscdd::scene::Scene;
+use nscdd::solver::Method;
 
 /// Memory a fuzzed scene may use: generators asked for more are refused.
 const MAX_MEMORY: f64 = 2e9;
@@ -72,12 +73,15 @@ pub fn fc_json(data: &[u8]) {
 }
 
 pub(crate) fn solve_problem(p: &FcProblem) {
-    let _ = p.solve(&FcOptions {
-        tol: 1e-8,
-        max_sweeps: 50,
-        check_every: 1,
-        norm: FcNorm::Natural,
-    });
+    for method in [Method::Nlgs, Method::Anderson, Method::Newton] {
+        let _ = p.solve(&FcOptions {
+            tol: 1e-8,
+            max_sweeps: 50,
+            check_every: 1,
+            norm: FcNorm::Natural,
+            method,
+        });
+    }
 }
 
 /// `solve-fc` on arbitrary W, q, μ: the bytes give the dimension, the number of

@@ -43,10 +43,8 @@ fn overflowing_problem_does_not_panic() {
     };
     assert!(p.validate().is_ok());
     let s = p.solve(&nscdd::fc::FcOptions {
-        tol: 1e-8,
         max_sweeps: 50,
-        check_every: 1,
-        norm: nscdd::fc::FcNorm::Natural,
+        ..nscdd::fc::FcOptions::natural(1e-8)
     });
     // no panic, and an answer of the problem's size (not converged: it cannot be)
     assert_eq!(s.r.len(), 2);

@@ -27,6 +27,11 @@ const T: f64 = 0.02;
 /// `wall`, a 4 m long wall of thickness T centred at the origin and rotated by α
 /// (its top face is then the plane at T/2 along n): both detectors are exercised.
 fn incline(alpha: f64, mu: f64, block: bool, wall: bool) -> Scene {
+    scene(&incline_text(alpha, mu, block, wall))
+}
+
+/// The scene text of [`incline`].
+fn incline_text(alpha: f64, mu: f64, block: bool, wall: bool) -> String {
     let (sa, ca) = alpha.sin_cos();
     let off = if wall { R + 0.5 * T } else { R };
     let pos = [-sa * off, ca * off];
@@ -36,7 +41,7 @@ fn incline(alpha: f64, mu: f64, block: bool, wall: bool) -> Scene {
     } else {
         "shape = \"halfplane\"".to_string()
     };
-    scene(&format!(
+    format!(
         r#"
 [time]
 step = {H:?}
@@ -65,7 +70,7 @@ position = [{:?}, {:?}]
 {drive}
 "#,
         pos[0], pos[1]
-    ))
+    )
 }
 
 fn downhill(alpha: f64) -> [f64; 2] {
@@ -167,4 +172,43 @@ fn disk_slips_below_mu_eq_tan_alpha_over_3() {
     assert!(slip > 0.0, "the contact point slides downhill, slip velocity {slip}");
     let r = s.world.contacts.r[0];
     assert_rel("friction impulse r_t = −μ r_n (N s)", r[1], -mu * r[0], EXACT);
+}
+
+/// Anderson and Newton (`[solver] method`) give the incline's answers too: the
+/// block sticking below tan α = μ and sliding above it, the free disk rolling above
+/// μ = tan α / 3 and slipping below it (one contact: every method solves its
+/// problem exactly, hence the same tolerance).
+#[test]
+fn every_method_gives_the_incline_answers() {
+    let m = disk_mass(RHO, R);
+    for method in ["anderson", "newton"] {
+        let with = |alpha: f64, mu: f64, block: bool| {
+            let text = incline_text(alpha, mu, block, true);
+            scene(&text.replace("tolerance = 1e-8", &format!("tolerance = 1e-8\nmethod = \"{method}\"")))
+        };
+        let mu: f64 = 0.5;
+        let alpha = (0.95 * mu).atan();
+        let mut s = with(alpha, mu, true);
+        steps(&mut s, 200);
+        assert_abs(&format!("{method}: block speed at rest"), v_slope(&s, alpha).0, 0.0, 1e-12);
+        assert_rel(
+            &format!("{method}: friction r_t"),
+            s.world.contacts.r[0][1],
+            -m * G * H * alpha.sin(),
+            EXACT,
+        );
+        let alpha = (1.05 * mu).atan();
+        let mut s = with(alpha, mu, true);
+        let (a, _) = acceleration(&mut s, alpha, 50, 150);
+        assert_rel(&format!("{method}: sliding block"), a, G * (alpha.sin() - mu * alpha.cos()), EXACT);
+        let alpha: f64 = 0.4;
+        let mut s = with(alpha, 1.05 * alpha.tan() / 3.0, false);
+        let (a, w) = acceleration(&mut s, alpha, 50, 150);
+        assert_rel(&format!("{method}: rolling disk"), a, 2.0 / 3.0 * G * alpha.sin(), EXACT);
+        assert_rel(&format!("{method}: rolling disk ω̇ R"), w * R, a, EXACT);
+        let mu = 0.95 * alpha.tan() / 3.0;
+        let mut s = with(alpha, mu, false);
+        let (a, _) = acceleration(&mut s, alpha, 50, 150);
+        assert_rel(&format!("{method}: slipping disk"), a, G * (alpha.sin() - mu * alpha.cos()), EXACT);
+    }
 }
