@@ -23,9 +23,11 @@
 //! damping), within [`EPS_MIN`, `EPS_MAX`]: near the solution full steps are taken
 //! and ε vanishes, so the convergence becomes superlinear. The sparse LU of faer factors it (symbolic
 //! analysis once, the block pattern of W). Globalization: an Armijo line search on
-//! ½‖Φ‖² (halving t down to 2⁻²⁰); a step that fails it, or a factorization that
-//! fails, is replaced by [`FALLBACK`] NLGS sweeps. One iteration = one Newton step
-//! (or one fallback block); the stopping test is checked every iteration.
+//! ½‖Φ‖² (halving t down to 2⁻²⁰); a step that fails it or a factorization that
+//! fails, or Newton creeping (the merit not halved in [`STRIKES`] steps), sends the
+//! iterate back to its best one for a block of NLGS sweeps (`solve`). One
+//! iteration = one Newton step (with its fallback block, if any); the stopping
+//! test is checked every iteration.
 //!
 //! ```
 //! use nscdd::fc::{CooMatrix, FcOptions, FcProblem};
@@ -44,8 +46,13 @@ use faer::prelude::*;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat};
 
-/// NLGS sweeps that replace a Newton step the line search rejects.
+/// NLGS sweeps of the first fallback block (see [`solve`]), and the most of one.
 pub const FALLBACK: usize = 5;
+pub const FALLBACK_MAX: usize = 320;
+/// Newton steps in a row that do not halve the merit before a fallback.
+pub const STRIKES: u32 = 3;
+/// The regularization ε of the first step, and after a fallback.
+pub const EPS_START: f64 = 1e-2;
 /// Bounds of the regularization ε.
 pub const EPS_MIN: f64 = 1e-14;
 pub const EPS_MAX: f64 = 1.0;
@@ -173,57 +180,93 @@ fn direction<const D: usize>(pat: &Pattern, vals: &[f64], rhs: &[f64]) -> Option
     d.iter().all(|v| v.is_finite()).then_some(d)
 }
 
+/// The scratch of the line search.
+struct Work<const D: usize> {
+    u: Vec<[f64; D]>,
+    ut: Vec<[f64; D]>,
+    wd: Vec<[f64; D]>,
+    trial: Vec<[f64; D]>,
+    vals: Vec<f64>,
+    rhs: Vec<f64>,
+}
+
+/// One regularized Newton step from `r` with an Armijo line search on ½‖Φ‖²:
+/// the step length taken, or None (r unchanged) when the factorization or the
+/// line search fails.
+fn step<const D: usize>(l: &Local<D>, pat: &Pattern, r: &mut [[f64; D]], rho: &[f64], eps: f64, w: &mut Work<D>) -> Option<(f64, f64)> {
+    let nc = l.len();
+    l.b.velocity(&l.q, r, &mut w.u);
+    let theta = merit(l, r, &w.u, rho);
+    assemble(l, r, &w.u, rho, eps, &mut w.vals, &mut w.rhs);
+    let d = super::solve::blocks::<D>(&direction::<D>(pat, &w.vals, &w.rhs)?);
+    // W Δ: u along the step is u + t W Δ
+    l.b.velocity(&vec![[0.0; D]; nc], &d, &mut w.wd);
+    let mut t = 1.0;
+    for _ in 0..=20 {
+        for a in 0..nc {
+            for x in 0..D {
+                w.trial[a][x] = r[a][x] + t * d[a][x];
+                w.ut[a][x] = w.u[a][x] + t * w.wd[a][x];
+            }
+        }
+        let m = merit(l, &w.trial, &w.ut, rho);
+        if m <= (1.0 - 1e-4 * t) * theta {
+            r.copy_from_slice(&w.trial);
+            return Some((t, m));
+        }
+        t *= 0.5;
+    }
+    None
+}
+
 /// Semismooth Newton from `r`; returns (iterations, converged).
+///
+/// Safeguard: the iterate with the least merit ½‖Φ‖² is kept; after a failed
+/// step, or [`STRIKES`] steps in a row that do not halve that merit (a creeping,
+/// heavily damped Newton, as on samples where many contacts change status), the
+/// iterate returns to it and takes a block of NLGS sweeps ([`FALLBACK`], doubled
+/// at each fallback up to [`FALLBACK_MAX`]), then Newton resumes.
 pub(crate) fn solve<const D: usize>(l: &Local<D>, r: &mut Vec<[f64; D]>, opts: &FcOptions) -> (u32, bool) {
     let nc = l.len();
-    let n = D * nc;
     let rho: Vec<f64> = l.b.diag.iter().map(|w| D as f64 / (0..D).map(|k| w[k][k]).sum::<f64>()).collect();
     let pat = Pattern::new(l);
-    let (mut u, mut ut) = (vec![[0.0; D]; nc], vec![[0.0; D]; nc]);
-    let (mut vals, mut rhs) = (Vec::new(), vec![0.0; n]);
-    let mut wd = vec![[0.0; D]; nc];
-    let zero = vec![[0.0; D]; nc];
-    let mut trial = r.clone();
-    let mut eps: f64 = 1e-2;
+    let mut w = Work {
+        u: vec![[0.0; D]; nc],
+        ut: vec![[0.0; D]; nc],
+        wd: vec![[0.0; D]; nc],
+        trial: r.clone(),
+        vals: Vec::new(),
+        rhs: vec![0.0; D * nc],
+    };
+    let mut eps: f64 = EPS_START;
+    l.b.velocity(&l.q, r, &mut w.u);
+    let mut best = (merit(l, r, &w.u, &rho), r.clone());
+    let (mut strikes, mut block) = (0, FALLBACK);
     crate::solver::check_loop(opts.max_sweeps, 1, |_| {
-        l.b.velocity(&l.q, r, &mut u);
-        let theta = merit(l, r, &u, &rho);
-        let step = pat.as_ref().and_then(|p| {
-            assemble(l, r, &u, &rho, eps, &mut vals, &mut rhs);
-            direction::<D>(p, &vals, &rhs)
-        });
-        // the step length the line search accepts
-        let accepted = step.and_then(|d| {
-            // W Δ (u along the step: u + t W Δ)
-            let dd = super::solve::blocks::<D>(&d);
-            l.b.velocity(&zero, &dd, &mut wd);
-            let mut t = 1.0;
-            for _ in 0..=20 {
-                for a in 0..nc {
-                    for x in 0..D {
-                        trial[a][x] = r[a][x] + t * dd[a][x];
-                        ut[a][x] = u[a][x] + t * wd[a][x];
-                    }
-                }
-                if merit(l, &trial, &ut, &rho) <= (1.0 - 1e-4 * t) * theta {
-                    r.copy_from_slice(&trial);
-                    return Some(t);
-                }
-                t *= 0.5;
-            }
-            None
-        });
+        let accepted = pat.as_ref().and_then(|p| step(l, p, r, &rho, eps, &mut w));
         // Levenberg–Marquardt-like: less regularization after a full step, more
         // after a damped or failed one
         eps = match accepted {
-            Some(t) if t == 1.0 => (0.1 * eps).max(EPS_MIN),
+            Some((t, _)) if t == 1.0 => (0.1 * eps).max(EPS_MIN),
             _ => (10.0 * eps).min(EPS_MAX),
         };
-        if accepted.is_none() {
-            for _ in 0..FALLBACK {
+        let theta = accepted.map_or(f64::INFINITY, |(_, m)| m);
+        strikes = if theta < 0.5 * best.0 { 0 } else { strikes + 1 };
+        if theta < best.0 {
+            best.0 = theta;
+            best.1.copy_from_slice(r);
+        }
+        if accepted.is_none() || strikes >= STRIKES {
+            r.copy_from_slice(&best.1);
+            for _ in 0..block {
                 l.b.sweep(&l.q, &l.mu, r);
             }
+            block = (2 * block).min(FALLBACK_MAX);
+            l.b.velocity(&l.q, r, &mut w.u);
+            best.0 = merit(l, r, &w.u, &rho);
+            best.1.copy_from_slice(r);
+            (strikes, eps) = (0, EPS_START);
         }
-        l.stop(r, &mut u, opts)
+        l.stop(r, &mut w.u, opts)
     })
 }

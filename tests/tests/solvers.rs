@@ -1,0 +1,211 @@
+//! The contact solvers of `[solver] method` (NLGS, Anderson-accelerated NLGS, the
+//! semismooth Newton method on Alart–Curnier) on assembled problems:
+//!
+//! - each reaches a natural-map residual of 1e-8 on a generated 2D problem (the
+//!   last step of a 300-disk deposit) and on the FCLIB files (3D), the residual it
+//!   reports being the one recomputed from its r with the problem's own W and q;
+//! - warm start: from a solution each stops at once, and from a loose solution in
+//!   fewer iterations than from r = 0;
+//! - a budget too small is reported as not converged, never silently;
+//! - settings a method cannot use are refused naming the key (`solver.ordering`,
+//!   `solver.relaxation`, `solver.method` with bonds or NSCDD subdomains).
+//!
+//! The physics tests run with each method where it applies
+//! (`physics::incline::every_method_gives_the_incline_answers`,
+//! `physics::stacks::column_contact_forces_are_k_m_g`).
+
+use nscdd::fc::{problem_from_world, FcOptions, FcProblem};
+use nscdd::solver::Method;
+
+const METHODS: [Method; 3] = [Method::Nlgs, Method::Anderson, Method::Newton];
+
+/// A ballistic deposit of 300 polydisperse disks on a floor, frictional.
+fn deposit(extra_solver: &str) -> String {
+    format!(
+        r#"
+[time]
+step = 1e-3
+steps = 100
+[solver]
+tolerance = 1e-4
+max_sweeps = 20000
+{extra_solver}
+[[materials]]
+name = "grain"
+density = 2600.0
+[[laws]]
+materials = ["grain", "grain"]
+friction = 0.4
+[[bodies]]
+name = "floor"
+shape = "wall"
+material = "grain"
+position = [0.15, -0.01]
+length = 0.5
+thickness = 0.02
+fixed = true
+[[generate]]
+kind = "disk_deposit"
+material = "grain"
+count = 300
+radius_min = 0.008
+radius_max = 0.012
+box = [0.0, 0.0, 0.3, 1.0]
+seed = 5
+"#
+    )
+}
+
+fn load(text: &str) -> Result<nscdd::scene::Scene, nscdd::error::InputError> {
+    nscdd::scene::load_str(text, "solvers.toml", &nscdd_rigid_disks::registry())
+}
+
+/// The problem of the deposit's 150th step.
+fn generated_problem() -> FcProblem {
+    let mut s = load(&deposit("")).unwrap();
+    for _ in 0..150 {
+        s.world.step().unwrap();
+    }
+    let p = problem_from_world(&s.world);
+    assert!(p.nc > 300, "only {} contacts", p.nc);
+    p
+}
+
+fn opts(method: Method, tol: f64) -> FcOptions {
+    FcOptions {
+        max_sweeps: 200_000,
+        check_every: 10,
+        method,
+        ..FcOptions::natural(tol)
+    }
+}
+
+/// Solves `p` to 1e-8 with every method and checks the reported residual against
+/// the one recomputed from r. Returns each method's iterations.
+fn reach_1e8(label: &str, p: &FcProblem) -> Vec<u32> {
+    METHODS
+        .iter()
+        .map(|&m| {
+            let s = p.solve(&opts(m, 1e-8));
+            println!("{label} {}: {} iterations, residual {:.2e}", m.name(), s.sweeps, s.residual);
+            assert!(s.converged && s.residual < 1e-8, "{label} {}: {s:?}", m.name());
+            let again = p.natural_residual(&s.r);
+            assert!(again < 1e-8, "{label} {}: recomputed residual {again:.3e}", m.name());
+            assert!(
+                (again - s.residual).abs() <= 1e-6 * again + 1e-15,
+                "{label} {}: {again} vs {}",
+                m.name(),
+                s.residual
+            );
+            s.sweeps
+        })
+        .collect()
+}
+
+#[test]
+fn every_method_reaches_1e8_on_a_generated_problem() {
+    let p = generated_problem();
+    reach_1e8("deposit", &p);
+}
+
+#[test]
+fn warm_start_and_budget() {
+    let p = generated_problem();
+    for m in METHODS {
+        let exact = p.solve(&opts(m, 1e-9));
+        assert!(exact.converged);
+        // from its own solution a method stops at the first check
+        let again = p.solve_from(Some(&exact.r), &opts(m, 1e-8));
+        assert!(
+            again.converged && again.sweeps <= 10,
+            "{}: {} iterations from a solution",
+            m.name(),
+            again.sweeps
+        );
+        // from a loose solution it needs fewer iterations than from r = 0
+        let loose = p.solve(&opts(Method::Nlgs, 1e-3));
+        let cold = p.solve(&opts(m, 1e-8));
+        let warm = p.solve_from(Some(&loose.r), &opts(m, 1e-8));
+        assert!(
+            warm.converged && warm.sweeps < cold.sweeps,
+            "{}: warm {} vs cold {}",
+            m.name(),
+            warm.sweeps,
+            cold.sweeps
+        );
+        // a budget too small is reported, with the residual reached
+        let short = p.solve(&FcOptions {
+            max_sweeps: 2,
+            ..opts(m, 1e-12)
+        });
+        assert!(!short.converged && short.residual > 1e-12, "{}: {short:?}", m.name());
+        let again = p.natural_residual(&short.r);
+        assert!(
+            (short.residual - again).abs() <= 1e-12 * again,
+            "{}: {} vs {again}",
+            m.name(),
+            short.residual
+        );
+    }
+}
+
+/// Every FCLIB file of `tests/data/fclib/` solved to 1e-8 by every method.
+#[cfg(feature = "hdf5")]
+#[test]
+fn every_method_reaches_1e8_on_the_fclib_files() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/fclib");
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "hdf5"))
+        .collect();
+    files.sort();
+    assert_eq!(files.len(), 4);
+    for f in files {
+        let p = nscdd::fc::read_any(&f).unwrap();
+        reach_1e8(&f.file_name().unwrap().to_string_lossy(), &p);
+    }
+}
+
+fn refused(extra_solver: &str, key: &str) {
+    let text = deposit(extra_solver);
+    let e = match load(&text) {
+        Err(e) => e.to_string(),
+        Ok(_) => panic!("`{extra_solver}` loads"),
+    };
+    assert!(e.contains(key), "`{extra_solver}`: {e}");
+}
+
+#[test]
+fn settings_a_method_cannot_use_are_refused() {
+    refused("method = \"cholesky\"", "method");
+    refused("method = \"newton\"\nordering = \"shuffled\"", "solver.ordering");
+    refused("method = \"anderson\"\nrelaxation = 0.8", "solver.relaxation");
+    // NSCDD's subdomains are swept by NLGS
+    let text = deposit("method = \"anderson\"").replace("[[materials]]", "[decomposition]\nnx = 2\nny = 1\n\n[[materials]]");
+    let mut s = load(&text).unwrap();
+    let dir = std::env::temp_dir().join(format!("nscdd_solvers_{}", std::process::id()));
+    let e = nscdd::run::run(&mut s, &nscdd_rigid_disks::registry(), &dir, |_, _| {}).unwrap_err();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(e.to_string().contains("solver.method"), "{e}");
+}
+
+/// A world stepped by each method: the one-domain stage reports LMGC90's norms and
+/// convergence, and the deposit settles the same way (the methods solve the same
+/// problems to the same tolerance, so the piles agree closely but not bitwise).
+#[test]
+fn every_method_steps_the_deposit() {
+    let mut tops = vec![];
+    for m in METHODS {
+        let mut s = load(&deposit(&format!("method = \"{}\"", m.name()))).unwrap();
+        for k in 0..100 {
+            let rep = s.world.step().unwrap();
+            assert!(rep.solve.converged, "{} step {k}: {rep:?}", m.name());
+        }
+        let top = s.world.bodies.pos.iter().map(|p| p[1]).fold(f64::MIN, f64::max);
+        tops.push(top);
+    }
+    for t in &tops[1..] {
+        assert!((t - tops[0]).abs() < 1e-3, "pile tops {tops:?}");
+    }
+}
