@@ -1,6 +1,9 @@
 //! Frictional contact problems in local (Delassus) form, read from the JSON exchange
 //! format (keys `dim`, `nc`, `W` = {`n`, `rows`, `cols`, `vals`}, `q`, `mu`, optional
-//! `meta`; `.gz` files are gzip) and solved by NLGS: the `solve-fc` command.
+//! `meta`; `.gz` files are gzip) and solved by NLGS, Anderson-accelerated NLGS
+//! ([`anderson`]) or a semismooth Newton method ([`newton`]) as
+//! [`FcOptions::method`] says: the `solve-fc` command, and the one-domain stage
+//! of a world whose `[solver] method` is not NLGS ([`solve_world`]).
 //!
 //! A problem with `nc` contacts in dimension `dim` (2 or 3) is: find
 //! `r, u ∈ ℝ^{dim·nc}` with
@@ -26,9 +29,10 @@
 //! Stopping tests: [`FcNorm::Natural`], the natural-map residual
 //! `‖F(r)‖ / ‖q‖ < tol` with `F(r) = r − P_K(r − (u + Φ(u)))`, `Φ(u)_α = (μ_α |u_t,α|, 0)`
 //! (divided by 1 when `q = 0`), evaluated every `check_every` sweeps; or
-//! [`FcNorm::Lmgc`], LMGC90's norms accumulated over a check sweep exactly as
-//! [`crate::solver::nlgs`] does (see [`crate::norms`]). The final residual is always
-//! the natural-map one.
+//! [`FcNorm::Lmgc`], LMGC90's norms over a non-updating check pass exactly as
+//! [`crate::solver::nlgs`] does (see [`crate::norms`]). Every method stops on the
+//! same test; the final residual is always the natural-map one, and the final
+//! norms are reported beside it.
 //!
 //! [`problem_from_world`] writes the local problem of a 2D world's last step: with
 //! `H_bᵀ = ±[[n_x, n_y, d_b×n], [t_x, t_y, d_b×t]]` (+ for the candidate body i, − for
