@@ -305,3 +305,62 @@ fn a_duration_of_no_step_or_of_too_many() {
         marker: "steps = 9",
     });
 }
+
+// ---- [solver] method and solve-fc --method (issue 19) ----
+
+/// A setting the chosen method cannot use is refused naming its key and line; an
+/// unknown method names `solver.method`.
+#[test]
+fn solver_settings_a_method_cannot_use() {
+    for (name, solver, key, marker) in [
+        ("method_unknown", "method = \"cg\"", "solver.method", "method"),
+        (
+            "method_ordering",
+            "method = \"newton\"\nordering = \"shuffled\"",
+            "solver.ordering",
+            "ordering",
+        ),
+        (
+            "method_relaxation",
+            "method = \"anderson\"\nrelaxation = 0.5",
+            "solver.relaxation",
+            "relaxation",
+        ),
+    ] {
+        let scene = edit(BASE, "[[materials]]", &format!("[solver]\n{solver}\n\n[[materials]]"));
+        check_bad(&Case { name, scene, key, marker });
+    }
+}
+
+/// `solve-fc --method`: every method solves a two-contact problem; an unknown
+/// method or `--repeat 0` is an input error (exit 2).
+#[test]
+fn solve_fc_methods() {
+    let dir = scratch("solve_fc_methods");
+    let p = dir.join("two.json");
+    let json = r#"{"dim": 2, "nc": 2, "W": {"n": 4, "rows": [0, 1, 2, 3, 0, 2], "cols": [0, 1, 2, 3, 2, 0],
+        "vals": [2.0, 2.0, 2.0, 2.0, 1.0, 1.0]}, "q": [-1.0, 0.0, -1.0, 0.0], "mu": [0.5, 0.5]}"#;
+    std::fs::write(&p, json).unwrap();
+    for m in ["nlgs", "anderson", "newton"] {
+        let o = nscdd(&[
+            "solve-fc".as_ref(),
+            p.as_os_str(),
+            "--method".as_ref(),
+            m.as_ref(),
+            "--repeat".as_ref(),
+            "3".as_ref(),
+        ]);
+        let out = text(&o.stdout);
+        assert!(
+            o.status.success() && out.contains("\"converged\":true"),
+            "{m}: {out} {}",
+            text(&o.stderr)
+        );
+    }
+    for bad in [["--method", "cg"], ["--repeat", "0"]] {
+        let o = nscdd(&["solve-fc".as_ref(), p.as_os_str(), bad[0].as_ref(), bad[1].as_ref()]);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}: {}", text(&o.stderr));
+        assert!(text(&o.stderr).contains(bad[0]), "{bad:?}: {}", text(&o.stderr));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -41,7 +41,25 @@ impl<const D: usize> Blocks<D> {
                 off.push((a as u32, b as u32, (i % D) as u8, (j % D) as u8, v));
             }
         }
-        off.sort_by_key(|x| (x.0, x.1)); // stable: duplicates summed in file order
+        // by row block (a counting sort), then by column block within a row (a
+        // stable sort of a few entries): duplicates are summed in file order
+        let mut start = vec![0usize; nc + 1];
+        for e in &off {
+            start[e.0 as usize + 1] += 1;
+        }
+        for a in 0..nc {
+            start[a + 1] += start[a];
+        }
+        let mut sorted = vec![(0, 0, 0, 0, 0.0); off.len()];
+        let mut next = start.clone();
+        for &e in &off {
+            sorted[next[e.0 as usize]] = e;
+            next[e.0 as usize] += 1;
+        }
+        for a in 0..nc {
+            sorted[start[a]..start[a + 1]].sort_by_key(|x| x.1);
+        }
+        let off = sorted;
         let mut ptr = vec![0usize; nc + 1];
         let mut col = Vec::new();
         let mut blk: Vec<[[f64; D]; D]> = Vec::new();
