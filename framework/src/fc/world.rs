@@ -37,7 +37,7 @@ fn family_parts<H, B>(
 }
 
 /// The 3 × 3 block contributions (α ≤ β) summed per pair and written as the
-/// symmetric matrix's triplets, sorted.
+/// symmetric matrix's triplets, block pair by block pair (α, β) then (β, α).
 fn triplets3(mut contrib: Vec<(u32, u32, [[f64; 3]; 3])>) -> Vec<(usize, usize, f64)> {
     contrib.sort_by_key(|x| (x.0, x.1));
     let mut trip: Vec<(usize, usize, f64)> = Vec::with_capacity(9 * contrib.len());
@@ -63,7 +63,6 @@ fn triplets3(mut contrib: Vec<(u32, u32, [[f64; 3]; 3])>) -> Vec<(usize, usize, 
             }
         }
     }
-    trip.sort_by_key(|x| (x.0, x.1));
     trip
 }
 
@@ -120,8 +119,8 @@ pub fn problem_with(w: &World2, shares: &[FamilyShare]) -> FcProblem {
         |b| [b[0], b[1], b[2], b[3]],
     );
     inc.extend(finc);
-    inc.sort_by_key(|x| (x.0, x.1));
-    // Contributions to the blocks (α ≤ β) from each shared body (and the families' own).
+    inc.sort_unstable_by_key(|x| (x.0, x.1)); // (body, contact): unique keys
+                                              // Contributions to the blocks (α ≤ β) from each shared body (and the families' own).
     for c in contrib.iter_mut().filter(|c| c.0 == c.1) {
         c.2[2] = c.2[1];
     }
@@ -163,7 +162,6 @@ pub fn problem_with(w: &World2, shares: &[FamilyShare]) -> FcProblem {
             }
         }
     }
-    trip.sort_by_key(|x| (x.0, x.1));
     let mut q = Vec::with_capacity(2 * nc);
     for a in 0..nw {
         q.push(c.u_free[a][0] - c.target[a].u_target);
@@ -223,7 +221,7 @@ pub fn problem_with3(w: &crate::world::World3, shares: &[FamilyShare]) -> FcProb
     let block = |v: &[f64]| -> [[f64; 3]; 3] { std::array::from_fn(|p| std::array::from_fn(|q| v[3 * p + q])) };
     let (finc, mut contrib) = family_parts(shares, &off, rows, block);
     inc.extend(finc);
-    inc.sort_by_key(|x| (x.0, x.1));
+    inc.sort_unstable_by_key(|x| (x.0, x.1)); // (body, contact): unique keys
     let mut g0 = 0;
     while g0 < inc.len() {
         let body = inc[g0].0 as usize;
