@@ -46,7 +46,7 @@ use faer::prelude::*;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat};
 
-/// NLGS sweeps of the first fallback block (see [`solve`]), and the most of one.
+/// NLGS sweeps of the first fallback block (see the module doc), and the most of one.
 pub const FALLBACK: usize = 5;
 pub const FALLBACK_MAX: usize = 320;
 /// Newton steps in a row that do not halve the merit before a fallback.
