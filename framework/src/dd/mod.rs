@@ -197,6 +197,8 @@ pub struct NscddOf<D: Family> {
     grid_empty: bool,
     transport: InProcess,
     bufs: GlueBuffers,
+    /// Threads or one, by their measured speed ([`team::ThreadChoice`]).
+    choice: team::ThreadChoice,
     v_free: Vec<D::V>,
     /// Set for a multi-process run ([`ranks`]): this process sweeps and glues only
     /// its ranks' subdomains.
@@ -225,6 +227,7 @@ impl<D: Family> NscddOf<D> {
             grid_empty: false,
             transport: InProcess::default(),
             bufs: GlueBuffers::default(),
+            choice: team::ThreadChoice::default(),
             v_free: Vec::new(),
             ranks: None,
         }
@@ -418,7 +421,9 @@ impl<D: Family> NscddOf<D> {
             stages
         } else {
             let (iface, transport, bufs) = (&d.iface, &mut self.transport, &mut self.bufs);
-            let stages = team::with_team(&mut d.subs, set.threads, iface, |team| {
+            let threads = self.choice.threads(self.steps, set.threads);
+            let t0 = std::time::Instant::now();
+            let stages = team::with_team(&mut d.subs, threads, iface, |team| {
                 if iface.fresh.iter().any(|&f| f) {
                     team.with_all(|subs| glue_stage(subs, iface, set.scheme, transport, true, bufs));
                 }
@@ -435,6 +440,7 @@ impl<D: Family> NscddOf<D> {
                 })
                 .0
             });
+            self.choice.record(threads, t0.elapsed().as_secs_f64(), stages);
             rep.exchange = self.transport.stats();
             stages
         };

@@ -32,13 +32,15 @@ use super::schemes::{self, glue_stage, ChainBuffers, GlueBuffers, Scheme};
 use super::subdomain::{Subdomain, SubdomainSolver};
 use super::transport::Transport;
 use crate::norms::Sums;
-use std::sync::atomic::{AtomicBool, AtomicU32, AtomicUsize, Ordering::SeqCst};
+use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, AtomicUsize, Ordering::Relaxed, Ordering::SeqCst};
 use std::sync::{Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
-/// How long a thread spins before it parks: longer than the coordinator's serial
+/// The longest a thread spins before it parks: longer than the coordinator's serial
 /// work between two phases and a phase's imbalance, far shorter than a step.
-const SPIN: Duration = Duration::from_micros(200);
+const SPIN_MAX: u64 = 200_000;
+/// The shortest spin (ns): a phase's usual end-of-phase imbalance on a quiet machine.
+const SPIN_MIN: u64 = 5_000;
 
 fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
@@ -47,22 +49,46 @@ fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
 /// Waiting for a condition set by another thread: spin, then park. No
 /// `yield_now`: on a loaded machine it hands the core to another process for a
 /// whole time slice.
-#[derive(Default)]
+///
+/// The spin bound adapts: halved (down to [`SPIN_MIN`]) after a wait that had to
+/// park, doubled (up to [`SPIN_MAX`]) after one that ended while spinning. On a
+/// quiet machine a phase's waits end within microseconds and the bound stays at
+/// its maximum (a park once a step, at the serial work between steps, costs one
+/// halving). When the team has fewer cores than threads (another process busy),
+/// the thread that spins holds the core its partner needs, no wait ends while
+/// spinning, and the bound falls to the minimum within a few phases instead of
+/// costing [`SPIN_MAX`] a phase. The bound only changes timing, never results.
 struct Parker {
     sleepers: AtomicU32,
     m: Mutex<()>,
     cv: Condvar,
+    /// The current spin bound (ns).
+    spin: AtomicU64,
+}
+
+impl Default for Parker {
+    fn default() -> Self {
+        Parker {
+            sleepers: AtomicU32::new(0),
+            m: Mutex::new(()),
+            cv: Condvar::new(),
+            spin: AtomicU64::new(SPIN_MAX),
+        }
+    }
 }
 
 impl Parker {
     /// Returns once `ready()` (which must load with `SeqCst`) holds.
     fn wait(&self, ready: impl Fn() -> bool) {
         let t0 = Instant::now();
+        let bound = Duration::from_nanos(self.spin.load(Relaxed));
         let mut i = 0u32;
         while !ready() {
             std::hint::spin_loop();
             i = i.wrapping_add(1);
-            if i.is_multiple_of(64) && t0.elapsed() > SPIN {
+            if i.is_multiple_of(64) && t0.elapsed() > bound {
+                let halved = (bound.as_nanos() as u64 / 2).max(SPIN_MIN);
+                self.spin.store(halved, Relaxed);
                 let mut g = lock(&self.m);
                 // sleepers before ready(), against wake()'s store then load: one of
                 // the two sees the other (SeqCst)
@@ -73,6 +99,10 @@ impl Parker {
                 self.sleepers.fetch_sub(1, SeqCst);
                 return;
             }
+        }
+        if i > 0 {
+            let doubled = (2 * bound.as_nanos() as u64).min(SPIN_MAX);
+            self.spin.store(doubled, Relaxed);
         }
     }
 
@@ -396,4 +426,72 @@ pub fn with_team<D: Family, R>(
         let _stop = StopOnDrop(&sh);
         drive()
     })
+}
+
+/// Steps between two pairs of probes of [`ThreadChoice`].
+pub const PROBE_EVERY: u64 = 50;
+/// How much slower per stage than one thread the threads must be to be dropped:
+/// a margin for the step-to-step scatter of a probe (with one core for two
+/// threads they are 2–3× slower).
+pub const SLOWER: f64 = 1.25;
+
+/// Whether this step's team runs the requested threads or one: threads that do not
+/// pay (fewer free cores than threads, as when another process keeps a core busy,
+/// and the threads then take turns on one core at every phase) are dropped until
+/// the next probe. Every [`PROBE_EVERY`] steps one step runs on one thread and the
+/// next on the requested threads, each timed per stage; the other steps run the
+/// faster of the two. The team's results do not depend on its thread count, so the
+/// choice changes timing only, never results.
+#[derive(Clone, Debug, Default)]
+pub struct ThreadChoice {
+    /// Seconds per stage measured on one thread and on the requested threads.
+    one: Option<f64>,
+    many: Option<f64>,
+}
+
+impl ThreadChoice {
+    /// The threads of step `step` (counted from 1) when `requested` are asked for.
+    pub fn threads(&self, step: u64, requested: usize) -> usize {
+        if requested <= 1 {
+            return 1;
+        }
+        match (step % PROBE_EVERY, self.one, self.many) {
+            (1, ..) => 1,
+            (2, ..) => requested,
+            (_, Some(one), Some(many)) if many > SLOWER * one => 1,
+            _ => requested,
+        }
+    }
+
+    /// Records a step's solve: `threads` used, its seconds and stages.
+    pub fn record(&mut self, threads: usize, seconds: f64, stages: u32) {
+        let per = seconds / f64::from(stages.max(1));
+        if threads <= 1 {
+            self.one = Some(per);
+        } else {
+            self.many = Some(per);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{ThreadChoice, PROBE_EVERY};
+
+    /// Probes one thread then the threads every PROBE_EVERY steps; in between, the
+    /// threads unless they were more than SLOWER times slower per stage.
+    #[test]
+    fn thread_choice_probes_and_keeps_the_faster() {
+        let mut c = ThreadChoice::default();
+        assert_eq!(c.threads(5, 1), 1);
+        assert_eq!((c.threads(1, 2), c.threads(2, 2), c.threads(3, 2)), (1, 2, 2));
+        c.record(1, 1.0, 100); // 10 ms a stage on one thread
+        c.record(2, 1.2, 100); // 12 ms on two: within the margin
+        assert_eq!(c.threads(3, 2), 2);
+        c.record(2, 3.0, 100); // 30 ms: two threads on one core
+        assert_eq!(c.threads(3, 2), 1);
+        assert_eq!((c.threads(PROBE_EVERY + 1, 2), c.threads(PROBE_EVERY + 2, 2)), (1, 2));
+        c.record(2, 0.6, 100);
+        assert_eq!(c.threads(PROBE_EVERY + 3, 2), 2);
+    }
 }
