@@ -199,6 +199,8 @@ pub struct NscddOf<D: Family> {
     bufs: GlueBuffers,
     /// Threads or one, by their measured speed ([`team::ThreadChoice`]).
     choice: team::ThreadChoice,
+    /// The subdomain threads, kept across steps.
+    workers: team::Workers,
     v_free: Vec<D::V>,
     /// Set for a multi-process run ([`ranks`]): this process sweeps and glues only
     /// its ranks' subdomains.
@@ -228,6 +230,7 @@ impl<D: Family> NscddOf<D> {
             transport: InProcess::default(),
             bufs: GlueBuffers::default(),
             choice: team::ThreadChoice::default(),
+            workers: team::Workers::default(),
             v_free: Vec::new(),
             ranks: None,
         }
@@ -423,7 +426,7 @@ impl<D: Family> NscddOf<D> {
             let (iface, transport, bufs) = (&d.iface, &mut self.transport, &mut self.bufs);
             let threads = self.choice.threads(self.steps, set.threads);
             let t0 = std::time::Instant::now();
-            let stages = team::with_team(&mut d.subs, threads, iface, |team| {
+            let stages = team::with_team(&mut d.subs, threads, iface, &mut self.workers, |team| {
                 if iface.fresh.iter().any(|&f| f) {
                     team.with_all(|subs| glue_stage(subs, iface, set.scheme, transport, true, bufs));
                 }
@@ -440,7 +443,7 @@ impl<D: Family> NscddOf<D> {
                 })
                 .0
             });
-            self.choice.record(threads, t0.elapsed().as_secs_f64(), stages);
+            self.choice.record(self.steps, t0.elapsed().as_secs_f64(), stages);
             rep.exchange = self.transport.stats();
             stages
         };

@@ -1,7 +1,10 @@
-//! Threads sweeping and gluing the subdomains, kept for a whole step.
+//! Threads sweeping and gluing the subdomains.
 //!
 //! The subdomains are split into groups, one per thread, balanced by contact count
-//! (the sweep's cost); the calling thread (the coordinator) runs group 0. The
+//! (the sweep's cost); the calling thread (the coordinator) runs group 0, the
+//! others run on [`Workers`], a rayon thread pool kept across steps (each worker
+//! blocks in its group's loop for the step), and [`ThreadChoice`] drops to one
+//! thread while the threads do not pay (a busy machine). The
 //! coordinator posts a *phase* (a command), every thread runs it on its group, and
 //! the coordinator waits until all are done; a phase costs two one-way signals, each
 //! waited for by spinning ([`Parker`]: `spin_loop` for a bounded time, then a
@@ -361,12 +364,36 @@ fn groups<D: Family>(subs: &[Subdomain<D>], threads: usize) -> Vec<Vec<usize>> {
     g
 }
 
+/// The worker threads of a run's teams, kept across steps: a team of T threads
+/// runs its groups 1..T on T − 1 of them (the calling thread runs group 0).
+#[derive(Default)]
+pub struct Workers {
+    pool: Option<rayon::ThreadPool>,
+}
+
+impl Workers {
+    /// A pool of at least `n` threads (built once, grown when more are asked for);
+    /// None when the system refuses threads (the team then spawns its own).
+    fn pool(&mut self, n: usize) -> Option<&rayon::ThreadPool> {
+        if self.pool.as_ref().is_none_or(|p| p.current_num_threads() < n) {
+            let built = rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .thread_name(|i| format!("nscdd-subdomains-{}", i + 1))
+                .build();
+            self.pool = built.ok();
+        }
+        self.pool.as_ref()
+    }
+}
+
 /// Runs `driver` with a [`Team`] of `threads` threads over `subs`, glued across
-/// `iface`; a gluing left pending is applied before returning.
+/// `iface`; a gluing left pending is applied before returning. The team's other
+/// threads come from `workers`.
 pub fn with_team<D: Family, R>(
     subs: &mut [Subdomain<D>],
     threads: usize,
     iface: &Interface,
+    workers: &mut Workers,
     driver: impl FnOnce(&mut Team<'_, '_, '_, D>) -> R,
 ) -> R {
     let groups = groups(subs, threads);
@@ -418,58 +445,101 @@ pub fn with_team<D: Family, R>(
     if sh.groups.len() == 1 {
         return drive();
     }
-    std::thread::scope(|sc| {
-        for g in 1..sh.groups.len() {
-            let s = &sh;
-            sc.spawn(move || s.work(g));
-        }
-        let _stop = StopOnDrop(&sh);
-        drive()
-    })
+    // each worker blocks in its group's loop until the team stops: the pool must
+    // hold one idle thread per group (it serves nothing else)
+    match workers.pool(sh.groups.len() - 1) {
+        Some(pool) => pool.in_place_scope(|sc| {
+            for g in 1..sh.groups.len() {
+                let s = &sh;
+                sc.spawn(move |_| s.work(g));
+            }
+            let _stop = StopOnDrop(&sh);
+            drive()
+        }),
+        None => std::thread::scope(|sc| {
+            for g in 1..sh.groups.len() {
+                let s = &sh;
+                sc.spawn(move || s.work(g));
+            }
+            let _stop = StopOnDrop(&sh);
+            drive()
+        }),
+    }
 }
 
-/// Steps between two pairs of probes of [`ThreadChoice`].
+/// Steps between two probes of [`ThreadChoice`] while the threads pay; doubled
+/// after each probe they lose, up to [`PROBE_MAX`].
 pub const PROBE_EVERY: u64 = 50;
+pub const PROBE_MAX: u64 = 800;
 /// How much slower per stage than one thread the threads must be to be dropped:
 /// a margin for the step-to-step scatter of a probe (with one core for two
 /// threads they are 2–3× slower).
 pub const SLOWER: f64 = 1.25;
 
-/// Whether this step's team runs the requested threads or one: threads that do not
+/// Whether a step's team runs the requested threads or one: threads that do not
 /// pay (fewer free cores than threads, as when another process keeps a core busy,
 /// and the threads then take turns on one core at every phase) are dropped until
-/// the next probe. Every [`PROBE_EVERY`] steps one step runs on one thread and the
-/// next on the requested threads, each timed per stage; the other steps run the
-/// faster of the two. The team's results do not depend on its thread count, so the
-/// choice changes timing only, never results.
-#[derive(Clone, Debug, Default)]
+/// the next probe. A probe is three steps: one on one thread, then two on the
+/// requested threads (the faster of the two counts: the first threaded step of a
+/// run also starts the workers), each timed per stage. Until the next probe the
+/// steps run one thread if the threads were more than [`SLOWER`] times slower,
+/// else the threads. Probes come every [`PROBE_EVERY`] steps while the threads pay,
+/// and twice as far apart after each probe they lose (up to [`PROBE_MAX`]), so that
+/// a busy machine pays for few threaded probes. The team's results do not depend
+/// on its thread count: the choice changes timing only, never results.
+#[derive(Clone, Debug)]
 pub struct ThreadChoice {
-    /// Seconds per stage measured on one thread and on the requested threads.
-    one: Option<f64>,
-    many: Option<f64>,
+    /// Seconds per stage on one thread and on the requested threads (last probe).
+    one: f64,
+    many: f64,
+    /// The first step of the next probe, and the steps between probes.
+    next: u64,
+    every: u64,
+    serial: bool,
+}
+
+impl Default for ThreadChoice {
+    fn default() -> Self {
+        ThreadChoice {
+            one: 0.0,
+            many: f64::INFINITY,
+            next: 1,
+            every: PROBE_EVERY,
+            serial: false,
+        }
+    }
 }
 
 impl ThreadChoice {
     /// The threads of step `step` (counted from 1) when `requested` are asked for.
     pub fn threads(&self, step: u64, requested: usize) -> usize {
-        if requested <= 1 {
-            return 1;
-        }
-        match (step % PROBE_EVERY, self.one, self.many) {
-            (1, ..) => 1,
-            (2, ..) => requested,
-            (_, Some(one), Some(many)) if many > SLOWER * one => 1,
+        let probe = step.wrapping_sub(self.next);
+        match probe {
+            _ if requested <= 1 => 1,
+            0 => 1,
+            1 | 2 => requested,
+            _ if self.serial => 1,
             _ => requested,
         }
     }
 
-    /// Records a step's solve: `threads` used, its seconds and stages.
-    pub fn record(&mut self, threads: usize, seconds: f64, stages: u32) {
+    /// Records the solve of step `step`: its seconds and stages.
+    pub fn record(&mut self, step: u64, seconds: f64, stages: u32) {
         let per = seconds / f64::from(stages.max(1));
-        if threads <= 1 {
-            self.one = Some(per);
-        } else {
-            self.many = Some(per);
+        match step.wrapping_sub(self.next) {
+            0 => self.one = per,
+            1 => self.many = per,
+            2 => {
+                self.many = self.many.min(per);
+                self.serial = self.many > SLOWER * self.one;
+                self.every = if self.serial {
+                    (2 * self.every).min(PROBE_MAX)
+                } else {
+                    PROBE_EVERY
+                };
+                self.next = step - 2 + self.every;
+            }
+            _ => {}
         }
     }
 }
@@ -484,14 +554,26 @@ mod tests {
     fn thread_choice_probes_and_keeps_the_faster() {
         let mut c = ThreadChoice::default();
         assert_eq!(c.threads(5, 1), 1);
-        assert_eq!((c.threads(1, 2), c.threads(2, 2), c.threads(3, 2)), (1, 2, 2));
-        c.record(1, 1.0, 100); // 10 ms a stage on one thread
-        c.record(2, 1.2, 100); // 12 ms on two: within the margin
-        assert_eq!(c.threads(3, 2), 2);
-        c.record(2, 3.0, 100); // 30 ms: two threads on one core
-        assert_eq!(c.threads(3, 2), 1);
-        assert_eq!((c.threads(PROBE_EVERY + 1, 2), c.threads(PROBE_EVERY + 2, 2)), (1, 2));
-        c.record(2, 0.6, 100);
-        assert_eq!(c.threads(PROBE_EVERY + 3, 2), 2);
+        let mut probe = |c: &mut ThreadChoice, at: u64, one: f64, many: [f64; 2]| {
+            assert_eq!([0, 1, 2].map(|k| c.threads(at + k, 2)), [1, 2, 2]);
+            c.record(at, one, 100);
+            c.record(at + 1, many[0], 100);
+            c.record(at + 2, many[1], 100);
+        };
+        // 10 ms a stage on one thread; 30 ms (starting the workers), then 12 ms on two
+        probe(&mut c, 1, 1.0, [3.0, 1.2]);
+        assert_eq!(c.threads(4, 2), 2);
+        assert_eq!(c.threads(PROBE_EVERY, 2), 2);
+        // two threads on one core: one thread until a probe twice as far
+        probe(&mut c, 1 + PROBE_EVERY, 1.0, [3.0, 2.8]);
+        assert_eq!(c.threads(PROBE_EVERY + 4, 2), 1);
+        assert_eq!(c.threads(2 * PROBE_EVERY + 1, 2), 1);
+        probe(&mut c, 1 + 3 * PROBE_EVERY, 1.0, [3.0, 2.8]);
+        assert_eq!(c.threads(3 * PROBE_EVERY + 4, 2), 1);
+        // the machine is free again at the probe four intervals later
+        probe(&mut c, 1 + 7 * PROBE_EVERY, 1.0, [0.6, 0.7]);
+        assert_eq!(c.threads(7 * PROBE_EVERY + 4, 2), 2);
+        c.record(7 * PROBE_EVERY + 5, 9.0, 100); // not a probe: ignored
+        assert_eq!(c.threads(7 * PROBE_EVERY + 6, 2), 2);
     }
 }
