@@ -142,15 +142,9 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     p
 }
 
-/// final.json without its NSCDD solver state (last in the file): one process saves
-/// it for a bitwise restart, several ranks do not (each holds only its subdomains'
-/// F_Γ; the README's restart section).
+/// final.json, with its NSCDD solver state (gathered from every rank on rank 0).
 fn final_json(out: &Path) -> String {
-    let s = std::fs::read_to_string(out.join("final.json")).unwrap_or_else(|e| panic!("{}: {e}", out.display()));
-    match s.find(",\n  \"nscdd\": {") {
-        Some(at) => s[..at].to_string(),
-        None => s.trim_end().trim_end_matches('}').trim_end().to_string(),
-    }
+    std::fs::read_to_string(out.join("final.json")).unwrap_or_else(|e| panic!("{}: {e}", out.display()))
 }
 
 /// The scene in one process with 2 threads, then on each rank count: final.json
@@ -219,6 +213,38 @@ fn two_ranks_give_the_one_process_result_for_a_bonded_wall() {
     same_as_threads(&scene, &dir, "2x1x2", "decentralized", &[2]);
     let fin = final_json(&dir.join("ranks2-2x1x2-decentralized"));
     assert!(fin.contains("\"bonded\": true"), "bonds in final.json");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A state written by 2 ranks continues on 4 ranks and in one process, and a state
+/// written by 4 ranks on 2: bitwise the uninterrupted one-process run (F_Γ of
+/// every rank's subdomains is gathered into the state).
+#[test]
+fn a_state_written_by_p_ranks_restarts_on_other_rank_counts() {
+    let dir = scratch("restart_ranks");
+    let whole = write(&dir, "pile.toml", PILE2D);
+    let half = write(&dir, "half.toml", &PILE2D.replace("steps = 15", "steps = 8"));
+    let flags = ["--subdomains", "2x2", "--scheme", "decentralized"];
+    let one = dir.join("one");
+    ok(
+        &nscdd(&args(&whole, &one, &[&flags[..], &["--threads", "2"]].concat())),
+        "the uninterrupted run",
+    );
+    let reference = final_json(&one);
+    for (first, then) in [(2, 4), (2, 1), (4, 2)] {
+        let a = dir.join(format!("first{first}-{then}"));
+        ok(&mpirun(&[(first, args(&half, &a, &flags))]), &format!("8 steps on {first} ranks"));
+        assert!(final_json(&a).contains("\"f_gamma\""), "the NSCDD state on {first} ranks");
+        let b = dir.join(format!("then{first}-{then}"));
+        let state = a.join("final.json");
+        let rest = args(&whole, &b, &[&flags[..], &["--restart", state.to_str().unwrap()]].concat());
+        let o = if then == 1 { nscdd(&rest) } else { mpirun(&[(then, rest)]) };
+        ok(&o, &format!("the restart on {then} rank(s)"));
+        assert!(
+            final_json(&b) == reference,
+            "{first} ranks then {then}: final.json differs from the uninterrupted run"
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

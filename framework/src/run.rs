@@ -167,15 +167,21 @@ pub(crate) fn write_rank_totals<D: crate::dd::Family>(dd: &mut Option<crate::dd:
     Ok(())
 }
 
+/// Writes the state on rank 0. Collective on MPI ranks (the NSCDD state is gathered
+/// from every rank): every rank calls it at the same step.
 fn save_state<D: Dim>(
     dir: &Path,
     name: &str,
     w: &World<D>,
     families: &[Box<dyn SceneFamily<D>>],
-    dd: &Option<NscddOf<Rigid<D>>>,
+    dd: &mut Option<NscddOf<Rigid<D>>>,
 ) -> Result<(), RunError> {
+    let root = dd.as_mut().and_then(|n| n.ranks_mut()).is_none_or(|r| r.cluster.rank() == 0);
+    let dd = dd.as_mut().and_then(|n| n.gather_state());
+    if !root {
+        return Ok(());
+    }
     let states = (!families.is_empty()).then(|| crate::family::states(families));
-    let dd = dd.as_ref().and_then(|n| n.save_state());
     save_state_text(dir, name, &final_json_with(w, states.as_ref(), dd.as_ref()))
 }
 
@@ -333,9 +339,9 @@ pub fn run_on<D: Dim>(
         fams.iter().for_each(|f| f.history_values(&mut values));
         hist.row_dd(w, &rep, dd_rep.as_ref(), t_out, &values)
             .map_err(io(dir, "history.csv"))?;
-        if root && scene.output.checkpoint_every > 0 && s % scene.output.checkpoint_every == 0 && s != steps {
+        if scene.output.checkpoint_every > 0 && s % scene.output.checkpoint_every == 0 && s != steps {
             hist.flush().map_err(io(dir, "history.csv"))?;
-            save_state(dir, "checkpoint.json", w, fams, &dd)?;
+            save_state(dir, "checkpoint.json", w, fams, &mut dd)?;
         }
         if let Some(r) = &dd_rep {
             sum.migrations += r.migrations as u64;
@@ -344,9 +350,7 @@ pub fn run_on<D: Dim>(
         on_step(w, &rep);
         if s != steps && stop_agreed(&mut dd) {
             hist.flush().map_err(io(dir, "history.csv"))?;
-            if root {
-                save_state(dir, "checkpoint.json", w, fams, &dd)?;
-            }
+            save_state(dir, "checkpoint.json", w, fams, &mut dd)?;
             finish_outputs(&mut writers, fams, vtk, dir)?;
             return Err(RunError::Interrupted(s));
         }
@@ -354,9 +358,7 @@ pub fn run_on<D: Dim>(
     hist.flush().map_err(io(dir, "history.csv"))?;
     finish_outputs(&mut writers, fams, vtk, dir)?;
     write_rank_totals(&mut dd, dir)?;
-    if root {
-        save_state(dir, "final.json", w, fams, &dd)?;
-    }
+    save_state(dir, "final.json", w, fams, &mut dd)?;
     sum.wall_seconds = start.elapsed().as_secs_f64();
     Ok(sum)
 }

@@ -3,7 +3,10 @@
 //! the subdomain of each contact kept between repartitions, and the step count that
 //! schedules them. Saved in `final.json` and checkpoints under `nscdd`
 //! ([`crate::run`]) with the decomposition it belongs to; a restart with another
-//! decomposition starts F_Γ from zero.
+//! decomposition starts F_Γ from zero. On MPI ranks each rank holds F_Γ of its own
+//! subdomains only: [`NscddOf::gather_state`] collects them on rank 0, so that the
+//! state written by P ranks is the one-process state, and every rank loads all of
+//! it (a restart on P′ ranks, or in one process, continues bitwise).
 
 use super::{FGammaStore, Family, Grid, NscddOf};
 use crate::model::ContactKey;
@@ -24,11 +27,16 @@ struct Saved {
 
 impl<D: Family> NscddOf<D> {
     /// The state of the solver between steps (module docs); `None` on several MPI
-    /// ranks (each holds only its subdomains' F_Γ).
+    /// ranks (each holds only its subdomains' F_Γ: see [`NscddOf::gather_state`]).
     pub fn save_state(&self) -> Option<serde_json::Value> {
         if self.ranks.is_some() {
             return None;
         }
+        let f_gamma = self.store.iter().map(|(b, e, v)| (b, e, v.as_ref().to_vec())).collect();
+        Some(self.saved(f_gamma))
+    }
+
+    fn saved(&self, f_gamma: Vec<(u32, u32, Vec<f64>)>) -> serde_json::Value {
         let s = Saved {
             grid_of: [self.settings.nx, self.settings.ny, self.settings.nz],
             by_model: self.by_model,
@@ -36,9 +44,41 @@ impl<D: Family> NscddOf<D> {
             grid: self.grid,
             grid_empty: self.grid_empty,
             kept: self.kept.clone(),
-            f_gamma: self.store.iter().map(|(b, e, v)| (b, e, v.as_ref().to_vec())).collect(),
+            f_gamma,
         };
-        Some(serde_json::to_value(s).expect("plain data"))
+        serde_json::to_value(s).expect("plain data")
+    }
+
+    /// The state on rank 0 (None elsewhere), collected from every rank's own
+    /// subdomains; [`NscddOf::save_state`] in one process. Collective on MPI ranks:
+    /// every rank calls it at the same step.
+    pub fn gather_state(&mut self) -> Option<serde_json::Value> {
+        let Some(rs) = self.ranks.as_mut() else {
+            return self.save_state();
+        };
+        let me = rs.cluster.rank();
+        let dofs = D::V::default().as_ref().len();
+        // (body, subdomain, F_Γ) of this rank's subdomains, flat
+        let mut mine = Vec::new();
+        for (b, e, v) in self.store.iter().filter(|e| rs.rank_of.get(e.1 as usize) == Some(&me)) {
+            mine.extend([f64::from(b), f64::from(e)]);
+            mine.extend_from_slice(v.as_ref());
+        }
+        let size = rs.cluster.size() as usize;
+        let mut counts = Vec::new();
+        rs.cluster.all_gather(&[mine.len() as f64], &vec![1; size], &mut counts);
+        let counts: Vec<usize> = counts.iter().map(|&c| c as usize).collect();
+        let mut all = Vec::new();
+        rs.cluster.gather(&mine, &counts, &mut all);
+        if me != 0 {
+            return None;
+        }
+        let mut f_gamma: Vec<(u32, u32, Vec<f64>)> = all
+            .chunks_exact(2 + dofs)
+            .map(|c| (c[0] as u32, c[1] as u32, c[2..].to_vec()))
+            .collect();
+        f_gamma.sort_unstable_by_key(|e| (e.0, e.1));
+        Some(self.saved(f_gamma))
     }
 
     /// Puts a saved state back (a solver made from the same decomposition, before its
@@ -46,7 +86,7 @@ impl<D: Family> NscddOf<D> {
     /// out (F_Γ starts from zero); an error: a malformed state.
     pub fn load_state(&mut self, state: &serde_json::Value) -> Result<bool, String> {
         let s: Saved = Saved::deserialize(state).map_err(|e| format!("not an NSCDD state: {e}"))?;
-        if s.grid_of != [self.settings.nx, self.settings.ny, self.settings.nz] || s.by_model != self.by_model || self.ranks.is_some() {
+        if s.grid_of != [self.settings.nx, self.settings.ny, self.settings.nz] || s.by_model != self.by_model {
             return Ok(false);
         }
         let dofs = D::V::default().as_ref().len();
