@@ -216,6 +216,27 @@ fn two_ranks_give_the_one_process_result_for_a_bonded_wall() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Threads inside ranks (hybrid): 2 ranks × 2 threads on 3 × 2 subdomains (three a
+/// rank, swept in parallel), bitwise the one-process result.
+#[test]
+fn threads_inside_ranks_give_the_one_process_result() {
+    let dir = scratch("hybrid");
+    let scene = write(&dir, "pile.toml", PILE2D);
+    let flags = ["--subdomains", "3x2", "--scheme", "decentralized"];
+    let one = dir.join("one");
+    ok(&nscdd(&args(&scene, &one, &flags)), "the one-process run");
+    let out = dir.join("hybrid");
+    ok(
+        &mpirun(&[(2, args(&scene, &out, &[&flags[..], &["--threads", "2"]].concat()))]),
+        "2 ranks × 2 threads",
+    );
+    assert!(
+        final_json(&out) == final_json(&one),
+        "2 ranks × 2 threads: final.json differs from one process"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// A state written by 2 ranks continues on 4 ranks and in one process, and a state
 /// written by 4 ranks on 2: bitwise the uninterrupted one-process run (F_Γ of
 /// every rank's subdomains is gathered into the state).

@@ -419,7 +419,10 @@ impl<D: Family> NscddOf<D> {
             rep.solve.converged || !sums.is_finite()
         };
         let stages = if let Some(rs) = self.ranks.as_mut() {
-            let (stages, stats) = ranks::iterate(rs, d, set.scheme, (per, sv.relaxation), max_stages, k, |s, g| converged(s, g, rep));
+            let hybrid = (set.threads, &mut self.workers);
+            let (stages, stats) = ranks::iterate(rs, d, set.scheme, (per, sv.relaxation), max_stages, k, hybrid, |s, g| {
+                converged(s, g, rep)
+            });
             rep.exchange = stats;
             stages
         } else {

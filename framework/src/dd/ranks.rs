@@ -360,6 +360,7 @@ impl RankState {
 /// every rank from the same merged numbers; then every subdomain's results on every
 /// rank. The subdomains' ranks are those of [`RankState::assign`] at the partition.
 /// Returns the stages run and this step's exchange counts.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn iterate<D: Family>(
     st: &mut RankState,
     d: &mut Decomposition<D>,
@@ -367,6 +368,7 @@ pub(super) fn iterate<D: Family>(
     (per, omega): (u32, f64),
     max_stages: u32,
     k: u32,
+    (threads, workers): (usize, &mut super::team::Workers),
     mut converged: impl FnMut(&Sums, &GluePartial) -> bool,
 ) -> (u32, TransportStats) {
     let t0 = Instant::now();
@@ -379,9 +381,17 @@ pub(super) fn iterate<D: Family>(
     if d.iface.fresh.iter().any(|&f| f) {
         st.glue(d, scheme, true, &mut own);
     }
+    // threads inside the rank (hybrid): the rank's subdomains swept in parallel,
+    // each on its own data (the sums are reduced later in subdomain order)
+    let pool = if threads > 1 { workers.pool(threads) } else { None };
     let (stages, _) = crate::solver::check_loop(max_stages, k, |check| {
-        for s in d.subs.iter_mut().filter(|s| st.rank_of[s.id as usize] == me) {
-            s.sweeps(per, omega, check);
+        let mut mine: Vec<&mut Subdomain<D>> = d.subs.iter_mut().filter(|s| st.rank_of[s.id as usize] == me).collect();
+        match pool {
+            Some(p) if mine.len() > 1 => p.install(|| {
+                use rayon::prelude::*;
+                mine.par_iter_mut().with_max_len(1).for_each(|s| s.sweeps(per, omega, check));
+            }),
+            _ => mine.into_iter().for_each(|s| s.sweeps(per, omega, check)),
         }
         own.clear();
         if !d.iface.is_empty() {

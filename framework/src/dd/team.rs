@@ -374,7 +374,7 @@ pub struct Workers {
 impl Workers {
     /// A pool of at least `n` threads (built once, grown when more are asked for);
     /// None when the system refuses threads (the team then spawns its own).
-    fn pool(&mut self, n: usize) -> Option<&rayon::ThreadPool> {
+    pub(crate) fn pool(&mut self, n: usize) -> Option<&rayon::ThreadPool> {
         if self.pool.as_ref().is_none_or(|p| p.current_num_threads() < n) {
             let built = rayon::ThreadPoolBuilder::new()
                 .num_threads(n)
