@@ -429,7 +429,7 @@ impl<D: Family> NscddOf<D> {
             let (iface, transport, bufs) = (&d.iface, &mut self.transport, &mut self.bufs);
             let threads = self.choice.threads(self.steps, set.threads);
             let t0 = std::time::Instant::now();
-            let stages = team::with_team(&mut d.subs, threads, iface, &mut self.workers, |team| {
+            let stages = team::with_team(&mut d.subs, (threads, &|_| true), iface, &mut self.workers, |team| {
                 if iface.fresh.iter().any(|&f| f) {
                     team.with_all(|subs| glue_stage(subs, iface, set.scheme, transport, true, bufs));
                 }

@@ -38,7 +38,7 @@
 use super::cluster::Cluster;
 use super::family::Family;
 use super::gluing::GluePartial;
-use super::partition::Decomposition;
+use super::partition::{Decomposition, Interface};
 pub use super::rank_balance::{balanced_ranks, contiguous_ranks};
 use super::rank_link::{RankLink, RankTransport};
 use super::schemes::{self, glue_stage, ChainBuffers, GlueBuffers, Scheme};
@@ -160,17 +160,17 @@ impl RankState {
 
     /// The centralized gluing across ranks; returns the own subdomains' residual
     /// shares (subdomain order).
-    fn central<D: Family>(&mut self, d: &mut Decomposition<D>, only_fresh: bool, own: &mut Vec<GluePartial>) {
-        let (me, np, ns) = (self.cluster.rank(), self.cluster.size(), d.subs.len());
+    fn central<D: Family>(&mut self, subs: &mut [&mut Subdomain<D>], iface: &Interface, only_fresh: bool, own: &mut Vec<GluePartial>) {
+        let (me, np, ns) = (self.cluster.rank(), self.cluster.size(), subs.len());
         let values = |s: &Subdomain<D>| s.iface_off.last().copied().unwrap_or(0) as usize;
         let t0 = Instant::now();
         self.send.clear();
-        for s in d.subs.iter().filter(|s| self.rank_of[s.id as usize] == me) {
+        for s in subs.iter().filter(|s| self.rank_of[s.id as usize] == me) {
             for q in 0..s.slots() {
                 s.interface_velocity(q, &mut self.send);
             }
         }
-        let at = self.counts_by(ns, |s| values(&d.subs[s]));
+        let at = self.counts_by(ns, |s| values(&*subs[s]));
         if me != 0 {
             self.sent(1, self.send.len());
         }
@@ -181,17 +181,17 @@ impl RankState {
             self.per_sub_out.resize_with(ns, Vec::new);
             for (s, v) in self.per_sub.iter_mut().enumerate() {
                 v.clear();
-                let (pos, n) = (at[s], values(&d.subs[s]));
+                let (pos, n) = (at[s], values(&*subs[s]));
                 v.extend_from_slice(&self.all[pos..pos + n]);
             }
             self.parts.clear();
             self.parts.resize(ns, GluePartial::default());
-            let subs = &d.subs;
+            let subs = &*subs;
             schemes::root_solve(
                 &self.per_sub,
                 &mut self.per_sub_out,
                 &mut self.parts,
-                &d.iface,
+                iface,
                 |s| (&subs[s].iface_ib, &subs[s].iface_k),
                 only_fresh,
                 &mut self.chain,
@@ -205,7 +205,7 @@ impl RankState {
                 }
             }
         }
-        let _ = self.counts_by(ns, |s| values(&d.subs[s]) + 4);
+        let _ = self.counts_by(ns, |s| values(&*subs[s]) + 4);
         if me == 0 {
             // the root's scatter: everything but its own part
             self.sent(np as u64 - 1, self.all.len() - self.counts[0]);
@@ -216,10 +216,10 @@ impl RankState {
         self.link.seconds += t0.elapsed().as_secs_f64();
         let mut pos = 0;
         own.clear();
-        for s in d.subs.iter_mut().filter(|s| self.rank_of[s.id as usize] == me) {
+        for s in subs.iter_mut().filter(|s| self.rank_of[s.id as usize] == me) {
             for q in 0..s.slots() {
                 let n = (s.iface_off[q + 1] - s.iface_off[q]) as usize;
-                if !only_fresh || d.iface.fresh[s.iface_ib[q] as usize] {
+                if !only_fresh || iface.fresh[s.iface_ib[q] as usize] {
                     s.glue(q, &mine[pos..pos + n]);
                 }
                 pos += n;
@@ -237,30 +237,37 @@ impl RankState {
     }
 
     /// One gluing stage over the own subdomains; their residual shares in `own`.
-    fn glue<D: Family>(&mut self, d: &mut Decomposition<D>, scheme: Scheme, only_fresh: bool, own: &mut Vec<GluePartial>) {
+    fn glue<D: Family>(
+        &mut self,
+        subs: &mut [&mut Subdomain<D>],
+        iface: &Interface,
+        scheme: Scheme,
+        only_fresh: bool,
+        own: &mut Vec<GluePartial>,
+    ) {
         match scheme {
-            Scheme::Centralized => self.central(d, only_fresh, own),
+            Scheme::Centralized => self.central(subs, iface, only_fresh, own),
             Scheme::Decentralized => {
                 let me = self.cluster.rank();
                 let rank_of = &self.rank_of;
-                let mut subs: Vec<&mut Subdomain<D>> = d.subs.iter_mut().filter(|s| rank_of[s.id as usize] == me).collect();
+                let mut subs: Vec<&mut Subdomain<D>> = subs.iter_mut().filter(|s| rank_of[s.id as usize] == me).map(|s| &mut **s).collect();
                 let mut t = RankTransport {
                     link: &mut self.link,
                     cl: &mut *self.cluster,
                 };
-                *own = glue_stage(&mut subs, &d.iface, Scheme::Decentralized, &mut t, only_fresh, &mut self.glue);
+                *own = glue_stage(&mut subs, iface, Scheme::Decentralized, &mut t, only_fresh, &mut self.glue);
             }
         }
     }
 
     /// A check stage: every subdomain's sums and residual share, on every rank, merged
     /// in subdomain order.
-    fn check<D: Family>(&mut self, d: &Decomposition<D>, own: &[GluePartial]) -> (Sums, GluePartial) {
+    fn check<D: Family>(&mut self, subs: &[&mut Subdomain<D>], own: &[GluePartial]) -> (Sums, GluePartial) {
         let me = self.cluster.rank();
         let t0 = Instant::now();
         self.send.clear();
         let mut parts = own.iter();
-        for s in d.subs.iter().filter(|s| self.rank_of[s.id as usize] == me) {
+        for s in subs.iter().filter(|s| self.rank_of[s.id as usize] == me) {
             let u = &s.sums;
             let p = parts.next().copied().unwrap_or_default();
             self.send.extend([
@@ -278,7 +285,7 @@ impl RankState {
                 p.copies as f64,
             ]);
         }
-        let at = self.counts_by(d.subs.len(), |_| CHECK_VALUES);
+        let at = self.counts_by(subs.len(), |_| CHECK_VALUES);
         self.reduced(self.send.len());
         self.cluster.all_gather(&self.send, &self.counts, &mut self.all);
         self.totals.reduce_seconds += t0.elapsed().as_secs_f64();
@@ -378,29 +385,29 @@ pub(super) fn iterate<D: Family>(
     st.link.stats = TransportStats::default();
     st.link.seconds = 0.0;
     let mut own = Vec::new();
-    if d.iface.fresh.iter().any(|&f| f) {
-        st.glue(d, scheme, true, &mut own);
-    }
-    // threads inside the rank (hybrid): the rank's subdomains swept in parallel,
-    // each on its own data (the sums are reduced later in subdomain order)
-    let pool = if threads > 1 { workers.pool(threads) } else { None };
-    let (stages, _) = crate::solver::check_loop(max_stages, k, |check| {
-        let mut mine: Vec<&mut Subdomain<D>> = d.subs.iter_mut().filter(|s| st.rank_of[s.id as usize] == me).collect();
-        match pool {
-            Some(p) if mine.len() > 1 => p.install(|| {
-                use rayon::prelude::*;
-                mine.par_iter_mut().with_max_len(1).for_each(|s| s.sweeps(per, omega, check));
-            }),
-            _ => mine.into_iter().for_each(|s| s.sweeps(per, omega, check)),
+    // the rank's subdomains swept by a team of `threads` (hybrid: threads inside
+    // the rank; each subdomain on its own data, so any thread count gives the same
+    // result), glued and checked over the ranks on this thread
+    let rank_of = st.rank_of.clone();
+    let mine = |k: usize| rank_of[k] == me;
+    let iface = &d.iface;
+    let (stages, _) = super::team::with_team(&mut d.subs, (threads, &mine), iface, workers, |team| {
+        if iface.fresh.iter().any(|&f| f) {
+            team.with_all(|subs| st.glue(subs, iface, scheme, true, &mut own));
         }
-        own.clear();
-        if !d.iface.is_empty() {
-            st.glue(d, scheme, false, &mut own);
-        }
-        check && {
-            let (sums, g) = st.check(d, &own);
-            converged(&sums, &g)
-        }
+        crate::solver::check_loop(max_stages, k, |check| {
+            team.sweep(per, omega, check);
+            team.with_all(|subs| {
+                own.clear();
+                if !iface.is_empty() {
+                    st.glue(subs, iface, scheme, false, &mut own);
+                }
+                check && {
+                    let (sums, g) = st.check(subs, &own);
+                    converged(&sums, &g)
+                }
+            })
+        })
     });
     st.share_results(d);
     let t = &mut st.totals;

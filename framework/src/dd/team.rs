@@ -343,9 +343,9 @@ impl<D: Family> Drop for StopOnDrop<'_, '_, '_, D> {
 
 /// Groups of subdomains, one per thread, balanced by contact count (largest first to
 /// the least loaded group; ties to the smaller id); each group in subdomain order.
-fn groups<D: Family>(subs: &[Subdomain<D>], threads: usize) -> Vec<Vec<usize>> {
-    let n = threads.clamp(1, subs.len().max(1));
-    let mut by_load: Vec<usize> = (0..subs.len()).collect();
+fn groups<D: Family>(subs: &[Subdomain<D>], threads: usize, mine: &dyn Fn(usize) -> bool) -> Vec<Vec<usize>> {
+    let mut by_load: Vec<usize> = (0..subs.len()).filter(|&k| mine(k)).collect();
+    let n = threads.clamp(1, by_load.len().max(1));
     by_load.sort_by_key(|&k| (std::cmp::Reverse(subs[k].n_contacts()), k));
     let mut g = vec![Vec::new(); n];
     let mut load = vec![0usize; n];
@@ -386,17 +386,18 @@ impl Workers {
     }
 }
 
-/// Runs `driver` with a [`Team`] of `threads` threads over `subs`, glued across
-/// `iface`; a gluing left pending is applied before returning. The team's other
-/// threads come from `workers`.
+/// Runs `driver` with a [`Team`] of `threads` threads over the subdomains `k` of
+/// `subs` for which `mine(k)` (on MPI ranks: the rank's own; all in one process),
+/// glued across `iface`; a gluing left pending is applied before returning. The
+/// team's other threads come from `workers`.
 pub fn with_team<D: Family, R>(
     subs: &mut [Subdomain<D>],
-    threads: usize,
+    (threads, mine): (usize, &dyn Fn(usize) -> bool),
     iface: &Interface,
     workers: &mut Workers,
     driver: impl FnOnce(&mut Team<'_, '_, '_, D>) -> R,
 ) -> R {
-    let groups = groups(subs, threads);
+    let groups = groups(subs, threads, mine);
     let mut links = Vec::new();
     let back: Vec<Vec<(usize, usize)>> = subs
         .iter()
