@@ -418,17 +418,19 @@ impl<D: Family> NscddOf<D> {
             // an overflow stops the stages, unconverged
             rep.solve.converged || !sums.is_finite()
         };
+        // threads, or one while they do not pay (timing only: any count gives the same result)
+        let threads = self.choice.threads(self.steps, set.threads);
+        let t0 = std::time::Instant::now();
         let stages = if let Some(rs) = self.ranks.as_mut() {
-            let hybrid = (set.threads, &mut self.workers);
+            let hybrid = (threads, &mut self.workers);
             let (stages, stats) = ranks::iterate(rs, d, set.scheme, (per, sv.relaxation), max_stages, k, hybrid, |s, g| {
                 converged(s, g, rep)
             });
+            self.choice.record(self.steps, t0.elapsed().as_secs_f64(), stages);
             rep.exchange = stats;
             stages
         } else {
             let (iface, transport, bufs) = (&d.iface, &mut self.transport, &mut self.bufs);
-            let threads = self.choice.threads(self.steps, set.threads);
-            let t0 = std::time::Instant::now();
             let stages = team::with_team(&mut d.subs, (threads, &|_| true), iface, &mut self.workers, |team| {
                 if iface.fresh.iter().any(|&f| f) {
                     team.with_all(|subs| glue_stage(subs, iface, set.scheme, transport, true, bufs));
