@@ -62,15 +62,21 @@ pub trait ContactStage<W> {
     fn solve(&mut self, w: &mut W) -> SolveReport;
 }
 
-/// The one-domain stage: NLGS, or the method of `[solver] method` over the
+/// The one-domain stage: NLGS, Anderson-accelerated NLGS over the same sweeps
+/// ([`crate::solver::anderson`]), or the semismooth Newton method over the
 /// assembled Delassus operator ([`crate::fc::solve_world`]).
 pub struct Nlgs;
 
 impl<D: Dim> ContactStage<World<D>> for Nlgs {
     fn solve(&mut self, w: &mut World<D>) -> SolveReport {
-        if w.solver.method != crate::solver::Method::Nlgs {
-            // Anderson or Newton over the assembled W
-            return crate::fc::solve_world(w);
+        match w.solver.method {
+            crate::solver::Method::Nlgs => {}
+            // the world's own sweeps, mixed
+            crate::solver::Method::Anderson => {
+                return crate::solver::anderson::solve(&mut w.contacts, &mut w.bodies.vel, &w.bodies.inv_mass, &w.solver)
+            }
+            // Newton over the assembled W
+            crate::solver::Method::Newton => return crate::fc::solve_world(w),
         }
         nlgs::solve(
             &mut w.contacts,

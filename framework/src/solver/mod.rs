@@ -1,6 +1,7 @@
 //! The contact solver: settings, the per-step report, the one convergence-check loop
 //! ([`SolverSettings::run_sweeps`]) and NLGS ([`nlgs`]), for every dimension.
 
+pub mod anderson;
 pub mod nlgs;
 
 use crate::norms::{Criterion, Norms, Sums};
