@@ -426,7 +426,6 @@ impl<D: Family> NscddOf<D> {
             let (stages, stats) = ranks::iterate(rs, d, set.scheme, (per, sv.relaxation), max_stages, k, hybrid, |s, g| {
                 converged(s, g, rep)
             });
-            self.choice.record(self.steps, t0.elapsed().as_secs_f64(), stages);
             rep.exchange = stats;
             stages
         } else {
@@ -448,10 +447,10 @@ impl<D: Family> NscddOf<D> {
                 })
                 .0
             });
-            self.choice.record(self.steps, t0.elapsed().as_secs_f64(), stages);
             rep.exchange = self.transport.stats();
             stages
         };
+        self.choice.record(self.steps, t0.elapsed().as_secs_f64(), stages);
         rep.stages = stages;
         rep.solve.sweeps = stages * per;
         write_back(d, w);

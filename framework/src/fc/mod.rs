@@ -3,7 +3,7 @@
 //! `meta`; `.gz` files are gzip) and solved by NLGS, Anderson-accelerated NLGS
 //! ([`anderson`]) or a semismooth Newton method ([`newton`]) as
 //! [`FcOptions::method`] says: the `solve-fc` command, and the one-domain stage
-//! of a world whose `[solver] method` is not NLGS ([`solve_world`]).
+//! of a world whose `[solver] method` is Newton ([`solve_world`]).
 //!
 //! A problem with `nc` contacts in dimension `dim` (2 or 3) is: find
 //! `r, u ∈ ℝ^{dim·nc}` with

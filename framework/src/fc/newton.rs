@@ -185,6 +185,8 @@ struct Work<const D: usize> {
     u: Vec<[f64; D]>,
     ut: Vec<[f64; D]>,
     wd: Vec<[f64; D]>,
+    /// Zeros: W Δ is the velocity of Δ with q = 0.
+    zero: Vec<[f64; D]>,
     trial: Vec<[f64; D]>,
     vals: Vec<f64>,
     rhs: Vec<f64>,
@@ -200,7 +202,7 @@ fn step<const D: usize>(l: &Local<D>, pat: &Pattern, r: &mut [[f64; D]], rho: &[
     assemble(l, r, &w.u, rho, eps, &mut w.vals, &mut w.rhs);
     let d = super::solve::blocks::<D>(&direction::<D>(pat, &w.vals, &w.rhs)?);
     // W Δ: u along the step is u + t W Δ
-    l.b.velocity(&vec![[0.0; D]; nc], &d, &mut w.wd);
+    l.b.velocity(&w.zero, &d, &mut w.wd);
     let mut t = 1.0;
     for _ in 0..=20 {
         for a in 0..nc {
@@ -234,6 +236,7 @@ pub(crate) fn solve<const D: usize>(l: &Local<D>, r: &mut Vec<[f64; D]>, opts: &
         u: vec![[0.0; D]; nc],
         ut: vec![[0.0; D]; nc],
         wd: vec![[0.0; D]; nc],
+        zero: vec![[0.0; D]; nc],
         trial: r.clone(),
         vals: Vec::new(),
         rhs: vec![0.0; D * nc],

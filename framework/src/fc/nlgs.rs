@@ -111,7 +111,7 @@ impl<const D: usize> Blocks<D> {
 
     /// `q_α + Σ_{β≠α} W_αβ r_β`.
     #[inline(always)]
-    pub(crate) fn off_sum(&self, a: usize, q: [f64; D], r: &[[f64; D]]) -> [f64; D] {
+    fn off_sum(&self, a: usize, q: [f64; D], r: &[[f64; D]]) -> [f64; D] {
         let mut u = q;
         for k in self.ptr[a]..self.ptr[a + 1] {
             let (m, rb) = (&self.blk[k], &r[self.col[k] as usize]);

@@ -279,8 +279,7 @@ pub fn problem_of<D: crate::dim::Dim>(w: &crate::world::World<D>, shares: &[Fami
     }
 }
 
-/// The contact stage of `[solver] method = "anderson"` or `"newton"`: W of the
-/// step's contacts assembled from their frames and the bodies' M̂⁻¹
+/// The contact stage of `[solver] method = "newton"`: W of the step's contacts assembled from their frames and the bodies' M̂⁻¹
 /// ([`problem_of`]), solved from the warm start (the contacts' r, already applied
 /// to the bodies) with the scene's norm, tolerance, iteration limit and check
 /// period; then V += M̂⁻¹ H (r − r_warm) contact by contact.
