@@ -18,7 +18,8 @@ PRESSURE = 1.0e4
 H_STEP = 5e-4
 
 
-def biaxial_scene(n, eps1_max, tol=1e-3, norm="Quad", max_sweeps=1000, decomposition=None, compact_only=False, ordering="stored"):
+def biaxial_scene(n, eps1_max, tol=1e-3, norm="Quad", max_sweeps=1000, decomposition=None, compact_only=False, ordering="stored",
+                  method="nlgs"):
     """TOML text of the biaxial test of n disks loaded to eps1_max (compact_only: the
     compaction phase alone, T_COMPACT seconds, whose final.json restarts the loading)."""
     scale = math.sqrt(n / 2000.0)
@@ -29,6 +30,8 @@ def biaxial_scene(n, eps1_max, tol=1e-3, norm="Quad", max_sweeps=1000, decomposi
     t = 0.02
     # the default order writes no line (so that cached runs keep their key)
     order_line = "" if ordering == "stored" else f'ordering = "{ordering}"'
+    if method != "nlgs":
+        order_line += f'\nmethod = "{method}"'
     dec = ""
     if decomposition:
         dec = "[decomposition]\n" + "".join(f"{k} = {v!r}\n".replace("'", '"') for k, v in decomposition.items())

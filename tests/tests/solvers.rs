@@ -149,6 +149,28 @@ fn warm_start_and_budget() {
     }
 }
 
+/// Anderson stopped by its budget ends on its last iterate or its best sweep
+/// output, whichever has the lower residual: never far worse than NLGS after as
+/// many sweeps (a mixed iterate of a stagnating history alone could be).
+#[test]
+fn an_unconverged_anderson_solve_is_not_far_worse_than_nlgs() {
+    let p = generated_problem();
+    for budget in [3, 7, 15, 31, 63] {
+        let o = |m| FcOptions {
+            max_sweeps: budget,
+            ..opts(m, 1e-14)
+        };
+        let (a, n) = (p.solve(&o(Method::Anderson)), p.solve(&o(Method::Nlgs)));
+        println!("budget {budget}: anderson {:.3e}, nlgs {:.3e}", a.residual, n.residual);
+        assert!(
+            !a.converged && a.residual <= 1.5 * n.residual,
+            "budget {budget}: {} vs {}",
+            a.residual,
+            n.residual
+        );
+    }
+}
+
 /// Every FCLIB file of `tests/data/fclib/` solved to 1e-8 by every method.
 #[cfg(feature = "hdf5")]
 #[test]

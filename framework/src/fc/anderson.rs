@@ -3,7 +3,9 @@
 //! the map G, mixed by [`crate::solver::anderson::Mixer`] (the method and its
 //! safeguard are described there; the engine's stage drives the same mixing with
 //! the world's own sweeps). One iteration = one sweep; the stopping test is checked
-//! every `check_every` iterations on the mixed impulses.
+//! every `check_every` iterations on the mixed impulses. A solve that does not
+//! converge returns the last iterate or the sweep output with the least ‖G(r) − r‖
+//! seen, whichever has the lower natural-map residual.
 //!
 //! ```
 //! use nscdd::fc::{CooMatrix, FcNorm, FcOptions, FcProblem};
@@ -29,10 +31,17 @@ pub(crate) fn solve<const D: usize>(l: &Local<D>, r: &mut Vec<[f64; D]>, opts: &
     let mut mixer = Mixer::new(D * nc);
     let mut g: Vec<[f64; D]> = r.clone();
     let mut u = vec![[0.0; D]; nc];
-    crate::solver::check_loop(opts.max_sweeps, opts.check_every, |check| {
+    // the sweep output with the least ‖f‖ (where an unconverged solve ends)
+    let (mut best, mut best_f) = (r.clone(), f64::INFINITY);
+    let (iterations, converged) = crate::solver::check_loop(opts.max_sweeps, opts.check_every, |check| {
         g.copy_from_slice(r);
         l.b.sweep(&l.q, &l.mu, &mut g);
-        match mixer.step(r.as_flattened(), g.as_flattened()) {
+        let mixing = mixer.step(r.as_flattened(), g.as_flattened());
+        if mixer.f_norm() < best_f {
+            best_f = mixer.f_norm();
+            best.copy_from_slice(&g);
+        }
+        match mixing {
             None => r.copy_from_slice(&g),
             Some(gamma) => {
                 let gf = g.as_flattened();
@@ -44,5 +53,9 @@ pub(crate) fn solve<const D: usize>(l: &Local<D>, r: &mut Vec<[f64; D]>, opts: &
             }
         }
         check && l.stop(r, &mut u, opts)
-    })
+    });
+    if !converged && best_f.is_finite() && l.residual(&best, &mut u) < l.residual(r, &mut u) {
+        r.copy_from_slice(&best);
+    }
+    (iterations, converged)
 }

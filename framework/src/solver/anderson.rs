@@ -23,7 +23,7 @@ use super::nlgs::{check_pass, residual, sweep};
 use super::{SolveReport, SolverSettings};
 use crate::dim::{Dim, Vector};
 use crate::model::Contacts;
-use crate::norms::project_cone;
+use crate::norms::{project_cone, Norms, Sums};
 
 /// Differences kept (m).
 pub const MEMORY: usize = 5;
@@ -97,6 +97,11 @@ impl Mixer {
         self.coefficients()
     }
 
+    /// ‖f‖ = ‖G(x) − x‖ of the last recorded sweep.
+    pub fn f_norm(&self) -> f64 {
+        self.f_norm_prev
+    }
+
     /// Component k of G − ΔG γ.
     #[inline]
     pub fn mixed(&self, gamma: &[f64; MEMORY], g: &[f64], k: usize) -> f64 {
@@ -157,7 +162,10 @@ impl Mixer {
 /// The one-domain stage with `[solver] method = "anderson"`: the world's own NLGS
 /// sweeps (storage order, unrelaxed) as the map G, the mixed impulses applied to
 /// the bodies contact by contact (V += M̂⁻¹ H Δr), LMGC90's check pass after every
-/// `check_every`-th iteration. No Delassus operator is assembled.
+/// `check_every`-th iteration. No Delassus operator is assembled. A solve that
+/// does not converge ends on the last iterate or on the sweep output with the least
+/// ‖f‖ seen, whichever has the lower natural-map residual (a mixed iterate of a
+/// stagnating history can be far worse than NLGS's).
 pub fn solve<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMass], s: &SolverSettings) -> SolveReport {
     if c.is_empty() {
         return SolveReport {
@@ -169,6 +177,8 @@ pub fn solve<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMas
     let n = d * c.len();
     let mut mixer = Mixer::new(n);
     let (mut x, mut g) = (vec![0.0; n], vec![0.0; n]);
+    // the sweep output with the least ‖f‖, and that ‖f‖
+    let (mut best, mut best_f) = (vec![0.0; n], f64::INFINITY);
     let flat = |c: &Contacts<D>, out: &mut [f64]| {
         for (a, r) in c.r.iter().enumerate() {
             out[d * a..d * a + d].copy_from_slice(r.as_ref());
@@ -178,7 +188,12 @@ pub fn solve<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMas
         flat(c, &mut x);
         sweep(c, vel, inv, &[], 1.0, None);
         flat(c, &mut g);
-        if let Some(gamma) = mixer.step(&x, &g) {
+        let mixing = mixer.step(&x, &g);
+        if mixer.f_norm() < best_f {
+            best_f = mixer.f_norm();
+            best.copy_from_slice(&g);
+        }
+        if let Some(gamma) = mixing {
             for a in 0..c.len() {
                 let z: [f64; 3] = std::array::from_fn(|k| if k < d { mixer.mixed(&gamma, &g, d * a + k) } else { 0.0 });
                 let p = project_cone(&z[..d], c.target[a].mu);
@@ -195,5 +210,33 @@ pub fn solve<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMas
         }
     });
     report.residual = residual(c, vel);
+    if !report.converged && best_f.is_finite() {
+        // the last iterate or the best sweep output, whichever has the lower residual
+        flat(c, &mut x);
+        set_impulses(c, vel, inv, &best);
+        let at_best = residual(c, vel);
+        if at_best < report.residual {
+            report.residual = at_best;
+            let mut sums = Sums::default();
+            check_pass(c, vel, inv, &[], 1.0, &mut sums);
+            report.norms = Norms::from_sums(&sums, s.tolerance);
+        } else {
+            set_impulses(c, vel, inv, &x);
+        }
+    }
     report
+}
+
+/// Sets every contact's impulse to `flat` (d values a contact), the velocities
+/// following (V += M̂⁻¹ H Δr).
+fn set_impulses<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMass], flat: &[f64]) {
+    let d = <D::Local as Vector>::LEN;
+    for a in 0..c.len() {
+        let r = <D::Local as Vector>::from_fn(|k| flat[d * a + k]);
+        let dr = r.sub(&c.r[a]);
+        if !dr.is_zero() {
+            c.apply(a, &dr, vel, inv);
+            c.r[a] = r;
+        }
+    }
 }
