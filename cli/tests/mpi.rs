@@ -345,6 +345,24 @@ fn a_rank_count_that_does_not_fit_the_decomposition_is_bad_input() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Anderson over NSCDD mixes on one process: ranks of a cluster are refused,
+/// naming the key, with exit code 2.
+#[test]
+fn anderson_on_ranks_is_bad_input() {
+    let dir = scratch("anderson");
+    let scene = write(
+        &dir,
+        "pile.toml",
+        &PILE2D.replace("[solver]\n", "[solver]\nmethod = \"anderson\"\n"),
+    );
+    let o = mpirun(&[(2, args(&scene, &dir.join("out"), &["--subdomains", "2x1"]))]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("solver.method") && err.contains("ranks"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Rank 1 reads a scene with an error (an MPMD launch: the ranks run different
 /// files): every rank stops with exit code 2 and rank 1's message names the file,
 /// line and key.

@@ -244,6 +244,7 @@ fn scene_solver<D: Dim>(scene: &mut Scene<D>, cluster: Option<Box<dyn crate::dd:
         .decomposition
         .as_ref()
         .or(crate::family::needs_nscdd(false, &mut scene.families).then_some(&one));
+    let ranks = cluster.is_some();
     let mut dd: Option<NscddOf<Rigid<D>>> = dd_solver(dd_config, cluster)?;
     if dd.is_some() && scene.world.solver.ordering == crate::solver::Ordering::Scrambled {
         return Err(RunError::Param(crate::error::ParamError::new(
@@ -253,15 +254,25 @@ fn scene_solver<D: Dim>(scene: &mut Scene<D>, cluster: Option<Box<dyn crate::dd:
         )));
     }
     let method = scene.world.solver.method;
-    if dd.is_some() && method != crate::solver::Method::Nlgs {
-        return Err(RunError::Param(crate::error::ParamError::new(
-            "solver.method",
-            format!(
-                "`{}` solves the one-domain problem over the assembled W; NSCDD's subdomains (a decomposition, \
-                 or body families) are swept by NLGS: use method = \"nlgs\"",
-                method.name()
-            ),
-        )));
+    let families = !scene.families.is_empty();
+    let refusal = match method {
+        crate::solver::Method::Nlgs => None,
+        _ if dd.is_none() => None,
+        crate::solver::Method::Newton => Some(
+            "`newton` solves the one-domain problem over the assembled W; NSCDD's subdomains (a decomposition, or body \
+             families) are swept between gluing stages: use method = \"nlgs\" or \"anderson\"",
+        ),
+        crate::solver::Method::Anderson if families => Some(
+            "`anderson` over NSCDD mixes rigid bodies' impulses only; the scene's body families (deformable bodies) \
+             need method = \"nlgs\"",
+        ),
+        crate::solver::Method::Anderson if ranks => {
+            Some("`anderson` over NSCDD mixes on one process; ranks of a cluster (mpirun) need method = \"nlgs\"")
+        }
+        crate::solver::Method::Anderson => None,
+    };
+    if let Some(msg) = refusal {
+        return Err(RunError::Param(crate::error::ParamError::new("solver.method", msg)));
     }
     // a restarted run of the same decomposition continues its F_Γ
     if let (Some(n), Some(state)) = (dd.as_mut(), scene.dd_state.take()) {

@@ -8,12 +8,15 @@
 //!   fewer iterations than from r = 0;
 //! - a budget too small is reported as not converged, never silently;
 //! - settings a method cannot use are refused naming the key (`solver.ordering`,
-//!   `solver.relaxation`, `solver.method` with bonds or NSCDD subdomains).
+//!   `solver.relaxation`, `solver.method` with bonds, Newton with NSCDD subdomains);
+//! - Anderson over NSCDD's stages converges in fewer stages than NLGS, bitwise the
+//!   same for any thread count.
 //!
 //! The physics tests run with each method where it applies
 //! (`physics::incline::every_method_gives_the_incline_answers`,
 //! `physics::stacks::column_contact_forces_are_k_m_g`).
 
+use nscdd::dd::{DdSettings, Nscdd};
 use nscdd::fc::{problem_from_world, FcOptions, FcProblem};
 use nscdd::solver::Method;
 
@@ -203,13 +206,51 @@ fn settings_a_method_cannot_use_are_refused() {
     refused("method = \"cholesky\"", "method");
     refused("method = \"newton\"\nordering = \"shuffled\"", "solver.ordering");
     refused("method = \"anderson\"\nrelaxation = 0.8", "solver.relaxation");
-    // NSCDD's subdomains are swept by NLGS
-    let text = deposit("method = \"anderson\"").replace("[[materials]]", "[decomposition]\nnx = 2\nny = 1\n\n[[materials]]");
+    // Newton has no place between NSCDD's gluing stages
+    let text = deposit("method = \"newton\"").replace("[[materials]]", "[decomposition]\nnx = 2\nny = 1\n\n[[materials]]");
     let mut s = load(&text).unwrap();
     let dir = std::env::temp_dir().join(format!("nscdd_solvers_{}", std::process::id()));
     let e = nscdd::run::run(&mut s, &nscdd_rigid_disks::registry(), &dir, |_, _| {}).unwrap_err();
     let _ = std::fs::remove_dir_all(&dir);
     assert!(e.to_string().contains("solver.method"), "{e}");
+}
+
+/// Anderson over NSCDD's stages (`nscdd::dd` module `anderson`): every step of
+/// the deposit on 2 × 2 subdomains converges, in fewer stages than NLGS over the
+/// same decomposition; 1 and 2 threads give bitwise the same result; the pile
+/// settles as with NLGS.
+#[test]
+fn anderson_mixes_the_nscdd_stages() {
+    let run = |method: &str, threads: usize| {
+        let mut s = load(&deposit(&format!("method = \"{method}\""))).unwrap();
+        let mut n = Nscdd::new(DdSettings {
+            nx: 2,
+            ny: 2,
+            threads,
+            ..Default::default()
+        });
+        let mut stages = 0;
+        for k in 0..100 {
+            let rep = n.step(&mut s.world).unwrap();
+            assert!(rep.solve.converged, "{method}, {threads} thread(s), step {k}: {rep:?}");
+            stages += rep.stages;
+        }
+        (s, stages)
+    };
+    let (nlgs, nlgs_stages) = run("nlgs", 1);
+    let (one, stages) = run("anderson", 1);
+    let (two, stages2) = run("anderson", 2);
+    println!("stages over 100 steps: NLGS {nlgs_stages}, Anderson {stages}");
+    assert!(stages < nlgs_stages, "Anderson {stages} stages, NLGS {nlgs_stages}");
+    assert_eq!(stages, stages2);
+    let bits = |s: &nscdd::scene::Scene| -> Vec<u64> {
+        let w = &s.world;
+        let v = w.bodies.vel.iter().flatten().chain(w.bodies.pos.iter().flatten());
+        v.chain(w.contacts.r.iter().flatten()).map(|x| x.to_bits()).collect()
+    };
+    assert!(bits(&one) == bits(&two), "1 and 2 threads differ");
+    let top = |s: &nscdd::scene::Scene| s.world.bodies.pos.iter().map(|p| p[1]).fold(f64::MIN, f64::max);
+    assert!((top(&one) - top(&nlgs)).abs() < 1e-3, "pile tops {} vs {}", top(&one), top(&nlgs));
 }
 
 /// A world stepped by each method: the one-domain stage reports LMGC90's norms and

@@ -44,6 +44,11 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     fn warm_start(c: &Self::Contacts, vel: &mut [Self::V], inv: &[Self::InvMass]);
     /// One NLGS sweep (a check pass when `sums` is given).
     fn sweep(c: &mut Self::Contacts, vel: &mut [Self::V], inv: &[Self::InvMass], order: &[u32], omega: f64, sums: Option<&mut Sums>);
+    /// Friction coefficient of contact `a` (its Coulomb cone |r_t| ≤ μ r_n).
+    fn mu(c: &Self::Contacts, a: usize) -> f64;
+    /// Sets the impulse of contact `a` to `r`, the two bodies' velocities following
+    /// (V += M̂⁻¹ H Δr).
+    fn set_r(c: &mut Self::Contacts, a: usize, r: &[f64], vel: &mut [Self::V], inv: &[Self::InvMass]);
     /// M̂_E⁻¹ = m M̂⁻¹ (partition of unity over m copies).
     fn scale_inv(inv: Self::InvMass, m: f64) -> Self::InvMass;
     /// v += M̂_E⁻¹ f.
@@ -132,6 +137,12 @@ impl<D: Dim> Family for Rigid<D> {
         if let Some(s) = sums {
             nlgs::check_pass(c, vel, inv, order, omega, s);
         }
+    }
+    fn mu(c: &Self::Contacts, a: usize) -> f64 {
+        c.target[a].mu
+    }
+    fn set_r(c: &mut Self::Contacts, a: usize, r: &[f64], vel: &mut [Self::V], inv: &[Self::InvMass]) {
+        c.set_r(a, r, vel, inv);
     }
     fn scale_inv(im: Self::InvMass, m: f64) -> Self::InvMass {
         D::scale_inv(&im, m)

@@ -41,6 +41,7 @@
 //! only its own data and every reduction runs in subdomain order, so the result does
 //! not depend on the number of threads.
 
+mod anderson;
 pub mod attach;
 pub mod cluster;
 pub mod family;
@@ -201,6 +202,8 @@ pub struct NscddOf<D: Family> {
     choice: team::ThreadChoice,
     /// The subdomain threads, kept across steps.
     workers: team::Workers,
+    /// Anderson mixing of the stages (`[solver] method = "anderson"`).
+    mixer: anderson::StageMixer,
     v_free: Vec<D::V>,
     /// Set for a multi-process run ([`ranks`]): this process sweeps and glues only
     /// its ranks' subdomains.
@@ -231,6 +234,7 @@ impl<D: Family> NscddOf<D> {
             bufs: GlueBuffers::default(),
             choice: team::ThreadChoice::default(),
             workers: team::Workers::default(),
+            mixer: anderson::StageMixer::default(),
             v_free: Vec::new(),
             ranks: None,
         }
@@ -429,23 +433,34 @@ impl<D: Family> NscddOf<D> {
             rep.exchange = stats;
             stages
         } else {
-            let (iface, transport, bufs) = (&d.iface, &mut self.transport, &mut self.bufs);
+            let (iface, transport, bufs, mixer) = (&d.iface, &mut self.transport, &mut self.bufs, &mut self.mixer);
+            let anderson = sv.method == crate::solver::Method::Anderson;
             let stages = team::with_team(&mut d.subs, (threads, &|_| true), iface, &mut self.workers, |team| {
                 if iface.fresh.iter().any(|&f| f) {
                     team.with_all(|subs| glue_stage(subs, iface, set.scheme, transport, true, bufs));
                 }
-                crate::solver::check_loop(max_stages, k, |check| {
+                if anderson {
+                    team.with_all(|subs| mixer.start(subs));
+                }
+                let (stages, ok) = crate::solver::check_loop(max_stages, k, |check| {
                     // sweeps and gluing; with `check`, the sums reduced in subdomain order
                     let (sums, parts) = team.stage(per, sv.relaxation, check, set.scheme, transport, bufs);
-                    check && {
+                    let done = check && {
                         let mut g = GluePartial::default();
                         for p in &parts {
                             g.merge(p);
                         }
                         converged(&sums, &g, rep)
+                    };
+                    if anderson && !done {
+                        team.with_all(|subs| mixer.after(subs));
                     }
-                })
-                .0
+                    done
+                });
+                if anderson && !ok {
+                    team.with_all(|subs| mixer.give_up(subs));
+                }
+                stages
             });
             rep.exchange = self.transport.stats();
             stages

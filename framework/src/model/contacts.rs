@@ -111,6 +111,18 @@ impl<D: Dim> Contacts<D> {
         D::apply(&self.frame[a], dr, i as usize, j as usize, vel, inv);
     }
 
+    /// Sets contact α's impulse to `r` (its first D::Local::LEN values), its bodies
+    /// following: V += M̂⁻¹ H (r − r_α).
+    #[inline]
+    pub fn set_r(&mut self, a: usize, r: &[f64], vel: &mut [D::Twist], inv: &[D::InvMass]) {
+        let r = <D::Local as Vector>::from_fn(|k| r[k]);
+        let dr = r.sub(&self.r[a]);
+        if !dr.is_zero() {
+            self.apply(a, &dr, vel, inv);
+            self.r[a] = r;
+        }
+    }
+
     /// V += M̂⁻¹ H r for every contact with r ≠ 0, in storage order (the warm start).
     pub fn apply_all(&self, vel: &mut [D::Twist], inv: &[D::InvMass]) {
         for a in 0..self.len() {

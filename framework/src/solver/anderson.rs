@@ -75,6 +75,17 @@ impl Mixer {
         }
     }
 
+    /// Forgets the history, for a new problem of n unknowns (the buffers kept).
+    pub fn reset(&mut self, n: usize) {
+        for v in self.df.iter_mut().chain(self.dg.iter_mut()) {
+            v.resize(n, 0.0);
+        }
+        for v in [&mut self.f, &mut self.f_prev, &mut self.g_prev] {
+            v.resize(n, 0.0);
+        }
+        (self.count, self.next, self.f_norm_prev, self.first) = (0, 0, f64::INFINITY, true);
+    }
+
     /// Records a sweep from `x` to `g` = G(x); returns γ (its first `count` values
     /// used), or None when the plain sweep is to be kept.
     pub fn step(&mut self, x: &[f64], g: &[f64]) -> Option<[f64; MEMORY]> {
@@ -100,6 +111,16 @@ impl Mixer {
     /// ‖f‖ = ‖G(x) − x‖ of the last recorded sweep.
     pub fn f_norm(&self) -> f64 {
         self.f_norm_prev
+    }
+
+    /// z = G − ΔG γ (the same sums as [`Self::mixed`], vectorized).
+    pub fn mix_into(&self, gamma: &[f64; MEMORY], g: &[f64], z: &mut [f64]) {
+        z.copy_from_slice(g);
+        for (j, gj) in gamma.iter().enumerate().take(self.count) {
+            for (zk, dk) in z.iter_mut().zip(&self.dg[j]) {
+                *zk -= gj * dk;
+            }
+        }
     }
 
     /// Component k of G − ΔG γ.
@@ -176,7 +197,7 @@ pub fn solve<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMas
     let d = <D::Local as Vector>::LEN;
     let n = d * c.len();
     let mut mixer = Mixer::new(n);
-    let (mut x, mut g) = (vec![0.0; n], vec![0.0; n]);
+    let (mut x, mut g, mut z) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     // the sweep output with the least ‖f‖, and that ‖f‖
     let (mut best, mut best_f) = (vec![0.0; n], f64::INFINITY);
     let flat = |c: &Contacts<D>, out: &mut [f64]| {
@@ -194,15 +215,10 @@ pub fn solve<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMas
             best.copy_from_slice(&g);
         }
         if let Some(gamma) = mixing {
+            mixer.mix_into(&gamma, &g, &mut z);
             for a in 0..c.len() {
-                let z: [f64; 3] = std::array::from_fn(|k| if k < d { mixer.mixed(&gamma, &g, d * a + k) } else { 0.0 });
-                let p = project_cone(&z[..d], c.target[a].mu);
-                let r = <D::Local as Vector>::from_fn(|k| p[k]);
-                let dr = r.sub(&c.r[a]);
-                if !dr.is_zero() {
-                    c.apply(a, &dr, vel, inv);
-                    c.r[a] = r;
-                }
+                let p = project_cone(&z[d * a..d * a + d], c.target[a].mu);
+                c.set_r(a, &p, vel, inv);
             }
         }
         if let Some(sums) = sums {
@@ -232,11 +248,6 @@ pub fn solve<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMas
 fn set_impulses<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMass], flat: &[f64]) {
     let d = <D::Local as Vector>::LEN;
     for a in 0..c.len() {
-        let r = <D::Local as Vector>::from_fn(|k| flat[d * a + k]);
-        let dr = r.sub(&c.r[a]);
-        if !dr.is_zero() {
-            c.apply(a, &dr, vel, inv);
-            c.r[a] = r;
-        }
+        c.set_r(a, &flat[d * a..d * a + d], vel, inv);
     }
 }
