@@ -345,21 +345,19 @@ fn a_rank_count_that_does_not_fit_the_decomposition_is_bad_input() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Anderson over NSCDD mixes on one process: ranks of a cluster are refused,
-/// naming the key, with exit code 2.
+/// Anderson over NSCDD's stages on ranks: the dot products of the mixing summed
+/// subdomain by subdomain in subdomain order, so 2 and 4 ranks give bitwise the
+/// one-process (2 threads) result.
 #[test]
-fn anderson_on_ranks_is_bad_input() {
+fn anderson_on_ranks_gives_the_one_process_result() {
     let dir = scratch("anderson");
     let scene = write(
         &dir,
         "pile.toml",
         &PILE2D.replace("[solver]\n", "[solver]\nmethod = \"anderson\"\n"),
     );
-    let o = mpirun(&[(2, args(&scene, &dir.join("out"), &["--subdomains", "2x1"]))]);
-    let err = text(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(err.contains("solver.method") && err.contains("ranks"), "{err}");
-    assert!(!err.contains("panicked"), "{err}");
+    same_as_threads(&scene, &dir, "2x2", "decentralized", &[2, 4]);
+    same_as_threads(&scene, &dir, "3x1", "centralized", &[2]);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -244,7 +244,6 @@ fn scene_solver<D: Dim>(scene: &mut Scene<D>, cluster: Option<Box<dyn crate::dd:
         .decomposition
         .as_ref()
         .or(crate::family::needs_nscdd(false, &mut scene.families).then_some(&one));
-    let ranks = cluster.is_some();
     let mut dd: Option<NscddOf<Rigid<D>>> = dd_solver(dd_config, cluster)?;
     if dd.is_some() && scene.world.solver.ordering == crate::solver::Ordering::Scrambled {
         return Err(RunError::Param(crate::error::ParamError::new(
@@ -266,9 +265,6 @@ fn scene_solver<D: Dim>(scene: &mut Scene<D>, cluster: Option<Box<dyn crate::dd:
             "`anderson` over NSCDD mixes rigid bodies' impulses only; the scene's body families (deformable bodies) \
              need method = \"nlgs\"",
         ),
-        crate::solver::Method::Anderson if ranks => {
-            Some("`anderson` over NSCDD mixes on one process; ranks of a cluster (mpirun) need method = \"nlgs\"")
-        }
         crate::solver::Method::Anderson => None,
     };
     if let Some(msg) = refusal {

@@ -17,15 +17,17 @@
 //! whose check converges is not mixed (the state the check judged is kept); a
 //! step that runs out of stages ends on the stage output with the least ‖f‖.
 //!
-//! The mixing runs on the coordinator over the subdomains in subdomain order, so
-//! the result does not depend on the number of threads. Body families attached to
-//! the subdomains (deformable bodies) and ranks of a cluster are refused by the
-//! run (`solver.method`): their state is not in x.
+//! The mixing runs on the coordinator (of each rank) over its subdomains; every
+//! dot product is the sum, in subdomain order, of each subdomain's own
+//! ([`crate::solver::anderson::Reduce`]: over the ranks an all-gather of the
+//! subdomains' values), so the result is bitwise the same for any number of
+//! threads and ranks. Body families attached to the subdomains (deformable bodies)
+//! are refused by the run (`solver.method`): their state is not in x.
 
 use super::family::Family;
 use super::subdomain::Subdomain;
 use crate::norms::project_cone;
-use crate::solver::anderson::Mixer;
+use crate::solver::anderson::{Mixer, Reduce};
 
 /// The mixing state of one step's stages (buffers kept across steps).
 pub struct StageMixer {
@@ -34,6 +36,7 @@ pub struct StageMixer {
     g: Vec<f64>,
     best: Vec<f64>,
     best_f: f64,
+    offsets: Vec<usize>,
 }
 
 impl Default for StageMixer {
@@ -44,14 +47,26 @@ impl Default for StageMixer {
             g: Vec::new(),
             best: Vec::new(),
             best_f: f64::INFINITY,
+            offsets: Vec::new(),
         }
     }
 }
 
-/// The iterate x of the subdomains into `out` (see the module docs).
-fn gather<D: Family>(subs: &[&mut Subdomain<D>], out: &mut Vec<f64>) {
+/// Which subdomains this process mixes (its own; the others' state arrives with
+/// the step's results).
+pub type Own<'a> = &'a dyn Fn(u32) -> bool;
+
+/// The iterate x of the own subdomains into `out`, one segment a subdomain (see the
+/// module docs); with `offsets`, the segments' starts and the end.
+fn gather<D: Family>(subs: &[&mut Subdomain<D>], own: Own, out: &mut Vec<f64>, mut offsets: Option<&mut Vec<usize>>) {
     out.clear();
-    for s in subs {
+    if let Some(o) = offsets.as_deref_mut() {
+        o.clear();
+    }
+    for s in subs.iter().filter(|s| own(s.id)) {
+        if let Some(o) = offsets.as_deref_mut() {
+            o.push(out.len());
+        }
         for a in 0..D::len(&s.contacts) {
             out.extend_from_slice(D::r(&s.contacts, a));
         }
@@ -59,13 +74,16 @@ fn gather<D: Family>(subs: &[&mut Subdomain<D>], out: &mut Vec<f64>) {
             out.extend_from_slice(f.as_ref());
         }
     }
+    if let Some(o) = offsets {
+        o.push(out.len());
+    }
 }
 
-/// Sets the subdomains' state to the iterate `x` (impulses projected on their
-/// cones, the projections written back into `x`), the velocities following.
-fn scatter<D: Family>(subs: &mut [&mut Subdomain<D>], x: &mut [f64]) {
+/// Sets the own subdomains' state to the iterate `x` (impulses projected on their
+/// cones; `x` then holds the state as set), the velocities following.
+fn scatter<D: Family>(subs: &mut [&mut Subdomain<D>], own: Own, x: &mut [f64]) {
     let mut k = 0;
-    for s in subs.iter_mut() {
+    for s in subs.iter_mut().filter(|s| own(s.id)) {
         let s = &mut **s;
         for a in 0..D::len(&s.contacts) {
             let d = D::r(&s.contacts, a).len();
@@ -92,17 +110,18 @@ fn scatter<D: Family>(subs: &mut [&mut Subdomain<D>], x: &mut [f64]) {
 
 impl StageMixer {
     /// Before the first stage of a step: forgets the last step's history.
-    pub fn start<D: Family>(&mut self, subs: &[&mut Subdomain<D>]) {
-        gather(subs, &mut self.x);
-        self.mixer.reset(self.x.len());
+    pub fn start<D: Family>(&mut self, subs: &[&mut Subdomain<D>], own: Own) {
+        gather(subs, own, &mut self.x, Some(&mut self.offsets));
+        self.mixer.reset(&self.offsets);
         self.best_f = f64::INFINITY;
     }
 
-    /// After a stage that did not converge: records G(x) and sets the subdomains
-    /// to the mixed iterate, the next x.
-    pub fn after<D: Family>(&mut self, subs: &mut [&mut Subdomain<D>]) {
-        gather(subs, &mut self.g);
-        let gamma = self.mixer.step(&self.x, &self.g);
+    /// After a stage that did not converge: records G(x) and sets the own
+    /// subdomains to the mixed iterate, the next x (dot products over every
+    /// process's subdomains through `red`, in subdomain order).
+    pub fn after<D: Family>(&mut self, subs: &mut [&mut Subdomain<D>], own: Own, red: &mut dyn Reduce) {
+        gather(subs, own, &mut self.g, None);
+        let gamma = self.mixer.step(&self.x, &self.g, red);
         if self.mixer.f_norm() < self.best_f {
             self.best_f = self.mixer.f_norm();
             self.best.clone_from(&self.g);
@@ -112,16 +131,16 @@ impl StageMixer {
             Some(gamma) => {
                 self.x.resize(self.g.len(), 0.0);
                 self.mixer.mix_into(&gamma, &self.g, &mut self.x);
-                scatter(subs, &mut self.x);
+                scatter(subs, own, &mut self.x);
             }
         }
     }
 
-    /// After the last stage of a step that did not converge: the subdomains back to
-    /// the stage output with the least ‖f‖.
-    pub fn give_up<D: Family>(&mut self, subs: &mut [&mut Subdomain<D>]) {
+    /// After the last stage of a step that did not converge: the own subdomains
+    /// back to the stage output with the least ‖f‖ (the same stage on every process).
+    pub fn give_up<D: Family>(&mut self, subs: &mut [&mut Subdomain<D>], own: Own) {
         if self.best_f.is_finite() {
-            scatter(subs, &mut self.best);
+            scatter(subs, own, &mut self.best);
         }
     }
 }

@@ -72,6 +72,7 @@ pub use transport::{InProcess, Transport, TransportStats};
 
 use crate::engine::{ContactStage, Diverged};
 use crate::norms::{Norms, Sums, VANISHING};
+use crate::solver::anderson::InOrder;
 use crate::solver::SolveReport;
 use gluing::GluePartial;
 use schemes::{glue_stage, GlueBuffers};
@@ -427,7 +428,8 @@ impl<D: Family> NscddOf<D> {
         let t0 = std::time::Instant::now();
         let stages = if let Some(rs) = self.ranks.as_mut() {
             let hybrid = (threads, &mut self.workers);
-            let (stages, stats) = ranks::iterate(rs, d, set.scheme, (per, sv.relaxation), max_stages, k, hybrid, |s, g| {
+            let mixer = (sv.method == crate::solver::Method::Anderson).then_some(&mut self.mixer);
+            let (stages, stats) = ranks::iterate(rs, d, set.scheme, (per, sv.relaxation), max_stages, k, hybrid, mixer, |s, g| {
                 converged(s, g, rep)
             });
             rep.exchange = stats;
@@ -440,7 +442,7 @@ impl<D: Family> NscddOf<D> {
                     team.with_all(|subs| glue_stage(subs, iface, set.scheme, transport, true, bufs));
                 }
                 if anderson {
-                    team.with_all(|subs| mixer.start(subs));
+                    team.with_all(|subs| mixer.start(subs, &|_| true));
                 }
                 let (stages, ok) = crate::solver::check_loop(max_stages, k, |check| {
                     // sweeps and gluing; with `check`, the sums reduced in subdomain order
@@ -453,12 +455,12 @@ impl<D: Family> NscddOf<D> {
                         converged(&sums, &g, rep)
                     };
                     if anderson && !done {
-                        team.with_all(|subs| mixer.after(subs));
+                        team.with_all(|subs| mixer.after(subs, &|_| true, &mut InOrder));
                     }
                     done
                 });
                 if anderson && !ok {
-                    team.with_all(|subs| mixer.give_up(subs));
+                    team.with_all(|subs| mixer.give_up(subs, &|_| true));
                 }
                 stages
             });

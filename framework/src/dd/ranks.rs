@@ -376,6 +376,7 @@ pub(super) fn iterate<D: Family>(
     max_stages: u32,
     k: u32,
     (threads, workers): (usize, &mut super::team::Workers),
+    mut mixer: Option<&mut super::anderson::StageMixer>,
     mut converged: impl FnMut(&Sums, &GluePartial) -> bool,
 ) -> (u32, TransportStats) {
     let t0 = Instant::now();
@@ -391,23 +392,36 @@ pub(super) fn iterate<D: Family>(
     let rank_of = st.rank_of.clone();
     let mine = |k: usize| rank_of[k] == me;
     let iface = &d.iface;
+    let mine_id = |id: u32| rank_of[id as usize] == me;
     let (stages, _) = super::team::with_team(&mut d.subs, (threads, &mine), iface, workers, |team| {
         if iface.fresh.iter().any(|&f| f) {
             team.with_all(|subs| st.glue(subs, iface, scheme, true, &mut own));
         }
-        crate::solver::check_loop(max_stages, k, |check| {
+        if let Some(m) = mixer.as_deref_mut() {
+            team.with_all(|subs| m.start(subs, &mine_id));
+        }
+        let (stages, ok) = crate::solver::check_loop(max_stages, k, |check| {
             team.sweep(per, omega, check);
             team.with_all(|subs| {
                 own.clear();
                 if !iface.is_empty() {
                     st.glue(subs, iface, scheme, false, &mut own);
                 }
-                check && {
+                let done = check && {
                     let (sums, g) = st.check(subs, &own);
                     converged(&sums, &g)
+                };
+                if let (Some(m), false) = (mixer.as_deref_mut(), done) {
+                    let ns = subs.len();
+                    m.after(subs, &mine_id, &mut Reduced { st: &mut *st, ns });
                 }
+                done
             })
-        })
+        });
+        if let (Some(m), false) = (mixer.as_deref_mut(), ok) {
+            team.with_all(|subs| m.give_up(subs, &mine_id));
+        }
+        (stages, ok)
     });
     st.share_results(d);
     let t = &mut st.totals;
@@ -431,6 +445,28 @@ pub(super) fn iterate<D: Family>(
         }
     }
     (stages, st.link.stats)
+}
+
+/// The dot products of Anderson's mixing over the ranks: every subdomain's values
+/// gathered on every rank, summed in subdomain order.
+struct Reduced<'a> {
+    st: &'a mut RankState,
+    ns: usize,
+}
+
+impl crate::solver::anderson::Reduce for Reduced<'_> {
+    fn reduce(&mut self, local: &[f64], k: usize, out: &mut [f64]) {
+        if k == 0 {
+            return;
+        }
+        let t0 = Instant::now();
+        let at = self.st.counts_by(self.ns, |_| k);
+        self.st.reduced(local.len());
+        self.st.cluster.all_gather(local, &self.st.counts, &mut self.st.all);
+        let all = &self.st.all;
+        crate::solver::anderson::sum_in_order(at.iter().map(|&a| &all[a..a + k]), k, out);
+        self.st.totals.reduce_seconds += t0.elapsed().as_secs_f64();
+    }
 }
 
 /// Every rank's totals, gathered on every rank (collective), as a JSON document:

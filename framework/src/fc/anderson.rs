@@ -23,7 +23,7 @@
 use super::solve::Local;
 use super::FcOptions;
 use crate::norms::project_cone;
-use crate::solver::anderson::Mixer;
+use crate::solver::anderson::{InOrder, Mixer};
 
 /// Anderson-accelerated NLGS from `r`; returns (sweeps, converged).
 pub(crate) fn solve<const D: usize>(l: &Local<D>, r: &mut Vec<[f64; D]>, opts: &FcOptions) -> (u32, bool) {
@@ -36,7 +36,7 @@ pub(crate) fn solve<const D: usize>(l: &Local<D>, r: &mut Vec<[f64; D]>, opts: &
     let (iterations, converged) = crate::solver::check_loop(opts.max_sweeps, opts.check_every, |check| {
         g.copy_from_slice(r);
         l.b.sweep(&l.q, &l.mu, &mut g);
-        let mixing = mixer.step(r.as_flattened(), g.as_flattened());
+        let mixing = mixer.step(r.as_flattened(), g.as_flattened(), &mut InOrder);
         if mixer.f_norm() < best_f {
             best_f = mixer.f_norm();
             best.copy_from_slice(&g);

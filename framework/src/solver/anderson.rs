@@ -43,8 +43,41 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
+/// Sums over the segments of a vector split over processes: each process holds
+/// some segments (an NSCDD subdomain's unknowns), and a dot product is the sum, in
+/// global segment order, of each segment's own dot product, so that any split of
+/// the segments over processes gives bitwise the same numbers.
+pub trait Reduce {
+    /// `local[s * k + i]`: value i of this process's segment s (k values a
+    /// segment); writes into `out[..k]` the sums over every segment of every
+    /// process in global segment order ([`sum_in_order`]).
+    fn reduce(&mut self, local: &[f64], k: usize, out: &mut [f64]);
+}
+
+/// One process holding every segment.
+pub struct InOrder;
+
+impl Reduce for InOrder {
+    fn reduce(&mut self, local: &[f64], k: usize, out: &mut [f64]) {
+        if k > 0 {
+            sum_in_order(local.chunks_exact(k), k, out);
+        }
+    }
+}
+
+/// out[i] = p₀[i] + p₁[i] + … over the parts in order (0 without parts).
+pub fn sum_in_order<'a>(parts: impl Iterator<Item = &'a [f64]>, k: usize, out: &mut [f64]) {
+    out[..k].fill(0.0);
+    for (n, p) in parts.enumerate() {
+        for i in 0..k {
+            out[i] = if n == 0 { p[i] } else { out[i] + p[i] };
+        }
+    }
+}
+
 /// The mixing state: the last m differences ΔF, ΔG, the Gram matrix ΔFᵀΔF, and
-/// the previous sweep's f and G.
+/// the previous sweep's f and G; the unknowns split in segments (dot products
+/// summed over them by a [`Reduce`]).
 pub struct Mixer {
     df: Vec<Vec<f64>>,
     dg: Vec<Vec<f64>>,
@@ -56,45 +89,65 @@ pub struct Mixer {
     g_prev: Vec<f64>,
     f_norm_prev: f64,
     first: bool,
+    /// Segment offsets (one more than the segments; the last: the unknowns).
+    seg: Vec<usize>,
+    partial: Vec<f64>,
 }
 
 impl Mixer {
-    /// For n unknowns.
+    /// For n unknowns in one segment.
     pub fn new(n: usize) -> Self {
-        Mixer {
-            df: vec![vec![0.0; n]; MEMORY],
-            dg: vec![vec![0.0; n]; MEMORY],
+        let mut m = Mixer {
+            df: vec![Vec::new(); MEMORY],
+            dg: vec![Vec::new(); MEMORY],
             gram: [[0.0; MEMORY]; MEMORY],
             count: 0,
             next: 0,
-            f: vec![0.0; n],
-            f_prev: vec![0.0; n],
-            g_prev: vec![0.0; n],
+            f: Vec::new(),
+            f_prev: Vec::new(),
+            g_prev: Vec::new(),
             f_norm_prev: f64::INFINITY,
             first: true,
-        }
+            seg: Vec::new(),
+            partial: Vec::new(),
+        };
+        m.reset(&[0, n]);
+        m
     }
 
-    /// Forgets the history, for a new problem of n unknowns (the buffers kept).
-    pub fn reset(&mut self, n: usize) {
+    /// Forgets the history, for a new problem whose local unknowns are split at
+    /// `offsets` (segment s: `offsets[s]..offsets[s + 1]`); the buffers are kept.
+    pub fn reset(&mut self, offsets: &[usize]) {
+        let n = offsets.last().copied().unwrap_or(0);
         for v in self.df.iter_mut().chain(self.dg.iter_mut()) {
             v.resize(n, 0.0);
         }
         for v in [&mut self.f, &mut self.f_prev, &mut self.g_prev] {
             v.resize(n, 0.0);
         }
+        self.seg.clear();
+        self.seg.extend_from_slice(offsets);
         (self.count, self.next, self.f_norm_prev, self.first) = (0, 0, f64::INFINITY, true);
     }
 
     /// Records a sweep from `x` to `g` = G(x); returns γ (its first `count` values
-    /// used), or None when the plain sweep is to be kept.
-    pub fn step(&mut self, x: &[f64], g: &[f64]) -> Option<[f64; MEMORY]> {
+    /// used), or None when the plain sweep is to be kept. Two reductions: ‖f‖², then
+    /// the new Gram row with the right-hand side ΔFᵀf.
+    pub fn step(&mut self, x: &[f64], g: &[f64], red: &mut dyn Reduce) -> Option<[f64; MEMORY]> {
         for k in 0..x.len() {
             self.f[k] = g[k] - x[k];
         }
-        let f_norm = dot(&self.f, &self.f).sqrt();
+        self.partial.clear();
+        for w in self.seg.windows(2) {
+            let f = &self.f[w[0]..w[1]];
+            self.partial.push(dot(f, f));
+        }
+        let mut ff = [0.0];
+        red.reduce(&self.partial, 1, &mut ff);
+        let f_norm = ff[0].sqrt();
         if !self.first && f_norm > GROWTH * self.f_norm_prev {
-            self.count = 0;
+            // the history dropped: slots refill from the first (slots 0..count hold it)
+            (self.count, self.next) = (0, 0);
         } else if !self.first {
             self.push(g);
         }
@@ -105,7 +158,27 @@ impl Mixer {
         if self.count == 0 {
             return None;
         }
-        self.coefficients()
+        // the newest slot's Gram row and ΔFᵀf, one reduction
+        let (m, s) = (self.count, (self.next + MEMORY - 1) % MEMORY);
+        self.partial.clear();
+        for w in self.seg.windows(2) {
+            let r = w[0]..w[1];
+            for j in 0..m {
+                self.partial.push(dot(&self.df[s][r.clone()], &self.df[j][r.clone()]));
+            }
+            for i in 0..m {
+                self.partial.push(dot(&self.df[i][r.clone()], &self.f[r.clone()]));
+            }
+        }
+        let mut tot = [0.0; 2 * MEMORY];
+        red.reduce(&self.partial, 2 * m, &mut tot);
+        for j in 0..m {
+            self.gram[s][j] = tot[j];
+            self.gram[j][s] = tot[j];
+        }
+        let mut rhs = [0.0; MEMORY];
+        rhs[..m].copy_from_slice(&tot[m..2 * m]);
+        self.coefficients(rhs)
     }
 
     /// ‖f‖ = ‖G(x) − x‖ of the last recorded sweep.
@@ -142,22 +215,16 @@ impl Mixer {
         }
         self.count = (self.count + 1).min(MEMORY);
         self.next = (s + 1) % MEMORY;
-        for j in 0..self.count {
-            let v = dot(&self.df[s], &self.df[j]);
-            self.gram[s][j] = v;
-            self.gram[j][s] = v;
-        }
     }
 
-    /// γ = argmin ‖f − ΔF γ‖ (normal equations, Cholesky); None when singular.
-    fn coefficients(&self) -> Option<[f64; MEMORY]> {
+    /// γ = argmin ‖f − ΔF γ‖ from the Gram matrix and `g` = ΔFᵀf (normal
+    /// equations, Cholesky); None when singular.
+    fn coefficients(&self, mut g: [f64; MEMORY]) -> Option<[f64; MEMORY]> {
         let m = self.count;
         let trace: f64 = (0..m).map(|i| self.gram[i][i]).sum();
         let mut a = self.gram;
-        let mut g = [0.0; MEMORY];
         for i in 0..m {
             a[i][i] += 1e-12 * trace;
-            g[i] = dot(&self.df[i], &self.f);
         }
         // Cholesky a = L Lᵀ in place (lower triangle)
         for j in 0..m {
@@ -209,7 +276,7 @@ pub fn solve<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMas
         flat(c, &mut x);
         sweep(c, vel, inv, &[], 1.0, None);
         flat(c, &mut g);
-        let mixing = mixer.step(&x, &g);
+        let mixing = mixer.step(&x, &g, &mut InOrder);
         if mixer.f_norm() < best_f {
             best_f = mixer.f_norm();
             best.copy_from_slice(&g);
