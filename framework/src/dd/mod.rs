@@ -472,25 +472,30 @@ impl<D: Family> NscddOf<D> {
         rep.solve.sweeps = stages * per;
         write_back(d, w);
         self.store.keep(&d.subs);
-        if fams.is_empty() {
-            rep.solve.residual = D::residual(w);
-            return;
-        }
-        let (mut f2, mut q2) = D::residual_parts(w);
-        for (f, fam) in fams.iter_mut().enumerate() {
-            let parts: Vec<(u32, &dyn LocalPart<D>)> = d
-                .subs
-                .iter()
-                .flat_map(|s| s.parts.0.iter().filter(|p| p.0 == f as u32).map(|p| (s.id, &*p.1)))
-                .collect();
-            fam.write_back(w, &parts);
-        }
-        for fam in fams.iter() {
-            let (a, b) = fam.residual_parts(w);
-            (f2, q2) = (f2 + a, q2 + b);
-        }
-        rep.solve.residual = crate::solver::nlgs::residual_of(f2, q2);
+        rep.solve.residual = write_back_families(d, w, fams);
     }
+}
+
+/// The attached families' results from the subdomains' parts into `w`; returns the
+/// natural-map residual of the whole contact problem (rigid and families').
+fn write_back_families<D: Family>(d: &Decomposition<D>, w: &mut D::World, fams: &mut [&mut dyn Attached<D>]) -> f64 {
+    if fams.is_empty() {
+        return D::residual(w);
+    }
+    let (mut f2, mut q2) = D::residual_parts(w);
+    for (f, fam) in fams.iter_mut().enumerate() {
+        let parts: Vec<(u32, &dyn LocalPart<D>)> = d
+            .subs
+            .iter()
+            .flat_map(|s| s.parts.0.iter().filter(|p| p.0 == f as u32).map(|p| (s.id, &*p.1)))
+            .collect();
+        fam.write_back(w, &parts);
+    }
+    for fam in fams.iter() {
+        let (a, b) = fam.residual_parts(w);
+        (f2, q2) = (f2 + a, q2 + b);
+    }
+    crate::solver::nlgs::residual_of(f2, q2)
 }
 
 /// Global impulses and velocities from the subdomains: a body with one copy takes
