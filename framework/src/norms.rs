@@ -203,7 +203,6 @@ pub fn natural_map_sq(r: &[f64], u: &[f64], mu: f64) -> f64 {
 }
 
 /// Projection on the Coulomb cone `{ |z_t| ≤ μ z_n }`.
-#[inline]
 pub fn project_cone(z: &[f64], mu: f64) -> [f64; 3] {
     let zn = z[0];
     let zt = z[1..].iter().map(|x| x * x).sum::<f64>().sqrt();
