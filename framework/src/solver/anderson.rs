@@ -14,8 +14,11 @@
 //! least-squares problem is solved by its m × m normal equations (the Gram matrix
 //! ΔFᵀΔF kept up to date one column a sweep, Tikhonov-regularized by 1e-12 of its
 //! trace). Safeguard: when ‖f‖ grows (by more than the factor [`GROWTH`] = 1) from
-//! one sweep to the next the history is dropped and the plain sweep G(r_k) is kept,
-//! so the method is never worse than NLGS by more than the restarts. One iteration
+//! one sweep to the next, the plain sweep G(r_k) is kept and the history's count
+//! restarts; the slots keep their pairs until new ones overwrite them (slot by slot
+//! from where the history stood), so the next mixings use the oldest pairs stored
+//! — on the FCLIB files and the biaxial sample at tight tolerances this beats
+//! dropping the pairs (docs/PERFORMANCE.md). One iteration
 //! = one sweep. The same mixing drives the assembled problems of `solve-fc`
 //! (`fc::anderson`).
 
@@ -146,8 +149,10 @@ impl Mixer {
         red.reduce(&self.partial, 1, &mut ff);
         let f_norm = ff[0].sqrt();
         if !self.first && f_norm > GROWTH * self.f_norm_prev {
-            // the history dropped: slots refill from the first (slots 0..count hold it)
-            (self.count, self.next) = (0, 0);
+            // restart the count; the slots keep their pairs until overwritten, so the
+            // first mixings after a growth use the oldest pairs stored (measured
+            // against refilling from slot 0 and other safeguards: docs/PERFORMANCE.md)
+            self.count = 0;
         } else if !self.first {
             self.push(g);
         }
