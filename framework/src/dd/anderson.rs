@@ -5,8 +5,8 @@
 //! x ↦ G(x) of the iterate x = (r, F_Γ): every subdomain's contact impulses and its
 //! interface copies' net gluing impulses, subdomain after subdomain (the copies'
 //! velocities follow from them: V_E = V_free + M̂_E⁻¹ (H r + F_Γ)). The mixing of
-//! the one-domain method ([`crate::solver::anderson::Mixer`]: type II, memory 5, the
-//! history dropped when ‖G(x) − x‖ grows) takes the next iterate
+//! the one-domain method ([`crate::solver::anderson::Mixer`]: type II, memory 5, a
+//! plain stage and a restarted history when ‖G(x) − x‖ grows) takes the next iterate
 //!
 //! ```text
 //! x_{k+1} = P(G(x_k) − ΔG γ),   γ = argmin ‖f_k − ΔF γ‖
