@@ -150,7 +150,21 @@ pub(crate) fn dd_solver<D: crate::dd::Family>(
     };
     let n = c.solver_of::<D>();
     match cluster {
-        Some(cl) => n.with_cluster(cl).map(Some).map_err(RunError::Ranks),
+        Some(cl) => {
+            // MPI launchers bind each rank to one core by default: threads inside a
+            // rank then share it (the run is right, but slower than one thread)
+            let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+            if c.dd.threads > cores {
+                eprintln!(
+                    "warning: rank {} may run on {cores} core(s) for {} threads (the launcher's binding: \
+                     `mpirun --bind-to none` or `--map-by slot:PE={}` gives each rank its cores)",
+                    cl.rank(),
+                    c.dd.threads,
+                    c.dd.threads
+                );
+            }
+            n.with_cluster(cl).map(Some).map_err(RunError::Ranks)
+        }
         None => Ok(Some(n)),
     }
 }
