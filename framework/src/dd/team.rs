@@ -555,7 +555,7 @@ mod tests {
     fn thread_choice_probes_and_keeps_the_faster() {
         let mut c = ThreadChoice::default();
         assert_eq!(c.threads(5, 1), 1);
-        let mut probe = |c: &mut ThreadChoice, at: u64, one: f64, many: [f64; 2]| {
+        let probe = |c: &mut ThreadChoice, at: u64, one: f64, many: [f64; 2]| {
             assert_eq!([0, 1, 2].map(|k| c.threads(at + k, 2)), [1, 2, 2]);
             c.record(at, one, 100);
             c.record(at + 1, many[0], 100);
