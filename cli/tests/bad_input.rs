@@ -322,9 +322,15 @@ fn solver_settings_a_method_cannot_use() {
         ),
         (
             "method_relaxation",
-            "method = \"anderson\"\nrelaxation = 0.5",
+            "method = \"newton\"\nrelaxation = 0.5",
             "solver.relaxation",
             "relaxation",
+        ),
+        (
+            "method_scrambled",
+            "method = \"anderson\"\nordering = \"scrambled\"",
+            "solver.ordering",
+            "ordering",
         ),
     ] {
         let scene = edit(BASE, "[[materials]]", &format!("[solver]\n{solver}\n\n[[materials]]"));

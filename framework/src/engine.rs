@@ -73,7 +73,7 @@ impl<D: Dim> ContactStage<World<D>> for Nlgs {
             crate::solver::Method::Nlgs => {}
             // the world's own sweeps, mixed
             crate::solver::Method::Anderson => {
-                return crate::solver::anderson::solve(&mut w.contacts, &mut w.bodies.vel, &w.bodies.inv_mass, &w.solver)
+                return crate::solver::anderson::solve(&mut w.contacts, &mut w.bodies.vel, &w.bodies.inv_mass, &w.scratch.order, &w.solver)
             }
             // Newton over the assembled W
             crate::solver::Method::Newton => return crate::fc::solve_world(w),

@@ -7,8 +7,10 @@
 //! - warm start: from a solution each stops at once, and from a loose solution in
 //!   fewer iterations than from r = 0;
 //! - a budget too small is reported as not converged, never silently;
-//! - settings a method cannot use are refused naming the key (`solver.ordering`,
-//!   `solver.relaxation`, `solver.method` with bonds, Newton with NSCDD subdomains);
+//! - settings a method cannot use are refused naming the key (Newton's
+//!   `solver.ordering` and `solver.relaxation`, Anderson's `scrambled` ordering,
+//!   `solver.method` with bonds, Newton with NSCDD subdomains); Anderson honours
+//!   the other orderings and the relaxation;
 //! - Anderson over NSCDD's stages converges in fewer stages than NLGS, bitwise the
 //!   same for any thread count.
 //!
@@ -205,7 +207,8 @@ fn refused(extra_solver: &str, key: &str) {
 fn settings_a_method_cannot_use_are_refused() {
     refused("method = \"cholesky\"", "method");
     refused("method = \"newton\"\nordering = \"shuffled\"", "solver.ordering");
-    refused("method = \"anderson\"\nrelaxation = 0.8", "solver.relaxation");
+    refused("method = \"newton\"\nrelaxation = 0.8", "solver.relaxation");
+    refused("method = \"anderson\"\nordering = \"scrambled\"", "solver.ordering");
     // Newton has no place between NSCDD's gluing stages
     let text = deposit("method = \"newton\"").replace("[[materials]]", "[decomposition]\nnx = 2\nny = 1\n\n[[materials]]");
     let mut s = load(&text).unwrap();
@@ -251,6 +254,26 @@ fn anderson_mixes_the_nscdd_stages() {
     assert!(bits(&one) == bits(&two), "1 and 2 threads differ");
     let top = |s: &nscdd::scene::Scene| s.world.bodies.pos.iter().map(|p| p[1]).fold(f64::MIN, f64::max);
     assert!((top(&one) - top(&nlgs)).abs() < 1e-3, "pile tops {} vs {}", top(&one), top(&nlgs));
+}
+
+/// Anderson mixes the world's sweeps in their visiting order and relaxation: the
+/// deposit converges every step with each order and with ω = 0.8, and each order
+/// gives its own (different) iterates.
+#[test]
+fn anderson_honours_ordering_and_relaxation() {
+    let mut tops = vec![];
+    for extra in ["", "ordering = \"reversed\"", "ordering = \"shuffled\"", "relaxation = 0.8"] {
+        let mut s = load(&deposit(&format!("method = \"anderson\"\n{extra}"))).unwrap();
+        for k in 0..100 {
+            let rep = s.world.step().unwrap();
+            assert!(rep.solve.converged, "`{extra}` step {k}: {rep:?}");
+        }
+        tops.push(s.world.bodies.pos.iter().map(|p| p[1]).fold(f64::MIN, f64::max));
+    }
+    assert!(tops[1] != tops[0] && tops[2] != tops[0], "the orders are used: {tops:?}");
+    for t in &tops[1..] {
+        assert!((t - tops[0]).abs() < 1e-3, "pile tops {tops:?}");
+    }
 }
 
 /// A world stepped by each method: the one-domain stage reports LMGC90's norms and

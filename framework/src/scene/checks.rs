@@ -285,9 +285,11 @@ pub(crate) fn validate_solver(cx: &Ctx, s: &crate::solver::SolverSettings) -> Re
     if !(s.relaxation > 0.0 && s.relaxation <= 1.0) {
         return Err(cx.err(&p("relaxation"), format!("ω must lie in (0, 1], got {}", s.relaxation)));
     }
-    // Anderson and Newton sweep the assembled W in storage order, unrelaxed
+    // Newton sweeps nothing (its fallback sweeps the assembled W in storage order,
+    // unrelaxed); Anderson mixes the world's sweeps in their order and relaxation,
+    // but one map a step (no re-permutation between blocks)
     let m = s.method.name();
-    if s.method != crate::solver::Method::Nlgs {
+    if s.method == crate::solver::Method::Newton {
         if s.ordering != crate::solver::Ordering::Stored {
             let msg =
                 format!("`{m}` visits the contacts in storage order; `ordering` is an NLGS setting (remove it or use method = \"nlgs\")");
@@ -297,6 +299,13 @@ pub(crate) fn validate_solver(cx: &Ctx, s: &crate::solver::SolverSettings) -> Re
             let msg = format!("`{m}` takes unrelaxed sweeps; `relaxation` is an NLGS setting (remove it or use method = \"nlgs\")");
             return Err(cx.err(&p("relaxation"), msg));
         }
+    }
+    if s.method == crate::solver::Method::Anderson && s.ordering == crate::solver::Ordering::Scrambled {
+        let msg = format!(
+            "`{m}` mixes the iterates of one sweep map a step; `scrambled` re-permutes the contacts between blocks \
+             (use \"stored\", \"reversed\" or \"shuffled\", or method = \"nlgs\")"
+        );
+        return Err(cx.err(&p("ordering"), msg));
     }
     Ok(())
 }

@@ -253,13 +253,14 @@ impl Mixer {
 }
 
 /// The one-domain stage with `[solver] method = "anderson"`: the world's own NLGS
-/// sweeps (storage order, unrelaxed) as the map G, the mixed impulses applied to
+/// sweeps (in the step's visiting `order`, empty: storage order, with the relaxation
+/// ω of the settings) as the map G, the mixed impulses applied to
 /// the bodies contact by contact (V += M̂⁻¹ H Δr), LMGC90's check pass after every
 /// `check_every`-th iteration. No Delassus operator is assembled. A solve that
 /// does not converge ends on the last iterate or on the sweep output with the least
 /// ‖f‖ seen, whichever has the lower natural-map residual (a mixed iterate of a
 /// stagnating history can be far worse than NLGS's).
-pub fn solve<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMass], s: &SolverSettings) -> SolveReport {
+pub fn solve<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMass], order: &[u32], s: &SolverSettings) -> SolveReport {
     if c.is_empty() {
         return SolveReport {
             converged: true,
@@ -279,7 +280,7 @@ pub fn solve<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMas
     };
     let mut report = s.run_sweeps(|sums| {
         flat(c, &mut x);
-        sweep(c, vel, inv, &[], 1.0, None);
+        sweep(c, vel, inv, order, s.relaxation, None);
         flat(c, &mut g);
         let mixing = mixer.step(&x, &g, &mut InOrder);
         if mixer.f_norm() < best_f {
@@ -294,7 +295,7 @@ pub fn solve<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMas
             }
         }
         if let Some(sums) = sums {
-            check_pass(c, vel, inv, &[], 1.0, sums);
+            check_pass(c, vel, inv, order, s.relaxation, sums);
         }
     });
     report.residual = residual(c, vel);
@@ -306,7 +307,7 @@ pub fn solve<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMas
         if at_best < report.residual {
             report.residual = at_best;
             let mut sums = Sums::default();
-            check_pass(c, vel, inv, &[], 1.0, &mut sums);
+            check_pass(c, vel, inv, order, s.relaxation, &mut sums);
             report.norms = Norms::from_sums(&sums, s.tolerance);
         } else {
             set_impulses(c, vel, inv, &x);
