@@ -278,8 +278,9 @@ pub fn solve<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMas
             out[d * a..d * a + d].copy_from_slice(r.as_ref());
         }
     };
+    // x: the impulses before each sweep (kept up to date below, not re-read)
+    flat(c, &mut x);
     let mut report = s.run_sweeps(|sums| {
-        flat(c, &mut x);
         sweep(c, vel, inv, order, s.relaxation, None);
         flat(c, &mut g);
         let mixing = mixer.step(&x, &g, &mut InOrder);
@@ -287,11 +288,15 @@ pub fn solve<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMas
             best_f = mixer.f_norm();
             best.copy_from_slice(&g);
         }
-        if let Some(gamma) = mixing {
-            mixer.mix_into(&gamma, &g, &mut z);
-            for a in 0..c.len() {
-                let p = project_cone(&z[d * a..d * a + d], c.target[a].mu);
-                c.set_r(a, &p, vel, inv);
+        match mixing {
+            None => std::mem::swap(&mut x, &mut g),
+            Some(gamma) => {
+                mixer.mix_into(&gamma, &g, &mut z);
+                for a in 0..c.len() {
+                    let p = project_cone(&z[d * a..d * a + d], c.target[a].mu);
+                    c.set_r(a, &p, vel, inv);
+                    x[d * a..d * a + d].copy_from_slice(c.r[a].as_ref());
+                }
             }
         }
         if let Some(sums) = sums {
