@@ -14,6 +14,15 @@
 //! cells (no hashing). A pair is `[i, j]` with i < j; pairs are sorted by kind pair,
 //! then by bodies: the order of the raw contacts depends on the scene only, never
 //! on the grid. Pairs of two bodies that impulses cannot move are skipped.
+//!
+//! A [`Region`] restricts detection to one part of space (a rank's subdomains, once
+//! ranks hold only their part: docs/SCALING.md): only the bodies whose box, grown by
+//! the alert distance, meets the region enter the broad phase, and a pair is kept
+//! when the intersection of its two grown boxes meets the region (or the region
+//! names the pair). A contact point lies in both bodies' boxes grown by the alert
+//! distance, so every contact whose point is in the region is found; and since pairs
+//! are sorted by kind pair and bodies, the result is the whole detection's list
+//! restricted to the kept pairs, in the same order.
 
 use crate::dim::Dim;
 use crate::model::Bodies;
@@ -45,6 +54,25 @@ impl<D: Dim> Clone for DetectorTable<D> {
     }
 }
 
+/// A part of space for [`Detector::detect`]: a union of axis-aligned boxes (bounds
+/// may be infinite; coordinates past the dimension ignored), and pairs of bodies
+/// kept wherever they are (sorted, `[i, j]` with i < j).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Region {
+    pub boxes: Vec<[[f64; 3]; 2]>,
+    pub pairs: Vec<[u32; 2]>,
+}
+
+impl Region {
+    /// Whether the box `[lo, hi]` (first `n` coordinates) meets one of the boxes.
+    pub fn meets(&self, n: usize, lo: &[f64], hi: &[f64]) -> bool {
+        self.boxes.iter().any(|b| (0..n).all(|k| lo[k] <= b[1][k] && b[0][k] <= hi[k]))
+    }
+    fn names(&self, i: u32, j: u32) -> bool {
+        self.pairs.binary_search(&[i, j]).is_ok()
+    }
+}
+
 /// Reusable buffers of the detection stage (no allocation once warmed up).
 pub struct Detector<D: Dim> {
     aabb: Vec<Aabb<D>>,
@@ -56,6 +84,8 @@ pub struct Detector<D: Dim> {
     fill: Vec<u32>,
     pairs: Vec<(u32, [u32; 2])>,
     batch: Vec<[u32; 2]>,
+    /// With a region: whether each body enters the broad phase.
+    inside: Vec<bool>,
 }
 
 impl<D: Dim> Default for Detector<D> {
@@ -70,6 +100,7 @@ impl<D: Dim> Default for Detector<D> {
             fill: vec![],
             pairs: vec![],
             batch: vec![],
+            inside: vec![],
         }
     }
 }
@@ -108,9 +139,22 @@ impl<D: Dim> Detector<D> {
         alert: f64,
         out: &mut Vec<RawContact<D>>,
     ) {
+        self.detect_in(bodies, shapes, table, alert, None, out)
+    }
+
+    /// [`Detector::detect`] restricted to `region` (None: everywhere).
+    pub fn detect_in(
+        &mut self,
+        bodies: &Bodies<D>,
+        shapes: &[Box<dyn ShapeStore<D>>],
+        table: &DetectorTable<D>,
+        alert: f64,
+        region: Option<&Region>,
+        out: &mut Vec<RawContact<D>>,
+    ) {
         out.clear();
         let nk = table.nk;
-        self.broad_phase(bodies, shapes, alert, nk);
+        self.broad_phase(bodies, shapes, alert, nk, region);
         let mut p = 0;
         while p < self.pairs.len() {
             let key = self.pairs[p].0;
@@ -135,7 +179,7 @@ impl<D: Dim> Detector<D> {
 
     /// Candidate pairs whose boxes overlap within `alert`, sorted by kind pair and
     /// bodies.
-    fn broad_phase(&mut self, bodies: &Bodies<D>, shapes: &[Box<dyn ShapeStore<D>>], alert: f64, nk: usize) {
+    fn broad_phase(&mut self, bodies: &Bodies<D>, shapes: &[Box<dyn ShapeStore<D>>], alert: f64, nk: usize, region: Option<&Region>) {
         self.aabb.clear();
         self.small.clear();
         self.large.clear();
@@ -144,9 +188,13 @@ impl<D: Dim> Detector<D> {
             let s = bodies.shape[b];
             self.aabb.push(shapes[s.kind as usize].aabb(s.index, bodies.pos[b], bodies.rot[b]));
         }
+        self.mark_inside(region, alert);
         let mut cell = self.cell_size(alert);
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for (b, a) in self.aabb.iter().enumerate() {
+            if !self.inside[b] {
+                continue;
+            }
             if !a.is_bounded() || a.extent() > LARGE_CELLS as f64 * cell {
                 self.large.push(b as u32);
             } else {
@@ -158,7 +206,16 @@ impl<D: Dim> Detector<D> {
             }
         }
         let kind = |b: u32| bodies.shape[b as usize].kind as u32;
-        let movable = |b: u32| bodies.movable(b as usize);
+        // both bodies movable by impulses or one of them, and the pair in the region
+        let wanted = |aabb: &[Aabb<D>], a: u32, b: u32| {
+            (bodies.movable(a as usize) || bodies.movable(b as usize))
+                && region.is_none_or(|r| {
+                    let (x, y) = (&aabb[a as usize], &aabb[b as usize]);
+                    let lo: [f64; 3] = std::array::from_fn(|k| if k < D::N { x.min[k].max(y.min[k]) - alert } else { 0.0 });
+                    let hi: [f64; 3] = std::array::from_fn(|k| if k < D::N { x.max[k].min(y.max[k]) + alert } else { 0.0 });
+                    r.meets(D::N, &lo, &hi) || r.names(a.min(b), a.max(b))
+                })
+        };
         let key = |a: u32, b: u32| kind(a) * nk as u32 + kind(b);
         if !self.small.is_empty() {
             // keep the number of cells O(N)
@@ -175,7 +232,7 @@ impl<D: Dim> Detector<D> {
                     let ba = &self.aabb[a as usize];
                     for &b in &items[p + 1..] {
                         let bb = &self.aabb[b as usize];
-                        if !(movable(a) || movable(b)) || !ba.overlaps(bb, alert) {
+                        if !ba.overlaps(bb, alert) || !wanted(&self.aabb, a, b) {
                             continue;
                         }
                         // the pair's home cell: lower corner of the extended boxes' intersection
@@ -192,7 +249,7 @@ impl<D: Dim> Detector<D> {
         for (p, &a) in self.large.iter().enumerate() {
             let ba = self.aabb[a as usize];
             for &b in self.small.iter().chain(&self.large[p + 1..]) {
-                if (movable(a) || movable(b)) && ba.overlaps(&self.aabb[b as usize], alert) {
+                if ba.overlaps(&self.aabb[b as usize], alert) && wanted(&self.aabb, a, b) {
                     let (i, j) = if a < b { (a, b) } else { (b, a) };
                     self.pairs.push((key(i, j), [i, j]));
                 }
@@ -200,6 +257,28 @@ impl<D: Dim> Detector<D> {
         }
         // group by kind pair, then by bodies: a deterministic order
         self.pairs.sort_unstable();
+    }
+
+    /// Which bodies enter the broad phase: all, or those whose box grown by `alert`
+    /// meets the region, and the bodies of the pairs it names.
+    fn mark_inside(&mut self, region: Option<&Region>, alert: f64) {
+        self.inside.clear();
+        let Some(r) = region else {
+            self.inside.resize(self.aabb.len(), true);
+            return;
+        };
+        self.inside.extend(self.aabb.iter().map(|a| {
+            let lo: [f64; 3] = std::array::from_fn(|k| if k < D::N { a.min[k] - alert } else { 0.0 });
+            let hi: [f64; 3] = std::array::from_fn(|k| if k < D::N { a.max[k] + alert } else { 0.0 });
+            r.meets(D::N, &lo, &hi)
+        }));
+        for p in &r.pairs {
+            for &b in p {
+                if let Some(x) = self.inside.get_mut(b as usize) {
+                    *x = true;
+                }
+            }
+        }
     }
 
     /// Median extent of the bounded boxes plus the alert distance (1 if none).

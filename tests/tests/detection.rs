@@ -94,3 +94,63 @@ fn grid_matches_brute_force_radii_spread_1_to_100() {
     disks.extend((0..6).map(|_| ([rng.random_range(0.0..1.0), rng.random_range(0.0..1.0)], 0.2)));
     check(disks, 0.001);
 }
+
+/// Detection restricted to a region (what a rank will detect once ranks hold only
+/// their part): the whole detection's list restricted, in the same order; every
+/// contact whose point is in the region; and the pairs the region names, wherever
+/// they are.
+#[test]
+fn detection_in_a_region_is_the_whole_list_restricted() {
+    use nscdd::detect::{Detector, Region};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    let mut disks: Vec<_> = (0..1200)
+        .map(|_| {
+            (
+                [rng.random_range(0.0..1.0), rng.random_range(0.0..0.6)],
+                rng.random_range(0.004..0.012),
+            )
+        })
+        .collect();
+    disks.extend((0..4).map(|_| ([rng.random_range(0.0..1.0), rng.random_range(0.0..0.6)], 0.1)));
+    let reg = nscdd_rigid_disks::registry();
+    let s = load_str(&scene(&disks, 0.003), "detect.toml", &reg).unwrap_or_else(|e| panic!("{e}"));
+    let w = &s.world;
+    let key = |c: &nscdd::shape::RawContact<nscdd::dim::D2>| (c.i, c.j, c.feature);
+    let mut all = Vec::new();
+    Detector::default().detect(&w.bodies, &w.shapes, &w.detectors, w.alert, &mut all);
+    assert!(all.len() > 1000, "{}", all.len());
+    let inf = f64::INFINITY;
+    // two cells of a 2 × 2 grid at x = 0.5, y = 0.3 (edge cells unbounded), and a far pair
+    let far = all
+        .iter()
+        .find(|c| c.point[0] > 0.8 && c.point[1] > 0.5 && c.j > 1)
+        .map(|c| [c.i.min(c.j), c.i.max(c.j)]);
+    let region = Region {
+        boxes: vec![[[-inf, -inf, 0.0], [0.5, 0.3, 0.0]], [[0.5, 0.3, 0.0], [inf, inf, 0.0]]],
+        pairs: far.into_iter().collect(),
+    };
+    let inside = |p: &[f64; 2]| (p[0] <= 0.5 && p[1] <= 0.3) || (p[0] >= 0.5 && p[1] >= 0.3);
+    let mut part = Vec::new();
+    let mut det = Detector::default();
+    det.detect_in(&w.bodies, &w.shapes, &w.detectors, w.alert, Some(&region), &mut part);
+    // a subsequence of the whole list, each contact identical
+    let mut k = 0;
+    for c in &part {
+        while k < all.len() && key(&all[k]) != key(c) {
+            k += 1;
+        }
+        assert!(k < all.len(), "{:?} not in the whole list (or out of order)", key(c));
+        assert_eq!(&all[k], c);
+    }
+    // every contact whose point is in the region, and the named pair
+    for c in all.iter().filter(|c| inside(&c.point)) {
+        assert!(part.iter().any(|x| key(x) == key(c)), "{:?} at {:?} missed", key(c), c.point);
+    }
+    let far = far.expect("a contact in the far corner");
+    assert!(part.iter().any(|c| [c.i.min(c.j), c.i.max(c.j)] == far));
+    let kept = part.len() as f64 / all.len() as f64;
+    assert!(kept < 0.65, "the region keeps {kept} of the contacts");
+    // the same detector again, everywhere: the whole list
+    det.detect(&w.bodies, &w.shapes, &w.detectors, w.alert, &mut part);
+    assert_eq!(part, all);
+}
