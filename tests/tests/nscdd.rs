@@ -405,6 +405,30 @@ fn one_subdomain_is_the_plain_engine_with_every_ordering() {
     }
 }
 
+/// `shuffled` with subdomains: each subdomain permutes its own contacts (seeded by
+/// the step and its id, so that a rank needs no other subdomain's contacts), and the
+/// result does not depend on the threads.
+#[test]
+fn shuffled_permutes_each_subdomain_on_its_own() {
+    let run = |threads: usize| {
+        let mut s = loaded(0.3);
+        s.world.solver.ordering = nscdd::solver::Ordering::Shuffled;
+        let mut n = Nscdd::new(DdSettings { threads, ..dd(2, 2) });
+        let reps: Vec<_> = (0..3).map(|_| dd_step(&mut n, &mut s).solve.sweeps).collect();
+        (s, n, reps)
+    };
+    let (a, n, ra) = run(1);
+    let (b, _, rb) = run(2);
+    same_state(&a, &b, "shuffled, 1 and 2 threads");
+    assert_eq!(ra, rb);
+    for sub in &n.last.subs {
+        let mut o = sub.order.clone();
+        o.sort_unstable();
+        assert_eq!(o, (0..sub.contact_global.len() as u32).collect::<Vec<_>>(), "subdomain {}", sub.id);
+        assert!(sub.order.windows(2).any(|w| w[1] != w[0] + 1), "subdomain {}: not permuted", sub.id);
+    }
+}
+
 #[test]
 fn interface_impulses_are_kept_between_steps() {
     let mut s = loaded(0.3);

@@ -69,10 +69,14 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     fn vel_mut(w: &mut Self::World) -> &mut [Self::V];
     /// The step's visiting order of the contacts (empty: storage order).
     fn order(w: &Self::World) -> &[u32];
+    /// Steps completed (the step being computed, during a step).
+    fn step(w: &Self::World) -> u64;
     /// Natural-map residual of the world's contact problem.
     fn residual(w: &Self::World) -> f64;
     /// Its squared sums (‖F(r)‖², ‖q‖²), to add an attached family's.
     fn residual_parts(w: &Self::World) -> (f64, f64);
+    /// The squared sums over the contacts `which` (one subdomain's), in that order.
+    fn residual_parts_in(w: &Self::World, which: &[u32]) -> (f64, f64);
     fn solver(w: &Self::World) -> &crate::solver::SolverSettings;
     /// One step of the world with NSCDD as its contact stage.
     fn step_with(w: &mut Self::World, stage: &mut super::Stage<'_, '_, Self>) -> Result<StepReport, Diverged>;
@@ -180,6 +184,9 @@ impl<D: Dim> Family for Rigid<D> {
     fn order(w: &Self::World) -> &[u32] {
         &w.scratch.order
     }
+    fn step(w: &Self::World) -> u64 {
+        w.step
+    }
     fn residual(w: &Self::World) -> f64 {
         nlgs::residual(&w.contacts, &w.bodies.vel)
     }
@@ -188,6 +195,9 @@ impl<D: Dim> Family for Rigid<D> {
     }
     fn residual_parts(w: &Self::World) -> (f64, f64) {
         nlgs::residual_parts(&w.contacts, &w.bodies.vel)
+    }
+    fn residual_parts_in(w: &Self::World, which: &[u32]) -> (f64, f64) {
+        nlgs::residual_parts_of(&w.contacts, &w.bodies.vel, which.iter().map(|&a| a as usize))
     }
     fn step_with(w: &mut Self::World, stage: &mut super::Stage<'_, '_, Self>) -> Result<StepReport, Diverged> {
         w.step_with(stage)

@@ -477,12 +477,15 @@ impl<D: Family> NscddOf<D> {
 }
 
 /// The attached families' results from the subdomains' parts into `w`; returns the
-/// natural-map residual of the whole contact problem (rigid and families').
+/// natural-map residual of the whole contact problem (rigid and families'), its sums
+/// taken per subdomain and added in subdomain order.
 fn write_back_families<D: Family>(d: &Decomposition<D>, w: &mut D::World, fams: &mut [&mut dyn Attached<D>]) -> f64 {
-    if fams.is_empty() {
-        return D::residual(w);
+    // each subdomain's sums, added in subdomain order (whichever rank holds it)
+    let (mut f2, mut q2) = (0.0, 0.0);
+    for s in &d.subs {
+        let (a, b) = D::residual_parts_in(w, &s.contact_global);
+        (f2, q2) = (f2 + a, q2 + b);
     }
-    let (mut f2, mut q2) = D::residual_parts(w);
     for (f, fam) in fams.iter_mut().enumerate() {
         let parts: Vec<(u32, &dyn LocalPart<D>)> = d
             .subs

@@ -225,7 +225,9 @@ pub struct FamilyOwners<'a, 'f, D: Family> {
 /// Splits the contact set of `w` over the `ns` subdomains given by `owner` (one per
 /// contact, each below `ns`), and the attached families' contacts by theirs;
 /// copies start at V_free + M̂_E⁻¹(F_Γ + H_E r).
-/// The world's visiting order (empty: storage order) is restricted to each subdomain.
+/// Each subdomain visits its contacts in the scene's `ordering` of its own
+/// (`nlgs::make_order_of`: storage order, reversed, or a permutation seeded by the
+/// step and the subdomain id), which needs no other subdomain's contacts.
 /// With `build`, only the subdomains it marks get their copies' M̂_E⁻¹, W_αα and
 /// starting velocities (the others are swept by another process: their structure
 /// alone is kept, for the exchange of results; no attached family then).
@@ -242,14 +244,14 @@ pub fn decompose_owned<D: Family>(
 ) -> Decomposition<D> {
     let built = |s: u32| build.is_none_or(|b| b[s as usize]);
     let c = D::contacts(w);
-    let order = D::order(w);
     let nb = D::n_bodies(w);
     let (mut subs, mut mult, mut copy_of) = split_contacts::<D>(c, &owner, ns, nb);
     let ent_copies = split_families(w, &mut subs, &mut mult, &mut copy_of, fam);
-    // copies' M̂_E⁻¹ and W_αα; the visiting order restricted to each subdomain
-    let mut local_of = vec![0u32; D::len(c)];
+    // copies' M̂_E⁻¹ and W_αα; each subdomain's visiting order
+    let (sv, step) = (D::solver(w), D::step(w));
     for sub in subs.iter_mut() {
         if built(sub.id) {
+            crate::solver::nlgs::make_order_of(&mut sub.order, sub.contact_global.len(), sv, step, sub.id as u64);
             sub.inv_mass = sub
                 .body_global
                 .iter()
@@ -262,12 +264,6 @@ pub fn decompose_owned<D: Family>(
                 p.prepare(inv_mass, &m);
             }
         }
-        for (la, &ga) in sub.contact_global.iter().enumerate() {
-            local_of[ga as usize] = la as u32;
-        }
-    }
-    for &a in order {
-        subs[owner[a as usize] as usize].order.push(local_of[a as usize]);
     }
     // interface bodies: copies grouped by body, in subdomain order
     copy_of.sort_unstable_by_key(|e| (e.0, e.1));

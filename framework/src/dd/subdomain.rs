@@ -34,7 +34,8 @@ pub struct Subdomain<D: Family> {
     pub contacts: D::Contacts,
     /// Global index of each local contact.
     pub contact_global: Vec<u32>,
-    /// Visiting order (local ids; empty: storage order), the global order restricted.
+    /// Visiting order (local ids; empty: storage order): `nlgs::make_order_of` of the
+    /// subdomain.
     pub order: Vec<u32>,
     /// Global id of each local body copy.
     pub body_global: Vec<u32>,

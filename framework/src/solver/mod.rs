@@ -15,7 +15,8 @@ pub enum Ordering {
     Stored,
     /// Reversed storage order.
     Reversed,
-    /// A random permutation drawn once per step from `seed` and the step number.
+    /// A random permutation drawn once per step from `seed` and the step number
+    /// (NSCDD: one per subdomain, also from its id; `nlgs::make_order_of`).
     Shuffled,
     /// LMGC90's "quick scramble": a new random permutation before every block of
     /// `check_every` sweeps (one-domain NLGS).

@@ -51,6 +51,13 @@ use rand::SeedableRng;
 /// Fills `order` with the visiting order of this step's contacts (left empty for
 /// storage order).
 pub fn make_order(order: &mut Vec<u32>, n: usize, s: &SolverSettings, step: u64) {
+    make_order_of(order, n, s, step, 0)
+}
+
+/// [`make_order`] for part `part` of a step's contacts (NSCDD's subdomain `part`):
+/// its own permutation for `shuffled`, seeded by the step and the part (part 0: the
+/// one-domain permutation), so that a subdomain's order needs only its own contacts.
+pub fn make_order_of(order: &mut Vec<u32>, n: usize, s: &SolverSettings, step: u64, part: u64) {
     order.clear();
     match s.ordering {
         // empty: storage order, visited without indirection
@@ -58,7 +65,9 @@ pub fn make_order(order: &mut Vec<u32>, n: usize, s: &SolverSettings, step: u64)
         Ordering::Reversed => order.extend((0..n as u32).rev()),
         Ordering::Shuffled | Ordering::Scrambled => {
             order.extend(0..n as u32);
-            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(s.seed ^ step.wrapping_mul(0x9E37_79B9_7F4A_7C15));
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(
+                s.seed ^ step.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ part.wrapping_mul(0xC2B2_AE3D_27D4_EB4F),
+            );
             order.shuffle(&mut rng);
         }
     }
@@ -236,8 +245,14 @@ pub fn residual_of(f2: f64, q2: f64) -> f64 {
 /// The squared sums (‖F(r)‖², ‖q‖²) of [`residual`], for problems that add other
 /// contacts to these.
 pub fn residual_parts<D: Dim>(c: &Contacts<D>, vel: &[D::Twist]) -> (f64, f64) {
+    residual_parts_of(c, vel, 0..c.len())
+}
+
+/// [`residual_parts`] over the contacts `which`, summed in that order (NSCDD: one
+/// subdomain's, so that the sums can be added in subdomain order whoever holds them).
+pub fn residual_parts_of<D: Dim>(c: &Contacts<D>, vel: &[D::Twist], which: impl Iterator<Item = usize>) -> (f64, f64) {
     let (mut f2, mut q2) = (0.0, 0.0);
-    for a in 0..c.len() {
+    for a in which {
         let t = c.target[a];
         let mut u = c.local_velocity(a, vel);
         u[0] -= t.u_target;
