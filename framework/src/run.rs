@@ -214,10 +214,12 @@ pub fn run<D: Dim>(
     run_on(scene, registry, dir, None, on_step)
 }
 
-/// The writers of a run (rank 0 only).
+/// The writers of a run: on rank 0 all of them, on the other MPI ranks the VTK
+/// writer alone (each rank writes its piece of a frame).
 fn writers<D: Dim>(scene: &Scene<D>, registry: &Registry, root: bool) -> Vec<Box<dyn Writer<D>>> {
     let mut out: Vec<Box<dyn Writer<D>>> = vec![];
     if !root {
+        out.extend(scene.output.vtk.then(|| registry.writer::<D>("vtk")).flatten().map(|make| make()));
         return out;
     }
     let names = scene
@@ -294,7 +296,8 @@ fn scene_solver<D: Dim>(scene: &mut Scene<D>, cluster: Option<Box<dyn crate::dd:
 
 /// [`run`], as one rank of a multi-process run when `cluster` is given: every rank
 /// steps the whole world and sweeps its subdomains ([`crate::dd::ranks`]); rank 0
-/// writes the outputs (the same files as one process, and `ranks.json`). A scene's
+/// writes the outputs (the same files as one process, and `ranks.json`), except the
+/// VTK frames, of which every rank writes its piece (`.pvtp` by rank 0). A scene's
 /// body families ([`crate::family`]) step with the world, add their history columns
 /// and VTK frames, and save their state in `final.json` and the checkpoints.
 pub fn run_on<D: Dim>(

@@ -131,3 +131,32 @@ impl<F: Family> std::fmt::Debug for Parts<F> {
         write!(f, "Parts(family, contacts) {n:?}")
     }
 }
+
+/// The attached families' results from the subdomains' parts into `w`; returns the
+/// natural-map residual of the whole contact problem (rigid and families'), its sums
+/// taken per subdomain and added in subdomain order.
+pub(super) fn write_back_families<D: Family>(
+    d: &super::partition::Decomposition<D>,
+    w: &mut D::World,
+    fams: &mut [&mut dyn Attached<D>],
+) -> f64 {
+    // each subdomain's sums, added in subdomain order (whichever rank holds it)
+    let (mut f2, mut q2) = (0.0, 0.0);
+    for s in &d.subs {
+        let (a, b) = D::residual_parts_in(w, &s.contact_global);
+        (f2, q2) = (f2 + a, q2 + b);
+    }
+    for (f, fam) in fams.iter_mut().enumerate() {
+        let parts: Vec<(u32, &dyn LocalPart<D>)> = d
+            .subs
+            .iter()
+            .flat_map(|s| s.parts.0.iter().filter(|p| p.0 == f as u32).map(|p| (s.id, &*p.1)))
+            .collect();
+        fam.write_back(w, &parts);
+    }
+    for fam in fams.iter() {
+        let (a, b) = fam.residual_parts(w);
+        (f2, q2) = (f2 + a, q2 + b);
+    }
+    crate::solver::nlgs::residual_of(f2, q2)
+}

@@ -65,7 +65,7 @@ pub use cluster::{Cluster, Solo};
 pub use family::{Family, Rigid, Rigid2, Rigid3};
 pub use partition::{Decomposition, FGammaStore, FamilyOwners, Grid, Interface};
 pub use ranks::RankState;
-pub use report::{DdStepReport, DdView, Prevailing};
+pub use report::{DdStepReport, DdView, Piece, Prevailing};
 pub use schemes::Scheme;
 pub use subdomain::{Subdomain, Subdomain2, Subdomain3, SubdomainSolver};
 pub use transport::{InProcess, Transport, TransportStats};
@@ -280,6 +280,11 @@ impl<D: Family> NscddOf<D> {
             body_subdomain: vec![-1; nb],
             multiplicity: (0..nb).map(|b| d.mult.get(b).copied().unwrap_or(0)).collect(),
             contact_subdomain: Vec::new(),
+            piece: self.ranks.as_ref().map(|rs| Piece {
+                rank: rs.cluster.rank(),
+                ranks: rs.cluster.size(),
+                rank_of: rs.rank_of.clone(),
+            }),
         };
         if d.owner.len() != D::len(c) {
             return v;
@@ -472,33 +477,8 @@ impl<D: Family> NscddOf<D> {
         rep.solve.sweeps = stages * per;
         write_back(d, w);
         self.store.keep(&d.subs);
-        rep.solve.residual = write_back_families(d, w, fams);
+        rep.solve.residual = attach::write_back_families(d, w, fams);
     }
-}
-
-/// The attached families' results from the subdomains' parts into `w`; returns the
-/// natural-map residual of the whole contact problem (rigid and families'), its sums
-/// taken per subdomain and added in subdomain order.
-fn write_back_families<D: Family>(d: &Decomposition<D>, w: &mut D::World, fams: &mut [&mut dyn Attached<D>]) -> f64 {
-    // each subdomain's sums, added in subdomain order (whichever rank holds it)
-    let (mut f2, mut q2) = (0.0, 0.0);
-    for s in &d.subs {
-        let (a, b) = D::residual_parts_in(w, &s.contact_global);
-        (f2, q2) = (f2 + a, q2 + b);
-    }
-    for (f, fam) in fams.iter_mut().enumerate() {
-        let parts: Vec<(u32, &dyn LocalPart<D>)> = d
-            .subs
-            .iter()
-            .flat_map(|s| s.parts.0.iter().filter(|p| p.0 == f as u32).map(|p| (s.id, &*p.1)))
-            .collect();
-        fam.write_back(w, &parts);
-    }
-    for fam in fams.iter() {
-        let (a, b) = fam.residual_parts(w);
-        (f2, q2) = (f2 + a, q2 + b);
-    }
-    crate::solver::nlgs::residual_of(f2, q2)
 }
 
 /// Global impulses and velocities from the subdomains: a body with one copy takes

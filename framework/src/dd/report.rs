@@ -78,4 +78,32 @@ pub struct DdView {
     pub multiplicity: Vec<u32>,
     /// Subdomain of each contact of the world's contact set.
     pub contact_subdomain: Vec<u32>,
+    /// On MPI ranks: this process's part of the outputs.
+    pub piece: Option<Piece>,
+}
+
+/// A rank's part of a decomposed run's outputs: the contacts of its subdomains, the
+/// bodies whose [`DdView::body_subdomain`] is one of them (rank 0 also those without
+/// contacts), written as its piece of each frame (`vtk/NAME_NNNNNN_RANK.vtp`, with
+/// rank 0's `.pvtp` naming every piece).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Piece {
+    pub rank: u32,
+    pub ranks: u32,
+    /// The rank of each subdomain.
+    pub rank_of: Vec<u32>,
+}
+
+impl Piece {
+    /// Whether a body of subdomain `s` (−1: no contacts) is in this piece.
+    pub fn has_body(&self, s: i32) -> bool {
+        match self.rank_of.get(s.max(0) as usize) {
+            Some(&r) if s >= 0 => r == self.rank,
+            _ => self.rank == 0,
+        }
+    }
+    /// Whether a contact of subdomain `s` is in this piece.
+    pub fn has_contact(&self, s: u32) -> bool {
+        self.rank_of.get(s as usize).map_or(self.rank == 0, |&r| r == self.rank)
+    }
 }
