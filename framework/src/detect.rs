@@ -86,6 +86,8 @@ pub struct Detector<D: Dim> {
     batch: Vec<[u32; 2]>,
     /// With a region: whether each body enters the broad phase.
     inside: Vec<bool>,
+    /// Per small body: the cell of its box's lower corner grown by the alert distance.
+    low: Vec<[u32; 3]>,
 }
 
 impl<D: Dim> Default for Detector<D> {
@@ -101,6 +103,7 @@ impl<D: Dim> Default for Detector<D> {
             pairs: vec![],
             batch: vec![],
             inside: vec![],
+            low: vec![],
         }
     }
 }
@@ -232,12 +235,15 @@ impl<D: Dim> Detector<D> {
                     let ba = &self.aabb[a as usize];
                     for &b in &items[p + 1..] {
                         let bb = &self.aabb[b as usize];
-                        if !ba.overlaps(bb, alert) || !wanted(&self.aabb, a, b) {
+                        if !ba.overlaps(bb, alert) {
                             continue;
                         }
-                        // the pair's home cell: lower corner of the extended boxes' intersection
-                        let home = grid.cell_of(D::N, |k| ba.min[k].max(bb.min[k]) - alert);
-                        if grid.flat(home) == c {
+                        // the pair's home cell: that of the lower corner of the extended boxes'
+                        // intersection, max(min_a, min_b) − alert; cells are monotone in the
+                        // coordinates, so it is the larger of the two bodies' lower cells
+                        let (la, lb) = (self.low[a as usize], self.low[b as usize]);
+                        let home = std::array::from_fn(|k| la[k].max(lb[k]) as usize);
+                        if grid.flat(home) == c && wanted(&self.aabb, a, b) {
                             let (i, j) = if a < b { (a, b) } else { (b, a) };
                             self.pairs.push((key(i, j), [i, j]));
                         }
@@ -301,9 +307,11 @@ impl<D: Dim> Detector<D> {
     /// over cells (stable: bodies stay in id order inside a cell).
     fn bucket(&mut self, grid: &Grid, alert: f64) {
         self.entries.clear();
+        self.low.resize(self.aabb.len(), [0; 3]);
         for &b in &self.small {
             let a = &self.aabb[b as usize];
             let c0 = grid.cell_of(D::N, |k| a.min[k] - alert);
+            self.low[b as usize] = c0.map(|x| x as u32);
             let c1 = grid.cell_of(D::N, |k| a.max[k]);
             for z in c0[2]..=c1[2] {
                 for y in c0[1]..=c1[1] {
