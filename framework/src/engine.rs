@@ -60,6 +60,11 @@ pub trait ContactStage<W> {
     fn prepare(&mut self, _w: &mut W) {}
     /// Solves the contact problem: V⁺ in the bodies' velocities, r in the contacts.
     fn solve(&mut self, w: &mut W) -> SolveReport;
+    /// Sets the per-body reactions itself (NSCDD: per subdomain, added in subdomain
+    /// order) and returns true; false: the engine sums them over the world's contacts.
+    fn reactions(&mut self, _w: &mut W) -> bool {
+        false
+    }
 }
 
 /// The one-domain stage: NLGS, Anderson-accelerated NLGS over the same sweeps
@@ -111,8 +116,9 @@ impl<D: Dim> World<D> {
         let t2 = Instant::now();
         rep.solve = stage.solve(self);
         update_joints(self);
+        let own_reactions = stage.reactions(self);
         let t3 = Instant::now();
-        update_positions(self)?;
+        update_positions_with(self, !own_reactions)?;
         let t4 = Instant::now();
         rep.contacts = self.contacts.len();
         rep.times = StageTimes {
@@ -325,12 +331,20 @@ pub fn update_joints<D: Dim>(w: &mut World<D>) {
 
 /// q⁺ = q⁻ + h((1 − θ)V⁻ + θV⁺); the per-body reactions; the divergence check.
 pub fn update_positions<D: Dim>(w: &mut World<D>) -> Result<(), Diverged> {
+    update_positions_with(w, true)
+}
+
+/// [`update_positions`], the reactions summed over the world's contacts when
+/// `reactions` (else the contact stage set them).
+fn update_positions_with<D: Dim>(w: &mut World<D>, reactions: bool) -> Result<(), Diverged> {
     let (h, theta) = (w.time.h, w.time.theta);
     let b = &mut w.bodies;
     if let Err(k) = crate::step::integrate(b, &w.scratch.v_begin, h, theta) {
         return Err(Diverged::non_finite(w.step + 1, k, w.body_label(k), &w.bodies));
     }
-    crate::step::reactions(&w.contacts, w.bodies.len(), &mut w.reaction);
+    if reactions {
+        crate::step::reactions(&w.contacts, w.bodies.len(), &mut w.reaction);
+    }
     w.step += 1;
     w.t = w.step as f64 * h;
     if let (Some(bw), None) = (&w.box_walls, w.box_h0) {

@@ -48,6 +48,12 @@ pub fn integrate<D: Dim>(b: &mut Bodies<D>, v_begin: &[D::Twist], h: f64, theta:
 pub fn reactions<D: Dim>(c: &Contacts<D>, n_bodies: usize, reaction: &mut Vec<D::Twist>) {
     reaction.clear();
     reaction.resize(n_bodies, D::Twist::zero());
+    add_reactions(c, reaction);
+}
+
+/// Adds Σ ±H r of the contacts `c` to `reaction` (indexed by the contacts' body ids),
+/// in storage order.
+pub fn add_reactions<D: Dim>(c: &Contacts<D>, reaction: &mut [D::Twist]) {
     for a in 0..c.len() {
         let [i, j] = c.bodies[a];
         let (f, r) = (&c.frame[a], &c.r[a]);

@@ -89,6 +89,7 @@ density = 1000.0
 materials = ["m", "m"]
 friction = 0.3
 [[bodies]]
+name = "floor"
 shape = "wall"
 material = "m"
 position = [0.16, -0.005]

@@ -77,6 +77,12 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     fn residual_parts(w: &Self::World) -> (f64, f64);
     /// The squared sums over the contacts `which` (one subdomain's), in that order.
     fn residual_parts_in(w: &Self::World, which: &[u32]) -> (f64, f64);
+    /// Adds the contacts' Σ ±H r to `out` (indexed by the contacts' body ids).
+    fn add_reactions(c: &Self::Contacts, out: &mut [Self::V]);
+    /// The world's per-body reactions, and the bodies whose reactions are observed
+    /// (ascending: outputs and drives read them).
+    fn reactions_mut(w: &mut Self::World) -> &mut Vec<Self::V>;
+    fn observed(w: &Self::World) -> Vec<u32>;
     fn solver(w: &Self::World) -> &crate::solver::SolverSettings;
     /// One step of the world with NSCDD as its contact stage.
     fn step_with(w: &mut Self::World, stage: &mut super::Stage<'_, '_, Self>) -> Result<StepReport, Diverged>;
@@ -198,6 +204,15 @@ impl<D: Dim> Family for Rigid<D> {
     }
     fn residual_parts_in(w: &Self::World, which: &[u32]) -> (f64, f64) {
         nlgs::residual_parts_of(&w.contacts, &w.bodies.vel, which.iter().map(|&a| a as usize))
+    }
+    fn add_reactions(c: &Self::Contacts, out: &mut [Self::V]) {
+        crate::step::add_reactions(c, out);
+    }
+    fn reactions_mut(w: &mut Self::World) -> &mut Vec<Self::V> {
+        &mut w.reaction
+    }
+    fn observed(w: &Self::World) -> Vec<u32> {
+        w.observed()
     }
     fn step_with(w: &mut Self::World, stage: &mut super::Stage<'_, '_, Self>) -> Result<StepReport, Diverged> {
         w.step_with(stage)

@@ -52,6 +52,7 @@ pub mod partition;
 mod rank_balance;
 mod rank_link;
 pub mod ranks;
+mod reactions;
 mod report;
 pub mod schemes;
 mod state;
@@ -561,6 +562,16 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
         self.dd.pending = rep;
         s
     }
+    /// Per subdomain, in subdomain order ([`reactions`]); the attached families'
+    /// contacts are the world's business (their reactions stay the engine's sum).
+    fn reactions(&mut self, w: &mut D::World) -> bool {
+        if !self.fams.is_empty() || self.dd.last.subs.is_empty() {
+            return false;
+        }
+        let observed = D::observed(w);
+        reactions::set(&self.dd.last, w, self.dd.ranks.as_mut(), &observed);
+        true
+    }
 }
 
 /// NSCDD without attached families as a contact stage (`world.step_with(&mut dd)`).
@@ -573,5 +584,8 @@ impl<D: Family> ContactStage<D::World> for NscddOf<D> {
     }
     fn solve(&mut self, w: &mut D::World) -> SolveReport {
         Stage { dd: self, fams: &mut [] }.solve(w)
+    }
+    fn reactions(&mut self, w: &mut D::World) -> bool {
+        Stage { dd: self, fams: &mut [] }.reactions(w)
     }
 }

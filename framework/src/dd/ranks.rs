@@ -144,6 +144,42 @@ impl RankState {
         at
     }
 
+    /// Whether subdomain `s` is this rank's (the last repartition's ranks).
+    pub(super) fn is_own(&self, s: u32) -> bool {
+        self.rank_of.get(s as usize) == Some(&self.cluster.rank())
+    }
+
+    /// The observed bodies' reaction shares of every subdomain, from its rank (one
+    /// all-gather; `shares`: this rank's subdomains' shares by local body).
+    pub(super) fn share_reactions<D: Family>(
+        &mut self,
+        d: &Decomposition<D>,
+        shares: &[Vec<D::V>],
+        observed: &[u32],
+    ) -> super::reactions::Remote {
+        let t0 = Instant::now();
+        let ndof = super::subdomain::dofs::<D>();
+        let local = super::reactions::observed_local(d, observed);
+        let me = self.cluster.rank();
+        self.send.clear();
+        for (s, ls) in local.iter().enumerate().filter(|(s, _)| self.rank_of[*s] == me) {
+            for &l in ls {
+                self.send.extend_from_slice(shares[s][l as usize].as_ref());
+            }
+        }
+        let at = self.counts_by(d.subs.len(), |s| local[s].len() * ndof);
+        self.reduced(self.send.len());
+        self.cluster.all_gather(&self.send, &self.counts, &mut self.all);
+        self.totals.reduce_seconds += t0.elapsed().as_secs_f64();
+        super::reactions::Remote {
+            own: self.rank_of.iter().map(|&r| r == me).collect(),
+            local,
+            at,
+            values: std::mem::take(&mut self.all),
+            ndof,
+        }
+    }
+
     /// Records this rank's part of a gluing collective (centralized scheme).
     fn sent(&mut self, messages: u64, values: usize) {
         self.link.stats.messages += messages;

@@ -65,15 +65,11 @@ impl<W: Write, D: Dim> History<W, D> {
     /// With `dd`, the NSCDD columns [`DD_COLUMNS`] follow the timings; `extra`
     /// columns (the body families') come last.
     pub fn with_columns(mut out: W, w: &World<D>, dd: bool, extra: &[String]) -> std::io::Result<Self> {
-        let mut tracked: Vec<(u32, String)> = vec![];
-        for b in 0..w.bodies.len() {
-            let driven = w.drives.iter().any(|d| d.body as usize == b);
-            match &w.names[b] {
-                Some(n) => tracked.push((b as u32, n.clone())),
-                None if driven => tracked.push((b as u32, format!("body{b}"))),
-                None => {}
-            }
-        }
+        let tracked: Vec<(u32, String)> = w
+            .observed()
+            .into_iter()
+            .map(|b| (b, w.names[b as usize].clone().unwrap_or_else(|| format!("body{b}"))))
+            .collect();
         let has_box = w.box_walls.is_some();
         let mut head = String::from(SOLVER_COLUMNS);
         for (_, n) in &tracked {

@@ -114,6 +114,14 @@ impl<D: Dim> Default for Scratch<D> {
 }
 
 impl<D: Dim> World<D> {
+    /// The bodies whose reactions are observed (ascending): those with a name or a
+    /// drive (the history's tracked bodies, the box walls, servo-driven walls).
+    pub fn observed(&self) -> Vec<u32> {
+        (0..self.bodies.len() as u32)
+            .filter(|&b| self.names[b as usize].is_some() || self.drives.iter().any(|d| d.body == b))
+            .collect()
+    }
+
     /// V⁻, the velocities at the start of the step being computed (kept by the
     /// free-velocity stage).
     pub fn velocity_begin(&self) -> &[D::Twist] {
