@@ -139,12 +139,25 @@ pub(super) fn write_back_families<D: Family>(
     d: &super::partition::Decomposition<D>,
     w: &mut D::World,
     fams: &mut [&mut dyn Attached<D>],
+    ranks: Option<&mut super::ranks::RankState>,
 ) -> f64 {
-    // each subdomain's sums, added in subdomain order (whichever rank holds it)
+    // each subdomain's sums, by the rank that holds it, added in subdomain order
+    let sums = |s: usize, out: &mut Vec<f64>| {
+        let (a, b) = D::residual_parts_in(w, &d.subs[s].contact_global);
+        out.extend([a, b]);
+    };
+    let ns = d.subs.len();
+    let per_sub = match ranks {
+        Some(r) => r.per_subdomain(ns, 2, sums),
+        None => {
+            let mut v = Vec::with_capacity(2 * ns);
+            (0..ns).for_each(|s| sums(s, &mut v));
+            v
+        }
+    };
     let (mut f2, mut q2) = (0.0, 0.0);
-    for s in &d.subs {
-        let (a, b) = D::residual_parts_in(w, &s.contact_global);
-        (f2, q2) = (f2 + a, q2 + b);
+    for x in per_sub.chunks_exact(2) {
+        (f2, q2) = (f2 + x[0], q2 + x[1]);
     }
     for (f, fam) in fams.iter_mut().enumerate() {
         let parts: Vec<(u32, &dyn LocalPart<D>)> = d

@@ -478,7 +478,7 @@ impl<D: Family> NscddOf<D> {
         rep.solve.sweeps = stages * per;
         write_back(d, w);
         self.store.keep(&d.subs);
-        rep.solve.residual = attach::write_back_families(d, w, fams);
+        rep.solve.residual = attach::write_back_families(d, w, fams, self.ranks.as_mut());
     }
 }
 

@@ -144,6 +144,23 @@ impl RankState {
         at
     }
 
+    /// `k` values of every subdomain on every rank, by subdomain id: this rank's
+    /// subdomains' from `own(s, out)` (which appends them), the others' from their
+    /// ranks (one all-gather).
+    pub(super) fn per_subdomain(&mut self, ns: usize, k: usize, mut own: impl FnMut(usize, &mut Vec<f64>)) -> Vec<f64> {
+        let t0 = Instant::now();
+        let me = self.cluster.rank();
+        self.send.clear();
+        for s in (0..ns).filter(|&s| self.rank_of[s] == me) {
+            own(s, &mut self.send);
+        }
+        let at = self.counts_by(ns, |_| k);
+        self.reduced(self.send.len());
+        self.cluster.all_gather(&self.send, &self.counts, &mut self.all);
+        self.totals.reduce_seconds += t0.elapsed().as_secs_f64();
+        at.iter().flat_map(|&a| self.all[a..a + k].iter().copied()).collect()
+    }
+
     /// Whether subdomain `s` is this rank's (the last repartition's ranks).
     pub(super) fn is_own(&self, s: u32) -> bool {
         self.rank_of.get(s as usize) == Some(&self.cluster.rank())
