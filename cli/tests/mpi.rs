@@ -212,6 +212,21 @@ fn two_and_four_ranks_give_the_one_process_result_3d() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A box sample (the deposit example, 300 steps): the history's box columns —
+/// stresses from the walls' reactions, coordination numbers from the subdomains'
+/// census — are the one process's on 2 and 4 ranks.
+#[test]
+fn a_box_sample_on_ranks_gives_the_one_process_history() {
+    let dir = scratch("box");
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/scenes/deposit.toml")).expect("the example");
+    let text = text.replace("steps = 2000", "steps = 300").replace("every = 100", "every = 0");
+    let scene = write(&dir, "deposit.toml", &text);
+    same_as_threads(&scene, &dir, "2x2", "decentralized", &[2, 4]);
+    let h = std::fs::read_to_string(dir.join("ranks4-2x2-decentralized").join("history.csv")).expect("history");
+    assert!(h.lines().next().is_some_and(|l| l.contains(",z,z_m")), "box columns");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn two_ranks_give_the_one_process_result_for_a_bonded_wall() {
     // polyhedra with mortar joints: the bonds and the joint failures (a tilted

@@ -461,3 +461,30 @@ fn the_rank_driver_in_one_process_gives_the_threads_result_bitwise() {
         println!("{scheme:?}: {stages} stages, {iface} interface bodies over 20 steps, bitwise equal");
     }
 }
+
+/// NSCDD's census (the contact count and the coordination numbers, computed
+/// subdomain by subdomain so that ranks can add them up) gives the world's integers
+/// exactly: the deposit example's box sample, 2 × 2 subdomains, a step with grains
+/// on the floor and in the bulk.
+#[test]
+fn the_census_of_the_subdomains_is_the_worlds() {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/scenes/deposit.toml")).expect("the example");
+    let mut s = load(&text.replace("steps = 2000", "steps = 400"));
+    for _ in 0..300 {
+        s.world.step().unwrap();
+    }
+    let mut n = Nscdd::new(DdSettings {
+        nx: 2,
+        ny: 2,
+        ..Default::default()
+    });
+    for _ in 0..3 {
+        let rep = n.step(&mut s.world).unwrap();
+        let c = rep.census.expect("a census");
+        let (z, z_m) = s.world.coordination();
+        assert_eq!(c.contacts, s.world.contacts.len());
+        assert_eq!((c.z.to_bits(), c.z_m.to_bits()), (z.to_bits(), z_m.to_bits()), "{c:?} vs {z} {z_m}");
+        assert!(z > 1.0 && z_m > z, "{z} {z_m}");
+        assert!(rep.interface_bodies > 10);
+    }
+}

@@ -83,6 +83,10 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     /// (ascending: outputs and drives read them).
     fn reactions_mut(w: &mut Self::World) -> &mut Vec<Self::V>;
     fn observed(w: &Self::World) -> Vec<u32>;
+    /// Whether body g is a grain (a free disk or sphere: the coordination numbers'
+    /// population), and whether the world's outputs need the coordination numbers.
+    fn is_grain(w: &Self::World, g: usize) -> bool;
+    fn wants_coordination(w: &Self::World) -> bool;
     fn solver(w: &Self::World) -> &crate::solver::SolverSettings;
     /// One step of the world with NSCDD as its contact stage.
     fn step_with(w: &mut Self::World, stage: &mut super::Stage<'_, '_, Self>) -> Result<StepReport, Diverged>;
@@ -213,6 +217,12 @@ impl<D: Dim> Family for Rigid<D> {
     }
     fn observed(w: &Self::World) -> Vec<u32> {
         w.observed()
+    }
+    fn is_grain(w: &Self::World, g: usize) -> bool {
+        w.is_grain(g)
+    }
+    fn wants_coordination(w: &Self::World) -> bool {
+        w.box_walls.is_some()
     }
     fn step_with(w: &mut Self::World, stage: &mut super::Stage<'_, '_, Self>) -> Result<StepReport, Diverged> {
         w.step_with(stage)

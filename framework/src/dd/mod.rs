@@ -43,6 +43,7 @@
 
 mod anderson;
 pub mod attach;
+mod census;
 pub mod cluster;
 pub mod family;
 pub mod gluing;
@@ -62,6 +63,7 @@ pub mod transport;
 
 use crate::model::ContactKey;
 pub use attach::{Attached, EntityInfo, LocalPart};
+pub use census::Census;
 pub use cluster::{Cluster, Solo};
 pub use family::{Family, Rigid, Rigid2, Rigid3};
 pub use partition::{Decomposition, FGammaStore, FamilyOwners, Grid, Interface};
@@ -479,6 +481,7 @@ impl<D: Family> NscddOf<D> {
         write_back(d, w);
         self.store.keep(&d.subs);
         rep.solve.residual = attach::write_back_families(d, w, fams, self.ranks.as_mut());
+        rep.census = Some(census::census(d, w, self.ranks.as_mut()));
     }
 }
 

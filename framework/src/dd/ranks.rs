@@ -147,18 +147,30 @@ impl RankState {
     /// `k` values of every subdomain on every rank, by subdomain id: this rank's
     /// subdomains' from `own(s, out)` (which appends them), the others' from their
     /// ranks (one all-gather).
-    pub(super) fn per_subdomain(&mut self, ns: usize, k: usize, mut own: impl FnMut(usize, &mut Vec<f64>)) -> Vec<f64> {
+    pub(super) fn per_subdomain(&mut self, ns: usize, k: usize, own: impl FnMut(usize, &mut Vec<f64>)) -> Vec<f64> {
+        let (at, all) = self.per_subdomain_v(ns, |_| k, own);
+        at.iter().flat_map(|&a| all[a..a + k].iter().copied()).collect()
+    }
+
+    /// As [`RankState::per_subdomain`] with `len(s)` values for subdomain s (known
+    /// on every rank): where each subdomain's values start, and the values.
+    pub(super) fn per_subdomain_v(
+        &mut self,
+        ns: usize,
+        len: impl Fn(usize) -> usize,
+        mut own: impl FnMut(usize, &mut Vec<f64>),
+    ) -> (Vec<usize>, Vec<f64>) {
         let t0 = Instant::now();
         let me = self.cluster.rank();
         self.send.clear();
         for s in (0..ns).filter(|&s| self.rank_of[s] == me) {
             own(s, &mut self.send);
         }
-        let at = self.counts_by(ns, |_| k);
+        let at = self.counts_by(ns, len);
         self.reduced(self.send.len());
         self.cluster.all_gather(&self.send, &self.counts, &mut self.all);
         self.totals.reduce_seconds += t0.elapsed().as_secs_f64();
-        at.iter().flat_map(|&a| self.all[a..a + k].iter().copied()).collect()
+        (at, std::mem::take(&mut self.all))
     }
 
     /// Whether subdomain `s` is this rank's (the last repartition's ranks).

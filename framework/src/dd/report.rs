@@ -32,6 +32,9 @@ pub struct DdStepReport {
     /// Messages and values exchanged during the step.
     pub exchange: TransportStats,
     pub times: StageTimes,
+    /// The counts outputs read, from the subdomains (exact on ranks; None: the
+    /// step had no contact).
+    pub census: Option<super::census::Census>,
 }
 
 /// Which stopping criterion was met last in a step: `Nlgs` when the gluing residual

@@ -116,7 +116,13 @@ impl<W: Write, D: Dim> History<W, D> {
     /// `dd` is `None`), `extra` the extra columns.
     pub fn row_dd(&mut self, w: &World<D>, r: &StepReport, dd: Option<&DdStepReport>, t_output: f64, extra: &[f64]) -> std::io::Result<()> {
         let (ek, ep) = w.energies();
-        let mut s = solver_fields(w.step, w.t, w.bodies.len(), r, ek, ep);
+        // NSCDD's counts (the same as the world's in one process; exact on ranks)
+        let census = dd.and_then(|d| d.census);
+        let mut r = *r;
+        if let Some(c) = census {
+            r.contacts = c.contacts;
+        }
+        let mut s = solver_fields(w.step, w.t, w.bodies.len(), &r, ek, ep);
         let h = w.time.h;
         for (b, _) in &self.tracked {
             let b = *b as usize;
@@ -130,7 +136,7 @@ impl<W: Write, D: Dim> History<W, D> {
             }
         }
         if self.has_box {
-            box_fields(w, self.margin, &mut s);
+            box_fields(w, self.margin, census.map(|c| (c.z, c.z_m)).filter(|z| !z.0.is_nan()), &mut s);
         }
         let tm = r.times;
         s.push_str(&format!(
@@ -154,7 +160,7 @@ impl<W: Write, D: Dim> History<W, D> {
 }
 
 /// The box sample's fields of a row (see [`History`]).
-fn box_fields<D: Dim>(w: &World<D>, margin: f64, s: &mut String) {
+fn box_fields<D: Dim>(w: &World<D>, margin: f64, z: Option<(f64, f64)>, s: &mut String) {
     let nu = w.solid_fraction().unwrap_or(f64::NAN);
     let height = w.box_extent().map_or(f64::NAN, |e| e.max[D::N - 1] - e.min[D::N - 1]);
     let eps1 = w.box_h0.map_or(0.0, |h0| (h0 - height) / h0);
@@ -168,7 +174,7 @@ fn box_fields<D: Dim>(w: &World<D>, margin: f64, s: &mut String) {
     for k in 0..D::N {
         s.push_str(&format!(",{:e}", sg[k]));
     }
-    let (z, zm) = w.coordination();
+    let (z, zm) = z.unwrap_or_else(|| w.coordination());
     let q_over_p = if p != 0.0 { q / p } else { 0.0 };
     s.push_str(&format!(",{p:e},{q:e},{q_over_p:e},{sin_phi:e},{z:e},{zm:e}"));
     if let Some(w3) = (w as &dyn std::any::Any).downcast_ref::<World3>() {

@@ -1,0 +1,133 @@
+//! The contact counts of an NSCDD step that outputs read, computed subdomain by
+//! subdomain so that a rank holding only its subdomains gets the same integers as
+//! one process: the number of contacts and the coordination numbers `z`, `z_m`
+//! (`World::coordination`: grain–grain contacts carrying a normal impulse, and the
+//! loaded contacts of the grains that are not rattlers).
+//!
+//! A contact belongs to one subdomain; a body's loaded contacts are the sum of its
+//! counts in the subdomains holding it, exchanged for the bodies held by several
+//! (one all-gather); each body is then counted by its first subdomain, and the
+//! per-subdomain integers are added (a second all-gather on ranks).
+
+use super::family::Family;
+use super::partition::Decomposition;
+use super::ranks::RankState;
+
+/// The counts of a step (see the module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Census {
+    pub contacts: usize,
+    /// Coordination numbers (NaN when not computed: the world has no box sample).
+    pub z: f64,
+    pub z_m: f64,
+}
+
+/// Each subdomain's loaded contacts per local body, and its loaded grain–grain contacts.
+fn loaded<D: Family>(w: &D::World, d: &Decomposition<D>, s: usize) -> (Vec<u32>, u64) {
+    let sub = &d.subs[s];
+    let mut count = vec![0u32; sub.body_global.len()];
+    let mut ngg = 0u64;
+    let grain = |l: u32| D::is_grain(w, sub.body_global[l as usize] as usize);
+    for a in 0..D::len(&sub.contacts) {
+        if D::r(&sub.contacts, a)[0] > 0.0 {
+            let [i, j] = D::bodies(&sub.contacts, a);
+            count[i as usize] += 1;
+            count[j as usize] += 1;
+            ngg += (grain(i) && grain(j)) as u64;
+        }
+    }
+    (count, ngg)
+}
+
+/// The census of the step of `d` (on ranks: collective).
+pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: Option<&mut RankState>) -> Census {
+    let ns = d.subs.len();
+    let own = |s: usize| ranks.as_ref().is_none_or(|r| r.is_own(s as u32));
+    let mut out = Census {
+        z: f64::NAN,
+        z_m: f64::NAN,
+        ..Default::default()
+    };
+    if !D::wants_coordination(w) {
+        let n = |s: usize, v: &mut Vec<f64>| v.push(D::len(&d.subs[s].contacts) as f64);
+        let per = match ranks {
+            Some(r) => r.per_subdomain(ns, 1, n),
+            None => (0..ns).fold(Vec::new(), |mut v, s| {
+                n(s, &mut v);
+                v
+            }),
+        };
+        out.contacts = per.iter().map(|&x| x as usize).sum();
+        return out;
+    }
+    let counts: Vec<Option<(Vec<u32>, u64)>> = (0..ns).map(|s| own(s).then(|| loaded(w, d, s))).collect();
+    // the bodies held by several subdomains: their counts in every subdomain
+    let multi: Vec<Vec<u32>> = d
+        .subs
+        .iter()
+        .map(|s| {
+            (0..s.body_global.len() as u32)
+                .filter(|&l| d.mult[s.body_global[l as usize] as usize] >= 2)
+                .collect()
+        })
+        .collect();
+    let mut total = vec![0u32; D::n_bodies(w)];
+    let fill = |s: usize, v: &mut Vec<f64>| {
+        let (c, _) = counts[s].as_ref().expect("an own subdomain");
+        v.extend(multi[s].iter().map(|&l| c[l as usize] as f64));
+    };
+    let (at, all) = match ranks.as_deref_mut() {
+        Some(r) => r.per_subdomain_v(ns, |s| multi[s].len(), fill),
+        None => {
+            let (mut at, mut v) = (Vec::with_capacity(ns), Vec::new());
+            for s in 0..ns {
+                at.push(v.len());
+                fill(s, &mut v);
+            }
+            (at, v)
+        }
+    };
+    for (s, ls) in multi.iter().enumerate() {
+        for (k, &l) in ls.iter().enumerate() {
+            total[d.subs[s].body_global[l as usize] as usize] += all[at[s] + k] as u32;
+        }
+    }
+    // per subdomain: contacts, loaded grain–grain contacts, non-rattler grains and
+    // their loaded contacts, each body counted by its first subdomain
+    let mut first = vec![u32::MAX; D::n_bodies(w)];
+    for s in (0..ns).rev() {
+        for &g in &d.subs[s].body_global {
+            first[g as usize] = s as u32;
+        }
+    }
+    let aggregate = |s: usize, v: &mut Vec<f64>| {
+        let sub = &d.subs[s];
+        let (c, ngg) = counts[s].as_ref().expect("an own subdomain");
+        let (mut n_m, mut sum_m) = (0u64, 0u64);
+        for (l, &g) in sub.body_global.iter().enumerate() {
+            let g = g as usize;
+            let n = if d.mult[g] >= 2 { total[g] } else { c[l] };
+            if first[g] == s as u32 && n >= 2 && D::is_grain(w, g) {
+                n_m += 1;
+                sum_m += n as u64;
+            }
+        }
+        v.extend([D::len(&sub.contacts) as f64, *ngg as f64, n_m as f64, sum_m as f64]);
+    };
+    let per = match ranks {
+        Some(r) => r.per_subdomain(ns, 4, aggregate),
+        None => (0..ns).fold(Vec::new(), |mut v, s| {
+            aggregate(s, &mut v);
+            v
+        }),
+    };
+    let (mut ngg, mut n_m, mut sum_m) = (0u64, 0u64, 0u64);
+    for x in per.chunks_exact(4) {
+        out.contacts += x[0] as usize;
+        (ngg, n_m, sum_m) = (ngg + x[1] as u64, n_m + x[2] as u64, sum_m + x[3] as u64);
+    }
+    let ng = (0..D::n_bodies(w)).filter(|&g| D::is_grain(w, g)).count();
+    out.z = if ng > 0 { 2.0 * ngg as f64 / ng as f64 } else { 0.0 };
+    out.z_m = if n_m > 0 { sum_m as f64 / n_m as f64 } else { 0.0 };
+    out
+}
