@@ -7,7 +7,7 @@
 //! installs it). Ranks beyond the cores run with `--oversubscribe`.
 #![cfg(feature = "mpi")]
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
@@ -136,17 +136,6 @@ courses = 4
 bricks = 4
 "#;
 
-fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).expect("write scene");
-    p
-}
-
-/// final.json, with its NSCDD solver state (gathered from every rank on rank 0).
-fn final_json(out: &Path) -> String {
-    std::fs::read_to_string(out.join("final.json")).unwrap_or_else(|e| panic!("{}: {e}", out.display()))
-}
-
 /// The scene in one process with 2 threads, then on each rank count: final.json
 /// bitwise the same, history.csv with the same rows' physics.
 fn same_as_threads(scene: &Path, dir: &Path, subdomains: &str, scheme: &str, ranks: &[u32]) {
@@ -241,18 +230,6 @@ fn two_ranks_give_the_one_process_result_for_a_bonded_wall() {
 
 /// Threads inside ranks (hybrid): 2 ranks × 2 threads on 3 × 2 subdomains (three a
 /// rank, swept in parallel), bitwise the one-process result.
-/// `NumberOf…="n"` attributes of a VTK file's pieces, summed.
-fn vtk_count(path: &Path, what: &str) -> usize {
-    let t = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let key = format!("{what}=\"");
-    t.match_indices(&key)
-        .map(|(i, _)| {
-            let rest = &t[i + key.len()..];
-            rest[..rest.find('"').expect("closing quote")].parse::<usize>().expect("a count")
-        })
-        .sum()
-}
-
 /// On ranks every rank writes its piece of each VTK frame and rank 0 the `.pvtp`
 /// naming them, which the `.pvd` series list: together the pieces hold the bodies
 /// and contacts of the one-process frame.

@@ -120,3 +120,26 @@ ny = 4
 radius = 0.01
 origin = [0.01, 0.01]
 "#;
+
+/// `NumberOf…="n"` attributes of a VTK file's pieces, summed.
+pub fn vtk_count(path: &Path, what: &str) -> usize {
+    let t = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let key = format!("{what}=\"");
+    t.match_indices(&key)
+        .map(|(i, _)| {
+            let rest = &t[i + key.len()..];
+            rest[..rest.find('"').expect("closing quote")].parse::<usize>().expect("a count")
+        })
+        .sum()
+}
+
+pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).expect("write scene");
+    p
+}
+
+/// final.json, with its NSCDD solver state (gathered from every rank on rank 0).
+pub fn final_json(out: &Path) -> String {
+    std::fs::read_to_string(out.join("final.json")).unwrap_or_else(|e| panic!("{}: {e}", out.display()))
+}
