@@ -128,7 +128,12 @@ pub fn final_json_with<D: Dim>(
         })
         .collect();
     let c = &w.contacts;
-    let contacts = (0..c.len())
+    // in key order (candidate, antagonist, feature): the same list whichever
+    // process held which contact
+    let mut by_key: Vec<usize> = (0..c.len()).collect();
+    by_key.sort_unstable_by_key(|&a| c.key[a]);
+    let contacts = by_key
+        .into_iter()
         .map(|a| ContactOut::<D> {
             bodies: c.bodies[a],
             feature: c.key[a].feature,
