@@ -188,6 +188,10 @@ fn two_and_four_ranks_give_the_one_process_result_2d() {
     // 3 strips on 2 ranks: not contiguous when a greedy assignment balances better
     same_as_threads(&scene, &dir, "3x1", "decentralized", &[2]);
     same_as_threads(&scene, &dir, "3x1", "centralized", &[2]);
+    // contacts held per rank between repartitions
+    let held = write(&dir, "held.toml", &every(PILE2D, 4));
+    same_as_threads(&held, &dir, "2x2", "decentralized", &[2, 4]);
+    same_as_threads(&held, &dir, "3x2", "centralized", &[4]);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -198,6 +202,9 @@ fn two_and_four_ranks_give_the_one_process_result_3d() {
     same_as_threads(&scene, &dir, "2x2x1", "decentralized", &[2, 4]);
     same_as_threads(&scene, &dir, "2x2x2", "centralized", &[4]);
     same_as_threads(&scene, &dir, "2x2x2", "decentralized", &[4]);
+    let held = write(&dir, "held.toml", &every(PILE3D, 5));
+    same_as_threads(&held, &dir, "2x2x1", "decentralized", &[2, 4]);
+    same_as_threads(&held, &dir, "2x2x2", "decentralized", &[4]);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -213,6 +220,8 @@ fn a_box_sample_on_ranks_gives_the_one_process_history() {
     same_as_threads(&scene, &dir, "2x2", "decentralized", &[2, 4]);
     let h = std::fs::read_to_string(dir.join("ranks4-2x2-decentralized").join("history.csv")).expect("history");
     assert!(h.lines().next().is_some_and(|l| l.contains(",z,z_m")), "box columns");
+    let held = write(&dir, "held.toml", &every(&text, 5));
+    same_as_threads(&held, &dir, "2x2", "centralized", &[2, 4]);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -225,6 +234,9 @@ fn two_ranks_give_the_one_process_result_for_a_bonded_wall() {
     same_as_threads(&scene, &dir, "2x1x2", "decentralized", &[2]);
     let fin = final_json(&dir.join("ranks2-2x1x2-decentralized"));
     assert!(fin.contains("\"bonded\": true"), "bonds in final.json");
+    // multi-point contacts held per rank (their warm starts follow their points)
+    let held = write(&dir, "held.toml", &every(WALL, 3));
+    same_as_threads(&held, &dir, "2x1x2", "decentralized", &[2]);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -236,39 +248,15 @@ fn two_ranks_give_the_one_process_result_for_a_bonded_wall() {
 #[test]
 fn every_rank_writes_its_piece_of_the_vtk_frames() {
     let dir = scratch("pieces");
-    let scene = write(&dir, "pile.toml", PILE2D);
-    let one = dir.join("one");
-    ok(&nscdd(&args(&scene, &one, &["--subdomains", "2x2"])), "one process");
-    let out = dir.join("ranks");
-    ok(&mpirun(&[(4, args(&scene, &out, &["--subdomains", "2x2"]))]), "4 ranks");
-    for frame in 0..4 {
-        for (name, what) in [
-            ("bodies", "NumberOfPoints"),
-            ("contacts", "NumberOfLines"),
-            ("points", "NumberOfVerts"),
-        ] {
-            let stem = format!("{name}_{frame:06}");
-            let p = std::fs::read_to_string(out.join("vtk").join(format!("{stem}.pvtp"))).expect("the .pvtp");
-            let mut sum = 0;
-            for r in 0..4 {
-                let piece = format!("{stem}_{r}.vtp");
-                assert!(p.contains(&format!("Source=\"{piece}\"")), "{stem}.pvtp names {piece}");
-                let path = out.join("vtk").join(&piece);
-                // empty pieces too carry their counts (VTK's readers refuse them otherwise)
-                let t = std::fs::read_to_string(&path).expect("a piece");
-                assert!(t.contains("NumberOfPoints=\""), "{piece}: no NumberOfPoints");
-                sum += vtk_count(&path, what);
-            }
-            let whole = vtk_count(&one.join("vtk").join(format!("{stem}.vtp")), what);
-            assert_eq!(sum, whole, "{stem}: {what} of the pieces");
-            if name == "contacts" && frame > 0 {
-                assert!(whole > 0);
-            }
-        }
-        assert!(!out.join("vtk").join(format!("bodies_{frame:06}.vtp")).exists());
+    // contacts on every rank, and held per rank between repartitions
+    for (name, text) in [("pile", PILE2D.to_string()), ("held", every(PILE2D, 4))] {
+        let scene = write(&dir, &format!("{name}.toml"), &text);
+        let one = dir.join(format!("{name}-one"));
+        ok(&nscdd(&args(&scene, &one, &["--subdomains", "2x2"])), "one process");
+        let out = dir.join(format!("{name}-ranks"));
+        ok(&mpirun(&[(4, args(&scene, &out, &["--subdomains", "2x2"]))]), "4 ranks");
+        pieces_add_up(&one, &out);
     }
-    let pvd = std::fs::read_to_string(out.join("bodies.pvd")).expect("bodies.pvd");
-    assert!(pvd.contains("vtk/bodies_000003.pvtp"), "{pvd}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -412,6 +400,8 @@ fn anderson_on_ranks_gives_the_one_process_result() {
     );
     same_as_threads(&scene, &dir, "2x2", "decentralized", &[2, 4]);
     same_as_threads(&scene, &dir, "3x1", "centralized", &[2]);
+    let held = write(&dir, "held.toml", &every(&std::fs::read_to_string(&scene).expect("scene"), 4));
+    same_as_threads(&held, &dir, "2x2", "decentralized", &[2, 4]);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

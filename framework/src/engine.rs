@@ -52,6 +52,11 @@ pub use crate::step::Diverged;
 /// (`crate::dd::NscddOf`). The rest of the step is the same for both
 /// ([`World2::step_with`], `World3::step_with`).
 pub trait ContactStage<W> {
+    /// Before detection (after the free velocity): may restrict the detection to a
+    /// part of space and add other processes' last contacts to the warm start.
+    fn before_detection(&mut self, _w: &mut W) {}
+    /// After detection: may keep only the raw contacts this process solves.
+    fn after_detection(&mut self, _w: &mut W) {}
     /// After the free velocity (the bodies hold V_free), before the contact set is
     /// built and the warm-start impulses are applied.
     fn after_free_velocity(&mut self, _w: &W) {}
@@ -105,9 +110,17 @@ impl<D: Dim> World<D> {
         let mut rep = StepReport::default();
         let t0 = Instant::now();
         free_velocity(self);
-        self.scratch
-            .detector
-            .detect(&self.bodies, &self.shapes, &self.detectors, self.alert, &mut self.scratch.raw);
+        stage.before_detection(self);
+        let s = &mut self.scratch;
+        s.detector.detect_in(
+            &self.bodies,
+            &self.shapes,
+            &self.detectors,
+            self.alert,
+            s.region.as_ref(),
+            &mut s.raw,
+        );
+        stage.after_detection(self);
         let t1 = Instant::now();
         stage.after_free_velocity(self);
         build_contacts(self);
@@ -243,6 +256,7 @@ pub fn build_contacts<D: Dim>(w: &mut World<D>) {
         bonded: old.joint[a].bonded(),
         point: old.point[a],
     }));
+    s.prev_keys.extend_from_slice(&s.extra_prev);
     s.prev_keys.sort_unstable_by_key(|x| x.key);
     let c = &mut s.next;
     c.clear();

@@ -5,7 +5,7 @@ use crate::dd::{NscddOf, Rigid};
 use crate::dim::Dim;
 use crate::engine::StepReport;
 use crate::family::SceneFamily;
-use crate::output::{final_json_with, history::History};
+use crate::output::history::History;
 use crate::registry::{Registry, Writer};
 use crate::scene::Scene;
 use crate::world::World;
@@ -191,12 +191,25 @@ fn save_state<D: Dim>(
     dd: &mut Option<NscddOf<Rigid<D>>>,
 ) -> Result<(), RunError> {
     let root = dd.as_mut().and_then(|n| n.ranks_mut()).is_none_or(|r| r.cluster.rank() == 0);
+    // contacts held per rank: every rank's gathered on rank 0
+    let records = match dd.as_mut().filter(|n| n.holds_own_contacts()) {
+        Some(n) => {
+            let mut mine = Vec::new();
+            crate::output::contact_records(w, 0..w.contacts.len(), &mut mine);
+            n.gather_on_root(&mine)
+        }
+        None => None,
+    };
     let dd = dd.as_mut().and_then(|n| n.gather_state());
     if !root {
         return Ok(());
     }
     let states = (!families.is_empty()).then(|| crate::family::states(families));
-    save_state_text(dir, name, &final_json_with(w, states.as_ref(), dd.as_ref()))
+    save_state_text(
+        dir,
+        name,
+        &crate::output::final_json_of(w, states.as_ref(), dd.as_ref(), records.as_deref()),
+    )
 }
 
 /// Runs `scene` for its number of steps, writing `history.csv`, the writers' frames

@@ -143,3 +143,41 @@ pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 pub fn final_json(out: &Path) -> String {
     std::fs::read_to_string(out.join("final.json")).unwrap_or_else(|e| panic!("{}: {e}", out.display()))
 }
+
+/// `text` re-partitioned every `k` steps: in between, each rank holds only its
+/// subdomains' contacts (`dd::local`).
+pub fn every(text: &str, k: u32) -> String {
+    format!("{text}\n[decomposition]\nrepartition_every = {k}\n")
+}
+
+/// The 4 ranks' pieces of `out` hold the bodies and contacts of `one`'s frames.
+pub fn pieces_add_up(one: &Path, out: &Path) {
+    for frame in 0..4 {
+        for (name, what) in [
+            ("bodies", "NumberOfPoints"),
+            ("contacts", "NumberOfLines"),
+            ("points", "NumberOfVerts"),
+        ] {
+            let stem = format!("{name}_{frame:06}");
+            let p = std::fs::read_to_string(out.join("vtk").join(format!("{stem}.pvtp"))).expect("the .pvtp");
+            let mut sum = 0;
+            for r in 0..4 {
+                let piece = format!("{stem}_{r}.vtp");
+                assert!(p.contains(&format!("Source=\"{piece}\"")), "{stem}.pvtp names {piece}");
+                let path = out.join("vtk").join(&piece);
+                // empty pieces too carry their counts (VTK's readers refuse them otherwise)
+                let t = std::fs::read_to_string(&path).expect("a piece");
+                assert!(t.contains("NumberOfPoints=\""), "{piece}: no NumberOfPoints");
+                sum += vtk_count(&path, what);
+            }
+            let whole = vtk_count(&one.join("vtk").join(format!("{stem}.vtp")), what);
+            assert_eq!(sum, whole, "{stem}: {what} of the pieces");
+            if name == "contacts" && frame > 0 {
+                assert!(whole > 0);
+            }
+        }
+        assert!(!out.join("vtk").join(format!("bodies_{frame:06}.vtp")).exists());
+    }
+    let pvd = std::fs::read_to_string(out.join("bodies.pvd")).expect("bodies.pvd");
+    assert!(pvd.contains("vtk/bodies_000003.pvtp"), "{pvd}");
+}

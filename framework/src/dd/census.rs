@@ -17,6 +17,8 @@ use super::ranks::RankState;
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Census {
     pub contacts: usize,
+    /// Subdomains owning at least one contact.
+    pub subdomains: usize,
     /// Coordination numbers (NaN when not computed: the world has no box sample).
     pub z: f64,
     pub z_m: f64,
@@ -58,6 +60,7 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
             }),
         };
         out.contacts = per.iter().map(|&x| x as usize).sum();
+        out.subdomains = per.iter().filter(|&&x| x > 0.0).count();
         return out;
     }
     let counts: Vec<Option<(Vec<u32>, u64)>> = (0..ns).map(|s| own(s).then(|| loaded(w, d, s))).collect();
@@ -124,6 +127,7 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
     let (mut ngg, mut n_m, mut sum_m) = (0u64, 0u64, 0u64);
     for x in per.chunks_exact(4) {
         out.contacts += x[0] as usize;
+        out.subdomains += (x[0] > 0.0) as usize;
         (ngg, n_m, sum_m) = (ngg + x[1] as u64, n_m + x[2] as u64, sum_m + x[3] as u64);
     }
     let ng = (0..D::n_bodies(w)).filter(|&g| D::is_grain(w, g)).count();

@@ -6,7 +6,7 @@
 //! contact set, the copies' M̂_E⁻¹ and the operations of DESIGN.md §3: one NLGS sweep,
 //! M̂_E⁻¹ applied to an impulse, M̂_E applied to a velocity increment (the gluing).
 
-use crate::dim::{Dim, D2, D3};
+use crate::dim::{Dim, Vector, D2, D3};
 use crate::engine::{Diverged, StepReport};
 use crate::model::{ContactKey, Contacts};
 use crate::norms::Sums;
@@ -87,6 +87,18 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     /// population), and whether the world's outputs need the coordination numbers.
     fn is_grain(w: &Self::World, g: usize) -> bool;
     fn wants_coordination(w: &Self::World) -> bool;
+    /// Contacts held per rank ([`super::local`]): the next detection's region, the
+    /// raw contacts kept after it (by key and point), the bodies' boxes (first `N`
+    /// coordinates, the rest 0), and the other processes' last contacts for the warm
+    /// start (records of [`Family::prev_record`]).
+    fn set_region(w: &mut Self::World, region: Option<crate::detect::Region>);
+    fn alert(w: &Self::World) -> f64;
+    fn retain_raw(w: &mut Self::World, keep: &mut dyn FnMut(ContactKey, [f64; 3]) -> bool);
+    fn body_boxes(w: &Self::World, out: &mut Vec<[[f64; 3]; 2]>);
+    /// Contact a's warm-start record: key (3), r, point, bond (1).
+    fn prev_record(c: &Self::Contacts, a: usize, out: &mut Vec<f64>);
+    const PREV_RECORD: usize;
+    fn set_extra_prev(w: &mut Self::World, records: &[f64]);
     fn solver(w: &Self::World) -> &crate::solver::SolverSettings;
     /// One step of the world with NSCDD as its contact stage.
     fn step_with(w: &mut Self::World, stage: &mut super::Stage<'_, '_, Self>) -> Result<StepReport, Diverged>;
@@ -223,6 +235,62 @@ impl<D: Dim> Family for Rigid<D> {
     }
     fn wants_coordination(w: &Self::World) -> bool {
         w.box_walls.is_some()
+    }
+    fn set_region(w: &mut Self::World, region: Option<crate::detect::Region>) {
+        w.scratch.region = region;
+    }
+    fn alert(w: &Self::World) -> f64 {
+        w.alert
+    }
+    fn retain_raw(w: &mut Self::World, keep: &mut dyn FnMut(ContactKey, [f64; 3]) -> bool) {
+        w.scratch.raw.retain(|rc| {
+            let mut p = [0.0; 3];
+            p[..D::N].copy_from_slice(rc.point.as_ref());
+            keep(
+                ContactKey {
+                    i: rc.i,
+                    j: rc.j,
+                    feature: rc.feature,
+                },
+                p,
+            )
+        });
+    }
+    fn body_boxes(w: &Self::World, out: &mut Vec<[[f64; 3]; 2]>) {
+        let b = &w.bodies;
+        out.clear();
+        out.extend((0..b.len()).map(|k| {
+            let s = b.shape[k];
+            let a = w.shapes[s.kind as usize].aabb(s.index, b.pos[k], b.rot[k]);
+            let mut x = [[0.0; 3]; 2];
+            x[0][..D::N].copy_from_slice(a.min.as_ref());
+            x[1][..D::N].copy_from_slice(a.max.as_ref());
+            x
+        }));
+    }
+    const PREV_RECORD: usize = 4 + 2 * D::N;
+    fn prev_record(c: &Self::Contacts, a: usize, out: &mut Vec<f64>) {
+        let k = c.key[a];
+        out.extend([f64::from(k.i), f64::from(k.j), f64::from(k.feature)]);
+        out.extend_from_slice(c.r[a].as_ref());
+        out.extend_from_slice(c.point[a].as_ref());
+        out.push(c.joint[a].bonded() as u8 as f64);
+    }
+    fn set_extra_prev(w: &mut Self::World, records: &[f64]) {
+        let n = D::N;
+        w.scratch.extra_prev.clear();
+        w.scratch
+            .extra_prev
+            .extend(records.chunks_exact(4 + 2 * n).map(|x| crate::world::PrevContact {
+                key: ContactKey {
+                    i: x[0] as u32,
+                    j: x[1] as u32,
+                    feature: x[2] as u32,
+                },
+                r: D::Local::from_fn(|k| x[3 + k]),
+                point: D::Point::from_fn(|k| x[3 + n + k]),
+                bonded: x[3 + 2 * n] != 0.0,
+            }));
     }
     fn step_with(w: &mut Self::World, stage: &mut super::Stage<'_, '_, Self>) -> Result<StepReport, Diverged> {
         w.step_with(stage)

@@ -47,11 +47,13 @@ mod census;
 pub mod cluster;
 pub mod family;
 pub mod gluing;
+mod local;
 #[cfg(feature = "mpi")]
 pub mod mpi;
 pub mod partition;
 mod rank_balance;
 mod rank_link;
+mod rank_reduce;
 pub mod ranks;
 mod reactions;
 mod report;
@@ -212,6 +214,10 @@ pub struct NscddOf<D: Family> {
     /// Set for a multi-process run ([`ranks`]): this process sweeps and glues only
     /// its ranks' subdomains.
     ranks: Option<RankState>,
+    /// On ranks, whether contacts are held per rank between repartitions
+    /// ([`local`]; rigid bodies only), and that mode's state.
+    pub local_contacts: bool,
+    local: local::Local,
 }
 
 /// NSCDD of 2D rigid bodies.
@@ -241,6 +247,8 @@ impl<D: Family> NscddOf<D> {
             mixer: anderson::StageMixer::default(),
             v_free: Vec::new(),
             ranks: None,
+            local_contacts: true,
+            local: local::Local::default(),
         }
     }
 
@@ -273,53 +281,10 @@ impl<D: Family> NscddOf<D> {
         self
     }
 
-    /// The last step's subdomain of each body and contact of `w` and the bodies'
-    /// multiplicities (all −1 / 0 before the first step).
-    pub fn view(&self, w: &D::World) -> DdView {
-        let nb = D::n_bodies(w);
-        let c = D::contacts(w);
-        let d = &self.last;
-        let mut v = DdView {
-            body_subdomain: vec![-1; nb],
-            multiplicity: (0..nb).map(|b| d.mult.get(b).copied().unwrap_or(0)).collect(),
-            contact_subdomain: Vec::new(),
-            piece: self.ranks.as_ref().map(|rs| Piece {
-                rank: rs.cluster.rank(),
-                ranks: rs.cluster.size(),
-                rank_of: rs.rank_of.clone(),
-            }),
-        };
-        if d.owner.len() != D::len(c) {
-            return v;
-        }
-        v.contact_subdomain.clone_from(&d.owner);
-        let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(2 * d.owner.len());
-        for (a, &s) in d.owner.iter().enumerate() {
-            for g in D::bodies(c, a) {
-                pairs.push((g, s));
-            }
-        }
-        pairs.sort_unstable();
-        let mut best = vec![0usize; nb];
-        let mut p = 0;
-        while p < pairs.len() {
-            let q = p + pairs[p..].iter().take_while(|e| **e == pairs[p]).count();
-            let (g, s) = (pairs[p].0 as usize, pairs[p].1);
-            // ascending subdomain ids: a strictly larger count wins, ties keep the smaller id
-            if g < nb && q - p > best[g] {
-                best[g] = q - p;
-                v.body_subdomain[g] = s as i32;
-            }
-            p = q;
-        }
-        v
-    }
-
     /// This step's decomposition of `w.contacts`: a new grid every
     /// `repartition_every` steps, else the kept owners.
     fn partition(&mut self, w: &D::World, fams: &[&mut dyn Attached<D>], rep: &mut DdStepReport) {
         let s = &self.settings;
-        let k = self.repartition_every.max(1) as u64;
         let c = D::contacts(w);
         let nc = D::len(c);
         // the attached families' contact points, one range per family
@@ -330,7 +295,7 @@ impl<D: Family> NscddOf<D> {
             f.points(&mut self.fam_points);
             ranges.push(a..self.fam_points.len());
         }
-        let repart = self.grid.is_none() || self.grid_empty || self.steps.is_multiple_of(k);
+        let repart = self.repartitions();
         let (grid, owner) = match self.grid {
             Some(g) if !repart => (g, partition::kept_owners::<D>(c, &g, &self.kept)),
             _ => {
@@ -360,7 +325,9 @@ impl<D: Family> NscddOf<D> {
             fams,
             owner: &self.fam_owner,
         };
-        self.last = partition::decompose_owned::<D>(w, &self.v_free, grid, owner, ns, &self.store, build.as_deref(), &fo);
+        let mut shells = |subs: &mut [Subdomain<D>]| self.ranks.as_mut().expect("ranks").fill_shells(subs);
+        let shells = self.local.now.then_some(&mut shells as &mut dyn FnMut(&mut [Subdomain<D>]));
+        self.last = partition::decompose_owned::<D>(w, &self.v_free, grid, owner, ns, &self.store, build.as_deref(), &fo, shells);
         rep.repartitioned = repart;
         if let Some(before) = before {
             let after = partition::body_sets(&self.last, nb);
@@ -387,7 +354,9 @@ impl<D: Family> NscddOf<D> {
     /// parts and receives the others' packed results, [`LocalPart::pack`]).
     pub fn step_families(&mut self, w: &mut D::World, fams: &mut [&mut dyn Attached<D>]) -> Result<DdStepReport, Diverged> {
         self.pending = DdStepReport::default();
-        let base = D::step_with(w, &mut Stage { dd: self, fams })?;
+        let base = D::step_with(w, &mut Stage { dd: self, fams });
+        self.after_step();
+        let base = base?;
         let mut rep = std::mem::take(&mut self.pending);
         rep.solve = base.solve;
         rep.contacts = base.contacts;
@@ -481,7 +450,12 @@ impl<D: Family> NscddOf<D> {
         write_back(d, w);
         self.store.keep(&d.subs);
         rep.solve.residual = attach::write_back_families(d, w, fams, self.ranks.as_mut());
-        rep.census = Some(census::census(d, w, self.ranks.as_mut()));
+        if let (true, Some(rs)) = (self.local.now, self.ranks.as_mut()) {
+            self.local.body_sub = local::body_subdomains(rs, d, D::n_bodies(w));
+        }
+        let census = census::census(d, w, self.ranks.as_mut());
+        rep.subdomains = census.subdomains;
+        rep.census = Some(census);
     }
 }
 
@@ -543,6 +517,13 @@ pub struct Stage<'a, 'f, D: Family> {
 /// (the families' after theirs), builds the families' contacts and splits all
 /// contacts (timed with the Delassus stage), and runs the NSCDD iteration.
 impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
+    fn before_detection(&mut self, w: &mut D::World) {
+        let eligible = self.fams.is_empty() && !self.dd.by_model;
+        self.dd.before_detection(w, eligible);
+    }
+    fn after_detection(&mut self, w: &mut D::World) {
+        self.dd.after_detection(w);
+    }
     fn after_free_velocity(&mut self, w: &D::World) {
         self.dd.v_free.clear();
         self.dd.v_free.extend_from_slice(D::vel(w));
@@ -579,6 +560,12 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
 
 /// NSCDD without attached families as a contact stage (`world.step_with(&mut dd)`).
 impl<D: Family> ContactStage<D::World> for NscddOf<D> {
+    fn before_detection(&mut self, w: &mut D::World) {
+        Stage { dd: self, fams: &mut [] }.before_detection(w);
+    }
+    fn after_detection(&mut self, w: &mut D::World) {
+        Stage { dd: self, fams: &mut [] }.after_detection(w);
+    }
     fn after_free_velocity(&mut self, w: &D::World) {
         Stage { dd: self, fams: &mut [] }.after_free_velocity(w);
     }

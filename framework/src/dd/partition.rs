@@ -241,11 +241,22 @@ pub fn decompose_owned<D: Family>(
     store: &FGammaStore<D::V>,
     build: Option<&[bool]>,
     fam: &FamilyOwners<'_, '_, D>,
+    shells: Option<&mut dyn FnMut(&mut [Subdomain<D>])>,
 ) -> Decomposition<D> {
     let built = |s: u32| build.is_none_or(|b| b[s as usize]);
     let c = D::contacts(w);
     let nb = D::n_bodies(w);
     let (mut subs, mut mult, mut copy_of) = split_contacts::<D>(c, &owner, ns, nb);
+    if let Some(fill) = shells {
+        // contacts held per rank: the other ranks' subdomains get their bodies only
+        fill(&mut subs);
+        for sub in subs.iter().filter(|s| !built(s.id)) {
+            for (l, &g) in sub.body_global.iter().enumerate() {
+                mult[g as usize] += 1;
+                copy_of.push((g, sub.id, l as u32));
+            }
+        }
+    }
     let ent_copies = split_families(w, &mut subs, &mut mult, &mut copy_of, fam);
     // copies' M̂_E⁻¹ and W_αα; each subdomain's visiting order
     let (sv, step) = (D::solver(w), D::step(w));

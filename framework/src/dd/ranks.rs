@@ -79,13 +79,16 @@ pub struct RankState {
     link: RankLink,
     glue: GlueBuffers,
     chain: ChainBuffers,
-    send: Vec<f64>,
-    all: Vec<f64>,
-    counts: Vec<usize>,
+    pub(super) send: Vec<f64>,
+    pub(super) all: Vec<f64>,
+    pub(super) counts: Vec<usize>,
     per_sub: Vec<Vec<f64>>,
     per_sub_out: Vec<Vec<f64>>,
     parts: Vec<GluePartial>,
     pub totals: RankTotals,
+    /// The step runs with contacts held per rank ([`super::local`]): the other
+    /// ranks' subdomains are shells without contacts, their impulses not exchanged.
+    pub(super) local: bool,
 }
 
 impl RankState {
@@ -103,6 +106,7 @@ impl RankState {
             per_sub_out: Vec::new(),
             parts: Vec::new(),
             totals: RankTotals::default(),
+            local: false,
         }
     }
 
@@ -123,7 +127,7 @@ impl RankState {
 
     /// Per-rank counts of `per(subdomain)` values, and where each subdomain's values
     /// start in the gathered buffer (rank order, then subdomain order in a rank).
-    fn counts_by(&mut self, ns: usize, per: impl Fn(usize) -> usize) -> Vec<usize> {
+    pub(super) fn counts_by(&mut self, ns: usize, per: impl Fn(usize) -> usize) -> Vec<usize> {
         self.counts.clear();
         self.counts.resize(self.cluster.size() as usize, 0);
         let mut at = vec![0usize; ns];
@@ -173,42 +177,6 @@ impl RankState {
         (at, std::mem::take(&mut self.all))
     }
 
-    /// Whether subdomain `s` is this rank's (the last repartition's ranks).
-    pub(super) fn is_own(&self, s: u32) -> bool {
-        self.rank_of.get(s as usize) == Some(&self.cluster.rank())
-    }
-
-    /// The observed bodies' reaction shares of every subdomain, from its rank (one
-    /// all-gather; `shares`: this rank's subdomains' shares by local body).
-    pub(super) fn share_reactions<D: Family>(
-        &mut self,
-        d: &Decomposition<D>,
-        shares: &[Vec<D::V>],
-        observed: &[u32],
-    ) -> super::reactions::Remote {
-        let t0 = Instant::now();
-        let ndof = super::subdomain::dofs::<D>();
-        let local = super::reactions::observed_local(d, observed);
-        let me = self.cluster.rank();
-        self.send.clear();
-        for (s, ls) in local.iter().enumerate().filter(|(s, _)| self.rank_of[*s] == me) {
-            for &l in ls {
-                self.send.extend_from_slice(shares[s][l as usize].as_ref());
-            }
-        }
-        let at = self.counts_by(d.subs.len(), |s| local[s].len() * ndof);
-        self.reduced(self.send.len());
-        self.cluster.all_gather(&self.send, &self.counts, &mut self.all);
-        self.totals.reduce_seconds += t0.elapsed().as_secs_f64();
-        super::reactions::Remote {
-            own: self.rank_of.iter().map(|&r| r == me).collect(),
-            local,
-            at,
-            values: std::mem::take(&mut self.all),
-            ndof,
-        }
-    }
-
     /// Records this rank's part of a gluing collective (centralized scheme).
     fn sent(&mut self, messages: u64, values: usize) {
         self.link.stats.messages += messages;
@@ -217,7 +185,7 @@ impl RankState {
 
     /// Records this rank's part of a reduction (check stages, end of step): an
     /// all-gather counted as this rank's values sent to each other rank.
-    fn reduced(&mut self, values: usize) {
+    pub(super) fn reduced(&mut self, values: usize) {
         let others = self.cluster.size() as u64 - 1;
         self.totals.reduce.messages += others;
         self.totals.reduce.values += values as u64 * others;
@@ -386,10 +354,12 @@ impl RankState {
         // copies of other ranks' subdomains were not given starting velocities; the
         // attached families' parts travel as their packed results, after the rigid values
         let parts_len = |s: &Subdomain<D>| s.parts.0.iter().map(|(_, p)| p.packed_len()).sum::<usize>();
-        let size = |s: &Subdomain<D>| D::len(&s.contacts) * D::SPACE + (s.body_global.len() + s.f_gamma.len()) * ndof + parts_len(s);
+        let with_r = !self.local;
+        let r_len = |s: &Subdomain<D>| if with_r { D::len(&s.contacts) * D::SPACE } else { 0 };
+        let size = |s: &Subdomain<D>| r_len(s) + (s.body_global.len() + s.f_gamma.len()) * ndof + parts_len(s);
         self.send.clear();
         for s in d.subs.iter().filter(|s| self.rank_of[s.id as usize] == me) {
-            for a in 0..D::len(&s.contacts) {
+            for a in (0..D::len(&s.contacts)).filter(|_| with_r) {
                 self.send.extend_from_slice(D::r(&s.contacts, a));
             }
             for v in s.vel.iter().chain(&s.f_gamma) {

@@ -110,3 +110,52 @@ impl Piece {
         self.rank_of.get(s as usize).map_or(self.rank == 0, |&r| r == self.rank)
     }
 }
+
+impl<D: super::Family> super::NscddOf<D> {
+    /// The last step's subdomain of each body and contact of `w` and the bodies'
+    /// multiplicities (all −1 / 0 before the first step).
+    pub fn view(&self, w: &D::World) -> DdView {
+        let nb = D::n_bodies(w);
+        let c = D::contacts(w);
+        let d = &self.last;
+        let mut v = DdView {
+            body_subdomain: vec![-1; nb],
+            multiplicity: (0..nb).map(|b| d.mult.get(b).copied().unwrap_or(0)).collect(),
+            contact_subdomain: Vec::new(),
+            piece: self.ranks.as_ref().map(|rs| Piece {
+                rank: rs.cluster.rank(),
+                ranks: rs.cluster.size(),
+                rank_of: rs.rank_of.clone(),
+            }),
+        };
+        if d.owner.len() != D::len(c) {
+            return v;
+        }
+        v.contact_subdomain.clone_from(&d.owner);
+        if self.local.held && self.local.body_sub.len() == nb {
+            // contacts held per rank: the counts over every rank's
+            v.body_subdomain.clone_from(&self.local.body_sub);
+            return v;
+        }
+        let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(2 * d.owner.len());
+        for (a, &s) in d.owner.iter().enumerate() {
+            for g in D::bodies(c, a) {
+                pairs.push((g, s));
+            }
+        }
+        pairs.sort_unstable();
+        let mut best = vec![0usize; nb];
+        let mut p = 0;
+        while p < pairs.len() {
+            let q = p + pairs[p..].iter().take_while(|e| **e == pairs[p]).count();
+            let (g, s) = (pairs[p].0 as usize, pairs[p].1);
+            // ascending subdomain ids: a strictly larger count wins, ties keep the smaller id
+            if g < nb && q - p > best[g] {
+                best[g] = q - p;
+                v.body_subdomain[g] = s as i32;
+            }
+            p = q;
+        }
+        v
+    }
+}

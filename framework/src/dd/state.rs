@@ -64,12 +64,14 @@ impl<D: Family> NscddOf<D> {
             mine.extend([f64::from(b), f64::from(e)]);
             mine.extend_from_slice(v.as_ref());
         }
-        let size = rs.cluster.size() as usize;
-        let mut counts = Vec::new();
-        rs.cluster.all_gather(&[mine.len() as f64], &vec![1; size], &mut counts);
-        let counts: Vec<usize> = counts.iter().map(|&c| c as usize).collect();
-        let mut all = Vec::new();
-        rs.cluster.gather(&mine, &counts, &mut all);
+        let all = gather_on_root(rs, &mine);
+        // the kept subdomains of this rank's contacts (all of them when every rank
+        // holds every contact: each is some rank's)
+        let mut mine = Vec::new();
+        for (k, o) in self.kept.iter().filter(|e| rs.rank_of.get(e.1 as usize) == Some(&me)) {
+            mine.extend([f64::from(k.i), f64::from(k.j), f64::from(k.feature), f64::from(*o)]);
+        }
+        let kept = gather_on_root(rs, &mine);
         if me != 0 {
             return None;
         }
@@ -78,7 +80,21 @@ impl<D: Family> NscddOf<D> {
             .map(|c| (c[0] as u32, c[1] as u32, c[2..].to_vec()))
             .collect();
         f_gamma.sort_unstable_by_key(|e| (e.0, e.1));
-        Some(self.saved(f_gamma))
+        let mut kept: Vec<(ContactKey, u32)> = kept
+            .chunks_exact(4)
+            .map(|x| {
+                let key = ContactKey {
+                    i: x[0] as u32,
+                    j: x[1] as u32,
+                    feature: x[2] as u32,
+                };
+                (key, x[3] as u32)
+            })
+            .collect();
+        kept.sort_unstable_by_key(|e| e.0);
+        let mut v = self.saved(f_gamma);
+        v["kept"] = serde_json::to_value(kept).expect("plain data");
+        Some(v)
     }
 
     /// Puts a saved state back (a solver made from the same decomposition, before its
@@ -107,4 +123,15 @@ impl<D: Family> NscddOf<D> {
         self.kept.sort_unstable_by_key(|x| x.0);
         Ok(true)
     }
+}
+
+/// Every rank's `mine` (any lengths) concatenated on rank 0 (empty elsewhere).
+pub(super) fn gather_on_root(rs: &mut super::RankState, mine: &[f64]) -> Vec<f64> {
+    let size = rs.cluster.size() as usize;
+    let mut counts = Vec::new();
+    rs.cluster.all_gather(&[mine.len() as f64], &vec![1; size], &mut counts);
+    let counts: Vec<usize> = counts.iter().map(|&c| c as usize).collect();
+    let mut all = Vec::new();
+    rs.cluster.gather(mine, &counts, &mut all);
+    all
 }

@@ -19,7 +19,7 @@ pub fn write_atomic(path: &std::path::Path, write: impl FnOnce(&std::path::Path)
     std::fs::rename(&tmp, path)
 }
 
-use crate::dim::Dim;
+use crate::dim::{Dim, Vector};
 use crate::world::World;
 use serde::Serialize;
 
@@ -109,6 +109,37 @@ pub fn final_json_with<D: Dim>(
     families: Option<&serde_json::Map<String, serde_json::Value>>,
     nscdd: Option<&serde_json::Value>,
 ) -> String {
+    final_json_of(w, families, nscdd, None)
+}
+
+/// Values per contact of [`contact_records`].
+pub const fn contact_record_len(n: usize) -> usize {
+    5 + 4 * n
+}
+
+/// The `final.json` fields of the contacts `which` of `w`, as numbers (bodies,
+/// feature, point, normal, r, impulse, gap, bond): what a process sends the one
+/// that writes the file.
+pub fn contact_records<D: Dim>(w: &World<D>, which: impl Iterator<Item = usize>, out: &mut Vec<f64>) {
+    let c = &w.contacts;
+    for a in which {
+        out.extend([f64::from(c.bodies[a][0]), f64::from(c.bodies[a][1]), f64::from(c.key[a].feature)]);
+        out.extend_from_slice(c.point[a].as_ref());
+        out.extend_from_slice(D::normal(&c.frame[a]).as_ref());
+        out.extend_from_slice(c.r[a].as_ref());
+        out.extend_from_slice(c.world_impulse(a).as_ref());
+        out.extend([c.gap[a], c.joint[a].bonded() as u8 as f64]);
+    }
+}
+
+/// [`final_json_with`], the contacts from `records` ([`contact_records`] of every
+/// process) when given, else from the world.
+pub fn final_json_of<D: Dim>(
+    w: &World<D>,
+    families: Option<&serde_json::Map<String, serde_json::Value>>,
+    nscdd: Option<&serde_json::Value>,
+    records: Option<&[f64]>,
+) -> String {
     let b = &w.bodies;
     let bodies = (0..b.len())
         .map(|k| {
@@ -127,24 +158,31 @@ pub fn final_json_with<D: Dim>(
             }
         })
         .collect();
-    let c = &w.contacts;
-    // in key order (candidate, antagonist, feature): the same list whichever
-    // process held which contact
-    let mut by_key: Vec<usize> = (0..c.len()).collect();
-    by_key.sort_unstable_by_key(|&a| c.key[a]);
-    let contacts = by_key
-        .into_iter()
-        .map(|a| ContactOut::<D> {
-            bodies: c.bodies[a],
-            feature: c.key[a].feature,
-            point: c.point[a],
-            normal: D::normal(&c.frame[a]),
-            r: c.r[a],
-            impulse: c.world_impulse(a),
-            gap: c.gap[a],
-            bonded: c.joint[a].bonded(),
+    let mut own = Vec::new();
+    let records = records.unwrap_or_else(|| {
+        contact_records(w, 0..w.contacts.len(), &mut own);
+        &own
+    });
+    let n = D::N;
+    let mut contacts: Vec<ContactOut<D>> = records
+        .chunks_exact(contact_record_len(n))
+        .map(|x| {
+            let v = |k: usize| &x[3 + k * n..3 + (k + 1) * n];
+            ContactOut::<D> {
+                bodies: [x[0] as u32, x[1] as u32],
+                feature: x[2] as u32,
+                point: D::Point::from_fn(|d| v(0)[d]),
+                normal: D::Point::from_fn(|d| v(1)[d]),
+                r: D::Local::from_fn(|d| v(2)[d]),
+                impulse: D::Point::from_fn(|d| v(3)[d]),
+                gap: x[3 + 4 * n],
+                bonded: x[4 + 4 * n] != 0.0,
+            }
         })
         .collect();
+    // in key order (candidate, antagonist, feature): the same list whichever
+    // process held which contact
+    contacts.sort_unstable_by_key(|c| (c.bodies, c.feature));
     let mut s = serde_json::to_string_pretty(&FinalOut {
         dimension: D::N as u8,
         step: w.step,

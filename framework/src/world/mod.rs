@@ -96,6 +96,11 @@ pub(crate) struct Scratch<D: Dim> {
     pub laws: LawBatches,
     /// W_αα of the contacts being built.
     pub w: Vec<D::W>,
+    /// Detection restricted to this part of space (a rank's subdomains).
+    pub region: Option<crate::detect::Region>,
+    /// Last step's contacts held by other processes that this one may meet again
+    /// (their warm starts), beside the world's own.
+    pub extra_prev: Vec<PrevContact<D>>,
 }
 
 impl<D: Dim> Default for Scratch<D> {
@@ -109,6 +114,8 @@ impl<D: Dim> Default for Scratch<D> {
             next: Contacts::default(),
             laws: LawBatches::default(),
             w: vec![],
+            region: None,
+            extra_prev: vec![],
         }
     }
 }

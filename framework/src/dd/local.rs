@@ -1,0 +1,287 @@
+//! Contacts held per rank (docs/SCALING.md, "Owned data per rank"): on MPI ranks,
+//! between repartitions, each rank detects, builds and solves only the contacts of
+//! its own subdomains, and the world's contact list holds those alone.
+//!
+//! ```text
+//! before detection:  the last step's contacts another rank may meet again (their
+//!                    pair's boxes, grown by the alert distance, reach its cells)
+//!                    go to every rank (one all-gather): their warm starts, and their
+//!                    kept subdomains (a contact kept by another rank is its)
+//! detection:         the own cells (edge cells unbounded) and the own kept pairs
+//! after detection:   a raw contact stays when its owner — its kept subdomain, else
+//!                    the cell of its point — is an own subdomain
+//! partition:         the other ranks' subdomains as shells: their bodies, from one
+//!                    exchange of the own subdomains' body lists (the interface and
+//!                    multiplicities are then those of one process)
+//! ```
+//!
+//! A repartition step runs on the whole sample (every rank detects and builds
+//! everything, as with replicated data), all the last step's contacts gathered
+//! first. Every decision above is the one a single process takes with all the
+//! contacts, so results stay bitwise those of one process.
+
+use super::family::Family;
+use super::partition::Grid;
+use super::ranks::RankState;
+use crate::detect::Region;
+use crate::model::ContactKey;
+
+/// The state of the mode across steps.
+#[derive(Default)]
+pub(super) struct Local {
+    /// Whether the world's contacts are this rank's only (the last step ran local).
+    pub held: bool,
+    /// Whether the step in progress runs local.
+    pub now: bool,
+    boxes: Vec<[[f64; 3]; 2]>,
+    /// With contacts held per rank: each body's subdomain for the outputs
+    /// ([`body_subdomains`]).
+    pub body_sub: Vec<i32>,
+}
+
+/// The boxes of the grid cells whose subdomain is `rank`'s (edge cells unbounded,
+/// a flat axis whole, each grown by 10⁻⁶ of a cell).
+pub(super) fn cells_of(grid: &Grid, rank_of: &[u32], rank: u32) -> Vec<[[f64; 3]; 2]> {
+    let n = [grid.nx, grid.ny, grid.nz];
+    let inf = f64::INFINITY;
+    (0..grid.len() as u32)
+        .filter(|&c| rank_of.get(c as usize) == Some(&rank))
+        .map(|c| {
+            let idx = [c % n[0], (c / n[0]) % n[1], c / (n[0] * n[1])];
+            let mut b = [[0.0; 3]; 2];
+            for d in 0..3 {
+                let h = grid.cell[d];
+                let flat = !(h > 0.0);
+                let at = |k: u32| grid.origin[d] + k as f64 * h;
+                b[0][d] = if flat || idx[d] == 0 { -inf } else { at(idx[d]) - 1e-6 * h };
+                b[1][d] = if flat || idx[d] + 1 == n[d] {
+                    inf
+                } else {
+                    at(idx[d] + 1) + 1e-6 * h
+                };
+            }
+            b
+        })
+        .collect()
+}
+
+/// The subdomain of a contact between repartitions: kept by key, else the cell of
+/// its point (as `partition::kept_owners`).
+pub(super) fn owner_of(kept: &[(ContactKey, u32)], grid: &Grid, key: ContactKey, p: [f64; 3]) -> u32 {
+    match kept.binary_search_by_key(&key, |e| e.0) {
+        Ok(k) => kept[k].1,
+        Err(_) => grid.cell_of(p),
+    }
+}
+
+/// Whether a pair's boxes, grown by `alert` and intersected, meet `region` (the
+/// detection's test, `detect::Detector::detect_in`).
+fn pair_meets(n: usize, a: &[[f64; 3]; 2], b: &[[f64; 3]; 2], alert: f64, region: &Region) -> bool {
+    let lo: [f64; 3] = std::array::from_fn(|k| if k < n { a[0][k].max(b[0][k]) - alert } else { 0.0 });
+    let hi: [f64; 3] = std::array::from_fn(|k| if k < n { a[1][k].min(b[1][k]) + alert } else { 0.0 });
+    region.meets(n, &lo, &hi)
+}
+
+impl Local {
+    /// Before a step's detection: the last step's contacts other ranks may meet
+    /// (all of them before a repartition) gathered from every rank into the warm
+    /// start; returns the other ranks' kept subdomains of theirs (key, owner).
+    pub(super) fn exchange<D: Family>(
+        &mut self,
+        rs: &mut RankState,
+        w: &mut D::World,
+        (owner, grid, alert): (&[u32], &Grid, f64),
+        all: bool,
+    ) -> Vec<(ContactKey, u32)> {
+        let me = rs.cluster.rank();
+        let regions: Vec<Region> = (0..rs.cluster.size())
+            .filter(|&q| q != me)
+            .map(|q| Region {
+                boxes: cells_of(grid, &rs.rank_of, q),
+                pairs: Vec::new(),
+            })
+            .collect();
+        D::body_boxes(w, &mut self.boxes);
+        let c = D::contacts(w);
+        let mut mine = Vec::new();
+        for a in 0..D::len(c) {
+            let [i, j] = D::bodies(c, a);
+            let (bi, bj) = (&self.boxes[i as usize], &self.boxes[j as usize]);
+            if all || regions.iter().any(|r| pair_meets(D::SPACE, bi, bj, alert, r)) {
+                D::prev_record(c, a, &mut mine);
+                mine.push(f64::from(owner[a]));
+            }
+        }
+        let (counts, got) = rs.all_gather_any(&mine);
+        let per = D::PREV_RECORD + 1;
+        let mut start = 0;
+        let (mut prev, mut kept) = (Vec::new(), Vec::new());
+        for (q, &n) in counts.iter().enumerate() {
+            if q as u32 != me {
+                for x in got[start..start + n].chunks_exact(per) {
+                    prev.extend_from_slice(&x[..D::PREV_RECORD]);
+                    let key = ContactKey {
+                        i: x[0] as u32,
+                        j: x[1] as u32,
+                        feature: x[2] as u32,
+                    };
+                    kept.push((key, x[D::PREV_RECORD] as u32));
+                }
+            }
+            start += n;
+        }
+        D::set_extra_prev(w, &prev);
+        kept
+    }
+}
+
+/// The region a rank detects in: its cells and the pairs of its kept contacts.
+pub(super) fn region(rs: &RankState, grid: &Grid, kept: &[(ContactKey, u32)]) -> Region {
+    let me = rs.cluster.rank();
+    let mut pairs: Vec<[u32; 2]> = kept
+        .iter()
+        .filter(|e| rs.rank_of.get(e.1 as usize) == Some(&me))
+        .map(|e| [e.0.i.min(e.0.j), e.0.i.max(e.0.j)])
+        .collect();
+    pairs.sort_unstable();
+    pairs.dedup();
+    Region {
+        boxes: cells_of(grid, &rs.rank_of, me),
+        pairs,
+    }
+}
+
+impl<D: Family> super::NscddOf<D> {
+    /// Whether this step re-partitions over a new grid.
+    pub(super) fn repartitions(&self) -> bool {
+        let k = self.repartition_every.max(1) as u64;
+        self.grid.is_none() || self.grid_empty || self.steps.is_multiple_of(k)
+    }
+
+    /// Before detection: on ranks, with `eligible` (rigid bodies only), the exchange
+    /// of the last step's contacts and this step's region (see the module docs).
+    pub(super) fn before_detection(&mut self, w: &mut D::World, eligible: bool) {
+        let repart = self.repartitions();
+        let (Some(rs), Some(grid)) = (self.ranks.as_mut(), self.grid.as_ref()) else {
+            self.local.now = false;
+            return;
+        };
+        if !(eligible && self.local_contacts) {
+            self.local.now = false;
+            return;
+        }
+        if self.local.held {
+            let got = self.local.exchange::<D>(rs, w, (&self.last.owner, grid, D::alert(w)), repart);
+            if !repart {
+                self.kept.extend(got);
+                self.kept.sort_unstable_by_key(|e| e.0);
+            }
+        } else {
+            D::set_extra_prev(w, &[]);
+        }
+        self.local.now = !repart;
+        rs.local = !repart;
+        D::set_region(w, (!repart).then(|| region(rs, grid, &self.kept)));
+    }
+
+    /// After detection: only the raw contacts of the own subdomains stay.
+    pub(super) fn after_detection(&mut self, w: &mut D::World) {
+        if !self.local.now {
+            return;
+        }
+        let (Some(rs), Some(grid)) = (self.ranks.as_ref(), self.grid.as_ref()) else {
+            return;
+        };
+        let me = rs.cluster.rank();
+        let (kept, rank_of) = (&self.kept, &rs.rank_of);
+        D::retain_raw(w, &mut |key, p| rank_of.get(owner_of(kept, grid, key, p) as usize) == Some(&me));
+    }
+
+    /// After the step: whether the world now holds this rank's contacts only.
+    pub(super) fn after_step(&mut self) {
+        self.local.held = self.local.now;
+    }
+
+    /// Whether the world holds this rank's contacts only (the last step ran with
+    /// contacts held per rank): outputs of every contact gather them
+    /// ([`super::NscddOf::gather_on_root`]).
+    pub fn holds_own_contacts(&self) -> bool {
+        self.local.held
+    }
+
+    /// Every rank's `mine` concatenated on rank 0 (collective; None elsewhere, or in
+    /// one process).
+    pub fn gather_on_root(&mut self, mine: &[f64]) -> Option<Vec<f64>> {
+        let rs = self.ranks.as_mut()?;
+        let all = super::state::gather_on_root(rs, mine);
+        (rs.cluster.rank() == 0).then_some(all)
+    }
+}
+
+impl RankState {
+    /// The other ranks' subdomains' bodies, in their order (two all-gathers): the
+    /// shells of [`super::partition::decompose_owned`].
+    pub(super) fn fill_shells<D: Family>(&mut self, subs: &mut [super::Subdomain<D>]) {
+        let ns = subs.len();
+        let lens = self.per_subdomain(ns, 1, |s, out| out.push(subs[s].body_global.len() as f64));
+        let (at, all) = self.per_subdomain_v(
+            ns,
+            |s| lens[s] as usize,
+            |s, out| out.extend(subs[s].body_global.iter().map(|&g| f64::from(g))),
+        );
+        for (s, sub) in subs.iter_mut().enumerate() {
+            if !self.is_own(s as u32) {
+                sub.body_global = all[at[s]..at[s] + lens[s] as usize].iter().map(|&g| g as u32).collect();
+            }
+        }
+    }
+}
+
+/// The subdomain owning most of each body's contacts (ties: the smaller id; −1
+/// without contacts), as `NscddOf::view` counts them over the whole contact list:
+/// a body held by one subdomain is its; the counts of the bodies held by several
+/// come from their subdomains' ranks (collective).
+pub(super) fn body_subdomains<D: Family>(rs: &mut RankState, d: &super::partition::Decomposition<D>, nb: usize) -> Vec<i32> {
+    let ns = d.subs.len();
+    let multi: Vec<Vec<u32>> = d
+        .subs
+        .iter()
+        .map(|s| {
+            (0..s.body_global.len() as u32)
+                .filter(|&l| d.mult[s.body_global[l as usize] as usize] >= 2)
+                .collect()
+        })
+        .collect();
+    let count = |s: usize, out: &mut Vec<f64>| {
+        let sub = &d.subs[s];
+        let mut n = vec![0u32; sub.body_global.len()];
+        for a in 0..D::len(&sub.contacts) {
+            for l in D::bodies(&sub.contacts, a) {
+                n[l as usize] += 1;
+            }
+        }
+        out.extend(multi[s].iter().map(|&l| f64::from(n[l as usize])));
+    };
+    let (at, all) = rs.per_subdomain_v(ns, |s| multi[s].len(), count);
+    let mut out = vec![-1i32; nb];
+    let mut best = vec![0u32; nb];
+    for (s, sub) in d.subs.iter().enumerate() {
+        let mut k = 0;
+        for (l, &g) in sub.body_global.iter().enumerate() {
+            let g = g as usize;
+            let n = if d.mult[g] >= 2 {
+                k += 1;
+                all[at[s] + k - 1] as u32
+            } else {
+                1
+            };
+            debug_assert!(d.mult[g] < 2 || multi[s][k - 1] == l as u32);
+            // ascending subdomain ids: a strictly larger count wins
+            if n > best[g] {
+                best[g] = n;
+                out[g] = s as i32;
+            }
+        }
+    }
+    out
+}
