@@ -294,21 +294,37 @@ fn a_state_written_by_p_ranks_restarts_on_other_rank_counts() {
         "the uninterrupted run",
     );
     let reference = final_json(&one);
+    restarts_match(&dir, &whole, &half, &reference, &flags, "");
+    // contacts held per rank (re-partitioned every 3 steps: the state is written
+    // between two repartitions)
+    let whole = write(&dir, "held.toml", &every(PILE2D, 3));
+    let half = write(&dir, "held_half.toml", &every(&PILE2D.replace("steps = 15", "steps = 8"), 3));
+    let one = dir.join("held-one");
+    ok(
+        &nscdd(&args(&whole, &one, &[&flags[..], &["--threads", "2"]].concat())),
+        "held, uninterrupted",
+    );
+    restarts_match(&dir, &whole, &half, &final_json(&one), &flags, "held-");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `half` on P ranks, then `whole` restarted from its state on P′: the reference's
+/// final.json.
+fn restarts_match(dir: &Path, whole: &Path, half: &Path, reference: &str, flags: &[&str], tag: &str) {
     for (first, then) in [(2, 4), (2, 1), (4, 2)] {
-        let a = dir.join(format!("first{first}-{then}"));
-        ok(&mpirun(&[(first, args(&half, &a, &flags))]), &format!("8 steps on {first} ranks"));
+        let a = dir.join(format!("{tag}first{first}-{then}"));
+        ok(&mpirun(&[(first, args(half, &a, flags))]), &format!("8 steps on {first} ranks"));
         assert!(final_json(&a).contains("\"f_gamma\""), "the NSCDD state on {first} ranks");
-        let b = dir.join(format!("then{first}-{then}"));
+        let b = dir.join(format!("{tag}then{first}-{then}"));
         let state = a.join("final.json");
-        let rest = args(&whole, &b, &[&flags[..], &["--restart", state.to_str().unwrap()]].concat());
+        let rest = args(whole, &b, &[flags, &["--restart", state.to_str().unwrap()]].concat());
         let o = if then == 1 { nscdd(&rest) } else { mpirun(&[(then, rest)]) };
         ok(&o, &format!("the restart on {then} rank(s)"));
         assert!(
             final_json(&b) == reference,
-            "{first} ranks then {then}: final.json differs from the uninterrupted run"
+            "{tag}{first} ranks then {then}: final.json differs from the uninterrupted run"
         );
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 fn per_rank(out: &Path) -> Vec<serde_json::Value> {

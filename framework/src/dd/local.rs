@@ -166,8 +166,12 @@ impl<D: Family> super::NscddOf<D> {
             self.local.now = false;
             return;
         };
-        if !(eligible && self.local_contacts) {
+        // (after a restart the ranks of the subdomains are not known before the first
+        // partition: that step runs on the whole sample)
+        if !(eligible && self.local_contacts) || rs.rank_of.len() != grid.len() {
             self.local.now = false;
+            rs.local = false;
+            D::set_region(w, None);
             return;
         }
         if self.local.held {
