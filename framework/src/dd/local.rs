@@ -101,7 +101,6 @@ impl Local {
                 pairs: Vec::new(),
             })
             .collect();
-        D::body_boxes(w, &mut self.boxes);
         let c = D::contacts(w);
         let mut mine = Vec::new();
         for a in 0..D::len(c) {
@@ -135,20 +134,26 @@ impl Local {
     }
 }
 
-/// The region a rank detects in: its cells and the pairs of its kept contacts.
-pub(super) fn region(rs: &RankState, grid: &Grid, kept: &[(ContactKey, u32)]) -> Region {
+/// The region a rank detects in: its cells, and the pairs of its kept contacts
+/// that the cells would miss (their grown boxes' intersection has left them).
+pub(super) fn region<D: Family>(rs: &RankState, grid: &Grid, kept: &[(ContactKey, u32)], boxes: &[[[f64; 3]; 2]], alert: f64) -> Region {
     let me = rs.cluster.rank();
+    let cells = Region {
+        boxes: cells_of(grid, &rs.rank_of, me),
+        pairs: Vec::new(),
+    };
     let mut pairs: Vec<[u32; 2]> = kept
         .iter()
         .filter(|e| rs.rank_of.get(e.1 as usize) == Some(&me))
+        .filter(|e| match (boxes.get(e.0.i as usize), boxes.get(e.0.j as usize)) {
+            (Some(a), Some(b)) => !pair_meets(D::SPACE, a, b, alert, &cells),
+            _ => false,
+        })
         .map(|e| [e.0.i.min(e.0.j), e.0.i.max(e.0.j)])
         .collect();
     pairs.sort_unstable();
     pairs.dedup();
-    Region {
-        boxes: cells_of(grid, &rs.rank_of, me),
-        pairs,
-    }
+    Region { pairs, ..cells }
 }
 
 impl<D: Family> super::NscddOf<D> {
@@ -174,6 +179,7 @@ impl<D: Family> super::NscddOf<D> {
             D::set_region(w, None);
             return;
         }
+        D::body_boxes(w, &mut self.local.boxes);
         if self.local.held {
             let got = self.local.exchange::<D>(rs, w, (&self.last.owner, grid, D::alert(w)), repart);
             if !repart {
@@ -185,7 +191,8 @@ impl<D: Family> super::NscddOf<D> {
         }
         self.local.now = !repart;
         rs.local = !repart;
-        D::set_region(w, (!repart).then(|| region(rs, grid, &self.kept)));
+        let region = (!repart).then(|| region::<D>(rs, grid, &self.kept, &self.local.boxes, D::alert(w)));
+        D::set_region(w, region);
     }
 
     /// After detection: only the raw contacts of the own subdomains stay.
