@@ -29,11 +29,12 @@
 //! and every reduction runs in subdomain order, a run gives bitwise the results of
 //! the same decomposition run in one process, whatever the number of ranks.
 //!
-//! What is not distributed yet (docs/SCALING.md): detection, partition and the
-//! position update run on every rank over the whole sample, and the end-of-step
-//! all-gather carries every contact's impulse. A subdomain that changes rank at a
-//! repartition needs no migration message: its bodies and the impulses of its
-//! contacts are already on every rank after the previous step's all-gather.
+//! Between repartitions, for rigid bodies, each rank holds only its subdomains'
+//! contacts ([`super::local`]): it detects and builds those alone, the other ranks'
+//! subdomains are shells (their bodies), and the end of the step no longer carries
+//! the impulses. What is not distributed yet (docs/SCALING.md): the bodies (every
+//! rank holds and moves all of them), a repartition step (run on the whole sample),
+//! and the copies' velocities and F_Γ, still sent to every rank.
 
 use super::cluster::Cluster;
 use super::family::Family;
