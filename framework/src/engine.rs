@@ -242,11 +242,13 @@ fn dist2<P: Vector>(a: &P, b: &P) -> f64 {
 /// This step's contact set from the raw contacts: frames, W_αα, ū, the warm start
 /// (applied at once to the free velocities) and the bonds of mortar joints.
 pub fn build_contacts<D: Dim>(w: &mut World<D>) {
-    let step = LawStep {
-        h: w.time.h,
-        theta: w.time.theta,
-        first: w.step == 0,
-    };
+    gather_prev(w);
+    build_from_raw(w);
+}
+
+/// The last step's contacts (and other processes' in `extra_prev`), sorted by key:
+/// the warm starts of [`build_from_raw`].
+fn gather_prev<D: Dim>(w: &mut World<D>) {
     let s = &mut w.scratch;
     s.prev_keys.clear();
     let old = &w.contacts;
@@ -258,6 +260,18 @@ pub fn build_contacts<D: Dim>(w: &mut World<D>) {
     }));
     s.prev_keys.extend_from_slice(&s.extra_prev);
     s.prev_keys.sort_unstable_by_key(|x| x.key);
+}
+
+/// The contact set from the raw contacts, warm-started from the gathered previous
+/// ones (which a second call in the same step reuses: NSCDD's distributed
+/// repartition).
+pub(crate) fn build_from_raw<D: Dim>(w: &mut World<D>) {
+    let step = LawStep {
+        h: w.time.h,
+        theta: w.time.theta,
+        first: w.step == 0,
+    };
+    let s = &mut w.scratch;
     let c = &mut s.next;
     c.clear();
     s.laws.clear();

@@ -99,6 +99,11 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     fn prev_record(c: &Self::Contacts, a: usize, out: &mut Vec<f64>);
     const PREV_RECORD: usize;
     fn set_extra_prev(w: &mut Self::World, records: &[f64]);
+    /// Detects again in `region`, keeps the raw contacts `keep` accepts and builds
+    /// them with the same warm starts as the step's first build, the velocities
+    /// back at `v_free` (a distributed repartition: the contacts move to their new
+    /// ranks).
+    fn redetect(w: &mut Self::World, region: crate::detect::Region, keep: &mut dyn FnMut(ContactKey, [f64; 3]) -> bool, v_free: &[Self::V]);
     fn solver(w: &Self::World) -> &crate::solver::SolverSettings;
     /// One step of the world with NSCDD as its contact stage.
     fn step_with(w: &mut Self::World, stage: &mut super::Stage<'_, '_, Self>) -> Result<StepReport, Diverged>;
@@ -275,6 +280,19 @@ impl<D: Dim> Family for Rigid<D> {
         out.extend_from_slice(c.r[a].as_ref());
         out.extend_from_slice(c.point[a].as_ref());
         out.push(c.joint[a].bonded() as u8 as f64);
+    }
+    fn redetect(
+        w: &mut Self::World,
+        region: crate::detect::Region,
+        keep: &mut dyn FnMut(ContactKey, [f64; 3]) -> bool,
+        v_free: &[Self::V],
+    ) {
+        w.bodies.vel.copy_from_slice(v_free);
+        let s = &mut w.scratch;
+        s.detector
+            .detect_in(&w.bodies, &w.shapes, &w.detectors, w.alert, Some(&region), &mut s.raw);
+        Self::retain_raw(w, keep);
+        crate::engine::build_from_raw(w);
     }
     fn set_extra_prev(w: &mut Self::World, records: &[f64]) {
         let n = D::N;

@@ -37,6 +37,8 @@ pub(super) struct Local {
     /// With contacts held per rank: each body's subdomain for the outputs
     /// ([`body_subdomains`]).
     pub body_sub: Vec<i32>,
+    /// A distributed repartition's grid and number of contacts, for the partition.
+    pub new_grid: Option<(Grid, usize)>,
 }
 
 /// The boxes of the grid cells whose subdomain is `rank`'s (edge cells unbounded,
@@ -182,17 +184,16 @@ impl<D: Family> super::NscddOf<D> {
         D::body_boxes(w, &mut self.local.boxes);
         if self.local.held {
             let got = self.local.exchange::<D>(rs, w, (&self.last.owner, grid, D::alert(w)), repart);
-            if !repart {
-                self.kept.extend(got);
-                self.kept.sort_unstable_by_key(|e| e.0);
-            }
+            self.kept.extend(got);
+            self.kept.sort_unstable_by_key(|e| e.0);
         } else {
             D::set_extra_prev(w, &[]);
         }
-        self.local.now = !repart;
-        rs.local = !repart;
-        let region = (!repart).then(|| region::<D>(rs, grid, &self.kept, &self.local.boxes, D::alert(w)));
-        D::set_region(w, region);
+        // a repartition detects in the old regions first ([`Self::repartition_local`])
+        self.local.now = true;
+        rs.local = true;
+        let region = region::<D>(rs, grid, &self.kept, &self.local.boxes, D::alert(w));
+        D::set_region(w, Some(region));
     }
 
     /// After detection: only the raw contacts of the own subdomains stay.
@@ -206,6 +207,58 @@ impl<D: Family> super::NscddOf<D> {
         let me = rs.cluster.rank();
         let (kept, rank_of) = (&self.kept, &rs.rank_of);
         D::retain_raw(w, &mut |key, p| rank_of.get(owner_of(kept, grid, key, p) as usize) == Some(&me));
+    }
+
+    /// A repartition with contacts held per rank (collective): the new grid over the
+    /// bounds of every rank's contact points (merged by min and max), the new ranks
+    /// by the counts per cell (added), then each rank detects and builds again the
+    /// contacts of its new cells, with the same warm starts.
+    pub(super) fn repartition_local(&mut self, w: &mut D::World) {
+        if !(self.local.now && self.repartitions()) {
+            return;
+        }
+        let Some(rs) = self.ranks.as_mut() else { return };
+        let s = &self.settings;
+        let c = D::contacts(w);
+        let nc = D::len(c);
+        let (lo, hi) = Grid::bounds((0..nc).map(|a| D::point(c, a)));
+        let mine: Vec<f64> = lo.iter().chain(&hi).copied().chain([nc as f64]).collect();
+        let (_, all) = rs.all_gather_any(&mine);
+        let (mut glo, mut ghi, mut total) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3], 0usize);
+        for x in all.chunks_exact(7) {
+            for d in 0..3 {
+                glo[d] = glo[d].min(x[d]);
+                ghi[d] = ghi[d].max(x[3 + d]);
+            }
+            total += x[6] as usize;
+        }
+        let grid = Grid::from_bounds(glo, ghi, s.nx, s.ny, s.nz);
+        let ns = grid.len();
+        let mut loads = vec![0f64; ns];
+        for a in 0..nc {
+            loads[grid.cell_of(D::point(c, a)) as usize] += 1.0;
+        }
+        let (_, all) = rs.all_gather_any(&loads);
+        let mut sum = vec![0usize; ns];
+        for x in all.chunks_exact(ns) {
+            for (t, v) in sum.iter_mut().zip(x) {
+                *t += *v as usize;
+            }
+        }
+        rs.rank_of = super::rank_balance::balanced_ranks(&sum, rs.cluster.size());
+        let me = rs.cluster.rank();
+        let region = Region {
+            boxes: cells_of(&grid, &rs.rank_of, me),
+            pairs: Vec::new(),
+        };
+        let rank_of = &rs.rank_of;
+        D::redetect(
+            w,
+            region,
+            &mut |_, p| rank_of.get(grid.cell_of(p) as usize) == Some(&me),
+            &self.v_free,
+        );
+        self.local.new_grid = Some((grid, total));
     }
 
     /// After the step: whether the world now holds this rank's contacts only.

@@ -300,7 +300,11 @@ impl<D: Family> NscddOf<D> {
             Some(g) if !repart => (g, partition::kept_owners::<D>(c, &g, &self.kept)),
             _ => {
                 let pts = (0..nc).map(|a| D::point(c, a)).chain(self.fam_points.iter().copied());
-                let g = Grid::over(pts, s.nx, s.ny, s.nz);
+                // contacts held per rank: the grid of the distributed repartition
+                let g = match self.local.new_grid {
+                    Some((g, _)) => g,
+                    None => Grid::over(pts, s.nx, s.ny, s.nz),
+                };
                 (g, (0..nc).map(|a| g.cell_of(D::point(c, a))).collect())
             }
         };
@@ -317,10 +321,12 @@ impl<D: Family> NscddOf<D> {
         let before = (repart && self.steps > 0).then(|| partition::body_sets(&self.last, nb));
         if repart {
             self.grid = Some(grid);
-            self.grid_empty = nc + self.fam_points.len() == 0;
+            let total = self.local.new_grid.take().map_or(nc, |(_, t)| t);
+            self.grid_empty = total + self.fam_points.len() == 0;
         }
-        // several processes: each builds only the subdomains of its rank
-        let build = self.ranks.as_mut().map(|rs| rs.assign(&owner, ns, repart));
+        // several processes: each builds only the subdomains of its rank (chosen by
+        // the distributed repartition when contacts are held per rank)
+        let build = self.ranks.as_mut().map(|rs| rs.assign(&owner, ns, repart && !self.local.now));
         let fo = FamilyOwners {
             fams,
             owner: &self.fam_owner,
@@ -535,6 +541,7 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
         for f in self.fams.iter_mut() {
             f.build(w);
         }
+        self.dd.repartition_local(w);
         let mut rep = std::mem::take(&mut self.dd.pending);
         self.dd.partition(w, self.fams, &mut rep);
         self.dd.pending = rep;

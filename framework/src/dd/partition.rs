@@ -26,7 +26,12 @@ pub struct Grid {
 
 impl Grid {
     pub fn over(points: impl Iterator<Item = [f64; 3]>, nx: u32, ny: u32, nz: u32) -> Grid {
-        let n = [nx.max(1), ny.max(1), nz.max(1)];
+        let (lo, hi) = Grid::bounds(points);
+        Grid::from_bounds(lo, hi, nx, ny, nz)
+    }
+
+    /// The bounds of the finite points (lo > hi without any).
+    pub fn bounds(points: impl Iterator<Item = [f64; 3]>) -> ([f64; 3], [f64; 3]) {
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for p in points.filter(|p| p.iter().all(|x| x.is_finite())) {
             for d in 0..3 {
@@ -34,6 +39,13 @@ impl Grid {
                 hi[d] = hi[d].max(p[d]);
             }
         }
+        (lo, hi)
+    }
+
+    /// The grid over the bounds of [`Grid::bounds`] (of points held by several
+    /// processes: the bounds are exact once merged by min and max).
+    pub fn from_bounds(mut lo: [f64; 3], mut hi: [f64; 3], nx: u32, ny: u32, nz: u32) -> Grid {
+        let n = [nx.max(1), ny.max(1), nz.max(1)];
         if lo[0] > hi[0] {
             (lo, hi) = ([0.0; 3], [0.0; 3]);
         }
