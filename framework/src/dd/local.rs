@@ -15,10 +15,13 @@
 //!                    multiplicities are then those of one process)
 //! ```
 //!
-//! A repartition step runs on the whole sample (every rank detects and builds
-//! everything, as with replicated data), all the last step's contacts gathered
-//! first. Every decision above is the one a single process takes with all the
-//! contacts, so results stay bitwise those of one process.
+//! A repartition step detects in the old regions (all the last step's contacts
+//! gathered first), merges every rank's bounds and counts into the new grid and
+//! ranks, and detects again in the new regions
+//! ([`super::NscddOf::repartition_local`]); only the first step, and the first
+//! after a restart, run on the whole sample. Every decision above is the one a
+//! single process takes with all the contacts, so results stay bitwise those of one
+//! process.
 
 use super::family::Family;
 use super::partition::Grid;
