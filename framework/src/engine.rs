@@ -70,6 +70,8 @@ pub trait ContactStage<W> {
     fn reactions(&mut self, _w: &mut W) -> bool {
         false
     }
+    /// After the position update (the step is done).
+    fn after_update(&mut self, _w: &mut W) {}
 }
 
 /// The one-domain stage: NLGS, Anderson-accelerated NLGS over the same sweeps
@@ -132,6 +134,7 @@ impl<D: Dim> World<D> {
         let own_reactions = stage.reactions(self);
         let t3 = Instant::now();
         update_positions_with(self, !own_reactions)?;
+        stage.after_update(self);
         let t4 = Instant::now();
         rep.contacts = self.contacts.len();
         rep.times = StageTimes {

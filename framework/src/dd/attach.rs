@@ -42,6 +42,7 @@
 //! [`LocalPart::sweep`] visits all its contacts in the family's own code.
 
 use super::family::Family;
+use super::subdomain::SubdomainSolver;
 use crate::norms::Sums;
 use std::any::Any;
 
@@ -172,4 +173,46 @@ pub(super) fn write_back_families<D: Family>(
         (f2, q2) = (f2 + a, q2 + b);
     }
     crate::solver::nlgs::residual_of(f2, q2)
+}
+
+/// Global impulses and velocities from the subdomains: a body with one copy takes
+/// its velocity, an interface body the average of its copies (chain order); an
+/// immovable body copied several times keeps its first copy's.
+pub fn write_back<D: Family>(d: &super::partition::Decomposition<D>, w: &mut D::World) {
+    let nb = D::n_bodies(w);
+    let movable: Vec<bool> = (0..nb).map(|g| D::movable(w, g)).collect();
+    let mut done = vec![false; nb];
+    for s in &d.subs {
+        let c = D::contacts_mut(w);
+        for (la, &ga) in s.contact_global.iter().enumerate() {
+            D::copy_r(c, ga as usize, &s.contacts, la);
+        }
+        let vel = D::vel_mut(w);
+        for (l, &g) in s.body_global.iter().enumerate() {
+            let g = g as usize;
+            if !done[g] && (d.mult[g] == 1 || !movable[g]) {
+                vel[g] = s.vel[l];
+                done[g] = true;
+            }
+        }
+    }
+    let ifc = &d.iface;
+    let vel = D::vel_mut(w);
+    let mut vc = Vec::new();
+    for ib in 0..ifc.n_rigid {
+        let r = ifc.copies(ib);
+        let m = r.len() as f64;
+        let mut v = D::V::default();
+        for c in r {
+            vc.clear();
+            d.subs[ifc.sub[c] as usize].interface_velocity(ifc.slot[c] as usize, &mut vc);
+            for (x, y) in v.as_mut().iter_mut().zip(&vc) {
+                *x += y;
+            }
+        }
+        for x in v.as_mut() {
+            *x /= m;
+        }
+        vel[ifc.body[ib] as usize] = v;
+    }
 }

@@ -22,6 +22,10 @@ pub struct Census {
     /// Coordination numbers (NaN when not computed: the world has no box sample).
     pub z: f64,
     pub z_m: f64,
+    /// A 3D box sample's bulk counts (`World3::bulk_measures_with`): Σ loaded
+    /// contacts of the inner non-rattlers, their number, the inner grains, the inner
+    /// rattlers.
+    pub bulk: Option<[u64; 4]>,
 }
 
 /// Each subdomain's loaded contacts per local body, and its loaded grain–grain contacts.
@@ -39,6 +43,48 @@ fn loaded<D: Family>(w: &D::World, d: &Decomposition<D>, s: usize) -> (Vec<u32>,
         }
     }
     (count, ngg)
+}
+
+/// The loaded contacts of the bodies held by several subdomains, summed over them
+/// (their counts exchanged; 0 for the other bodies).
+fn shared_totals<D: Family>(
+    d: &Decomposition<D>,
+    w: &D::World,
+    ranks: Option<&mut RankState>,
+    counts: &[Option<(Vec<u32>, u64)>],
+) -> Vec<u32> {
+    let ns = d.subs.len();
+    let multi: Vec<Vec<u32>> = d
+        .subs
+        .iter()
+        .map(|s| {
+            (0..s.body_global.len() as u32)
+                .filter(|&l| d.mult[s.body_global[l as usize] as usize] >= 2)
+                .collect()
+        })
+        .collect();
+    let mut total = vec![0u32; D::n_bodies(w)];
+    let fill = |s: usize, v: &mut Vec<f64>| {
+        let (c, _) = counts[s].as_ref().expect("an own subdomain");
+        v.extend(multi[s].iter().map(|&l| c[l as usize] as f64));
+    };
+    let (at, all) = match ranks {
+        Some(r) => r.per_subdomain_v(ns, |s| multi[s].len(), fill),
+        None => {
+            let (mut at, mut v) = (Vec::with_capacity(ns), Vec::new());
+            for s in 0..ns {
+                at.push(v.len());
+                fill(s, &mut v);
+            }
+            (at, v)
+        }
+    };
+    for (s, ls) in multi.iter().enumerate() {
+        for (k, &l) in ls.iter().enumerate() {
+            total[d.subs[s].body_global[l as usize] as usize] += all[at[s] + k] as u32;
+        }
+    }
+    total
 }
 
 /// The census of the step of `d` (on ranks: collective).
@@ -64,37 +110,7 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
         return out;
     }
     let counts: Vec<Option<(Vec<u32>, u64)>> = (0..ns).map(|s| own(s).then(|| loaded(w, d, s))).collect();
-    // the bodies held by several subdomains: their counts in every subdomain
-    let multi: Vec<Vec<u32>> = d
-        .subs
-        .iter()
-        .map(|s| {
-            (0..s.body_global.len() as u32)
-                .filter(|&l| d.mult[s.body_global[l as usize] as usize] >= 2)
-                .collect()
-        })
-        .collect();
-    let mut total = vec![0u32; D::n_bodies(w)];
-    let fill = |s: usize, v: &mut Vec<f64>| {
-        let (c, _) = counts[s].as_ref().expect("an own subdomain");
-        v.extend(multi[s].iter().map(|&l| c[l as usize] as f64));
-    };
-    let (at, all) = match ranks.as_deref_mut() {
-        Some(r) => r.per_subdomain_v(ns, |s| multi[s].len(), fill),
-        None => {
-            let (mut at, mut v) = (Vec::with_capacity(ns), Vec::new());
-            for s in 0..ns {
-                at.push(v.len());
-                fill(s, &mut v);
-            }
-            (at, v)
-        }
-    };
-    for (s, ls) in multi.iter().enumerate() {
-        for (k, &l) in ls.iter().enumerate() {
-            total[d.subs[s].body_global[l as usize] as usize] += all[at[s] + k] as u32;
-        }
-    }
+    let total = shared_totals(d, w, ranks.as_deref_mut(), &counts);
     // per subdomain: contacts, loaded grain–grain contacts, non-rattler grains and
     // their loaded contacts, each body counted by its first subdomain
     let mut first = vec![u32::MAX; D::n_bodies(w)];
@@ -103,32 +119,57 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
             first[g as usize] = s as u32;
         }
     }
+    let bulk = D::bulk_box(w);
+    let inner = |g: usize| bulk.is_some_and(|(lo, hi)| (0..3).all(|k| D::position(w, g)[k] > lo[k] && D::position(w, g)[k] < hi[k]));
     let aggregate = |s: usize, v: &mut Vec<f64>| {
         let sub = &d.subs[s];
         let (c, ngg) = counts[s].as_ref().expect("an own subdomain");
-        let (mut n_m, mut sum_m) = (0u64, 0u64);
+        let mut a = [0u64; 6]; // n_m, sum_m, then the bulk counts
         for (l, &g) in sub.body_global.iter().enumerate() {
             let g = g as usize;
-            let n = if d.mult[g] >= 2 { total[g] } else { c[l] };
-            if first[g] == s as u32 && n >= 2 && D::is_grain(w, g) {
-                n_m += 1;
-                sum_m += n as u64;
+            let n = if d.mult[g] >= 2 { total[g] } else { c[l] } as u64;
+            if first[g] != s as u32 || !D::is_grain(w, g) {
+                continue;
+            }
+            if n >= 2 {
+                a[0] += 1;
+                a[1] += n;
+            }
+            if inner(g) {
+                a[4] += 1;
+                if n >= 2 {
+                    a[2] += n;
+                    a[3] += 1;
+                } else {
+                    a[5] += 1;
+                }
             }
         }
-        v.extend([D::len(&sub.contacts) as f64, *ngg as f64, n_m as f64, sum_m as f64]);
+        v.extend([D::len(&sub.contacts) as f64, *ngg as f64]);
+        v.extend(a.map(|x| x as f64));
     };
     let per = match ranks {
-        Some(r) => r.per_subdomain(ns, 4, aggregate),
+        Some(r) => r.per_subdomain(ns, 8, aggregate),
         None => (0..ns).fold(Vec::new(), |mut v, s| {
             aggregate(s, &mut v);
             v
         }),
     };
-    let (mut ngg, mut n_m, mut sum_m) = (0u64, 0u64, 0u64);
-    for x in per.chunks_exact(4) {
+    let (mut ngg, mut n_m, mut sum_m, mut b) = (0u64, 0u64, 0u64, [0u64; 4]);
+    for x in per.chunks_exact(8) {
         out.contacts += x[0] as usize;
         out.subdomains += (x[0] > 0.0) as usize;
         (ngg, n_m, sum_m) = (ngg + x[1] as u64, n_m + x[2] as u64, sum_m + x[3] as u64);
+        for k in 0..4 {
+            b[k] += x[4 + k] as u64;
+        }
+    }
+    if bulk.is_some() {
+        // the inner grains without contacts are rattlers
+        let idle = (0..D::n_bodies(w))
+            .filter(|&g| d.mult[g] == 0 && D::is_grain(w, g) && inner(g))
+            .count() as u64;
+        out.bulk = Some([b[0], b[1], b[2] + idle, b[3] + idle]);
     }
     let ng = (0..D::n_bodies(w)).filter(|&g| D::is_grain(w, g)).count();
     out.z = if ng > 0 { 2.0 * ngg as f64 / ng as f64 } else { 0.0 };

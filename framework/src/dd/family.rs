@@ -87,6 +87,10 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     /// population), and whether the world's outputs need the coordination numbers.
     fn is_grain(w: &Self::World, g: usize) -> bool;
     fn wants_coordination(w: &Self::World) -> bool;
+    /// The inner box of a 3D box sample's bulk measures (`World3::bulk_box`, the
+    /// history's margin of 4 grain sizes), and a body's position.
+    fn bulk_box(w: &Self::World) -> Option<([f64; 3], [f64; 3])>;
+    fn position(w: &Self::World, g: usize) -> [f64; 3];
     /// Contacts held per rank ([`super::local`]): the next detection's region, the
     /// raw contacts kept after it (by key and point), the bodies' boxes (first `N`
     /// coordinates, the rest 0), and the other processes' last contacts for the warm
@@ -240,6 +244,15 @@ impl<D: Dim> Family for Rigid<D> {
     }
     fn wants_coordination(w: &Self::World) -> bool {
         w.box_walls.is_some()
+    }
+    fn bulk_box(w: &Self::World) -> Option<([f64; 3], [f64; 3])> {
+        let w3 = (w as &dyn std::any::Any).downcast_ref::<crate::world::World3>()?;
+        w3.bulk_box(4.0 * w3.max_grain_size())
+    }
+    fn position(w: &Self::World, g: usize) -> [f64; 3] {
+        let mut p = [0.0; 3];
+        p[..D::N].copy_from_slice(w.bodies.pos[g].as_ref());
+        p
     }
     fn set_region(w: &mut Self::World, region: Option<crate::detect::Region>) {
         w.scratch.region = region;

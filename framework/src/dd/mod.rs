@@ -381,7 +381,12 @@ impl<D: Family> NscddOf<D> {
         rep.interface_bodies = d.iface.len();
         rep.links = d.iface.links();
         rep.max_multiplicity = d.mult.iter().copied().max().unwrap_or(0);
-        if D::len(D::contacts(w)) + self.fam_points.len() == 0 {
+        let mut total = D::len(D::contacts(w)) + self.fam_points.len();
+        if let (true, Some(rs)) = (self.local.now, self.ranks.as_mut()) {
+            // contacts held per rank: whether any rank has one
+            total = rs.all_gather_any(&[total as f64]).1.iter().map(|&x| x as usize).sum();
+        }
+        if total == 0 {
             rep.solve.converged = true;
             self.store.keep(&d.subs);
             return;
@@ -453,57 +458,12 @@ impl<D: Family> NscddOf<D> {
         self.choice.record(self.steps, t0.elapsed().as_secs_f64(), stages);
         rep.stages = stages;
         rep.solve.sweeps = stages * per;
-        write_back(d, w);
+        attach::write_back(d, w);
         self.store.keep(&d.subs);
         rep.solve.residual = attach::write_back_families(d, w, fams, self.ranks.as_mut());
         if let (true, Some(rs)) = (self.local.now, self.ranks.as_mut()) {
             self.local.body_sub = local::body_subdomains(rs, d, D::n_bodies(w));
         }
-        let census = census::census(d, w, self.ranks.as_mut());
-        rep.subdomains = census.subdomains;
-        rep.census = Some(census);
-    }
-}
-
-/// Global impulses and velocities from the subdomains: a body with one copy takes
-/// its velocity, an interface body the average of its copies (chain order); an
-/// immovable body copied several times keeps its first copy's.
-pub fn write_back<D: Family>(d: &Decomposition<D>, w: &mut D::World) {
-    let nb = D::n_bodies(w);
-    let movable: Vec<bool> = (0..nb).map(|g| D::movable(w, g)).collect();
-    let mut done = vec![false; nb];
-    for s in &d.subs {
-        let c = D::contacts_mut(w);
-        for (la, &ga) in s.contact_global.iter().enumerate() {
-            D::copy_r(c, ga as usize, &s.contacts, la);
-        }
-        let vel = D::vel_mut(w);
-        for (l, &g) in s.body_global.iter().enumerate() {
-            let g = g as usize;
-            if !done[g] && (d.mult[g] == 1 || !movable[g]) {
-                vel[g] = s.vel[l];
-                done[g] = true;
-            }
-        }
-    }
-    let ifc = &d.iface;
-    let vel = D::vel_mut(w);
-    let mut vc = Vec::new();
-    for ib in 0..ifc.n_rigid {
-        let r = ifc.copies(ib);
-        let m = r.len() as f64;
-        let mut v = D::V::default();
-        for c in r {
-            vc.clear();
-            d.subs[ifc.sub[c] as usize].interface_velocity(ifc.slot[c] as usize, &mut vc);
-            for (x, y) in v.as_mut().iter_mut().zip(&vc) {
-                *x += y;
-            }
-        }
-        for x in v.as_mut() {
-            *x /= m;
-        }
-        vel[ifc.body[ib] as usize] = v;
     }
 }
 
@@ -553,6 +513,15 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
         self.dd.pending = rep;
         s
     }
+    /// The counts outputs read ([`census`]), on the moved bodies (collective).
+    fn after_update(&mut self, w: &mut D::World) {
+        if self.dd.last.subs.is_empty() || self.dd.pending.census.is_some() {
+            return;
+        }
+        let census = census::census(&self.dd.last, w, self.dd.ranks.as_mut());
+        self.dd.pending.subdomains = census.subdomains;
+        self.dd.pending.census = Some(census);
+    }
     /// Per subdomain, in subdomain order ([`reactions`]); the attached families'
     /// contacts are the world's business (their reactions stay the engine's sum).
     fn reactions(&mut self, w: &mut D::World) -> bool {
@@ -584,5 +553,8 @@ impl<D: Family> ContactStage<D::World> for NscddOf<D> {
     }
     fn reactions(&mut self, w: &mut D::World) -> bool {
         Stage { dd: self, fams: &mut [] }.reactions(w)
+    }
+    fn after_update(&mut self, w: &mut D::World) {
+        Stage { dd: self, fams: &mut [] }.after_update(w);
     }
 }

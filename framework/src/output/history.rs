@@ -136,7 +136,7 @@ impl<W: Write, D: Dim> History<W, D> {
             }
         }
         if self.has_box {
-            box_fields(w, self.margin, census.map(|c| (c.z, c.z_m)).filter(|z| !z.0.is_nan()), &mut s);
+            box_fields(w, self.margin, census.filter(|c| !c.z.is_nan()), &mut s);
         }
         let tm = r.times;
         s.push_str(&format!(
@@ -160,7 +160,7 @@ impl<W: Write, D: Dim> History<W, D> {
 }
 
 /// The box sample's fields of a row (see [`History`]).
-fn box_fields<D: Dim>(w: &World<D>, margin: f64, z: Option<(f64, f64)>, s: &mut String) {
+fn box_fields<D: Dim>(w: &World<D>, margin: f64, census: Option<crate::dd::Census>, s: &mut String) {
     let nu = w.solid_fraction().unwrap_or(f64::NAN);
     let height = w.box_extent().map_or(f64::NAN, |e| e.max[D::N - 1] - e.min[D::N - 1]);
     let eps1 = w.box_h0.map_or(0.0, |h0| (h0 - height) / h0);
@@ -174,11 +174,12 @@ fn box_fields<D: Dim>(w: &World<D>, margin: f64, z: Option<(f64, f64)>, s: &mut 
     for k in 0..D::N {
         s.push_str(&format!(",{:e}", sg[k]));
     }
-    let (z, zm) = z.unwrap_or_else(|| w.coordination());
+    let (z, zm) = census.map_or_else(|| w.coordination(), |c| (c.z, c.z_m));
     let q_over_p = if p != 0.0 { q / p } else { 0.0 };
     s.push_str(&format!(",{p:e},{q:e},{q_over_p:e},{sin_phi:e},{z:e},{zm:e}"));
     if let Some(w3) = (w as &dyn std::any::Any).downcast_ref::<World3>() {
-        let (nb, zb, rb) = w3.bulk_measures(margin).unwrap_or((f64::NAN, f64::NAN, f64::NAN));
+        let counts = census.and_then(|c| c.bulk);
+        let (nb, zb, rb) = w3.bulk_measures_with(margin, counts).unwrap_or((f64::NAN, f64::NAN, f64::NAN));
         s.push_str(&format!(",{nb:e},{zb:e},{rb:e}"));
     }
 }

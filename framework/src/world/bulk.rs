@@ -13,34 +13,46 @@ impl World3 {
     /// it, rattlers excluded (grains with fewer than 2 loaded contacts, walls
     /// counted): `(nu_bulk, z_bulk, rattler fraction)`.
     pub fn bulk_measures(&self, margin: f64) -> Option<(f64, f64, f64)> {
+        self.bulk_measures_with(margin, None)
+    }
+
+    /// The inner box of [`World3::bulk_measures`] (None when the margin leaves none).
+    pub fn bulk_box(&self, margin: f64) -> Option<([f64; 3], [f64; 3])> {
         let e = self.box_extent()?;
         let lo = e.min.map(|x| x + margin);
         let hi = e.max.map(|x| x - margin);
-        if (0..3).any(|k| hi[k] <= lo[k]) {
-            return None;
-        }
+        (0..3).all(|k| hi[k] > lo[k]).then_some((lo, hi))
+    }
+
+    /// [`World3::bulk_measures`], the coordination counts (Σ loaded contacts of the
+    /// inner non-rattlers, their number, the inner grains, the inner rattlers) from
+    /// `counts` when given (NSCDD's census, added over the subdomains), else from the
+    /// world's contacts.
+    pub fn bulk_measures_with(&self, margin: f64, counts: Option<[u64; 4]>) -> Option<(f64, f64, f64)> {
+        let (lo, hi) = self.bulk_box(margin)?;
         let n = self.bodies.len();
-        let count = self.loaded_contacts();
-        let (mut vol, mut zsum, mut nz, mut ninner, mut rattlers) = (0.0, 0u64, 0u64, 0u64, 0u64);
-        for b in 0..n {
-            if !self.is_grain(b) {
-                continue;
-            }
-            let x = self.bodies.pos[b];
+        let inner = |b: usize| (0..3).all(|k| self.bodies.pos[b][k] > lo[k] && self.bodies.pos[b][k] < hi[k]);
+        let mut vol = 0.0;
+        for b in (0..n).filter(|&b| self.is_grain(b)) {
             let v = self.bodies.volume[b];
             // equivalent radius of the grain's volume
             let r = (3.0 * v / (4.0 * std::f64::consts::PI)).cbrt();
-            vol += sphere_in_box(x, r, lo, hi);
-            if (0..3).all(|k| x[k] > lo[k] && x[k] < hi[k]) {
-                ninner += 1;
+            vol += sphere_in_box(self.bodies.pos[b], r, lo, hi);
+        }
+        let [zsum, nz, ninner, rattlers] = counts.unwrap_or_else(|| {
+            let count = self.loaded_contacts();
+            let mut c = [0u64; 4];
+            for b in (0..n).filter(|&b| self.is_grain(b) && inner(b)) {
+                c[2] += 1;
                 if count[b] >= 2 {
-                    zsum += count[b] as u64;
-                    nz += 1;
+                    c[0] += count[b] as u64;
+                    c[1] += 1;
                 } else {
-                    rattlers += 1;
+                    c[3] += 1;
                 }
             }
-        }
+            c
+        });
         let v_in = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
         let z = if nz > 0 { zsum as f64 / nz as f64 } else { 0.0 };
         let rf = if ninner > 0 { rattlers as f64 / ninner as f64 } else { 0.0 };
