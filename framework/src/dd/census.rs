@@ -54,15 +54,7 @@ fn shared_totals<D: Family>(
     counts: &[Option<(Vec<u32>, u64)>],
 ) -> Vec<u32> {
     let ns = d.subs.len();
-    let multi: Vec<Vec<u32>> = d
-        .subs
-        .iter()
-        .map(|s| {
-            (0..s.body_global.len() as u32)
-                .filter(|&l| d.mult[s.body_global[l as usize] as usize] >= 2)
-                .collect()
-        })
-        .collect();
+    let multi = d.shared_locals();
     let mut total = vec![0u32; D::n_bodies(w)];
     let fill = |s: usize, v: &mut Vec<f64>| {
         let (c, _) = counts[s].as_ref().expect("an own subdomain");

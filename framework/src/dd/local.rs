@@ -310,15 +310,7 @@ impl RankState {
 /// come from their subdomains' ranks (collective).
 pub(super) fn body_subdomains<D: Family>(rs: &mut RankState, d: &super::partition::Decomposition<D>, nb: usize) -> Vec<i32> {
     let ns = d.subs.len();
-    let multi: Vec<Vec<u32>> = d
-        .subs
-        .iter()
-        .map(|s| {
-            (0..s.body_global.len() as u32)
-                .filter(|&l| d.mult[s.body_global[l as usize] as usize] >= 2)
-                .collect()
-        })
-        .collect();
+    let multi = d.shared_locals();
     let count = |s: usize, out: &mut Vec<f64>| {
         let sub = &d.subs[s];
         let mut n = vec![0u32; sub.body_global.len()];

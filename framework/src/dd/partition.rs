@@ -191,6 +191,21 @@ pub struct Decomposition<D: Family> {
     pub iface: Interface,
 }
 
+impl<D: Family> Decomposition<D> {
+    /// Per subdomain, the local ids of its bodies that other subdomains hold too
+    /// (multiplicity ≥ 2, immovable bodies included), ascending.
+    pub fn shared_locals(&self) -> Vec<Vec<u32>> {
+        self.subs
+            .iter()
+            .map(|s| {
+                (0..s.body_global.len() as u32)
+                    .filter(|&l| self.mult[s.body_global[l as usize] as usize] >= 2)
+                    .collect()
+            })
+            .collect()
+    }
+}
+
 impl<D: Family> Default for Decomposition<D> {
     fn default() -> Self {
         Decomposition {
