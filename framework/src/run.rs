@@ -163,6 +163,14 @@ pub(crate) fn dd_solver<D: crate::dd::Family>(
                     c.dd.threads
                 );
             }
+            // contacts held per rank: a repartition detects and builds twice
+            if c.repartition_every <= 1 && cl.size() > 1 && cl.rank() == 0 {
+                eprintln!(
+                    "note: the subdomains are re-partitioned at every step ([decomposition] repartition_every = 1): \
+                     on ranks a repartition detects and builds the contacts twice; every 10 steps or so is usually \
+                     faster (docs/SCALING.md)"
+                );
+            }
             n.with_cluster(cl).map(Some).map_err(RunError::Ranks)
         }
         None => Ok(Some(n)),
