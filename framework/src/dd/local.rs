@@ -56,7 +56,7 @@ pub(super) fn cells_of(grid: &Grid, rank_of: &[u32], rank: u32) -> Vec<[[f64; 3]
             let mut b = [[0.0; 3]; 2];
             for d in 0..3 {
                 let h = grid.cell[d];
-                let flat = !(h > 0.0);
+                let flat = h.is_nan() || h <= 0.0;
                 let at = |k: u32| grid.origin[d] + k as f64 * h;
                 b[0][d] = if flat || idx[d] == 0 { -inf } else { at(idx[d]) - 1e-6 * h };
                 b[1][d] = if flat || idx[d] + 1 == n[d] {
@@ -108,12 +108,12 @@ impl Local {
             .collect();
         let c = D::contacts(w);
         let mut mine = Vec::new();
-        for a in 0..D::len(c) {
+        for (a, &o) in owner.iter().enumerate().take(D::len(c)) {
             let [i, j] = D::bodies(c, a);
             let (bi, bj) = (&self.boxes[i as usize], &self.boxes[j as usize]);
             if all || regions.iter().any(|r| pair_meets(D::SPACE, bi, bj, alert, r)) {
                 D::prev_record(c, a, &mut mine);
-                mine.push(f64::from(owner[a]));
+                mine.push(f64::from(o));
             }
         }
         let (counts, got) = rs.all_gather_any(&mine);

@@ -218,6 +218,9 @@ impl<D: Family> Default for Decomposition<D> {
     }
 }
 
+/// Fills the other ranks' subdomains with their bodies (contacts held per rank).
+pub type Shells<'a, D> = &'a mut dyn FnMut(&mut [Subdomain<D>]);
+
 /// The owners between repartitions: a contact whose key is in `kept` (sorted by key)
 /// stays in its subdomain; a new contact goes to the cell of `grid` (the grid of the
 /// last repartition) that holds its point.
@@ -268,7 +271,7 @@ pub fn decompose_owned<D: Family>(
     store: &FGammaStore<D::V>,
     build: Option<&[bool]>,
     fam: &FamilyOwners<'_, '_, D>,
-    shells: Option<&mut dyn FnMut(&mut [Subdomain<D>])>,
+    shells: Option<Shells<'_, D>>,
 ) -> Decomposition<D> {
     let built = |s: u32| build.is_none_or(|b| b[s as usize]);
     let c = D::contacts(w);
