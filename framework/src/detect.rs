@@ -68,6 +68,14 @@ impl Region {
     pub fn meets(&self, n: usize, lo: &[f64], hi: &[f64]) -> bool {
         self.boxes.iter().any(|b| (0..n).all(|k| lo[k] <= b[1][k] && b[0][k] <= hi[k]))
     }
+    /// Whether the intersection of two boxes (`min`, `max`, first `n` coordinates),
+    /// each grown by `alert`, meets one of the boxes: the test a pair passes to be
+    /// detected in the region (other processes ask it of their own pairs).
+    pub fn meets_pair(&self, n: usize, a: (&[f64], &[f64]), b: (&[f64], &[f64]), alert: f64) -> bool {
+        let lo: [f64; 3] = std::array::from_fn(|k| if k < n { a.0[k].max(b.0[k]) - alert } else { 0.0 });
+        let hi: [f64; 3] = std::array::from_fn(|k| if k < n { a.1[k].min(b.1[k]) + alert } else { 0.0 });
+        self.meets(n, &lo, &hi)
+    }
     fn names(&self, i: u32, j: u32) -> bool {
         self.pairs.binary_search(&[i, j]).is_ok()
     }
@@ -214,9 +222,8 @@ impl<D: Dim> Detector<D> {
             (bodies.movable(a as usize) || bodies.movable(b as usize))
                 && region.is_none_or(|r| {
                     let (x, y) = (&aabb[a as usize], &aabb[b as usize]);
-                    let lo: [f64; 3] = std::array::from_fn(|k| if k < D::N { x.min[k].max(y.min[k]) - alert } else { 0.0 });
-                    let hi: [f64; 3] = std::array::from_fn(|k| if k < D::N { x.max[k].min(y.max[k]) + alert } else { 0.0 });
-                    r.meets(D::N, &lo, &hi) || r.names(a.min(b), a.max(b))
+                    let (x, y) = ((x.min.as_ref(), x.max.as_ref()), (y.min.as_ref(), y.max.as_ref()));
+                    r.meets_pair(D::N, x, y, alert) || r.names(a.min(b), a.max(b))
                 })
         };
         let key = |a: u32, b: u32| kind(a) * nk as u32 + kind(b);

@@ -24,7 +24,7 @@
 //! process.
 
 use super::family::Family;
-use super::partition::Grid;
+use super::partition::{owner_of, Grid};
 use super::ranks::RankState;
 use crate::detect::Region;
 use crate::model::ContactKey;
@@ -70,21 +70,9 @@ pub(super) fn cells_of(grid: &Grid, rank_of: &[u32], rank: u32) -> Vec<[[f64; 3]
         .collect()
 }
 
-/// The subdomain of a contact between repartitions: kept by key, else the cell of
-/// its point (as `partition::kept_owners`).
-pub(super) fn owner_of(kept: &[(ContactKey, u32)], grid: &Grid, key: ContactKey, p: [f64; 3]) -> u32 {
-    match kept.binary_search_by_key(&key, |e| e.0) {
-        Ok(k) => kept[k].1,
-        Err(_) => grid.cell_of(p),
-    }
-}
-
-/// Whether a pair's boxes, grown by `alert` and intersected, meet `region` (the
-/// detection's test, `detect::Detector::detect_in`).
+/// [`Region::meets_pair`] of two bodies' boxes (the detection's own test).
 fn pair_meets(n: usize, a: &[[f64; 3]; 2], b: &[[f64; 3]; 2], alert: f64, region: &Region) -> bool {
-    let lo: [f64; 3] = std::array::from_fn(|k| if k < n { a[0][k].max(b[0][k]) - alert } else { 0.0 });
-    let hi: [f64; 3] = std::array::from_fn(|k| if k < n { a[1][k].min(b[1][k]) + alert } else { 0.0 });
-    region.meets(n, &lo, &hi)
+    region.meets_pair(n, (&a[0], &a[1]), (&b[0], &b[1]), alert)
 }
 
 impl Local {

@@ -225,12 +225,16 @@ pub type Shells<'a, D> = &'a mut dyn FnMut(&mut [Subdomain<D>]);
 /// stays in its subdomain; a new contact goes to the cell of `grid` (the grid of the
 /// last repartition) that holds its point.
 pub fn kept_owners<D: Family>(c: &D::Contacts, grid: &Grid, kept: &[(ContactKey, u32)]) -> Vec<u32> {
-    (0..D::len(c))
-        .map(|a| match kept.binary_search_by_key(&D::key(c, a), |e| e.0) {
-            Ok(p) => kept[p].1,
-            Err(_) => grid.cell_of(D::point(c, a)),
-        })
-        .collect()
+    (0..D::len(c)).map(|a| owner_of(kept, grid, D::key(c, a), D::point(c, a))).collect()
+}
+
+/// The subdomain of one contact between repartitions (see [`kept_owners`]): also
+/// what a rank holding its contacts decides on a raw contact before building it.
+pub fn owner_of(kept: &[(ContactKey, u32)], grid: &Grid, key: ContactKey, p: [f64; 3]) -> u32 {
+    match kept.binary_search_by_key(&key, |e| e.0) {
+        Ok(k) => kept[k].1,
+        Err(_) => grid.cell_of(p),
+    }
 }
 
 /// The subdomains of each body (ascending), `out[b]`, from a decomposition.
