@@ -268,7 +268,7 @@ impl<D: Family> super::NscddOf<D> {
     /// one process).
     pub fn gather_on_root(&mut self, mine: &[f64]) -> Option<Vec<f64>> {
         let rs = self.ranks.as_mut()?;
-        let all = super::state::gather_on_root(rs, mine);
+        let all = rs.gather_any_on_root(mine);
         (rs.cluster.rank() == 0).then_some(all)
     }
 }

@@ -11,15 +11,28 @@ impl RankState {
     /// (two all-gathers).
     pub(super) fn all_gather_any(&mut self, mine: &[f64]) -> (Vec<usize>, Vec<f64>) {
         let t0 = Instant::now();
-        let p = self.cluster.size() as usize;
-        let mut lens = Vec::new();
-        self.cluster.all_gather(&[mine.len() as f64], &vec![1; p], &mut lens);
-        let counts: Vec<usize> = lens.iter().map(|&x| x as usize).collect();
+        let counts = self.lengths(mine.len());
         let mut all = Vec::new();
         self.cluster.all_gather(mine, &counts, &mut all);
         self.reduced(mine.len() + 1);
         self.totals.reduce_seconds += t0.elapsed().as_secs_f64();
         (counts, all)
+    }
+
+    /// As [`RankState::all_gather_any`], into rank 0 only (empty elsewhere).
+    pub(super) fn gather_any_on_root(&mut self, mine: &[f64]) -> Vec<f64> {
+        let counts = self.lengths(mine.len());
+        let mut all = Vec::new();
+        self.cluster.gather(mine, &counts, &mut all);
+        all
+    }
+
+    /// Every rank's length `n` (one all-gather).
+    fn lengths(&mut self, n: usize) -> Vec<usize> {
+        let mut lens = Vec::new();
+        self.cluster
+            .all_gather(&[n as f64], &vec![1; self.cluster.size() as usize], &mut lens);
+        lens.iter().map(|&x| x as usize).collect()
     }
 
     /// Whether subdomain `s` is this rank's (the last repartition's ranks).
@@ -35,25 +48,19 @@ impl RankState {
         shares: &[Vec<D::V>],
         observed: &[u32],
     ) -> super::reactions::Remote {
-        let t0 = Instant::now();
         let ndof = super::subdomain::dofs::<D>();
         let local = super::reactions::observed_local(d, observed);
         let me = self.cluster.rank();
-        self.send.clear();
-        for (s, ls) in local.iter().enumerate().filter(|(s, _)| self.rank_of[*s] == me) {
-            for &l in ls {
-                self.send.extend_from_slice(shares[s][l as usize].as_ref());
-            }
-        }
-        let at = self.counts_by(d.subs.len(), |s| local[s].len() * ndof);
-        self.reduced(self.send.len());
-        self.cluster.all_gather(&self.send, &self.counts, &mut self.all);
-        self.totals.reduce_seconds += t0.elapsed().as_secs_f64();
+        let (at, values) = self.per_subdomain_v(
+            d.subs.len(),
+            |s| local[s].len() * ndof,
+            |s, out| local[s].iter().for_each(|&l| out.extend_from_slice(shares[s][l as usize].as_ref())),
+        );
         super::reactions::Remote {
             own: self.rank_of.iter().map(|&r| r == me).collect(),
             local,
             at,
-            values: std::mem::take(&mut self.all),
+            values,
             ndof,
         }
     }

@@ -164,8 +164,20 @@ impl RankState {
         &mut self,
         ns: usize,
         len: impl Fn(usize) -> usize,
-        mut own: impl FnMut(usize, &mut Vec<f64>),
+        own: impl FnMut(usize, &mut Vec<f64>),
     ) -> (Vec<usize>, Vec<f64>) {
+        let at = self.gather_per_subdomain(ns, len, own);
+        (at, std::mem::take(&mut self.all))
+    }
+
+    /// As [`RankState::per_subdomain_v`], the values left in `self.all` (its buffer
+    /// kept: for the reductions of every stage).
+    pub(super) fn gather_per_subdomain(
+        &mut self,
+        ns: usize,
+        len: impl Fn(usize) -> usize,
+        mut own: impl FnMut(usize, &mut Vec<f64>),
+    ) -> Vec<usize> {
         let t0 = Instant::now();
         let me = self.cluster.rank();
         self.send.clear();
@@ -176,7 +188,7 @@ impl RankState {
         self.reduced(self.send.len());
         self.cluster.all_gather(&self.send, &self.counts, &mut self.all);
         self.totals.reduce_seconds += t0.elapsed().as_secs_f64();
-        (at, std::mem::take(&mut self.all))
+        at
     }
 
     /// Records this rank's part of a gluing collective (centralized scheme).
@@ -455,7 +467,7 @@ pub(super) fn iterate<D: Family>(
                 done
             })
         });
-        if let (Some(m), false) = (mixer.as_deref_mut(), ok) {
+        if let (Some(m), false) = (mixer, ok) {
             team.with_all(|subs| m.give_up(subs, &mine_id));
         }
         (stages, ok)
@@ -496,13 +508,13 @@ impl crate::solver::anderson::Reduce for Reduced<'_> {
         if k == 0 {
             return;
         }
-        let t0 = Instant::now();
-        let at = self.st.counts_by(self.ns, |_| k);
-        self.st.reduced(local.len());
-        self.st.cluster.all_gather(local, &self.st.counts, &mut self.st.all);
+        // `local`: this rank's subdomains' k values each, in subdomain order
+        let mut own = local.chunks_exact(k);
+        let at = self
+            .st
+            .gather_per_subdomain(self.ns, |_| k, |_, v| v.extend_from_slice(own.next().unwrap_or_default()));
         let all = &self.st.all;
         crate::solver::anderson::sum_in_order(at.iter().map(|&a| &all[a..a + k]), k, out);
-        self.st.totals.reduce_seconds += t0.elapsed().as_secs_f64();
     }
 }
 

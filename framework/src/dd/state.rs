@@ -64,14 +64,14 @@ impl<D: Family> NscddOf<D> {
             mine.extend([f64::from(b), f64::from(e)]);
             mine.extend_from_slice(v.as_ref());
         }
-        let all = gather_on_root(rs, &mine);
+        let all = rs.gather_any_on_root(&mine);
         // the kept subdomains of this rank's contacts (all of them when every rank
         // holds every contact: each is some rank's)
         let mut mine = Vec::new();
         for (k, o) in self.kept.iter().filter(|e| rs.rank_of.get(e.1 as usize) == Some(&me)) {
             mine.extend([f64::from(k.i), f64::from(k.j), f64::from(k.feature), f64::from(*o)]);
         }
-        let kept = gather_on_root(rs, &mine);
+        let kept = rs.gather_any_on_root(&mine);
         if me != 0 {
             return None;
         }
@@ -123,15 +123,4 @@ impl<D: Family> NscddOf<D> {
         self.kept.sort_unstable_by_key(|x| x.0);
         Ok(true)
     }
-}
-
-/// Every rank's `mine` (any lengths) concatenated on rank 0 (empty elsewhere).
-pub(super) fn gather_on_root(rs: &mut super::RankState, mine: &[f64]) -> Vec<f64> {
-    let size = rs.cluster.size() as usize;
-    let mut counts = Vec::new();
-    rs.cluster.all_gather(&[mine.len() as f64], &vec![1; size], &mut counts);
-    let counts: Vec<usize> = counts.iter().map(|&c| c as usize).collect();
-    let mut all = Vec::new();
-    rs.cluster.gather(mine, &counts, &mut all);
-    all
 }
