@@ -148,14 +148,7 @@ pub(super) fn write_back_families<D: Family>(
         out.extend([a, b]);
     };
     let ns = d.subs.len();
-    let per_sub = match ranks {
-        Some(r) => r.per_subdomain(ns, 2, sums),
-        None => {
-            let mut v = Vec::with_capacity(2 * ns);
-            (0..ns).for_each(|s| sums(s, &mut v));
-            v
-        }
-    };
+    let per_sub = super::rank_reduce::per_subdomain(ranks, ns, 2, sums);
     let (mut f2, mut q2) = (0.0, 0.0);
     for x in per_sub.chunks_exact(2) {
         (f2, q2) = (f2 + x[0], q2 + x[1]);

@@ -11,6 +11,7 @@
 
 use super::family::Family;
 use super::partition::Decomposition;
+use super::rank_reduce::{per_subdomain, per_subdomain_v};
 use super::ranks::RankState;
 
 /// The counts of a step (see the module docs).
@@ -60,17 +61,7 @@ fn shared_totals<D: Family>(
         let (c, _) = counts[s].as_ref().expect("an own subdomain");
         v.extend(multi[s].iter().map(|&l| c[l as usize] as f64));
     };
-    let (at, all) = match ranks {
-        Some(r) => r.per_subdomain_v(ns, |s| multi[s].len(), fill),
-        None => {
-            let (mut at, mut v) = (Vec::with_capacity(ns), Vec::new());
-            for s in 0..ns {
-                at.push(v.len());
-                fill(s, &mut v);
-            }
-            (at, v)
-        }
-    };
+    let (at, all) = per_subdomain_v(ranks, ns, |s| multi[s].len(), fill);
     for (s, ls) in multi.iter().enumerate() {
         for (k, &l) in ls.iter().enumerate() {
             total[d.subs[s].body_global[l as usize] as usize] += all[at[s] + k] as u32;
@@ -90,13 +81,7 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
     };
     if !D::wants_coordination(w) {
         let n = |s: usize, v: &mut Vec<f64>| v.push(D::len(&d.subs[s].contacts) as f64);
-        let per = match ranks {
-            Some(r) => r.per_subdomain(ns, 1, n),
-            None => (0..ns).fold(Vec::new(), |mut v, s| {
-                n(s, &mut v);
-                v
-            }),
-        };
+        let per = per_subdomain(ranks, ns, 1, n);
         out.contacts = per.iter().map(|&x| x as usize).sum();
         out.subdomains = per.iter().filter(|&&x| x > 0.0).count();
         return out;
@@ -140,13 +125,7 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
         v.extend([D::len(&sub.contacts) as f64, *ngg as f64]);
         v.extend(a.map(|x| x as f64));
     };
-    let per = match ranks {
-        Some(r) => r.per_subdomain(ns, 8, aggregate),
-        None => (0..ns).fold(Vec::new(), |mut v, s| {
-            aggregate(s, &mut v);
-            v
-        }),
-    };
+    let per = per_subdomain(ranks, ns, 8, aggregate);
     let (mut ngg, mut n_m, mut sum_m, mut b) = (0u64, 0u64, 0u64, [0u64; 4]);
     for x in per.chunks_exact(8) {
         out.contacts += x[0] as usize;

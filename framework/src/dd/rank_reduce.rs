@@ -65,3 +65,37 @@ impl RankState {
         }
     }
 }
+
+/// [`RankState::per_subdomain`] on ranks; in one process every subdomain's `k`
+/// values from `own`, in subdomain order.
+pub(super) fn per_subdomain(ranks: Option<&mut RankState>, ns: usize, k: usize, mut own: impl FnMut(usize, &mut Vec<f64>)) -> Vec<f64> {
+    match ranks {
+        Some(r) => r.per_subdomain(ns, k, own),
+        None => {
+            let mut v = Vec::with_capacity(k * ns);
+            (0..ns).for_each(|s| own(s, &mut v));
+            v
+        }
+    }
+}
+
+/// [`RankState::per_subdomain_v`] on ranks; in one process every subdomain's values
+/// from `own` and where they start.
+pub(super) fn per_subdomain_v(
+    ranks: Option<&mut RankState>,
+    ns: usize,
+    len: impl Fn(usize) -> usize,
+    mut own: impl FnMut(usize, &mut Vec<f64>),
+) -> (Vec<usize>, Vec<f64>) {
+    match ranks {
+        Some(r) => r.per_subdomain_v(ns, len, own),
+        None => {
+            let (mut at, mut v) = (Vec::with_capacity(ns), Vec::new());
+            for s in 0..ns {
+                at.push(v.len());
+                own(s, &mut v);
+            }
+            (at, v)
+        }
+    }
+}
