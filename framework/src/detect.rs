@@ -24,7 +24,7 @@
 //! are sorted by kind pair and bodies, the result is the whole detection's list
 //! restricted to the kept pairs, in the same order.
 
-use crate::dim::Dim;
+use crate::dim::{Dim, Vector};
 use crate::model::Bodies;
 use crate::shape::{Aabb, DetectCtx, PairDetector, RawContact, ShapeStore};
 use std::sync::Arc;
@@ -163,9 +163,24 @@ impl<D: Dim> Detector<D> {
         region: Option<&Region>,
         out: &mut Vec<RawContact<D>>,
     ) {
+        self.detect_among((bodies, None), shapes, table, alert, region, out)
+    }
+
+    /// [`Detector::detect_in`] among the bodies `among.1` only (ascending ids;
+    /// `None`: all): the others are not looked at (a process's bodies whose state
+    /// it does not hold).
+    pub fn detect_among(
+        &mut self,
+        (bodies, among): (&Bodies<D>, Option<&[u32]>),
+        shapes: &[Box<dyn ShapeStore<D>>],
+        table: &DetectorTable<D>,
+        alert: f64,
+        region: Option<&Region>,
+        out: &mut Vec<RawContact<D>>,
+    ) {
         out.clear();
         let nk = table.nk;
-        self.broad_phase(bodies, shapes, alert, nk, region);
+        self.broad_phase((bodies, among), shapes, alert, nk, region);
         let mut p = 0;
         while p < self.pairs.len() {
             let key = self.pairs[p].0;
@@ -190,16 +205,42 @@ impl<D: Dim> Detector<D> {
 
     /// Candidate pairs whose boxes overlap within `alert`, sorted by kind pair and
     /// bodies.
-    fn broad_phase(&mut self, bodies: &Bodies<D>, shapes: &[Box<dyn ShapeStore<D>>], alert: f64, nk: usize, region: Option<&Region>) {
+    fn broad_phase(&mut self, (bodies, among): (&Bodies<D>, Option<&[u32]>), shapes: &[Box<dyn ShapeStore<D>>], alert: f64, nk: usize, region: Option<&Region>) {
         self.aabb.clear();
         self.small.clear();
         self.large.clear();
         self.pairs.clear();
-        for b in 0..bodies.len() {
+        let aabb = |b: usize| {
             let s = bodies.shape[b];
-            self.aabb.push(shapes[s.kind as usize].aabb(s.index, bodies.pos[b], bodies.rot[b]));
+            shapes[s.kind as usize].aabb(s.index, bodies.pos[b], bodies.rot[b])
+        };
+        match among {
+            None => self.aabb.extend((0..bodies.len()).map(aabb)),
+            Some(list) => {
+                // the others: an empty box, never bounded, never inside
+                let none = Aabb {
+                    min: D::Point::from_fn(|_| f64::INFINITY),
+                    max: D::Point::from_fn(|_| f64::NEG_INFINITY),
+                };
+                self.aabb.resize(bodies.len(), none);
+                for &b in list {
+                    self.aabb[b as usize] = aabb(b as usize);
+                }
+            }
         }
         self.mark_inside(region, alert);
+        if let Some(list) = among {
+            let mut keep = std::mem::take(&mut self.fill);
+            keep.clear();
+            keep.resize(self.inside.len(), 0);
+            for &b in list {
+                keep[b as usize] = 1;
+            }
+            for (x, k) in self.inside.iter_mut().zip(&keep) {
+                *x &= *k != 0;
+            }
+            self.fill = keep;
+        }
         let mut cell = self.cell_size(alert);
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for (b, a) in self.aabb.iter().enumerate() {

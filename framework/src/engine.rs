@@ -65,6 +65,12 @@ pub trait ContactStage<W> {
     fn prepare(&mut self, _w: &mut W) {}
     /// Solves the contact problem: V⁺ in the bodies' velocities, r in the contacts.
     fn solve(&mut self, w: &mut W) -> SolveReport;
+    /// After the position update of the bodies (`moved`: the first body found with a
+    /// non-finite state, if any), before the step is counted: may bring other
+    /// processes' bodies up to date and must agree on a divergence with them.
+    fn after_integrate(&mut self, _w: &mut W, moved: Result<(), usize>) -> Result<(), usize> {
+        moved
+    }
     /// Sets the per-body reactions itself (NSCDD: per subdomain, added in subdomain
     /// order) and returns true; false: the engine sums them over the world's contacts.
     fn reactions(&mut self, _w: &mut W) -> bool {
@@ -114,8 +120,8 @@ impl<D: Dim> World<D> {
         free_velocity(self);
         stage.before_detection(self);
         let s = &mut self.scratch;
-        s.detector.detect_in(
-            &self.bodies,
+        s.detector.detect_among(
+            (&self.bodies, s.active.as_deref()),
             &self.shapes,
             &self.detectors,
             self.alert,
@@ -133,7 +139,9 @@ impl<D: Dim> World<D> {
         update_joints(self);
         let own_reactions = stage.reactions(self);
         let t3 = Instant::now();
-        update_positions_with(self, !own_reactions)?;
+        let moved = integrate(self);
+        let moved = stage.after_integrate(self, moved);
+        finish_positions(self, !own_reactions, moved)?;
         stage.after_update(self);
         let t4 = Instant::now();
         rep.contacts = self.contacts.len();
@@ -158,17 +166,18 @@ pub fn free_velocity<D: Dim>(w: &mut World<D>) {
     for d in &w.drives {
         crate::step::drive_free_dofs(b, d.body as usize, &d.dof[..D::DOF], t_end);
     }
-    for k in 0..b.len() {
+    let only = w.scratch.active.as_deref();
+    crate::step::each_body(b.len(), only, |k| {
         if b.free[k] != 0 && !D::isotropic(&b.inertia[k]) {
             b.refresh_inverse(k);
         }
-    }
+    });
     let g = w.gravity;
-    for k in 0..b.len() {
+    crate::step::each_body(b.len(), only, |k| {
         if b.free[k] != 0 {
             D::free_flight(&mut b.vel[k], b.mass[k], &b.inertia[k], &b.rot[k], &b.inv_mass[k], &g, h);
         }
-    }
+    });
     apply_drives(w);
 }
 
@@ -368,11 +377,23 @@ pub fn update_positions<D: Dim>(w: &mut World<D>) -> Result<(), Diverged> {
 /// [`update_positions`], the reactions summed over the world's contacts when
 /// `reactions` (else the contact stage set them).
 fn update_positions_with<D: Dim>(w: &mut World<D>, reactions: bool) -> Result<(), Diverged> {
+    let moved = integrate(w);
+    finish_positions(w, reactions, moved)
+}
+
+/// q⁺ of the bodies the world steps ([`crate::world::World`]'s active bodies).
+fn integrate<D: Dim>(w: &mut World<D>) -> Result<(), usize> {
     let (h, theta) = (w.time.h, w.time.theta);
-    let b = &mut w.bodies;
-    if let Err(k) = crate::step::integrate(b, &w.scratch.v_begin, h, theta) {
+    crate::step::integrate_some(&mut w.bodies, &w.scratch.v_begin, h, theta, w.scratch.active.as_deref())
+}
+
+/// After the position update (`moved`: a body found diverging): the divergence
+/// error, the reactions (when `reactions`), the step and time counted.
+fn finish_positions<D: Dim>(w: &mut World<D>, reactions: bool, moved: Result<(), usize>) -> Result<(), Diverged> {
+    if let Err(k) = moved {
         return Err(Diverged::non_finite(w.step + 1, k, w.body_label(k), &w.bodies));
     }
+    let h = w.time.h;
     if reactions {
         crate::step::reactions(&w.contacts, w.bodies.len(), &mut w.reaction);
     }

@@ -34,14 +34,35 @@ pub const DIVERGED: f64 = 1e100;
 /// bodies' velocities). Stops at the first body whose state is not finite (or
 /// beyond [`DIVERGED`]) and returns its id (the bodies before it are updated).
 pub fn integrate<D: Dim>(b: &mut Bodies<D>, v_begin: &[D::Twist], h: f64, theta: f64) -> Result<(), usize> {
-    for k in 0..b.len() {
-        D::integrate(&mut b.pos[k], &mut b.rot[k], &v_begin[k], &b.vel[k], h, theta);
-        let finite = b.pos[k].as_ref().iter().chain(b.vel[k].as_ref()).all(|x| x.abs() < DIVERGED) && D::rot_finite(&b.rot[k]);
-        if !finite {
-            return Err(k);
+    integrate_some(b, v_begin, h, theta, None)
+}
+
+/// [`integrate`] of the bodies `only` (ascending ids; `None`: every body).
+pub fn integrate_some<D: Dim>(b: &mut Bodies<D>, v_begin: &[D::Twist], h: f64, theta: f64, only: Option<&[u32]>) -> Result<(), usize> {
+    let n = b.pos.len();
+    let (pos, rot, vel) = (&mut b.pos, &mut b.rot, &b.vel);
+    let mut one = |k: usize| {
+        D::integrate(&mut pos[k], &mut rot[k], &v_begin[k], &vel[k], h, theta);
+        let finite = pos[k].as_ref().iter().chain(vel[k].as_ref()).all(|x| x.abs() < DIVERGED) && D::rot_finite(&rot[k]);
+        if finite {
+            Ok(())
+        } else {
+            Err(k)
         }
+    };
+    match only {
+        Some(list) => list.iter().try_for_each(|&k| one(k as usize)),
+        None => (0..n).try_for_each(one),
     }
-    Ok(())
+}
+
+/// Calls `f` on every body id of `only` (ascending), or on 0..n when `None`.
+#[inline]
+pub fn each_body(n: usize, only: Option<&[u32]>, mut f: impl FnMut(usize)) {
+    match only {
+        Some(list) => list.iter().for_each(|&k| f(k as usize)),
+        None => (0..n).for_each(f),
+    }
 }
 
 /// The contact impulses' resultant on every body, Σ ±H r (N·s; force, then moment).

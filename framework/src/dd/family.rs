@@ -6,7 +6,7 @@
 //! contact set, the copies' M̂_E⁻¹ and the operations of DESIGN.md §3: one NLGS sweep,
 //! M̂_E⁻¹ applied to an impulse, M̂_E applied to a velocity increment (the gluing).
 
-use crate::dim::{Dim, Vector, D2, D3};
+use crate::dim::{Coords, Dim, Vector, D2, D3};
 use crate::engine::{Diverged, StepReport};
 use crate::model::{ContactKey, Contacts};
 use crate::norms::Sums;
@@ -99,6 +99,16 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     fn alert(w: &Self::World) -> f64;
     fn retain_raw(w: &mut Self::World, keep: &mut dyn FnMut(ContactKey, [f64; 3]) -> bool);
     fn body_boxes(w: &Self::World, out: &mut Vec<[[f64; 3]; 2]>);
+    /// Bodies owned per rank ([`super::owned`]): the bodies this process steps
+    /// (ascending; `None`: all), whether a body is stepped by every process (fixed,
+    /// driven or unbounded), and a body's moving state (position, orientation,
+    /// velocity) as `BODY_RECORD` numbers, and back.
+    fn set_active(w: &mut Self::World, active: Option<Vec<u32>>);
+    fn active(w: &Self::World) -> Option<&[u32]>;
+    fn everywhere(w: &Self::World, g: usize) -> bool;
+    const BODY_RECORD: usize;
+    fn body_record(w: &Self::World, g: usize, out: &mut Vec<f64>);
+    fn set_body_record(w: &mut Self::World, g: usize, x: &[f64]);
     /// Contact a's warm-start record: key (3), r, point, bond (1).
     fn prev_record(c: &Self::Contacts, a: usize, out: &mut Vec<f64>);
     const PREV_RECORD: usize;
@@ -274,17 +284,40 @@ impl<D: Dim> Family for Rigid<D> {
             )
         });
     }
+    /// (only the active bodies' boxes are recomputed)
     fn body_boxes(w: &Self::World, out: &mut Vec<[[f64; 3]; 2]>) {
         let b = &w.bodies;
-        out.clear();
-        out.extend((0..b.len()).map(|k| {
+        out.resize(b.len(), [[0.0; 3]; 2]);
+        crate::step::each_body(b.len(), w.scratch.active.as_deref(), |k| {
             let s = b.shape[k];
             let a = w.shapes[s.kind as usize].aabb(s.index, b.pos[k], b.rot[k]);
-            let mut x = [[0.0; 3]; 2];
-            x[0][..D::N].copy_from_slice(a.min.as_ref());
-            x[1][..D::N].copy_from_slice(a.max.as_ref());
-            x
-        }));
+            out[k][0][..D::N].copy_from_slice(a.min.as_ref());
+            out[k][1][..D::N].copy_from_slice(a.max.as_ref());
+        });
+    }
+    fn set_active(w: &mut Self::World, active: Option<Vec<u32>>) {
+        w.scratch.active = active;
+    }
+    fn active(w: &Self::World) -> Option<&[u32]> {
+        w.scratch.active.as_deref()
+    }
+    fn everywhere(w: &Self::World, g: usize) -> bool {
+        !w.bodies.movable(g) || w.drives.iter().any(|d| d.body as usize == g) || !w.aabb(g).is_bounded()
+    }
+    const BODY_RECORD: usize = D::N + D::DOF + if D::N == 2 { 1 } else { 4 };
+    fn body_record(w: &Self::World, g: usize, out: &mut Vec<f64>) {
+        let b = &w.bodies;
+        out.extend_from_slice(b.pos[g].as_ref());
+        out.extend_from_slice(b.rot[g].coords());
+        out.extend_from_slice(b.vel[g].as_ref());
+    }
+    fn set_body_record(w: &mut Self::World, g: usize, x: &[f64]) {
+        let b = &mut w.bodies;
+        let (p, rest) = x.split_at(D::N);
+        b.pos[g].as_mut().copy_from_slice(p);
+        let nr = b.rot[g].coords().len();
+        b.rot[g].coords_mut().copy_from_slice(&rest[..nr]);
+        b.vel[g].as_mut().copy_from_slice(&rest[nr..nr + D::DOF]);
     }
     const PREV_RECORD: usize = 4 + 2 * D::N;
     fn prev_record(c: &Self::Contacts, a: usize, out: &mut Vec<f64>) {

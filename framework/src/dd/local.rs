@@ -42,6 +42,8 @@ pub(super) struct Local {
     pub body_sub: Vec<i32>,
     /// A distributed repartition's grid and number of contacts, for the partition.
     pub new_grid: Option<(Grid, usize)>,
+    /// The bodies this rank steps ([`super::owned`]).
+    owned: super::owned::Owned,
 }
 
 /// The boxes of the grid cells whose subdomain is `rank`'s (edge cells unbounded,
@@ -170,9 +172,11 @@ impl<D: Family> super::NscddOf<D> {
             self.local.now = false;
             rs.local = false;
             D::set_region(w, None);
+            debug_assert!(D::active(w).is_none(), "a step on the whole sample needs every body");
             return;
         }
         D::body_boxes(w, &mut self.local.boxes);
+        self.local.owned.start::<D>(w, rs, grid);
         if self.local.held {
             let got = self.local.exchange::<D>(rs, w, (&self.last.owner, grid, D::alert(w)), repart);
             self.kept.extend(got);
@@ -250,6 +254,25 @@ impl<D: Family> super::NscddOf<D> {
             &self.v_free,
         );
         self.local.new_grid = Some((grid, total));
+    }
+
+    /// After the position update (collective with contacts held per rank): the
+    /// bodies other ranks need sent to them and the next step's bodies
+    /// ([`super::owned`]); every rank returns the same divergence.
+    pub(super) fn after_integrate(&mut self, w: &mut D::World, moved: Result<(), usize>) -> Result<(), usize> {
+        if let Some(rs) = self.ranks.as_mut() {
+            rs.totals.bodies_stepped += D::active(w).map_or(D::n_bodies(w), |a| a.len()) as u64;
+        }
+        if !self.local.now {
+            return moved;
+        }
+        let repart = self.repartitions();
+        let (Some(rs), Some(grid)) = (self.ranks.as_mut(), self.grid.as_ref()) else {
+            return moved;
+        };
+        let full_next = repart || rs.rank_of.len() != grid.len();
+        let Local { owned, boxes, .. } = &mut self.local;
+        owned.after_integrate::<D>(w, (rs, grid), (boxes, full_next), moved)
     }
 
     /// After the step: whether the world now holds this rank's contacts only.

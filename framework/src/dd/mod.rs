@@ -48,6 +48,7 @@ pub mod cluster;
 pub mod family;
 pub mod gluing;
 mod local;
+mod owned;
 #[cfg(feature = "mpi")]
 pub mod mpi;
 pub mod partition;
@@ -513,6 +514,9 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
         self.dd.pending = rep;
         s
     }
+    fn after_integrate(&mut self, w: &mut D::World, moved: Result<(), usize>) -> Result<(), usize> {
+        self.dd.after_integrate(w, moved)
+    }
     /// The counts outputs read ([`census`]), on the moved bodies (collective).
     fn after_update(&mut self, w: &mut D::World) {
         if self.dd.last.subs.is_empty() || self.dd.pending.census.is_some() {
@@ -556,5 +560,8 @@ impl<D: Family> ContactStage<D::World> for NscddOf<D> {
     }
     fn after_update(&mut self, w: &mut D::World) {
         Stage { dd: self, fams: &mut [] }.after_update(w);
+    }
+    fn after_integrate(&mut self, w: &mut D::World, moved: Result<(), usize>) -> Result<(), usize> {
+        Stage { dd: self, fams: &mut [] }.after_integrate(w, moved)
     }
 }

@@ -71,6 +71,11 @@ pub struct RankTotals {
     pub solve_seconds: f64,
     /// Ranks this rank sent gluing messages to, over the run (ascending).
     pub peers: Vec<u32>,
+    /// Bodies this rank stepped, summed over the steps ([`super::owned`]), and
+    /// bodies' states it sent to other ranks (to those whose halo they entered, to
+    /// all before a full step, to rank 0 for the outputs).
+    pub bodies_stepped: u64,
+    pub bodies_sent: u64,
 }
 
 /// The multi-process state of an NSCDD solver.
@@ -522,7 +527,7 @@ impl crate::solver::anderson::Reduce for Reduced<'_> {
 /// per rank its gluing messages and values sent, gluing rounds, peers (the ranks it
 /// sent gluing messages to), reduction messages and values, and seconds.
 pub fn totals_json(st: &mut RankState) -> String {
-    const H: usize = 10;
+    const H: usize = 12;
     let p = st.cluster.size() as usize;
     let t = &st.totals;
     let mut mine = vec![
@@ -535,6 +540,8 @@ pub fn totals_json(st: &mut RankState) -> String {
         t.solve_seconds,
         t.reduce.messages as f64,
         t.reduce.values as f64,
+        t.bodies_stepped as f64,
+        t.bodies_sent as f64,
         t.peers.len() as f64,
     ];
     mine.extend(t.peers.iter().map(|&x| x as f64));
@@ -559,6 +566,8 @@ pub fn totals_json(st: &mut RankState) -> String {
                 "solve_seconds": x[6],
                 "reduce_messages": x[7] as u64,
                 "reduce_values": x[8] as u64,
+                "bodies_stepped": x[9] as u64,
+                "bodies_sent": x[10] as u64,
                 "peers": peers,
                 "last_subdomains": subs,
             })

@@ -97,14 +97,21 @@ vector!(2 3 4 6);
 /// The components of a small value as a slice (a rotation vector, an angle).
 pub trait Coords {
     fn coords(&self) -> &[f64];
+    fn coords_mut(&mut self) -> &mut [f64];
 }
 impl Coords for f64 {
     fn coords(&self) -> &[f64] {
         std::slice::from_ref(self)
     }
+    fn coords_mut(&mut self) -> &mut [f64] {
+        std::slice::from_mut(self)
+    }
 }
 impl<const N: usize> Coords for [f64; N] {
     fn coords(&self) -> &[f64] {
+        self
+    }
+    fn coords_mut(&mut self) -> &mut [f64] {
         self
     }
 }
@@ -126,8 +133,9 @@ pub trait Dim: sealed::Sealed + Copy + Default + Debug + PartialEq + Send + Sync
     const NAME: &'static str;
     /// A point or a vector of space.
     type Point: Vector;
-    /// A body's orientation.
-    type Rot: Pod;
+    /// A body's orientation (its coordinates: the angle in 2D, the quaternion's
+    /// four in 3D).
+    type Rot: Pod + Coords;
     /// A body's generalized velocity V (and an impulse on it).
     type Twist: Vector;
     /// A local contact vector (normal first): u, r.

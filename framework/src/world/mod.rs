@@ -101,6 +101,9 @@ pub(crate) struct Scratch<D: Dim> {
     /// Last step's contacts held by other processes that this one may meet again
     /// (their warm starts), beside the world's own.
     pub extra_prev: Vec<PrevContact<D>>,
+    /// The bodies this process steps (ascending ids; `None`: all): on MPI ranks, its
+    /// own and its halo (`dd::owned`); the others' state is left as it was.
+    pub active: Option<Vec<u32>>,
 }
 
 impl<D: Dim> Default for Scratch<D> {
@@ -116,6 +119,7 @@ impl<D: Dim> Default for Scratch<D> {
             w: vec![],
             region: None,
             extra_prev: vec![],
+            active: None,
         }
     }
 }

@@ -1,0 +1,185 @@
+//! Bodies stepped per rank (docs/SCALING.md, "Bodies owned per rank", step 1): with
+//! contacts held per rank ([`super::local`]), a rank also steps only the bodies it
+//! needs — free velocity, detection boxes and position update — and leaves the
+//! others' state as it was (the arrays keep every body).
+//!
+//! ```text
+//! owner(b)   the rank of the grid cell holding b's centre (edge cells unbounded)
+//! halo(r)    the bodies whose box, grown by the alert distance, meets r's cells:
+//!            every body r's detection can pair (the region's own test)
+//! active(r)  halo(r) ∪ the bodies of r's contacts ∪ the fixed, driven and
+//!            unbounded bodies (stepped by every rank)
+//! ```
+//!
+//! A rank steps its active bodies exactly as one process does: their V⁺ is the
+//! subdomains' (every subdomain's copy velocities reach every rank) or their free
+//! velocity, so an active body's state is bitwise the same on every rank holding it.
+//! At the end of a step, the owner of a body at the start of the step sends its new
+//! state to the ranks whose halo it has just entered (one all-gather); every rank
+//! then keeps the bodies of its new halo. By induction a rank holds every body of its
+//! halo at the start of each step. Rank 0 also receives every owned body's state
+//! (one gather), so the outputs (energies, bulk measures, `final.json`, the bodies
+//! without contacts in the VTK frames) read an up-to-date world there. Before a
+//! repartition every rank receives every body (one all-gather) and the repartition
+//! step runs with all bodies, as the first step does.
+
+use super::family::Family;
+use super::partition::Grid;
+use super::ranks::RankState;
+use crate::detect::Region;
+
+/// The state of the mode across steps.
+#[derive(Default)]
+pub(super) struct Owned {
+    /// Every rank's cells at the start of the step.
+    regions: Vec<Region>,
+    /// The active bodies this rank owned at the start of the step.
+    mine: Vec<u32>,
+    /// Bodies stepped by every rank (fixed, driven, unbounded), by id.
+    everywhere: Vec<bool>,
+}
+
+/// Whether the box `b` grown by `alert` meets `region`'s boxes.
+fn meets(n: usize, b: &[[f64; 3]; 2], alert: f64, region: &Region) -> bool {
+    let lo: [f64; 3] = std::array::from_fn(|k| b[0][k] - alert);
+    let hi: [f64; 3] = std::array::from_fn(|k| b[1][k] + alert);
+    region.meets(n, &lo, &hi)
+}
+
+impl Owned {
+    /// At the start of a step with contacts held per rank (`boxes`: the active
+    /// bodies' boxes): every rank's cells and the bodies this rank owns.
+    pub(super) fn start<D: Family>(&mut self, w: &D::World, rs: &RankState, grid: &Grid) {
+        let me = rs.cluster.rank();
+        self.regions = (0..rs.cluster.size())
+            .map(|q| Region {
+                boxes: super::local::cells_of(grid, &rs.rank_of, q),
+                pairs: Vec::new(),
+            })
+            .collect();
+        let nb = D::n_bodies(w);
+        if self.everywhere.len() != nb {
+            self.everywhere = (0..nb).map(|g| D::everywhere(w, g)).collect();
+        }
+        self.mine.clear();
+        let owner = |g: usize| rs.rank_of.get(grid.cell_of(D::position(w, g)) as usize) == Some(&me);
+        crate::step::each_body(nb, D::active(w), |g| {
+            if owner(g) {
+                self.mine.push(g as u32);
+            }
+        });
+    }
+
+    /// After the position update of a step with contacts held per rank (`boxes`: the
+    /// active bodies' boxes at its start; `full_next`: the next step runs with every
+    /// body): brings the bodies other ranks now need to them, every owned body to
+    /// rank 0 (or to every rank before a full step), agrees on a divergence, and sets
+    /// the bodies of the next step. Collective.
+    pub(super) fn after_integrate<D: Family>(
+        &mut self,
+        w: &mut D::World,
+        (rs, grid): (&mut RankState, &Grid),
+        (boxes, full_next): (&[[[f64; 3]; 2]], bool),
+        moved: Result<(), usize>,
+    ) -> Result<(), usize> {
+        let alert = D::alert(w);
+        let me = rs.cluster.rank() as usize;
+        let mut now = Vec::new();
+        let (diverged, received) = if D::active(w).is_none() {
+            // every rank stepped every body: the same bodies, the same divergence
+            (moved.err(), Vec::new())
+        } else {
+            D::body_boxes(w, &mut now);
+            let entering = |g: u32| {
+                let (new, old) = (&now[g as usize], &boxes[g as usize]);
+                self.regions
+                    .iter()
+                    .enumerate()
+                    .any(|(q, r)| q != me && (full_next || (meets(D::SPACE, new, alert, r) && !meets(D::SPACE, old, alert, r))))
+            };
+            let send: Vec<u32> = self.mine.iter().copied().filter(|&g| entering(g)).collect();
+            let got = exchange::<D>(w, rs, &send, moved.err(), true);
+            if !full_next && got.0.is_none() {
+                exchange::<D>(w, rs, &self.mine, None, false);
+            }
+            got
+        };
+        if diverged.is_some() || full_next {
+            D::set_active(w, None);
+            return diverged.map_or(Ok(()), Err);
+        }
+        let mine = Region {
+            boxes: super::local::cells_of(grid, &rs.rank_of, me as u32),
+            pairs: Vec::new(),
+        };
+        self.next_active::<D>(w, &mine, &received, &mut now);
+        Ok(())
+    }
+
+    /// The bodies of the next step: the candidates (the active ones and those just
+    /// `received`; all of them after a full step) in this rank's halo (`mine`: its
+    /// cells) or contacts, and the bodies every rank steps.
+    fn next_active<D: Family>(&mut self, w: &mut D::World, mine: &Region, received: &[u32], boxes: &mut Vec<[[f64; 3]; 2]>) {
+        let nb = D::n_bodies(w);
+        let alert = D::alert(w);
+        let mut keep = vec![false; nb];
+        let c = D::contacts(w);
+        for a in 0..D::len(c) {
+            for g in D::bodies(c, a) {
+                keep[g as usize] = true;
+            }
+        }
+        let candidates: Option<Vec<u32>> = D::active(w).map(|a| {
+            let mut v = a.to_vec();
+            v.extend_from_slice(received);
+            v.sort_unstable();
+            v.dedup();
+            v
+        });
+        D::set_active(w, candidates);
+        D::body_boxes(w, boxes);
+        crate::step::each_body(nb, D::active(w), |g| {
+            keep[g] |= self.everywhere[g] || meets(D::SPACE, &boxes[g], alert, mine);
+        });
+        let active: Vec<u32> = (0..nb as u32).filter(|&g| keep[g as usize]).collect();
+        D::set_active(w, Some(active));
+    }
+}
+
+/// The states of the bodies `send` (and, with `diverged`, of the body found
+/// diverging, marked by its id as −1 − id) from every rank to every rank
+/// (`to_all`) or to rank 0, written into the receivers' worlds. Returns the first
+/// body any rank found diverging and the bodies received. Collective.
+fn exchange<D: Family>(w: &mut D::World, rs: &mut RankState, send: &[u32], diverged: Option<usize>, to_all: bool) -> (Option<usize>, Vec<u32>) {
+    let per = 1 + D::BODY_RECORD;
+    let mut mine = Vec::with_capacity((send.len() + 1) * per);
+    if let Some(k) = diverged {
+        mine.push(-1.0 - k as f64);
+        D::body_record(w, k, &mut mine);
+    }
+    for &g in send {
+        mine.push(f64::from(g));
+        D::body_record(w, g as usize, &mut mine);
+    }
+    if to_all || rs.cluster.rank() != 0 {
+        rs.totals.bodies_sent += send.len() as u64;
+    }
+    let all = if to_all {
+        rs.all_gather_any(&mine).1
+    } else {
+        rs.gather_any_on_root(&mine)
+    };
+    let (mut first, mut got) = (None::<usize>, Vec::new());
+    for x in all.chunks_exact(per) {
+        let g = if x[0] < 0.0 {
+            let k = (-1.0 - x[0]) as usize;
+            first = Some(first.map_or(k, |f| f.min(k)));
+            k
+        } else {
+            got.push(x[0] as u32);
+            x[0] as usize
+        };
+        D::set_body_record(w, g, &x[1..]);
+    }
+    (first, got)
+}
