@@ -205,41 +205,22 @@ impl<D: Dim> Detector<D> {
 
     /// Candidate pairs whose boxes overlap within `alert`, sorted by kind pair and
     /// bodies.
-    fn broad_phase(&mut self, (bodies, among): (&Bodies<D>, Option<&[u32]>), shapes: &[Box<dyn ShapeStore<D>>], alert: f64, nk: usize, region: Option<&Region>) {
+    fn broad_phase(
+        &mut self,
+        (bodies, among): (&Bodies<D>, Option<&[u32]>),
+        shapes: &[Box<dyn ShapeStore<D>>],
+        alert: f64,
+        nk: usize,
+        region: Option<&Region>,
+    ) {
         self.aabb.clear();
         self.small.clear();
         self.large.clear();
         self.pairs.clear();
-        let aabb = |b: usize| {
-            let s = bodies.shape[b];
-            shapes[s.kind as usize].aabb(s.index, bodies.pos[b], bodies.rot[b])
-        };
-        match among {
-            None => self.aabb.extend((0..bodies.len()).map(aabb)),
-            Some(list) => {
-                // the others: an empty box, never bounded, never inside
-                let none = Aabb {
-                    min: D::Point::from_fn(|_| f64::INFINITY),
-                    max: D::Point::from_fn(|_| f64::NEG_INFINITY),
-                };
-                self.aabb.resize(bodies.len(), none);
-                for &b in list {
-                    self.aabb[b as usize] = aabb(b as usize);
-                }
-            }
-        }
+        self.boxes((bodies, among), shapes);
         self.mark_inside(region, alert);
         if let Some(list) = among {
-            let mut keep = std::mem::take(&mut self.fill);
-            keep.clear();
-            keep.resize(self.inside.len(), 0);
-            for &b in list {
-                keep[b as usize] = 1;
-            }
-            for (x, k) in self.inside.iter_mut().zip(&keep) {
-                *x &= *k != 0;
-            }
-            self.fill = keep;
+            self.keep_only(list);
         }
         let mut cell = self.cell_size(alert);
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
@@ -311,6 +292,41 @@ impl<D: Dim> Detector<D> {
         }
         // group by kind pair, then by bodies: a deterministic order
         self.pairs.sort_unstable();
+    }
+
+    /// The bodies' boxes; the bodies not `among` get an empty box (never bounded).
+    fn boxes(&mut self, (bodies, among): (&Bodies<D>, Option<&[u32]>), shapes: &[Box<dyn ShapeStore<D>>]) {
+        let aabb = |b: usize| {
+            let s = bodies.shape[b];
+            shapes[s.kind as usize].aabb(s.index, bodies.pos[b], bodies.rot[b])
+        };
+        match among {
+            None => self.aabb.extend((0..bodies.len()).map(aabb)),
+            Some(list) => {
+                let none = Aabb {
+                    min: D::Point::from_fn(|_| f64::INFINITY),
+                    max: D::Point::from_fn(|_| f64::NEG_INFINITY),
+                };
+                self.aabb.resize(bodies.len(), none);
+                for &b in list {
+                    self.aabb[b as usize] = aabb(b as usize);
+                }
+            }
+        }
+    }
+
+    /// Only the bodies of `list` stay inside.
+    fn keep_only(&mut self, list: &[u32]) {
+        let mut keep = std::mem::take(&mut self.fill);
+        keep.clear();
+        keep.resize(self.inside.len(), 0);
+        for &b in list {
+            keep[b as usize] = 1;
+        }
+        for (x, k) in self.inside.iter_mut().zip(&keep) {
+            *x &= *k != 0;
+        }
+        self.fill = keep;
     }
 
     /// Which bodies enter the broad phase: all, or those whose box grown by `alert`

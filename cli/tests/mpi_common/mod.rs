@@ -1,11 +1,11 @@
-//! What the MPI tests share (`cli/tests/mpi.rs`, `cli/tests/mpi_signals.rs`): the
+//! What the MPI tests share (`cli/tests/mpi.rs`, `mpi_faults.rs`, `mpi_signals.rs`): the
 //! program, the time limit, scratch directories, the `mpirun` command a root
 //! container needs, and the 2D pile they run.
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
-use std::time::Duration;
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
 
 pub const BIN: &str = env!("CARGO_BIN_EXE_nscdd");
 
@@ -180,4 +180,33 @@ pub fn pieces_add_up(one: &Path, out: &Path) {
     }
     let pvd = std::fs::read_to_string(out.join("bodies.pvd")).expect("bodies.pvd");
     assert!(pvd.contains("vtk/bodies_000003.pvtp"), "{pvd}");
+}
+
+/// Runs a command to its end or kills it after [`LIMIT`] (then fails the test).
+pub fn run_limited(mut c: Command) -> Output {
+    let t0 = Instant::now();
+    let mut child = c.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("start the command");
+    loop {
+        if child.try_wait().expect("wait").is_some() {
+            break;
+        }
+        if t0.elapsed() > LIMIT {
+            let _ = child.kill();
+            let o = child.wait_with_output().expect("output");
+            panic!("still running after {LIMIT:?} (a hang): {}", String::from_utf8_lossy(&o.stderr));
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.wait_with_output().expect("output")
+}
+
+/// `mpirun` of `apps` ([`mpirun_command`]), run to its end within [`LIMIT`].
+pub fn mpirun(apps: &[(u32, Vec<String>)]) -> Output {
+    run_limited(mpirun_command(apps))
+}
+
+pub fn nscdd(args: &[String]) -> Output {
+    let mut c = Command::new(BIN);
+    c.args(args);
+    run_limited(c)
 }

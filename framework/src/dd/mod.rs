@@ -48,9 +48,9 @@ pub mod cluster;
 pub mod family;
 pub mod gluing;
 mod local;
-mod owned;
 #[cfg(feature = "mpi")]
 pub mod mpi;
+mod owned;
 pub mod partition;
 mod rank_balance;
 mod rank_link;

@@ -150,7 +150,13 @@ impl Owned {
 /// diverging, marked by its id as −1 − id) from every rank to every rank
 /// (`to_all`) or to rank 0, written into the receivers' worlds. Returns the first
 /// body any rank found diverging and the bodies received. Collective.
-fn exchange<D: Family>(w: &mut D::World, rs: &mut RankState, send: &[u32], diverged: Option<usize>, to_all: bool) -> (Option<usize>, Vec<u32>) {
+fn exchange<D: Family>(
+    w: &mut D::World,
+    rs: &mut RankState,
+    send: &[u32],
+    diverged: Option<usize>,
+    to_all: bool,
+) -> (Option<usize>, Vec<u32>) {
     let per = 1 + D::BODY_RECORD;
     let mut mine = Vec::with_capacity((send.len() + 1) * per);
     if let Some(k) = diverged {

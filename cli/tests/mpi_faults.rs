@@ -1,0 +1,90 @@
+//! Failures on MPI ranks (cargo feature `mpi`): a diverging body stops every rank at
+//! the same step, also when only one rank steps it. Needs OpenMPI's `mpirun` (the
+//! README's test command installs it).
+#![cfg(feature = "mpi")]
+
+mod mpi_common;
+use mpi_common::*;
+
+/// A grain that only one rank steps diverges between two repartitions: every rank
+/// stops at the same step, and rank 0 names the body one process names.
+#[test]
+fn a_diverging_body_stepped_by_one_rank_stops_every_rank() {
+    let dir = scratch("diverge_held");
+    let body = |x: f64, vx: f64| {
+        format!(
+            "[[bodies]]\nshape = \"disk\"\nmaterial = \"grain\"\nposition = [{x}, 0.001]\nradius = 1e-3\nvelocity = [{vx:e}, 0.0, 0.0]\n"
+        )
+    };
+    // gravity along x adds 1e98 m/s a step: the fast grain passes 1e100 at step 3
+    // (the first step with bodies stepped per rank: the first runs on the whole
+    // sample, the second with all its bodies), the slow one would at step 100
+    let scene_text = format!(
+        "gravity = [1e101, 0.0]\n[time]\nstep = 1e-3\nsteps = 20\n[[materials]]\nname = \"grain\"\ndensity = 1e3\n\
+         [[laws]]\nmaterials = [\"grain\", \"grain\"]\nfriction = 0.0\n[[bodies]]\nshape = \"halfplane\"\nmaterial = \"grain\"\n\
+         position = [0.0, 0.0]\nfixed = true\n{}{}",
+        body(0.0, 0.0),
+        body(0.1, 9.75e99)
+    );
+    let scene = write(&dir, "diverge.toml", &every(&scene_text, 10));
+    let one = nscdd(&args(&scene, &dir.join("one"), &["--subdomains", "2x1"]));
+    let one_err = text(&one.stderr);
+    assert_eq!(one.status.code(), Some(1), "{one_err}");
+    assert!(one_err.contains("step 3") && one_err.contains("body 2"), "{one_err}");
+    let out = dir.join("two");
+    let o = mpirun(&[(2, args(&scene, &out, &["--subdomains", "2x1"]))]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("step 3") && err.contains("body 2"), "{err}");
+    assert_eq!(err.matches("body 2").count(), 1, "rank 0 reports it once: {err}");
+    let hist = std::fs::read_to_string(out.join("history.csv")).expect("history.csv kept");
+    assert_eq!(hist.lines().count(), 1 + 2, "{hist}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_diverging_body_stops_every_rank_and_keeps_the_outputs() {
+    let dir = scratch("diverge");
+    let scene = write(
+        &dir,
+        "diverge.toml",
+        r#"[time]
+step = 1e-3
+steps = 20
+[[materials]]
+name = "grain"
+density = 1e-3
+[[laws]]
+materials = ["grain", "grain"]
+friction = 0.3
+[[bodies]]
+shape = "halfplane"
+material = "grain"
+position = [0.0, 0.0]
+fixed = true
+[[bodies]]
+name = "rocket"
+shape = "disk"
+material = "grain"
+position = [0.0, 0.001]
+radius = 1e-3
+drive.x = { force = { table = [[0.0, 0.0], [0.005, 0.0], [0.0051, 1e308]] } }
+[[bodies]]
+name = "bystander"
+shape = "disk"
+material = "grain"
+position = [0.1, 0.001]
+radius = 1e-3
+"#,
+    );
+    let out = dir.join("out");
+    let o = mpirun(&[(2, args(&scene, &out, &["--subdomains", "2x1"]))]);
+    let err = text(&o.stderr);
+    println!("{err}");
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("step 6") && err.contains("rocket"), "{err}");
+    assert_eq!(err.matches("rocket").count(), 1, "rank 0 reports it once: {err}");
+    let hist = std::fs::read_to_string(out.join("history.csv")).expect("history.csv kept");
+    assert_eq!(hist.lines().count(), 1 + 5, "{hist}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
