@@ -194,11 +194,15 @@ pub(crate) fn write_rank_totals<D: crate::dd::Family>(dd: &mut Option<crate::dd:
 fn save_state<D: Dim>(
     dir: &Path,
     name: &str,
-    w: &World<D>,
+    w: &mut World<D>,
     families: &[Box<dyn SceneFamily<D>>],
     dd: &mut Option<NscddOf<Rigid<D>>>,
 ) -> Result<(), RunError> {
     let root = dd.as_mut().and_then(|n| n.ranks_mut()).is_none_or(|r| r.cluster.rank() == 0);
+    // bodies held per rank: every body from its owner to rank 0
+    if let Some(n) = dd.as_mut() {
+        n.gather_bodies(w);
+    }
     // contacts held per rank: every rank's gathered on rank 0
     let records = match dd.as_mut().filter(|n| n.holds_own_contacts()) {
         Some(n) => {

@@ -510,7 +510,7 @@ fn the_bulk_census_of_the_subdomains_is_the_worlds() {
     let margin = 4.0 * s.world.max_grain_size();
     let (a, b) = (
         s.world.bulk_measures(margin).unwrap(),
-        s.world.bulk_measures_with(margin, Some(bulk)).unwrap(),
+        s.world.bulk_measures_with(margin, Some(bulk), None).unwrap(),
     );
     assert_eq!(
         (a.0.to_bits(), a.1.to_bits(), a.2.to_bits()),

@@ -27,6 +27,48 @@ pub struct Census {
     /// contacts of the inner non-rattlers, their number, the inner grains, the inner
     /// rattlers.
     pub bulk: Option<[u64; 4]>,
+    /// With a grid of cells (rigid bodies, [`BodySums`]): the kinetic energy and
+    /// gravity potential, and a 3D box sample's grain volume in the bulk box.
+    pub energies: Option<(f64, f64)>,
+    pub bulk_volume: Option<f64>,
+}
+
+/// The sums over bodies of the outputs, per grid cell (each body in the cell of its
+/// centre, the bodies of a cell in id order, the cells added in cell order): the
+/// same bits in one process and over ranks, where each rank adds its cells' bodies
+/// (it holds them, [`super::owned`]). With one cell, the world's own sums.
+pub(super) struct BodySums<'a> {
+    pub grid: &'a super::partition::Grid,
+}
+
+/// Values per cell in [`BodySums`]: Σ kinetic energy, Σ m g·x, Σ bulk volume, the
+/// inner grains without contacts.
+const SUMS: usize = 4;
+
+impl BodySums<'_> {
+    /// The sums of the cells `own` accepts (zero for the others).
+    fn per_cell<D: Family>(&self, w: &D::World, d: &Decomposition<D>, own: &dyn Fn(usize) -> bool) -> Vec<[f64; SUMS]> {
+        let mut out = vec![[0.0; SUMS]; self.grid.len()];
+        let bulk = D::bulk_box(w);
+        crate::step::each_body(D::n_bodies(w), D::active(w), |g| {
+            let p = D::position(w, g);
+            let c = self.grid.cell_of(p) as usize;
+            if !own(c) {
+                return;
+            }
+            let x = &mut out[c];
+            if let Some((ek, mgx)) = D::body_energies(w, g) {
+                x[0] += ek;
+                x[1] -= mgx;
+            }
+            if let (Some((lo, hi)), true) = (bulk, D::is_grain(w, g)) {
+                x[2] += D::grain_in_box(w, g, lo, hi);
+                let inner = (0..3).all(|k| p[k] > lo[k] && p[k] < hi[k]);
+                x[3] += (inner && d.mult.get(g).is_none_or(|&m| m == 0)) as u8 as f64;
+            }
+        });
+        out
+    }
 }
 
 /// Each subdomain's loaded contacts per local body, and its loaded grain–grain contacts.
@@ -71,7 +113,7 @@ fn shared_totals<D: Family>(
 }
 
 /// The census of the step of `d` (on ranks: collective).
-pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: Option<&mut RankState>) -> Census {
+pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: Option<&mut RankState>, sums: Option<BodySums>) -> Census {
     let ns = d.subs.len();
     let own = |s: usize| ranks.as_ref().is_none_or(|r| r.is_own(s as u32));
     let mut out = Census {
@@ -79,11 +121,19 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
         z_m: f64::NAN,
         ..Default::default()
     };
+    // the subdomains are the grid's cells (rigid bodies only)
+    let cells = sums.filter(|b| b.grid.len() == ns).map(|b| b.per_cell(w, d, &own));
+    let k = if cells.is_some() { SUMS } else { 0 };
+    let add_cell = |s: usize, v: &mut Vec<f64>| v.extend_from_slice(cells.as_ref().map_or(&[][..], |c| &c[s][..]));
     if !D::wants_coordination(w) {
-        let n = |s: usize, v: &mut Vec<f64>| v.push(D::len(&d.subs[s].contacts) as f64);
-        let per = per_subdomain(ranks, ns, 1, n);
-        out.contacts = per.iter().map(|&x| x as usize).sum();
-        out.subdomains = per.iter().filter(|&&x| x > 0.0).count();
+        let n = |s: usize, v: &mut Vec<f64>| {
+            v.push(D::len(&d.subs[s].contacts) as f64);
+            add_cell(s, v);
+        };
+        let per = per_subdomain(ranks, ns, 1 + k, n);
+        out.contacts = per.chunks_exact(1 + k).map(|x| x[0] as usize).sum();
+        out.subdomains = per.chunks_exact(1 + k).filter(|x| x[0] > 0.0).count();
+        out.add_sums(&per, 1, k, D::bulk_box(w).is_some());
         return out;
     }
     let counts: Vec<Option<(Vec<u32>, u64)>> = (0..ns).map(|s| own(s).then(|| loaded(w, d, s))).collect();
@@ -124,10 +174,11 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
         }
         v.extend([D::len(&sub.contacts) as f64, *ngg as f64]);
         v.extend(a.map(|x| x as f64));
+        add_cell(s, v);
     };
-    let per = per_subdomain(ranks, ns, 8, aggregate);
+    let per = per_subdomain(ranks, ns, 8 + k, aggregate);
     let (mut ngg, mut n_m, mut sum_m, mut b) = (0u64, 0u64, 0u64, [0u64; 4]);
-    for x in per.chunks_exact(8) {
+    for x in per.chunks_exact(8 + k) {
         out.contacts += x[0] as usize;
         out.subdomains += (x[0] > 0.0) as usize;
         (ngg, n_m, sum_m) = (ngg + x[1] as u64, n_m + x[2] as u64, sum_m + x[3] as u64);
@@ -135,15 +186,38 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
             b[k] += x[4 + k] as u64;
         }
     }
+    let idle = out.add_sums(&per, 8, k, bulk.is_some());
     if bulk.is_some() {
         // the inner grains without contacts are rattlers
-        let idle = (0..D::n_bodies(w))
-            .filter(|&g| d.mult[g] == 0 && D::is_grain(w, g) && inner(g))
-            .count() as u64;
+        let idle = idle.unwrap_or_else(|| {
+            (0..D::n_bodies(w))
+                .filter(|&g| d.mult[g] == 0 && D::is_grain(w, g) && inner(g))
+                .count() as u64
+        });
         out.bulk = Some([b[0], b[1], b[2] + idle, b[3] + idle]);
     }
     let ng = (0..D::n_bodies(w)).filter(|&g| D::is_grain(w, g)).count();
     out.z = if ng > 0 { 2.0 * ngg as f64 / ng as f64 } else { 0.0 };
     out.z_m = if n_m > 0 { sum_m as f64 / n_m as f64 } else { 0.0 };
     out
+}
+
+impl Census {
+    /// The cells' [`BodySums`] (`k` values at `at` of each subdomain's `per`, none
+    /// when `k` = 0) added in cell order; returns the inner grains without contacts.
+    fn add_sums(&mut self, per: &[f64], at: usize, k: usize, bulk: bool) -> Option<u64> {
+        if k == 0 {
+            return None;
+        }
+        let (mut ek, mut ep, mut vol, mut idle) = (0.0, 0.0, 0.0, 0u64);
+        for x in per.chunks_exact(at + k) {
+            ek += x[at];
+            ep += x[at + 1];
+            vol += x[at + 2];
+            idle += x[at + 3] as u64;
+        }
+        self.energies = Some((ek, ep));
+        self.bulk_volume = bulk.then_some(vol);
+        Some(idle)
+    }
 }

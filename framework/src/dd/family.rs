@@ -91,6 +91,10 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     /// history's margin of 4 grain sizes), and a body's position.
     fn bulk_box(w: &Self::World) -> Option<([f64; 3], [f64; 3])>;
     fn position(w: &Self::World, g: usize) -> [f64; 3];
+    /// Body g's terms of the history's sums over bodies: its kinetic energy and
+    /// m g·x when impulses can move it, and a 3D grain's volume inside the bulk box.
+    fn body_energies(w: &Self::World, g: usize) -> Option<(f64, f64)>;
+    fn grain_in_box(w: &Self::World, g: usize, lo: [f64; 3], hi: [f64; 3]) -> f64;
     /// Contacts held per rank ([`super::local`]): the next detection's region, the
     /// raw contacts kept after it (by key and point), the bodies' boxes (first `N`
     /// coordinates, the rest 0), and the other processes' last contacts for the warm
@@ -258,6 +262,14 @@ impl<D: Dim> Family for Rigid<D> {
     fn bulk_box(w: &Self::World) -> Option<([f64; 3], [f64; 3])> {
         let w3 = (w as &dyn std::any::Any).downcast_ref::<crate::world::World3>()?;
         w3.bulk_box(4.0 * w3.max_grain_size())
+    }
+    fn body_energies(w: &Self::World, g: usize) -> Option<(f64, f64)> {
+        w.body_energies(g)
+    }
+    fn grain_in_box(w: &Self::World, g: usize, lo: [f64; 3], hi: [f64; 3]) -> f64 {
+        (w as &dyn std::any::Any)
+            .downcast_ref::<crate::world::World3>()
+            .map_or(0.0, |w3| w3.grain_in_box(g, lo, hi))
     }
     fn position(w: &Self::World, g: usize) -> [f64; 3] {
         let mut p = [0.0; 3];

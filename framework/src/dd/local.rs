@@ -280,6 +280,34 @@ impl<D: Family> super::NscddOf<D> {
         self.local.held = self.local.now;
     }
 
+    /// With bodies held per rank (some not up to date here): which bodies this rank
+    /// holds and owns (the cell of their centre is its), the writer of a body's
+    /// outputs; `None` when every rank holds every body.
+    pub(super) fn owned_bodies(&self, w: &D::World) -> Option<Vec<bool>> {
+        let active = D::active(w)?;
+        let (rs, grid) = (self.ranks.as_ref()?, self.grid.as_ref()?);
+        let me = rs.cluster.rank();
+        let mut mine = vec![false; D::n_bodies(w)];
+        for &g in active {
+            mine[g as usize] = rs.rank_of.get(grid.cell_of(D::position(w, g as usize)) as usize) == Some(&me);
+        }
+        Some(mine)
+    }
+
+    /// [`Self::owned_bodies`], for the VTK pieces' bodies without contacts.
+    pub(super) fn contactless_writer(&self, w: &D::World) -> Option<Vec<bool>> {
+        self.owned_bodies(w)
+    }
+
+    /// With bodies held per rank, every body's state from its owner to rank 0
+    /// (collective; before rank 0 writes the state).
+    pub fn gather_bodies(&mut self, w: &mut D::World) {
+        let Some(mine) = self.owned_bodies(w) else { return };
+        let Some(rs) = self.ranks.as_mut() else { return };
+        let send: Vec<u32> = (0..mine.len() as u32).filter(|&g| mine[g as usize]).collect();
+        super::owned::exchange::<D>(w, rs, &send, None, false);
+    }
+
     /// Whether the world holds this rank's contacts only (the last step ran with
     /// contacts held per rank): outputs of every contact gather them
     /// ([`super::NscddOf::gather_on_root`]).

@@ -522,7 +522,12 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
         if self.dd.last.subs.is_empty() || self.dd.pending.census.is_some() {
             return;
         }
-        let census = census::census(&self.dd.last, w, self.dd.ranks.as_mut());
+        // rigid bodies: the sums over bodies per cell (the cells are the subdomains)
+        let sums = (self.fams.is_empty() && !self.dd.by_model)
+            .then_some(self.dd.grid.as_ref())
+            .flatten()
+            .map(|grid| census::BodySums { grid });
+        let census = census::census(&self.dd.last, w, self.dd.ranks.as_mut(), sums);
         self.dd.pending.subdomains = census.subdomains;
         self.dd.pending.census = Some(census);
     }

@@ -17,11 +17,14 @@
 //! At the end of a step, the owner of a body at the start of the step sends its new
 //! state to the ranks whose halo it has just entered (one all-gather); every rank
 //! then keeps the bodies of its new halo. By induction a rank holds every body of its
-//! halo at the start of each step. Rank 0 also receives every owned body's state
-//! (one gather), so the outputs (energies, bulk measures, `final.json`, the bodies
-//! without contacts in the VTK frames) read an up-to-date world there. Before a
-//! repartition every rank receives every body (one all-gather) and the repartition
-//! step runs with all bodies, as the first step does.
+//! halo at the start of each step. The outputs never read a body its rank does not
+//! hold: the sums over bodies are added per cell by the cells' ranks
+//! ([`super::census::BodySums`]), the named and driven bodies are stepped by every
+//! rank, a body without contacts is written in the VTK frames by its owner, and
+//! rank 0 gathers every body before it writes `final.json` or a checkpoint
+//! ([`super::NscddOf::gather_bodies`]). Before a repartition every rank receives
+//! every body (one all-gather) and the repartition step runs with all bodies, as
+//! the first step does.
 
 use super::family::Family;
 use super::partition::Grid;
@@ -59,7 +62,11 @@ impl Owned {
             .collect();
         let nb = D::n_bodies(w);
         if self.everywhere.len() != nb {
+            // and the observed bodies (named or driven: the history reads them on rank 0)
             self.everywhere = (0..nb).map(|g| D::everywhere(w, g)).collect();
+            for g in D::observed(w) {
+                self.everywhere[g as usize] = true;
+            }
         }
         self.mine.clear();
         let owner = |g: usize| rs.rank_of.get(grid.cell_of(D::position(w, g)) as usize) == Some(&me);
@@ -72,9 +79,9 @@ impl Owned {
 
     /// After the position update of a step with contacts held per rank (`boxes`: the
     /// active bodies' boxes at its start; `full_next`: the next step runs with every
-    /// body): brings the bodies other ranks now need to them, every owned body to
-    /// rank 0 (or to every rank before a full step), agrees on a divergence, and sets
-    /// the bodies of the next step. Collective.
+    /// body): brings the bodies other ranks now need to them (every owned body to
+    /// every rank before a full step), agrees on a divergence, and sets the bodies of
+    /// the next step. Collective.
     pub(super) fn after_integrate<D: Family>(
         &mut self,
         w: &mut D::World,
@@ -98,11 +105,7 @@ impl Owned {
                     .any(|(q, r)| q != me && (full_next || (meets(D::SPACE, new, alert, r) && !meets(D::SPACE, old, alert, r))))
             };
             let send: Vec<u32> = self.mine.iter().copied().filter(|&g| entering(g)).collect();
-            let got = exchange::<D>(w, rs, &send, moved.err(), true);
-            if !full_next && got.0.is_none() {
-                exchange::<D>(w, rs, &self.mine, None, false);
-            }
-            got
+            exchange::<D>(w, rs, &send, moved.err(), true)
         };
         if diverged.is_some() || full_next {
             D::set_active(w, None);
@@ -150,7 +153,7 @@ impl Owned {
 /// diverging, marked by its id as −1 − id) from every rank to every rank
 /// (`to_all`) or to rank 0, written into the receivers' worlds. Returns the first
 /// body any rank found diverging and the bodies received. Collective.
-fn exchange<D: Family>(
+pub(super) fn exchange<D: Family>(
     w: &mut D::World,
     rs: &mut RankState,
     send: &[u32],

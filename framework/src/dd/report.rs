@@ -95,14 +95,21 @@ pub struct Piece {
     pub ranks: u32,
     /// The rank of each subdomain.
     pub rank_of: Vec<u32>,
+    /// With bodies held per rank: whether this rank writes each body without
+    /// contacts (it holds it and the cell of its centre is its); `None`: rank 0
+    /// writes them all.
+    pub contactless: Option<Vec<bool>>,
 }
 
 impl Piece {
-    /// Whether a body of subdomain `s` (−1: no contacts) is in this piece.
-    pub fn has_body(&self, s: i32) -> bool {
+    /// Whether body k, of subdomain `s` (−1: no contacts), is in this piece.
+    pub fn has_body(&self, k: usize, s: i32) -> bool {
         match self.rank_of.get(s.max(0) as usize) {
             Some(&r) if s >= 0 => r == self.rank,
-            _ => self.rank == 0,
+            _ => match &self.contactless {
+                Some(mine) => mine.get(k).copied().unwrap_or(false),
+                None => self.rank == 0,
+            },
         }
     }
     /// Whether a contact of subdomain `s` is in this piece.
@@ -126,6 +133,7 @@ impl<D: super::Family> super::NscddOf<D> {
                 rank: rs.cluster.rank(),
                 ranks: rs.cluster.size(),
                 rank_of: rs.rank_of.clone(),
+                contactless: self.contactless_writer(w),
             }),
         };
         if d.owner.len() != D::len(c) {

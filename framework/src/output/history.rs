@@ -115,9 +115,10 @@ impl<W: Write, D: Dim> History<W, D> {
     /// A row; `dd` fills the NSCDD columns (empty when the history has them and
     /// `dd` is `None`), `extra` the extra columns.
     pub fn row_dd(&mut self, w: &World<D>, r: &StepReport, dd: Option<&DdStepReport>, t_output: f64, extra: &[f64]) -> std::io::Result<()> {
-        let (ek, ep) = w.energies();
-        // NSCDD's counts (the same as the world's in one process; exact on ranks)
+        // NSCDD's counts (the same as the world's in one process; exact on ranks) and
+        // sums over bodies (per cell, in cell order)
         let census = dd.and_then(|d| d.census);
+        let (ek, ep) = census.and_then(|c| c.energies).unwrap_or_else(|| w.energies());
         let mut r = *r;
         if let Some(c) = census {
             r.contacts = c.contacts;
@@ -178,8 +179,8 @@ fn box_fields<D: Dim>(w: &World<D>, margin: f64, census: Option<crate::dd::Censu
     let q_over_p = if p != 0.0 { q / p } else { 0.0 };
     s.push_str(&format!(",{p:e},{q:e},{q_over_p:e},{sin_phi:e},{z:e},{zm:e}"));
     if let Some(w3) = (w as &dyn std::any::Any).downcast_ref::<World3>() {
-        let counts = census.and_then(|c| c.bulk);
-        let (nb, zb, rb) = w3.bulk_measures_with(margin, counts).unwrap_or((f64::NAN, f64::NAN, f64::NAN));
+        let (counts, vol) = (census.and_then(|c| c.bulk), census.and_then(|c| c.bulk_volume));
+        let (nb, zb, rb) = w3.bulk_measures_with(margin, counts, vol).unwrap_or((f64::NAN, f64::NAN, f64::NAN));
         s.push_str(&format!(",{nb:e},{zb:e},{rb:e}"));
     }
 }

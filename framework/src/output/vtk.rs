@@ -172,7 +172,7 @@ impl VtkWriter {
         let (sel_b, sel_c): (Vec<usize>, Vec<usize>) = match (dd, piece) {
             (Some(d), Some(p)) => (
                 (0..nb)
-                    .filter(|&k| p.has_body(d.body_subdomain.get(k).copied().unwrap_or(-1)))
+                    .filter(|&k| p.has_body(k, d.body_subdomain.get(k).copied().unwrap_or(-1)))
                     .collect(),
                 (0..nc)
                     .filter(|&a| d.contact_subdomain.get(a).map_or(p.rank == 0, |&s| p.has_contact(s)))

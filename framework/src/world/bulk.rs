@@ -13,7 +13,7 @@ impl World3 {
     /// it, rattlers excluded (grains with fewer than 2 loaded contacts, walls
     /// counted): `(nu_bulk, z_bulk, rattler fraction)`.
     pub fn bulk_measures(&self, margin: f64) -> Option<(f64, f64, f64)> {
-        self.bulk_measures_with(margin, None)
+        self.bulk_measures_with(margin, None, None)
     }
 
     /// The inner box of [`World3::bulk_measures`] (None when the margin leaves none).
@@ -24,21 +24,30 @@ impl World3 {
         (0..3).all(|k| hi[k] > lo[k]).then_some((lo, hi))
     }
 
+    /// The volume of grain b inside the box `[lo, hi]`, the grain taken as the sphere
+    /// of its volume ([`sphere_in_box`]).
+    pub fn grain_in_box(&self, b: usize, lo: [f64; 3], hi: [f64; 3]) -> f64 {
+        let v = self.bodies.volume[b];
+        // equivalent radius of the grain's volume
+        let r = (3.0 * v / (4.0 * std::f64::consts::PI)).cbrt();
+        sphere_in_box(self.bodies.pos[b], r, lo, hi)
+    }
+
     /// [`World3::bulk_measures`], the coordination counts (Σ loaded contacts of the
     /// inner non-rattlers, their number, the inner grains, the inner rattlers) from
     /// `counts` when given (NSCDD's census, added over the subdomains), else from the
     /// world's contacts.
-    pub fn bulk_measures_with(&self, margin: f64, counts: Option<[u64; 4]>) -> Option<(f64, f64, f64)> {
+    pub fn bulk_measures_with(&self, margin: f64, counts: Option<[u64; 4]>, vol: Option<f64>) -> Option<(f64, f64, f64)> {
         let (lo, hi) = self.bulk_box(margin)?;
         let n = self.bodies.len();
         let inner = |b: usize| (0..3).all(|k| self.bodies.pos[b][k] > lo[k] && self.bodies.pos[b][k] < hi[k]);
-        let mut vol = 0.0;
-        for b in (0..n).filter(|&b| self.is_grain(b)) {
-            let v = self.bodies.volume[b];
-            // equivalent radius of the grain's volume
-            let r = (3.0 * v / (4.0 * std::f64::consts::PI)).cbrt();
-            vol += sphere_in_box(self.bodies.pos[b], r, lo, hi);
-        }
+        let vol = vol.unwrap_or_else(|| {
+            let mut vol = 0.0;
+            for b in (0..n).filter(|&b| self.is_grain(b)) {
+                vol += self.grain_in_box(b, lo, hi);
+            }
+            vol
+        });
         let [zsum, nz, ninner, rattlers] = counts.unwrap_or_else(|| {
             let count = self.loaded_contacts();
             let mut c = [0u64; 4];

@@ -239,15 +239,25 @@ impl<D: Dim> World<D> {
     /// Kinetic energy and gravity potential of the bodies impulses can move.
     pub fn energies(&self) -> (f64, f64) {
         let (mut ek, mut ep) = (0.0, 0.0);
-        let b = &self.bodies;
-        for k in 0..b.len() {
-            if !b.movable(k) {
-                continue;
+        for k in 0..self.bodies.len() {
+            if let Some((e, p)) = self.body_energies(k) {
+                ek += e;
+                ep -= p;
             }
-            ek += D::kinetic_energy(b.mass[k], &b.inertia[k], &b.rot[k], &b.vel[k]);
-            ep -= b.mass[k] * self.gravity.dot(&b.pos[k]);
         }
         (ek, ep)
+    }
+    /// Body k's kinetic energy and m g·x (its potential is −m g·x), if impulses can
+    /// move it: the terms of [`World::energies`].
+    #[inline]
+    pub fn body_energies(&self, k: usize) -> Option<(f64, f64)> {
+        let b = &self.bodies;
+        b.movable(k).then(|| {
+            (
+                D::kinetic_energy(b.mass[k], &b.inertia[k], &b.rot[k], &b.vel[k]),
+                b.mass[k] * self.gravity.dot(&b.pos[k]),
+            )
+        })
     }
 }
 
