@@ -113,6 +113,12 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     const BODY_RECORD: usize;
     fn body_record(w: &Self::World, g: usize, out: &mut Vec<f64>);
     fn set_body_record(w: &mut Self::World, g: usize, x: &[f64]);
+    /// During a step (a distributed repartition): a body's position, orientation,
+    /// V⁻ and V_free (`STEP_RECORD` numbers), and back (M̂⁻¹ refreshed; returns
+    /// V_free).
+    const STEP_RECORD: usize;
+    fn step_record(w: &Self::World, g: usize, v_free: &Self::V, out: &mut Vec<f64>);
+    fn set_step_record(w: &mut Self::World, g: usize, x: &[f64]) -> Self::V;
     /// Contact a's warm-start record: key (3), r, point, bond (1).
     fn prev_record(c: &Self::Contacts, a: usize, out: &mut Vec<f64>);
     const PREV_RECORD: usize;
@@ -331,6 +337,25 @@ impl<D: Dim> Family for Rigid<D> {
         b.rot[g].coords_mut().copy_from_slice(&rest[..nr]);
         b.vel[g].as_mut().copy_from_slice(&rest[nr..nr + D::DOF]);
     }
+    const STEP_RECORD: usize = Self::BODY_RECORD + D::DOF;
+    fn step_record(w: &Self::World, g: usize, v_free: &Self::V, out: &mut Vec<f64>) {
+        let b = &w.bodies;
+        out.extend_from_slice(b.pos[g].as_ref());
+        out.extend_from_slice(b.rot[g].coords());
+        out.extend_from_slice(w.scratch.v_begin[g].as_ref());
+        out.extend_from_slice(v_free.as_ref());
+    }
+    fn set_step_record(w: &mut Self::World, g: usize, x: &[f64]) -> Self::V {
+        Self::set_body_record(w, g, &x[..Self::BODY_RECORD]);
+        let (n, dof) = (Self::BODY_RECORD, D::DOF);
+        w.scratch.v_begin[g] = w.bodies.vel[g];
+        w.bodies.vel[g].as_mut().copy_from_slice(&x[n..n + dof]);
+        // as the free velocity stage does (an isotropic body's M̂⁻¹ never changes)
+        if w.bodies.free[g] != 0 && !D::isotropic(&w.bodies.inertia[g]) {
+            w.bodies.refresh_inverse(g);
+        }
+        w.bodies.vel[g]
+    }
     const PREV_RECORD: usize = 4 + 2 * D::N;
     fn prev_record(c: &Self::Contacts, a: usize, out: &mut Vec<f64>) {
         let k = c.key[a];
@@ -347,8 +372,14 @@ impl<D: Dim> Family for Rigid<D> {
     ) {
         w.bodies.vel.copy_from_slice(v_free);
         let s = &mut w.scratch;
-        s.detector
-            .detect_in(&w.bodies, &w.shapes, &w.detectors, w.alert, Some(&region), &mut s.raw);
+        s.detector.detect_among(
+            (&w.bodies, s.active.as_deref()),
+            &w.shapes,
+            &w.detectors,
+            w.alert,
+            Some(&region),
+            &mut s.raw,
+        );
         Self::retain_raw(w, keep);
         crate::engine::build_from_raw(w);
     }

@@ -241,6 +241,10 @@ impl<D: Family> super::NscddOf<D> {
             }
         }
         rs.rank_of = super::rank_balance::balanced_ranks(&sum, rs.cluster.size());
+        if D::active(w).is_some() {
+            let Local { owned, boxes, .. } = &mut self.local;
+            owned.repartition::<D>(w, (rs, &grid), boxes, &mut self.v_free);
+        }
         let me = rs.cluster.rank();
         let region = Region {
             boxes: cells_of(&grid, &rs.rank_of, me),
@@ -266,11 +270,11 @@ impl<D: Family> super::NscddOf<D> {
         if !self.local.now {
             return moved;
         }
-        let repart = self.repartitions();
         let (Some(rs), Some(grid)) = (self.ranks.as_mut(), self.grid.as_ref()) else {
             return moved;
         };
-        let full_next = repart || rs.rank_of.len() != grid.len();
+        // a repartition brings the bodies of the new halos itself
+        let full_next = rs.rank_of.len() != grid.len();
         let Local { owned, boxes, .. } = &mut self.local;
         owned.after_integrate::<D>(w, (rs, grid), (boxes, full_next), moved)
     }

@@ -17,7 +17,9 @@
 //! At the end of a step, the owner of a body at the start of the step sends its new
 //! state to the ranks whose halo it has just entered (one all-gather); every rank
 //! then keeps the bodies of its new halo. By induction a rank holds every body of its
-//! halo at the start of each step. The outputs never read a body its rank does not
+//! halo at the start of each step. A distributed repartition
+//! ([`super::NscddOf::repartition_local`]) sends, in the step, the bodies of each
+//! rank's new halo it lacks (their state at the start of the step, V⁻ and V_free). The outputs never read a body its rank does not
 //! hold: the sums over bodies are added per cell by the cells' ranks
 //! ([`super::census::BodySums`]), the named and driven bodies are stepped by every
 //! rank, a body without contacts is written in the VTK frames by its owner, and
@@ -53,7 +55,6 @@ impl Owned {
     /// At the start of a step with contacts held per rank (`boxes`: the active
     /// bodies' boxes): every rank's cells and the bodies this rank owns.
     pub(super) fn start<D: Family>(&mut self, w: &D::World, rs: &RankState, grid: &Grid) {
-        let me = rs.cluster.rank();
         self.regions = (0..rs.cluster.size())
             .map(|q| Region {
                 boxes: super::local::cells_of(grid, &rs.rank_of, q),
@@ -68,13 +69,67 @@ impl Owned {
                 self.everywhere[g as usize] = true;
             }
         }
+        self.own_bodies::<D>(w, rs, grid);
+    }
+
+    /// The active bodies whose centre lies in one of this rank's cells.
+    fn own_bodies<D: Family>(&mut self, w: &D::World, rs: &RankState, grid: &Grid) {
+        let me = rs.cluster.rank();
         self.mine.clear();
         let owner = |g: usize| rs.rank_of.get(grid.cell_of(D::position(w, g)) as usize) == Some(&me);
-        crate::step::each_body(nb, D::active(w), |g| {
+        crate::step::each_body(D::n_bodies(w), D::active(w), |g| {
             if owner(g) {
                 self.mine.push(g as u32);
             }
         });
+    }
+
+    /// A distributed repartition in the step (the new `grid` and `rs.rank_of` set,
+    /// before the new regions' detection): the bodies of each rank's new halo it
+    /// lacks, at the start of the step with their V⁻ and V_free, from their owners
+    /// (one all-gather of those bodies only); then the new cells and owners. `boxes`:
+    /// the active bodies' boxes at the start of the step (the received ones added).
+    /// Collective.
+    pub(super) fn repartition<D: Family>(
+        &mut self,
+        w: &mut D::World,
+        (rs, grid): (&mut RankState, &Grid),
+        boxes: &mut Vec<[[f64; 3]; 2]>,
+        v_free: &mut [D::V],
+    ) {
+        let alert = D::alert(w);
+        let me = rs.cluster.rank();
+        let new: Vec<Region> = (0..rs.cluster.size())
+            .map(|q| Region {
+                boxes: super::local::cells_of(grid, &rs.rank_of, q),
+                pairs: Vec::new(),
+            })
+            .collect();
+        let mut mine = Vec::new();
+        for &g in &self.mine {
+            let b = &boxes[g as usize];
+            for (q, r) in new.iter().enumerate().filter(|&(q, _)| q as u32 != me) {
+                if meets(D::SPACE, b, alert, r) && !meets(D::SPACE, b, alert, &self.regions[q]) {
+                    mine.extend([q as f64, f64::from(g)]);
+                    D::step_record(w, g as usize, &v_free[g as usize], &mut mine);
+                }
+            }
+        }
+        let per = 2 + D::STEP_RECORD;
+        rs.totals.bodies_sent += (mine.len() / per) as u64;
+        let (_, all) = rs.all_gather_any(&mine);
+        let mut active = D::active(w).map(<[u32]>::to_vec).unwrap_or_default();
+        for x in all.chunks_exact(per).filter(|x| x[0] as u32 == me) {
+            let g = x[1] as usize;
+            v_free[g] = D::set_step_record(w, g, &x[2..]);
+            active.push(g as u32);
+        }
+        active.sort_unstable();
+        active.dedup();
+        D::set_active(w, Some(active));
+        D::body_boxes(w, boxes);
+        self.regions = new;
+        self.own_bodies::<D>(w, rs, grid);
     }
 
     /// After the position update of a step with contacts held per rank (`boxes`: the
