@@ -218,7 +218,7 @@ impl<D: Dim> Detector<D> {
         self.large.clear();
         self.pairs.clear();
         self.boxes((bodies, among), shapes);
-        self.mark_inside(region, alert);
+        self.mark_inside(region, alert, among);
         if let Some(list) = among {
             self.keep_only(list);
         }
@@ -331,17 +331,26 @@ impl<D: Dim> Detector<D> {
 
     /// Which bodies enter the broad phase: all, or those whose box grown by `alert`
     /// meets the region, and the bodies of the pairs it names.
-    fn mark_inside(&mut self, region: Option<&Region>, alert: f64) {
+    /// Only the bodies `among` are looked at (`None`: all).
+    fn mark_inside(&mut self, region: Option<&Region>, alert: f64, among: Option<&[u32]>) {
         self.inside.clear();
-        let Some(r) = region else {
-            self.inside.resize(self.aabb.len(), true);
-            return;
+        let meets = |a: &Aabb<D>| {
+            region.is_none_or(|r| {
+                let lo: [f64; 3] = std::array::from_fn(|k| if k < D::N { a.min[k] - alert } else { 0.0 });
+                let hi: [f64; 3] = std::array::from_fn(|k| if k < D::N { a.max[k] + alert } else { 0.0 });
+                r.meets(D::N, &lo, &hi)
+            })
         };
-        self.inside.extend(self.aabb.iter().map(|a| {
-            let lo: [f64; 3] = std::array::from_fn(|k| if k < D::N { a.min[k] - alert } else { 0.0 });
-            let hi: [f64; 3] = std::array::from_fn(|k| if k < D::N { a.max[k] + alert } else { 0.0 });
-            r.meets(D::N, &lo, &hi)
-        }));
+        match among {
+            None => self.inside.extend(self.aabb.iter().map(meets)),
+            Some(list) => {
+                self.inside.resize(self.aabb.len(), false);
+                for &b in list {
+                    self.inside[b as usize] = meets(&self.aabb[b as usize]);
+                }
+            }
+        }
+        let Some(r) = region else { return };
         for p in &r.pairs {
             for &b in p {
                 if let Some(x) = self.inside.get_mut(b as usize) {

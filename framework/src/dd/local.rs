@@ -24,7 +24,7 @@
 //! process.
 
 use super::family::Family;
-use super::partition::{owner_of, Grid};
+use super::partition::{Grid, OwnerOf};
 use super::ranks::RankState;
 use crate::detect::Region;
 use crate::model::ContactKey;
@@ -201,7 +201,8 @@ impl<D: Family> super::NscddOf<D> {
         };
         let me = rs.cluster.rank();
         let (kept, rank_of) = (&self.kept, &rs.rank_of);
-        D::retain_raw(w, &mut |key, p| rank_of.get(owner_of(kept, grid, key, p) as usize) == Some(&me));
+        let mut owner = OwnerOf::new(kept, grid);
+        D::retain_raw(w, &mut |key, p| rank_of.get(owner.of(key, p) as usize) == Some(&me));
     }
 
     /// A repartition with contacts held per rank (collective): the new grid over the

@@ -51,6 +51,7 @@ mod local;
 #[cfg(feature = "mpi")]
 pub mod mpi;
 mod owned;
+mod owner;
 pub mod partition;
 mod rank_balance;
 mod rank_link;

@@ -10,8 +10,8 @@
 
 use super::attach::{Attached, EntityInfo};
 use super::family::Family;
+pub use super::owner::{kept_owners, owner_of, OwnerOf};
 use super::subdomain::{Neighbor, Subdomain, OWN};
-use crate::model::ContactKey;
 
 /// The grid of subdomains over the contact points' bounding box (nz = 1 in 2D,
 /// whose points have z = 0).
@@ -220,22 +220,6 @@ impl<D: Family> Default for Decomposition<D> {
 
 /// Fills the other ranks' subdomains with their bodies (contacts held per rank).
 pub type Shells<'a, D> = &'a mut dyn FnMut(&mut [Subdomain<D>]);
-
-/// The owners between repartitions: a contact whose key is in `kept` (sorted by key)
-/// stays in its subdomain; a new contact goes to the cell of `grid` (the grid of the
-/// last repartition) that holds its point.
-pub fn kept_owners<D: Family>(c: &D::Contacts, grid: &Grid, kept: &[(ContactKey, u32)]) -> Vec<u32> {
-    (0..D::len(c)).map(|a| owner_of(kept, grid, D::key(c, a), D::point(c, a))).collect()
-}
-
-/// The subdomain of one contact between repartitions (see [`kept_owners`]): also
-/// what a rank holding its contacts decides on a raw contact before building it.
-pub fn owner_of(kept: &[(ContactKey, u32)], grid: &Grid, key: ContactKey, p: [f64; 3]) -> u32 {
-    match kept.binary_search_by_key(&key, |e| e.0) {
-        Ok(k) => kept[k].1,
-        Err(_) => grid.cell_of(p),
-    }
-}
 
 /// The subdomains of each body (ascending), `out[b]`, from a decomposition.
 pub fn body_sets<D: Family>(d: &Decomposition<D>, nb: usize) -> Vec<Vec<u32>> {
