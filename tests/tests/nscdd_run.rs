@@ -486,6 +486,10 @@ fn the_census_of_the_subdomains_is_the_worlds() {
         assert_eq!((c.z.to_bits(), c.z_m.to_bits()), (z.to_bits(), z_m.to_bits()), "{c:?} vs {z} {z_m}");
         assert!(z > 1.0 && z_m > z, "{z} {z_m}");
         assert!(rep.interface_bodies > 10);
+        // the sums over bodies, added per cell in cell order: the world's to rounding
+        let ((ek, ep), (wk, wp)) = (c.energies.expect("energies"), s.world.energies());
+        assert!((ek - wk).abs() <= 1e-12 * wk.abs() && (ep - wp).abs() <= 1e-12 * wp.abs(), "{ek} {ep} vs {wk} {wp}");
+        assert!(wk > 0.0 && wp != 0.0);
     }
 }
 
@@ -512,6 +516,10 @@ fn the_bulk_census_of_the_subdomains_is_the_worlds() {
         s.world.bulk_measures(margin).unwrap(),
         s.world.bulk_measures_with(margin, Some(bulk), None).unwrap(),
     );
+    // the bulk volume added per cell: the world's to rounding
+    let vol = rep.census.and_then(|c| c.bulk_volume).expect("bulk volume");
+    let v = s.world.bulk_measures_with(margin, Some(bulk), Some(vol)).unwrap();
+    assert!((v.0 - a.0).abs() <= 1e-12 * a.0, "{v:?} {a:?}");
     assert_eq!(
         (a.0.to_bits(), a.1.to_bits(), a.2.to_bits()),
         (b.0.to_bits(), b.1.to_bits(), b.2.to_bits()),
