@@ -7,10 +7,12 @@ walls around it), settled 1500 steps in one process, then `--steps` more steps
 restarted from it with `mpirun -n P --oversubscribe nscdd run … --subdomains Px1`
 (one strip per rank), re-partitioned every 10 steps (contacts held per rank). Per
 rank, from ranks.json: the time in gluing exchanges and reductions (waits included)
-and the rest of the run (its own work: sweeps, detection, build, update), and the
-CPU seconds of every rank (`/usr/bin/time`). With more ranks than cores the ranks
-share the cores: the wall time grows with P / cores; the per-rank work is what
-weak scaling keeps constant.
+and the rest of the run (its own work: sweeps, detection, build, update), the CPU
+seconds of every rank (`/usr/bin/time`, loading included), and each rank's CPU
+seconds in communication and the rest, its compute CPU (ranks.json, from the start
+of the run). With more ranks than cores the ranks share the cores: the wall time
+grows with P / cores and time sharing blurs the wall split between own work and
+waits; the compute CPU per rank is what weak scaling keeps constant.
 
 Usage: python3 scripts/weak_scaling.py [--ranks 1,2,4,8] [--steps 200] [--out DIR]
 Needs the program built with `--features nscdd-cli/mpi` and OpenMPI.
@@ -68,9 +70,13 @@ def main():
         per = json.load(open(os.path.join(out, "ranks.json")))["per_rank"]
         waits = [r["exchange_seconds"] + r["reduce_seconds"] for r in per]
         own = [wall - x for x in waits]
+        compute = [r["compute_cpu_seconds"] for r in per]
+        wait_cpu = [r["wait_cpu_seconds"] for r in per]
         print(json.dumps(dict(ranks=p, disks=1000 * p, steps=a.steps, wall=wall,
                               own_mean=sum(own) / p, own_max=max(own), waits_mean=sum(waits) / p,
-                              cpu_per_rank=sum(cpu) / len(cpu) if cpu else None)), flush=True)
+                              cpu_per_rank=sum(cpu) / len(cpu) if cpu else None,
+                              compute_cpu_mean=sum(compute) / p, compute_cpu_max=max(compute),
+                              wait_cpu_mean=sum(wait_cpu) / p)), flush=True)
 
 
 if __name__ == "__main__":

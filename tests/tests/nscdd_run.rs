@@ -488,7 +488,10 @@ fn the_census_of_the_subdomains_is_the_worlds() {
         assert!(rep.interface_bodies > 10);
         // the sums over bodies, added per cell in cell order: the world's to rounding
         let ((ek, ep), (wk, wp)) = (c.energies.expect("energies"), s.world.energies());
-        assert!((ek - wk).abs() <= 1e-12 * wk.abs() && (ep - wp).abs() <= 1e-12 * wp.abs(), "{ek} {ep} vs {wk} {wp}");
+        assert!(
+            (ek - wk).abs() <= 1e-12 * wk.abs() && (ep - wp).abs() <= 1e-12 * wp.abs(),
+            "{ek} {ep} vs {wk} {wp}"
+        );
         assert!(wk > 0.0 && wp != 0.0);
     }
 }

@@ -32,6 +32,50 @@ pub trait Cluster {
     /// Stops every rank at once with exit code `code` (MPI_Abort): for a failure on
     /// one rank, which the others would wait for forever.
     fn abort(&self, code: i32) -> !;
+    /// Wall and CPU seconds (the calling thread's) spent in the operations above so
+    /// far: a rank's waits, measured apart from its compute.
+    fn waited(&self) -> (f64, f64) {
+        (0.0, 0.0)
+    }
+}
+
+/// CPU seconds of the calling thread (`thread`) or of the whole process (0 where
+/// the clock is not available).
+pub fn cpu_seconds(thread: bool) -> f64 {
+    #[cfg(unix)]
+    {
+        let clock = if thread {
+            libc::CLOCK_THREAD_CPUTIME_ID
+        } else {
+            libc::CLOCK_PROCESS_CPUTIME_ID
+        };
+        let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+        // SAFETY: clock_gettime writes the timespec it is given, nothing else.
+        if unsafe { libc::clock_gettime(clock, &mut ts) } == 0 {
+            return ts.tv_sec as f64 + 1e-9 * ts.tv_nsec as f64;
+        }
+    }
+    let _ = thread;
+    0.0
+}
+
+/// Adds the wall and thread-CPU seconds since its start to a pair of totals.
+pub struct WaitClock {
+    wall: std::time::Instant,
+    cpu: f64,
+}
+
+impl WaitClock {
+    pub fn start() -> Self {
+        WaitClock {
+            wall: std::time::Instant::now(),
+            cpu: cpu_seconds(true),
+        }
+    }
+    pub fn stop(self, total: &mut (f64, f64)) {
+        total.0 += self.wall.elapsed().as_secs_f64();
+        total.1 += cpu_seconds(true) - self.cpu;
+    }
 }
 
 /// The one-process cluster.

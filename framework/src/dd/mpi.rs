@@ -15,7 +15,7 @@
 //! probe (`MPI_Mprobe`, `MPI_Mrecv`: its length is read from the probe), then wait
 //! for the sends.
 
-use super::cluster::{displacements, Cluster};
+use super::cluster::{displacements, Cluster, WaitClock};
 use mpi::datatype::{Partition, PartitionMut};
 use mpi::topology::{Communicator, SimpleCommunicator};
 use mpi::traits::*;
@@ -66,6 +66,7 @@ impl MpiSession {
     pub fn cluster(&self) -> Box<dyn Cluster> {
         Box::new(MpiCluster {
             comm: self.universe.world().duplicate(),
+            wait: (0.0, 0.0),
         })
     }
 }
@@ -73,6 +74,8 @@ impl MpiSession {
 /// [`Cluster`] over an MPI communicator.
 pub struct MpiCluster {
     comm: SimpleCommunicator,
+    /// Wall and CPU seconds in communication ([`Cluster::waited`]).
+    wait: (f64, f64),
 }
 
 fn counts_displs(counts: &[usize]) -> (Vec<Count>, Vec<Count>) {
@@ -89,6 +92,7 @@ impl Cluster for MpiCluster {
         self.comm.size() as u32
     }
     fn exchange(&mut self, peers: &[u32], out: &[Vec<f64>], inbox: &mut [Vec<f64>]) {
+        let clock = WaitClock::start();
         let comm = &self.comm;
         mpi::request::scope(|sc| {
             let sends: Vec<_> = peers
@@ -107,15 +111,19 @@ impl Cluster for MpiCluster {
                 r.wait();
             }
         });
+        clock.stop(&mut self.wait);
     }
     fn all_gather(&mut self, mine: &[f64], counts: &[usize], all: &mut Vec<f64>) {
+        let clock = WaitClock::start();
         let (c, d) = counts_displs(counts);
         all.clear();
         all.resize(counts.iter().sum(), 0.0);
         let mut part = PartitionMut::new(&mut all[..], c, d);
         self.comm.all_gather_varcount_into(mine, &mut part);
+        clock.stop(&mut self.wait);
     }
     fn gather(&mut self, mine: &[f64], counts: &[usize], all: &mut Vec<f64>) {
+        let clock = WaitClock::start();
         let root = self.comm.process_at_rank(0);
         if self.comm.rank() == 0 {
             let (c, d) = counts_displs(counts);
@@ -126,8 +134,10 @@ impl Cluster for MpiCluster {
         } else {
             root.gather_varcount_into(mine);
         }
+        clock.stop(&mut self.wait);
     }
     fn scatter(&mut self, all: &[f64], counts: &[usize], mine: &mut Vec<f64>) {
+        let clock = WaitClock::start();
         let root = self.comm.process_at_rank(0);
         mine.clear();
         mine.resize(counts[self.comm.rank() as usize], 0.0);
@@ -138,12 +148,18 @@ impl Cluster for MpiCluster {
         } else {
             root.scatter_varcount_into(&mut mine[..]);
         }
+        clock.stop(&mut self.wait);
     }
     fn min_max(&mut self, x: u64) -> (u64, u64) {
+        let clock = WaitClock::start();
         let (mut lo, mut hi) = (0u64, 0u64);
         self.comm.all_reduce_into(&x, &mut lo, mpi::collective::SystemOperation::min());
         self.comm.all_reduce_into(&x, &mut hi, mpi::collective::SystemOperation::max());
+        clock.stop(&mut self.wait);
         (lo, hi)
+    }
+    fn waited(&self) -> (f64, f64) {
+        self.wait
     }
     fn abort(&self, code: i32) -> ! {
         self.comm.abort(code)

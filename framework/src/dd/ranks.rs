@@ -96,10 +96,15 @@ pub struct RankState {
     /// The step runs with contacts held per rank ([`super::local`]): the other
     /// ranks' subdomains are shells without contacts, their impulses not exchanged.
     pub(super) local: bool,
+    /// The process's CPU seconds and the cluster's waits when the rank's run started
+    /// (after loading).
+    cpu_start: f64,
+    wait_start: (f64, f64),
 }
 
 impl RankState {
     pub fn new(cluster: Box<dyn Cluster>) -> Self {
+        let wait_start = cluster.waited();
         RankState {
             cluster,
             rank_of: Vec::new(),
@@ -114,6 +119,8 @@ impl RankState {
             parts: Vec::new(),
             totals: RankTotals::default(),
             local: false,
+            cpu_start: super::cluster::cpu_seconds(false),
+            wait_start,
         }
     }
 
@@ -525,12 +532,22 @@ impl crate::solver::anderson::Reduce for Reduced<'_> {
 
 /// Every rank's totals, gathered on every rank (collective), as a JSON document:
 /// per rank its gluing messages and values sent, gluing rounds, peers (the ranks it
-/// sent gluing messages to), reduction messages and values, and seconds.
+/// sent gluing messages to), reduction messages and values, and seconds; its CPU
+/// seconds since the run started, those spent in communication (`wait_cpu_seconds`,
+/// the main thread's) and the rest (`compute_cpu_seconds`): a rank's compute
+/// measured apart from its waits even when ranks share cores.
 pub fn totals_json(st: &mut RankState) -> String {
-    const H: usize = 12;
+    const H: usize = 16;
     let p = st.cluster.size() as usize;
     let t = &st.totals;
+    let (wait_wall, wait_cpu) = st.cluster.waited();
+    let (wait_wall, wait_cpu) = (wait_wall - st.wait_start.0, wait_cpu - st.wait_start.1);
+    let cpu = super::cluster::cpu_seconds(false) - st.cpu_start;
     let mut mine = vec![
+        cpu,
+        wait_cpu,
+        wait_wall,
+        cpu - wait_cpu,
         t.steps as f64,
         t.sent.messages as f64,
         t.sent.values as f64,
@@ -557,17 +574,21 @@ pub fn totals_json(st: &mut RankState) -> String {
             let subs: Vec<usize> = (0..st.rank_of.len()).filter(|&s| st.rank_of[s] == r as u32).collect();
             serde_json::json!({
                 "rank": r,
-                "steps": x[0] as u64,
-                "messages": x[1] as u64,
-                "values": x[2] as u64,
-                "rounds": x[3] as u64,
-                "exchange_seconds": x[4],
-                "reduce_seconds": x[5],
-                "solve_seconds": x[6],
-                "reduce_messages": x[7] as u64,
-                "reduce_values": x[8] as u64,
-                "bodies_stepped": x[9] as u64,
-                "bodies_sent": x[10] as u64,
+                "cpu_seconds": x[0],
+                "wait_cpu_seconds": x[1],
+                "wait_seconds": x[2],
+                "compute_cpu_seconds": x[3],
+                "steps": x[4] as u64,
+                "messages": x[5] as u64,
+                "values": x[6] as u64,
+                "rounds": x[7] as u64,
+                "exchange_seconds": x[8],
+                "reduce_seconds": x[9],
+                "solve_seconds": x[10],
+                "reduce_messages": x[11] as u64,
+                "reduce_values": x[12] as u64,
+                "bodies_stepped": x[13] as u64,
+                "bodies_sent": x[14] as u64,
                 "peers": peers,
                 "last_subdomains": subs,
             })
