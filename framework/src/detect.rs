@@ -72,9 +72,15 @@ impl Region {
     /// each grown by `alert`, meets one of the boxes: the test a pair passes to be
     /// detected in the region (other processes ask it of their own pairs).
     pub fn meets_pair(&self, n: usize, a: (&[f64], &[f64]), b: (&[f64], &[f64]), alert: f64) -> bool {
+        let (lo, hi) = Self::pair_box(n, a, b, alert);
+        self.meets(n, &lo, &hi)
+    }
+    /// The box [`Region::meets_pair`] tests: the intersection of the two boxes, each
+    /// grown by `alert`.
+    pub fn pair_box(n: usize, a: (&[f64], &[f64]), b: (&[f64], &[f64]), alert: f64) -> ([f64; 3], [f64; 3]) {
         let lo: [f64; 3] = std::array::from_fn(|k| if k < n { a.0[k].max(b.0[k]) - alert } else { 0.0 });
         let hi: [f64; 3] = std::array::from_fn(|k| if k < n { a.1[k].min(b.1[k]) + alert } else { 0.0 });
-        self.meets(n, &lo, &hi)
+        (lo, hi)
     }
     fn names(&self, i: u32, j: u32) -> bool {
         self.pairs.binary_search(&[i, j]).is_ok()

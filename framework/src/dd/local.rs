@@ -46,31 +46,7 @@ pub(super) struct Local {
     owned: super::owned::Owned,
 }
 
-/// The boxes of the grid cells whose subdomain is `rank`'s (edge cells unbounded,
-/// a flat axis whole, each grown by 10⁻⁶ of a cell).
-pub(super) fn cells_of(grid: &Grid, rank_of: &[u32], rank: u32) -> Vec<[[f64; 3]; 2]> {
-    let n = [grid.nx, grid.ny, grid.nz];
-    let inf = f64::INFINITY;
-    (0..grid.len() as u32)
-        .filter(|&c| rank_of.get(c as usize) == Some(&rank))
-        .map(|c| {
-            let idx = [c % n[0], (c / n[0]) % n[1], c / (n[0] * n[1])];
-            let mut b = [[0.0; 3]; 2];
-            for d in 0..3 {
-                let h = grid.cell[d];
-                let flat = h.is_nan() || h <= 0.0;
-                let at = |k: u32| grid.origin[d] + k as f64 * h;
-                b[0][d] = if flat || idx[d] == 0 { -inf } else { at(idx[d]) - 1e-6 * h };
-                b[1][d] = if flat || idx[d] + 1 == n[d] {
-                    inf
-                } else {
-                    at(idx[d] + 1) + 1e-6 * h
-                };
-            }
-            b
-        })
-        .collect()
-}
+pub(super) use super::cells::cells_of;
 
 /// [`Region::meets_pair`] of two bodies' boxes (the detection's own test).
 fn pair_meets(n: usize, a: &[[f64; 3]; 2], b: &[[f64; 3]; 2], alert: f64, region: &Region) -> bool {
@@ -89,19 +65,15 @@ impl Local {
         all: bool,
     ) -> Vec<(ContactKey, u32)> {
         let me = rs.cluster.rank();
-        let regions: Vec<Region> = (0..rs.cluster.size())
-            .filter(|&q| q != me)
-            .map(|q| Region {
-                boxes: cells_of(grid, &rs.rank_of, q),
-                pairs: Vec::new(),
-            })
-            .collect();
+        let cells = super::cells::CellIndex::new(grid, &rs.rank_of);
         let c = D::contacts(w);
         let mut mine = Vec::new();
         for (a, &o) in owner.iter().enumerate().take(D::len(c)) {
             let [i, j] = D::bodies(c, a);
             let (bi, bj) = (&self.boxes[i as usize], &self.boxes[j as usize]);
-            if all || regions.iter().any(|r| pair_meets(D::SPACE, bi, bj, alert, r)) {
+            // the region's pair test ([`Region::meets_pair`]) over the other ranks' cells
+            let (lo, hi) = Region::pair_box(D::SPACE, (&bi[0], &bi[1]), (&bj[0], &bj[1]), alert);
+            if all || cells.meets_other(D::SPACE, &lo, &hi, me) {
                 D::prev_record(c, a, &mut mine);
                 mine.push(f64::from(o));
             }

@@ -43,6 +43,7 @@
 
 mod anderson;
 pub mod attach;
+mod cells;
 mod census;
 pub mod cluster;
 pub mod family;

@@ -28,6 +28,7 @@
 //! every body (one all-gather) and the repartition step runs with all bodies, as
 //! the first step does.
 
+use super::cells::CellIndex;
 use super::family::Family;
 use super::partition::Grid;
 use super::ranks::RankState;
@@ -37,30 +38,53 @@ use crate::detect::Region;
 #[derive(Default)]
 pub(super) struct Owned {
     /// Every rank's cells at the start of the step.
-    regions: Vec<Region>,
+    cells: Option<CellIndex>,
     /// The active bodies this rank owned at the start of the step.
     mine: Vec<u32>,
     /// Bodies stepped by every rank (fixed, driven, unbounded), by id.
     everywhere: Vec<bool>,
 }
 
+/// The box `b` grown by `alert`.
+fn grown(b: &[[f64; 3]; 2], alert: f64) -> ([f64; 3], [f64; 3]) {
+    (std::array::from_fn(|k| b[0][k] - alert), std::array::from_fn(|k| b[1][k] + alert))
+}
+
 /// Whether the box `b` grown by `alert` meets `region`'s boxes.
 fn meets(n: usize, b: &[[f64; 3]; 2], alert: f64, region: &Region) -> bool {
-    let lo: [f64; 3] = std::array::from_fn(|k| b[0][k] - alert);
-    let hi: [f64; 3] = std::array::from_fn(|k| b[1][k] + alert);
+    let (lo, hi) = grown(b, alert);
     region.meets(n, &lo, &hi)
+}
+
+/// The ranks other than `me` whose cells (`after`) a body's box `new`, grown by
+/// `alert`, meets and whose cells (`before`) its box `old` did not meet, into `out`
+/// (sorted, once each; `was`: scratch).
+fn entered(
+    n: usize,
+    (old, before): (&[[f64; 3]; 2], &CellIndex),
+    (new, after): (&[[f64; 3]; 2], &CellIndex),
+    alert: f64,
+    me: u32,
+    (was, out): (&mut Vec<u32>, &mut Vec<u32>),
+) {
+    (was.clear(), out.clear());
+    let (lo, hi) = grown(old, alert);
+    before.ranks_meeting(n, &lo, &hi, |q| was.push(q));
+    let (lo, hi) = grown(new, alert);
+    after.ranks_meeting(n, &lo, &hi, |q| {
+        if q != me && !was.contains(&q) {
+            out.push(q);
+        }
+    });
+    out.sort_unstable();
+    out.dedup();
 }
 
 impl Owned {
     /// At the start of a step with contacts held per rank (`boxes`: the active
     /// bodies' boxes): every rank's cells and the bodies this rank owns.
     pub(super) fn start<D: Family>(&mut self, w: &D::World, rs: &RankState, grid: &Grid) {
-        self.regions = (0..rs.cluster.size())
-            .map(|q| Region {
-                boxes: super::local::cells_of(grid, &rs.rank_of, q),
-                pairs: Vec::new(),
-            })
-            .collect();
+        self.cells = Some(CellIndex::new(grid, &rs.rank_of));
         let nb = D::n_bodies(w);
         if self.everywhere.len() != nb {
             // and the observed bodies (named or driven: the history reads them on rank 0)
@@ -99,20 +123,16 @@ impl Owned {
     ) {
         let alert = D::alert(w);
         let me = rs.cluster.rank();
-        let new: Vec<Region> = (0..rs.cluster.size())
-            .map(|q| Region {
-                boxes: super::local::cells_of(grid, &rs.rank_of, q),
-                pairs: Vec::new(),
-            })
-            .collect();
+        let new = CellIndex::new(grid, &rs.rank_of);
+        let Some(old) = self.cells.take() else { return };
         let mut mine = Vec::new();
+        let (mut was, mut to) = (Vec::new(), Vec::new());
         for &g in &self.mine {
             let b = &boxes[g as usize];
-            for (q, r) in new.iter().enumerate().filter(|&(q, _)| q as u32 != me) {
-                if meets(D::SPACE, b, alert, r) && !meets(D::SPACE, b, alert, &self.regions[q]) {
-                    mine.extend([q as f64, f64::from(g)]);
-                    D::step_record(w, g as usize, &v_free[g as usize], &mut mine);
-                }
+            entered(D::SPACE, (b, &old), (b, &new), alert, me, (&mut was, &mut to));
+            for &q in &to {
+                mine.extend([f64::from(q), f64::from(g)]);
+                D::step_record(w, g as usize, &v_free[g as usize], &mut mine);
             }
         }
         let per = 2 + D::STEP_RECORD;
@@ -128,7 +148,7 @@ impl Owned {
         active.dedup();
         D::set_active(w, Some(active));
         D::body_boxes(w, boxes);
-        self.regions = new;
+        self.cells = Some(new);
         self.own_bodies::<D>(w, rs, grid);
     }
 
@@ -152,12 +172,12 @@ impl Owned {
             (moved.err(), Vec::new())
         } else {
             D::body_boxes(w, &mut now);
-            let entering = |g: u32| {
+            let Some(cells) = self.cells.as_ref() else { return moved };
+            let (mut was, mut to) = (Vec::new(), Vec::new());
+            let mut entering = |g: u32| {
                 let (new, old) = (&now[g as usize], &boxes[g as usize]);
-                self.regions
-                    .iter()
-                    .enumerate()
-                    .any(|(q, r)| q != me && (full_next || (meets(D::SPACE, new, alert, r) && !meets(D::SPACE, old, alert, r))))
+                entered(D::SPACE, (old, cells), (new, cells), alert, me as u32, (&mut was, &mut to));
+                full_next || !to.is_empty()
             };
             let send: Vec<u32> = self.mine.iter().copied().filter(|&g| entering(g)).collect();
             exchange::<D>(w, rs, &send, moved.err(), true)
