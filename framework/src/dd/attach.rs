@@ -170,22 +170,18 @@ pub(super) fn write_back_families<D: Family>(
 
 /// Global impulses and velocities from the subdomains: a body with one copy takes
 /// its velocity, an interface body the average of its copies (chain order); an
-/// immovable body copied several times keeps its first copy's.
+/// immovable body copied several times takes its copies' velocity (the same in
+/// every copy: impulses never move it).
 pub fn write_back<D: Family>(d: &super::partition::Decomposition<D>, w: &mut D::World) {
-    let nb = D::n_bodies(w);
-    let movable: Vec<bool> = (0..nb).map(|g| D::movable(w, g)).collect();
-    let mut done = vec![false; nb];
     for s in &d.subs {
         let c = D::contacts_mut(w);
         for (la, &ga) in s.contact_global.iter().enumerate() {
             D::copy_r(c, ga as usize, &s.contacts, la);
         }
-        let vel = D::vel_mut(w);
         for (l, &g) in s.body_global.iter().enumerate() {
             let g = g as usize;
-            if !done[g] && (d.mult[g] == 1 || !movable[g]) {
-                vel[g] = s.vel[l];
-                done[g] = true;
+            if d.mult[g] == 1 || !D::movable(w, g) {
+                D::vel_mut(w)[g] = s.vel[l];
             }
         }
     }

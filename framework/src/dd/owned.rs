@@ -43,6 +43,8 @@ pub(super) struct Owned {
     mine: Vec<u32>,
     /// Bodies stepped by every rank (fixed, driven, unbounded), by id.
     everywhere: Vec<bool>,
+    /// The next step's bodies, by id (a buffer).
+    keep: Vec<bool>,
 }
 
 /// The box `b` grown by `alert`.
@@ -200,7 +202,9 @@ impl Owned {
     fn next_active<D: Family>(&mut self, w: &mut D::World, mine: &Region, received: &[u32], boxes: &mut Vec<[[f64; 3]; 2]>) {
         let nb = D::n_bodies(w);
         let alert = D::alert(w);
-        let mut keep = vec![false; nb];
+        let mut keep = std::mem::take(&mut self.keep);
+        keep.clear();
+        keep.resize(nb, false);
         let c = D::contacts(w);
         for a in 0..D::len(c) {
             for g in D::bodies(c, a) {
@@ -221,6 +225,7 @@ impl Owned {
         });
         let active: Vec<u32> = (0..nb as u32).filter(|&g| keep[g as usize]).collect();
         D::set_active(w, Some(active));
+        self.keep = keep;
     }
 }
 
