@@ -75,6 +75,13 @@ impl Region {
         let (lo, hi) = Self::pair_box(n, a, b, alert);
         self.meets(n, &lo, &hi)
     }
+    /// The box `[min, max]` grown by `alert` (first `n` coordinates, the rest 0): the
+    /// box a body's detection in the region tests.
+    pub fn grown_box(n: usize, min: &[f64], max: &[f64], alert: f64) -> ([f64; 3], [f64; 3]) {
+        let lo: [f64; 3] = std::array::from_fn(|k| if k < n { min[k] - alert } else { 0.0 });
+        let hi: [f64; 3] = std::array::from_fn(|k| if k < n { max[k] + alert } else { 0.0 });
+        (lo, hi)
+    }
     /// The box [`Region::meets_pair`] tests: the intersection of the two boxes, each
     /// grown by `alert`.
     pub fn pair_box(n: usize, a: (&[f64], &[f64]), b: (&[f64], &[f64]), alert: f64) -> ([f64; 3], [f64; 3]) {
@@ -342,8 +349,7 @@ impl<D: Dim> Detector<D> {
         self.inside.clear();
         let meets = |a: &Aabb<D>| {
             region.is_none_or(|r| {
-                let lo: [f64; 3] = std::array::from_fn(|k| if k < D::N { a.min[k] - alert } else { 0.0 });
-                let hi: [f64; 3] = std::array::from_fn(|k| if k < D::N { a.max[k] + alert } else { 0.0 });
+                let (lo, hi) = Region::grown_box(D::N, a.min.as_ref(), a.max.as_ref(), alert);
                 r.meets(D::N, &lo, &hi)
             })
         };

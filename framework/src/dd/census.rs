@@ -47,9 +47,15 @@ const SUMS: usize = 4;
 
 impl BodySums<'_> {
     /// The sums of the cells `own` accepts (zero for the others).
-    fn per_cell<D: Family>(&self, w: &D::World, d: &Decomposition<D>, own: &dyn Fn(usize) -> bool) -> Vec<[f64; SUMS]> {
+    /// (`bulk`: the 3D bulk box, [`Family::bulk_box`])
+    fn per_cell<D: Family>(
+        &self,
+        w: &D::World,
+        d: &Decomposition<D>,
+        bulk: Option<([f64; 3], [f64; 3])>,
+        own: &dyn Fn(usize) -> bool,
+    ) -> Vec<[f64; SUMS]> {
         let mut out = vec![[0.0; SUMS]; self.grid.len()];
-        let bulk = D::bulk_box(w);
         crate::step::each_body(D::n_bodies(w), D::active(w), |g| {
             let p = D::position(w, g);
             let c = self.grid.cell_of(p) as usize;
@@ -121,8 +127,9 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
         z_m: f64::NAN,
         ..Default::default()
     };
+    let bulk = D::bulk_box(w);
     // the subdomains are the grid's cells (rigid bodies only)
-    let cells = sums.filter(|b| b.grid.len() == ns).map(|b| b.per_cell(w, d, &own));
+    let cells = sums.filter(|b| b.grid.len() == ns).map(|b| b.per_cell(w, d, bulk, &own));
     let k = if cells.is_some() { SUMS } else { 0 };
     let add_cell = |s: usize, v: &mut Vec<f64>| v.extend_from_slice(cells.as_ref().map_or(&[][..], |c| &c[s][..]));
     if !D::wants_coordination(w) {
@@ -133,7 +140,7 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
         let per = per_subdomain(ranks, ns, 1 + k, n);
         out.contacts = per.chunks_exact(1 + k).map(|x| x[0] as usize).sum();
         out.subdomains = per.chunks_exact(1 + k).filter(|x| x[0] > 0.0).count();
-        out.add_sums(&per, 1, k, D::bulk_box(w).is_some());
+        out.add_sums(&per, 1, k, bulk.is_some());
         return out;
     }
     let counts: Vec<Option<(Vec<u32>, u64)>> = (0..ns).map(|s| own(s).then(|| loaded(w, d, s))).collect();
@@ -146,7 +153,6 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
             first[g as usize] = s as u32;
         }
     }
-    let bulk = D::bulk_box(w);
     let inner = |g: usize| bulk.is_some_and(|(lo, hi)| (0..3).all(|k| D::position(w, g)[k] > lo[k] && D::position(w, g)[k] < hi[k]));
     let aggregate = |s: usize, v: &mut Vec<f64>| {
         let sub = &d.subs[s];

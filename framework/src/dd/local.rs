@@ -23,6 +23,7 @@
 //! single process takes with all the contacts, so results stay bitwise those of one
 //! process.
 
+use super::cells::{cells_of, CellIndex};
 use super::family::Family;
 use super::partition::{Grid, OwnerOf};
 use super::ranks::RankState;
@@ -46,8 +47,6 @@ pub(super) struct Local {
     owned: super::owned::Owned,
 }
 
-pub(super) use super::cells::cells_of;
-
 /// [`Region::meets_pair`] of two bodies' boxes (the detection's own test).
 fn pair_meets(n: usize, a: &[[f64; 3]; 2], b: &[[f64; 3]; 2], alert: f64, region: &Region) -> bool {
     region.meets_pair(n, (&a[0], &a[1]), (&b[0], &b[1]), alert)
@@ -57,15 +56,15 @@ impl Local {
     /// Before a step's detection: the last step's contacts other ranks may meet
     /// (all of them before a repartition) gathered from every rank into the warm
     /// start; returns the other ranks' kept subdomains of theirs (key, owner).
+    /// (`cells`: every rank's cells)
     pub(super) fn exchange<D: Family>(
-        &mut self,
+        &self,
         rs: &mut RankState,
         w: &mut D::World,
-        (owner, grid, alert): (&[u32], &Grid, f64),
+        (owner, cells, alert): (&[u32], &CellIndex, f64),
         all: bool,
     ) -> Vec<(ContactKey, u32)> {
         let me = rs.cluster.rank();
-        let cells = super::cells::CellIndex::new(grid, &rs.rank_of);
         let c = D::contacts(w);
         let mut mine = Vec::new();
         for (a, &o) in owner.iter().enumerate().take(D::len(c)) {
@@ -150,7 +149,8 @@ impl<D: Family> super::NscddOf<D> {
         D::body_boxes(w, &mut self.local.boxes);
         self.local.owned.start::<D>(w, rs, grid);
         if self.local.held {
-            let got = self.local.exchange::<D>(rs, w, (&self.last.owner, grid, D::alert(w)), repart);
+            let cells = self.local.owned.cells.as_ref().expect("the step's cells (Owned::start)");
+            let got = self.local.exchange::<D>(rs, w, (&self.last.owner, cells, D::alert(w)), repart);
             self.kept.extend(got);
             self.kept.sort_unstable_by_key(|e| e.0);
         } else {

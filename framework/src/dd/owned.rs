@@ -37,8 +37,9 @@ use crate::detect::Region;
 /// The state of the mode across steps.
 #[derive(Default)]
 pub(super) struct Owned {
-    /// Every rank's cells at the start of the step.
-    cells: Option<CellIndex>,
+    /// Every rank's cells at the start of the step (also the boundary-contact
+    /// exchange's, [`super::local`]).
+    pub cells: Option<CellIndex>,
     /// The active bodies this rank owned at the start of the step.
     mine: Vec<u32>,
     /// Bodies stepped by every rank (fixed, driven, unbounded), by id.
@@ -47,15 +48,9 @@ pub(super) struct Owned {
     keep: Vec<bool>,
 }
 
-/// The box `b` grown by `alert`.
-fn grown(b: &[[f64; 3]; 2], alert: f64) -> ([f64; 3], [f64; 3]) {
-    (std::array::from_fn(|k| b[0][k] - alert), std::array::from_fn(|k| b[1][k] + alert))
-}
-
-/// Whether the box `b` grown by `alert` meets `region`'s boxes.
-fn meets(n: usize, b: &[[f64; 3]; 2], alert: f64, region: &Region) -> bool {
-    let (lo, hi) = grown(b, alert);
-    region.meets(n, &lo, &hi)
+/// The box `b` grown by `alert` ([`Region::grown_box`], the detection's own).
+fn grown(n: usize, b: &[[f64; 3]; 2], alert: f64) -> ([f64; 3], [f64; 3]) {
+    Region::grown_box(n, &b[0], &b[1], alert)
 }
 
 /// The ranks other than `me` whose cells (`after`) a body's box `new`, grown by
@@ -70,9 +65,9 @@ fn entered(
     (was, out): (&mut Vec<u32>, &mut Vec<u32>),
 ) {
     (was.clear(), out.clear());
-    let (lo, hi) = grown(old, alert);
+    let (lo, hi) = grown(n, old, alert);
     before.ranks_meeting(n, &lo, &hi, |q| was.push(q));
-    let (lo, hi) = grown(new, alert);
+    let (lo, hi) = grown(n, new, alert);
     after.ranks_meeting(n, &lo, &hi, |q| {
         if q != me && !was.contains(&q) {
             out.push(q);
@@ -189,7 +184,7 @@ impl Owned {
             return diverged.map_or(Ok(()), Err);
         }
         let mine = Region {
-            boxes: super::local::cells_of(grid, &rs.rank_of, me as u32),
+            boxes: super::cells::cells_of(grid, &rs.rank_of, me as u32),
             pairs: Vec::new(),
         };
         self.next_active::<D>(w, &mine, &received, &mut now);
@@ -221,7 +216,8 @@ impl Owned {
         D::set_active(w, candidates);
         D::body_boxes(w, boxes);
         crate::step::each_body(nb, D::active(w), |g| {
-            keep[g] |= self.everywhere[g] || meets(D::SPACE, &boxes[g], alert, mine);
+            let (lo, hi) = grown(D::SPACE, &boxes[g], alert);
+            keep[g] |= self.everywhere[g] || mine.meets(D::SPACE, &lo, &hi);
         });
         let active: Vec<u32> = (0..nb as u32).filter(|&g| keep[g as usize]).collect();
         D::set_active(w, Some(active));
