@@ -114,8 +114,8 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     fn body_record(w: &Self::World, g: usize, out: &mut Vec<f64>);
     fn set_body_record(w: &mut Self::World, g: usize, x: &[f64]);
     /// During a step (a distributed repartition): a body's position, orientation,
-    /// V⁻ and V_free (`STEP_RECORD` numbers), and back (M̂⁻¹ refreshed; returns
-    /// V_free).
+    /// V⁻ and V_free (`STEP_RECORD` numbers), and back (M̂⁻¹ refreshed as the free
+    /// velocity stage does; returns V_free).
     const STEP_RECORD: usize;
     fn step_record(w: &Self::World, g: usize, v_free: &Self::V, out: &mut Vec<f64>);
     fn set_step_record(w: &mut Self::World, g: usize, x: &[f64]) -> Self::V;

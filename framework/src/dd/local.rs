@@ -271,11 +271,6 @@ impl<D: Family> super::NscddOf<D> {
         Some(mine)
     }
 
-    /// [`Self::owned_bodies`], for the VTK pieces' bodies without contacts.
-    pub(super) fn contactless_writer(&self, w: &D::World) -> Option<Vec<bool>> {
-        self.owned_bodies(w)
-    }
-
     /// With bodies held per rank, every body's state from its owner to rank 0
     /// (collective; before rank 0 writes the state).
     pub fn gather_bodies(&mut self, w: &mut D::World) {

@@ -7,8 +7,8 @@
 //! owner(b)   the rank of the grid cell holding b's centre (edge cells unbounded)
 //! halo(r)    the bodies whose box, grown by the alert distance, meets r's cells:
 //!            every body r's detection can pair (the region's own test)
-//! active(r)  halo(r) ∪ the bodies of r's contacts ∪ the fixed, driven and
-//!            unbounded bodies (stepped by every rank)
+//! active(r)  halo(r) ∪ the bodies of r's contacts ∪ the fixed, driven, named
+//!            and unbounded bodies (stepped by every rank)
 //! ```
 //!
 //! A rank steps its active bodies exactly as one process does: their V⁺ is the
@@ -19,14 +19,14 @@
 //! then keeps the bodies of its new halo. By induction a rank holds every body of its
 //! halo at the start of each step. A distributed repartition
 //! ([`super::NscddOf::repartition_local`]) sends, in the step, the bodies of each
-//! rank's new halo it lacks (their state at the start of the step, V⁻ and V_free). The outputs never read a body its rank does not
-//! hold: the sums over bodies are added per cell by the cells' ranks
-//! ([`super::census::BodySums`]), the named and driven bodies are stepped by every
-//! rank, a body without contacts is written in the VTK frames by its owner, and
-//! rank 0 gathers every body before it writes `final.json` or a checkpoint
-//! ([`super::NscddOf::gather_bodies`]). Before a repartition every rank receives
-//! every body (one all-gather) and the repartition step runs with all bodies, as
-//! the first step does.
+//! rank's new halo it lacks (their state at the start of the step, V⁻ and V_free);
+//! only the first step, and the first after a restart, run with every body.
+//!
+//! The outputs never read a body its rank does not hold: the sums over bodies are
+//! added per cell by the cells' ranks ([`super::census::BodySums`]), the named and
+//! driven bodies are stepped by every rank, a body without contacts is written in
+//! the VTK frames by its owner, and rank 0 gathers every body before it writes
+//! `final.json` or a checkpoint ([`super::NscddOf::gather_bodies`]).
 
 use super::cells::CellIndex;
 use super::family::Family;

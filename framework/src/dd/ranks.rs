@@ -33,9 +33,9 @@
 //! contacts ([`super::local`]): it detects and builds those alone, the other ranks'
 //! subdomains are shells (their bodies), and the end of the step no longer carries
 //! the impulses; a repartition merges every rank's bounds and counts and detects
-//! again. What is not distributed yet (docs/SCALING.md): the bodies (every rank
-//! holds and moves all of them) and the copies' velocities and F_Γ, still sent to
-//! every rank.
+//! again; each rank steps only the bodies near its cells ([`super::owned`]). What is
+//! not distributed yet (docs/SCALING.md): the bodies' arrays (every rank allocates
+//! the whole sample) and the copies' velocities and F_Γ, still sent to every rank.
 
 use super::cluster::Cluster;
 use super::family::Family;

@@ -133,7 +133,7 @@ impl<D: super::Family> super::NscddOf<D> {
                 rank: rs.cluster.rank(),
                 ranks: rs.cluster.size(),
                 rank_of: rs.rank_of.clone(),
-                contactless: self.contactless_writer(w),
+                contactless: self.owned_bodies(w),
             }),
         };
         if d.owner.len() != D::len(c) {
