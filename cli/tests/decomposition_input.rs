@@ -402,6 +402,22 @@ fn decomposed_restart_continues_bitwise() {
     let state = dir.join("first").join("final.json");
     let b = run(&whole, "second", &["--threads", "2", "--restart", state.to_str().unwrap()]);
     assert!(a == b, "the restarted run ends elsewhere");
+    // a damaged NSCDD state: exit 2, the file, line and key named
+    let saved = std::fs::read_to_string(&state).unwrap();
+    let bad = dir.join("bad.json");
+    std::fs::write(&bad, saved.replacen("\"f_gamma\": [", "\"f_gamma\": 7, \"was\": [", 1)).unwrap();
+    let line = saved[..saved.find("\"f_gamma\"").unwrap()].lines().count();
+    let o = nscdd(&[
+        "run".as_ref(),
+        whole.as_os_str(),
+        "--out".as_ref(),
+        dir.join("bad").as_os_str(),
+        "--restart".as_ref(),
+        bad.as_os_str(),
+    ]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains(&format!("bad.json:{line}")) && err.contains("nscdd"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -90,9 +90,14 @@ pub(crate) fn io(dir: &Path, what: &str) -> impl Fn(std::io::Error) -> RunError 
 /// temporary file renamed into place, so that a run killed while writing keeps the
 /// previous one.
 pub(crate) fn save_state_text(dir: &Path, name: &str, text: &str) -> Result<(), RunError> {
+    save_state_with(dir, name, |f| f.write_all(text.as_bytes()))
+}
+
+/// [`save_state_text`], the file's text written by `write` as it is made.
+fn save_state_with(dir: &Path, name: &str, write: impl FnOnce(&mut std::fs::File) -> std::io::Result<()>) -> Result<(), RunError> {
     let tmp = dir.join(format!(".{name}.tmp"));
     let mut f = std::fs::File::create(&tmp).map_err(io(dir, name))?;
-    f.write_all(text.as_bytes()).map_err(io(dir, name))?;
+    write(&mut f).map_err(io(dir, name))?;
     drop(f);
     std::fs::rename(&tmp, dir.join(name)).map_err(io(dir, name))
 }
@@ -217,11 +222,9 @@ fn save_state<D: Dim>(
         return Ok(());
     }
     let states = (!families.is_empty()).then(|| crate::family::states(families));
-    save_state_text(
-        dir,
-        name,
-        &crate::output::final_json_of(w, states.as_ref(), dd.as_ref(), records.as_deref()),
-    )
+    save_state_with(dir, name, |f| {
+        crate::output::write_final_json(f, w, states.as_ref(), dd.as_ref(), records.as_deref())
+    })
 }
 
 /// Runs `scene` for its number of steps, writing `history.csv`, the writers' frames
@@ -313,7 +316,7 @@ fn scene_solver<D: Dim>(scene: &mut Scene<D>, cluster: Option<Box<dyn crate::dd:
     }
     // a restarted run of the same decomposition continues its F_Γ
     if let (Some(n), Some(state)) = (dd.as_mut(), scene.dd_state.take()) {
-        n.load_state(&state)
+        n.load_state(state)
             .map_err(|m| RunError::Ranks(format!("the restart file's `nscdd` state: {m}")))?;
     }
     Ok(dd)
@@ -406,8 +409,9 @@ pub fn run_on<D: Dim>(
     }
     hist.flush().map_err(io(dir, "history.csv"))?;
     finish_outputs(&mut writers, fams, vtk, dir)?;
-    write_rank_totals(&mut dd, dir)?;
     save_state(dir, "final.json", w, fams, &mut dd)?;
+    // after final.json: the peak memory of each rank counts its writing
+    write_rank_totals(&mut dd, dir)?;
     sum.wall_seconds = start.elapsed().as_secs_f64();
     Ok(sum)
 }

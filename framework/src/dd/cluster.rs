@@ -39,6 +39,22 @@ pub trait Cluster {
     }
 }
 
+/// The peak resident memory of this process so far (MiB; 0 where not available).
+pub fn peak_rss_mib() -> f64 {
+    #[cfg(unix)]
+    {
+        // SAFETY: getrusage writes the rusage it is given, nothing else; all-zero
+        // bytes are a valid rusage.
+        let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+        if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) } == 0 {
+            // kilobytes on Linux, bytes on macOS
+            let unit = if cfg!(target_os = "macos") { 1.0 } else { 1024.0 };
+            return u.ru_maxrss as f64 * unit / (1024.0 * 1024.0);
+        }
+    }
+    0.0
+}
+
 /// CPU seconds of the calling thread (`thread`) or of the whole process (0 where
 /// the clock is not available).
 pub fn cpu_seconds(thread: bool) -> f64 {

@@ -124,10 +124,16 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     const PREV_RECORD: usize;
     fn set_extra_prev(w: &mut Self::World, records: &[f64]);
     /// Detects again in `region`, keeps the raw contacts `keep` accepts and builds
-    /// them with the same warm starts as the step's first build, the velocities
-    /// back at `v_free` (a distributed repartition: the contacts move to their new
-    /// ranks).
-    fn redetect(w: &mut Self::World, region: crate::detect::Region, keep: &mut dyn FnMut(ContactKey, [f64; 3]) -> bool, v_free: &[Self::V]);
+    /// them with the same warm starts as the step's first build and those of
+    /// `more_prev` ([`Family::prev_record`]s; one already held is not repeated),
+    /// the velocities back at `v_free` (a distributed repartition: the contacts
+    /// move to their new ranks).
+    fn redetect(
+        w: &mut Self::World,
+        region: crate::detect::Region,
+        keep: &mut dyn FnMut(ContactKey, [f64; 3]) -> bool,
+        v_free_more_prev: (&[Self::V], &[f64]),
+    );
     fn solver(w: &Self::World) -> &crate::solver::SolverSettings;
     /// One step of the world with NSCDD as its contact stage.
     fn step_with(w: &mut Self::World, stage: &mut super::Stage<'_, '_, Self>) -> Result<StepReport, Diverged>;
@@ -368,10 +374,16 @@ impl<D: Dim> Family for Rigid<D> {
         w: &mut Self::World,
         region: crate::detect::Region,
         keep: &mut dyn FnMut(ContactKey, [f64; 3]) -> bool,
-        v_free: &[Self::V],
+        (v_free, more_prev): (&[Self::V], &[f64]),
     ) {
         w.bodies.vel.copy_from_slice(v_free);
         let s = &mut w.scratch;
+        if !more_prev.is_empty() {
+            s.prev_keys.extend(prev_contacts::<D>(more_prev));
+            s.prev_keys.sort_unstable_by_key(|x| x.key);
+            // a contact both exchanges brought: the same record twice
+            s.prev_keys.dedup_by(|a, b| a.key == b.key && a.point == b.point);
+        }
         s.detector.detect_among(
             (&w.bodies, s.active.as_deref()),
             &w.shapes,
@@ -384,24 +396,27 @@ impl<D: Dim> Family for Rigid<D> {
         crate::engine::build_from_raw(w);
     }
     fn set_extra_prev(w: &mut Self::World, records: &[f64]) {
-        let n = D::N;
         w.scratch.extra_prev.clear();
-        w.scratch
-            .extra_prev
-            .extend(records.chunks_exact(4 + 2 * n).map(|x| crate::world::PrevContact {
-                key: ContactKey {
-                    i: x[0] as u32,
-                    j: x[1] as u32,
-                    feature: x[2] as u32,
-                },
-                r: D::Local::from_fn(|k| x[3 + k]),
-                point: D::Point::from_fn(|k| x[3 + n + k]),
-                bonded: x[3 + 2 * n] != 0.0,
-            }));
+        w.scratch.extra_prev.extend(prev_contacts::<D>(records));
     }
     fn step_with(w: &mut Self::World, stage: &mut super::Stage<'_, '_, Self>) -> Result<StepReport, Diverged> {
         w.step_with(stage)
     }
+}
+
+/// The warm starts of [`Family::prev_record`]s.
+fn prev_contacts<D: Dim>(records: &[f64]) -> impl Iterator<Item = crate::world::PrevContact<D>> + '_ {
+    let n = D::N;
+    records.chunks_exact(4 + 2 * n).map(move |x| crate::world::PrevContact {
+        key: ContactKey {
+            i: x[0] as u32,
+            j: x[1] as u32,
+            feature: x[2] as u32,
+        },
+        r: D::Local::from_fn(|k| x[3 + k]),
+        point: D::Point::from_fn(|k| x[3 + n + k]),
+        bonded: x[3 + 2 * n] != 0.0,
+    })
 }
 
 pub use crate::dim::d3::InvMass3;

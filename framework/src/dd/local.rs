@@ -15,9 +15,10 @@
 //!                    multiplicities are then those of one process)
 //! ```
 //!
-//! A repartition step detects in the old regions (all the last step's contacts
-//! gathered first), merges every rank's bounds and counts into the new grid and
-//! ranks, and detects again in the new regions
+//! A repartition step detects in the old regions (the exchange above), merges every
+//! rank's bounds and counts into the new grid and ranks, sends the last step's
+//! contacts the other ranks' new cells may meet (their warm starts, one more
+//! all-gather of those only) and detects again in the new regions
 //! ([`super::NscddOf::repartition_local`]); only the first step, and the first
 //! after a restart, run on the whole sample. Every decision above is the one a
 //! single process takes with all the contacts, so results stay bitwise those of one
@@ -45,6 +46,9 @@ pub(super) struct Local {
     pub new_grid: Option<(Grid, usize)>,
     /// The bodies this rank steps ([`super::owned`]).
     owned: super::owned::Owned,
+    /// On a repartition step: this rank's contacts of the last step (their
+    /// [`Family::prev_record`]s), for the ranks whose new cells they may meet.
+    own_prev: Option<Vec<f64>>,
 }
 
 /// [`Region::meets_pair`] of two bodies' boxes (the detection's own test).
@@ -54,15 +58,13 @@ fn pair_meets(n: usize, a: &[[f64; 3]; 2], b: &[[f64; 3]; 2], alert: f64, region
 
 impl Local {
     /// Before a step's detection: the last step's contacts other ranks may meet
-    /// (all of them before a repartition) gathered from every rank into the warm
-    /// start; returns the other ranks' kept subdomains of theirs (key, owner).
-    /// (`cells`: every rank's cells)
+    /// gathered from every rank into the warm start; returns the other ranks' kept
+    /// subdomains of theirs (key, owner). (`cells`: every rank's cells)
     pub(super) fn exchange<D: Family>(
         &self,
         rs: &mut RankState,
         w: &mut D::World,
         (owner, cells, alert): (&[u32], &CellIndex, f64),
-        all: bool,
     ) -> Vec<(ContactKey, u32)> {
         let me = rs.cluster.rank();
         let c = D::contacts(w);
@@ -72,7 +74,7 @@ impl Local {
             let (bi, bj) = (&self.boxes[i as usize], &self.boxes[j as usize]);
             // the region's pair test ([`Region::meets_pair`]) over the other ranks' cells
             let (lo, hi) = Region::pair_box(D::SPACE, (&bi[0], &bi[1]), (&bj[0], &bj[1]), alert);
-            if all || cells.meets_other(D::SPACE, &lo, &hi, me) {
+            if cells.meets_other(D::SPACE, &lo, &hi, me) {
                 D::prev_record(c, a, &mut mine);
                 mine.push(f64::from(o));
             }
@@ -97,6 +99,30 @@ impl Local {
         }
         D::set_extra_prev(w, &prev);
         kept
+    }
+}
+
+impl Local {
+    /// On a repartition step (collective): this rank's last-step contacts `own`
+    /// ([`Family::prev_record`]s) whose pair's grown boxes meet another rank's new
+    /// `cells` go to every rank; returns the other ranks' that this one receives
+    /// (the warm starts its new cells may need; those of its old cells came before
+    /// detection).
+    fn prev_for_new_cells<D: Family>(&self, rs: &mut RankState, cells: &CellIndex, own: &[f64], alert: f64) -> Vec<f64> {
+        let me = rs.cluster.rank();
+        let mut mine = Vec::new();
+        for x in own.chunks_exact(D::PREV_RECORD) {
+            let (bi, bj) = (&self.boxes[x[0] as usize], &self.boxes[x[1] as usize]);
+            let (lo, hi) = Region::pair_box(D::SPACE, (&bi[0], &bi[1]), (&bj[0], &bj[1]), alert);
+            if cells.meets_other(D::SPACE, &lo, &hi, me) {
+                mine.extend_from_slice(x);
+            }
+        }
+        let (counts, got) = rs.all_gather_any(&mine);
+        let start: usize = counts[..me as usize].iter().sum();
+        let mut other = got;
+        other.drain(start..start + counts[me as usize]);
+        other
     }
 }
 
@@ -150,9 +176,15 @@ impl<D: Family> super::NscddOf<D> {
         self.local.owned.start::<D>(w, rs, grid);
         if self.local.held {
             let cells = self.local.owned.cells.as_ref().expect("the step's cells (Owned::start)");
-            let got = self.local.exchange::<D>(rs, w, (&self.last.owner, cells, D::alert(w)), repart);
+            let got = self.local.exchange::<D>(rs, w, (&self.last.owner, cells, D::alert(w)));
             self.kept.extend(got);
             self.kept.sort_unstable_by_key(|e| e.0);
+            if repart {
+                let c = D::contacts(w);
+                let mut own = Vec::with_capacity(D::len(c) * D::PREV_RECORD);
+                (0..D::len(c)).for_each(|a| D::prev_record(c, a, &mut own));
+                self.local.own_prev = Some(own);
+            }
         } else {
             D::set_extra_prev(w, &[]);
         }
@@ -219,6 +251,12 @@ impl<D: Family> super::NscddOf<D> {
             owned.repartition::<D>(w, (rs, &grid), boxes, &mut self.v_free);
         }
         let me = rs.cluster.rank();
+        let more_prev = match self.local.own_prev.take() {
+            Some(own) => self
+                .local
+                .prev_for_new_cells::<D>(rs, &CellIndex::new(&grid, &rs.rank_of), &own, D::alert(w)),
+            None => Vec::new(),
+        };
         let region = Region {
             boxes: cells_of(&grid, &rs.rank_of, me),
             pairs: Vec::new(),
@@ -228,7 +266,7 @@ impl<D: Family> super::NscddOf<D> {
             w,
             region,
             &mut |_, p| rank_of.get(grid.cell_of(p) as usize) == Some(&me),
-            &self.v_free,
+            (&self.v_free, &more_prev),
         );
         self.local.new_grid = Some((grid, total));
     }

@@ -75,20 +75,44 @@ struct ContactOut<D: Dim> {
 
 #[derive(Serialize)]
 #[serde(bound = "")]
-struct FinalOut<'a, D: Dim> {
+struct FinalOut<'a, D: Dim, N: Serialize> {
     dimension: u8,
     step: u64,
     time: f64,
     #[serde(skip_serializing_if = "Option::is_none")]
     box_h0: Option<f64>,
-    bodies: Vec<BodyOut<'a, D>>,
+    bodies: BodiesOut<'a, D>,
     contacts: Vec<ContactOut<D>>,
     /// The body families' states, by section ([`crate::family::SceneFamily::save_state`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     families: Option<&'a serde_json::Map<String, serde_json::Value>>,
-    /// The NSCDD solver's state ([`crate::dd::NscddOf::save_state`]).
+    /// The NSCDD solver's state ([`crate::dd::NscddOf::gather_state`]).
     #[serde(skip_serializing_if = "Option::is_none")]
-    nscdd: Option<&'a serde_json::Value>,
+    nscdd: Option<&'a N>,
+}
+
+/// The bodies of `final.json`, each made as it is written (no list of them held).
+struct BodiesOut<'a, D: Dim>(&'a World<D>);
+
+impl<D: Dim> Serialize for BodiesOut<'_, D> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let (w, b) = (self.0, &self.0.bodies);
+        s.collect_seq((0..b.len()).map(|k| {
+            let sh = b.shape[k];
+            BodyOut::<D> {
+                id: k as u32,
+                name: w.names[k].as_deref(),
+                kind: w.kind_name(k),
+                material: &w.materials[b.material[k] as usize].name,
+                position: b.pos[k],
+                rotation: D::rot_to_vec(&b.rot[k]),
+                quaternion: (D::N == 3).then_some(b.rot[k]),
+                velocity: b.vel[k],
+                fixed: w.fixed[k],
+                shape: w.shapes[sh.kind as usize].describe(sh.index),
+            }
+        }))
+    }
 }
 
 /// The state as `final.json`: the dimension, step, time, `box_h0` (the box height
@@ -99,17 +123,7 @@ struct FinalOut<'a, D: Dim> {
 /// `impulse` in world axes (N·s), gap (m), `bonded` for an intact joint). It is
 /// also a restart file ([`crate::scene::restart`]).
 pub fn final_json<D: Dim>(w: &World<D>) -> String {
-    final_json_with(w, None, None)
-}
-
-/// [`final_json`] with the body families' states under `families` (by section) and
-/// the NSCDD solver's under `nscdd`.
-pub fn final_json_with<D: Dim>(
-    w: &World<D>,
-    families: Option<&serde_json::Map<String, serde_json::Value>>,
-    nscdd: Option<&serde_json::Value>,
-) -> String {
-    final_json_of(w, families, nscdd, None)
+    final_json_of(w, None, None::<&()>, None)
 }
 
 /// Values per contact of [`contact_records`].
@@ -132,32 +146,29 @@ pub fn contact_records<D: Dim>(w: &World<D>, which: impl Iterator<Item = usize>,
     }
 }
 
-/// [`final_json_with`], the contacts from `records` ([`contact_records`] of every
-/// process) when given, else from the world.
-pub fn final_json_of<D: Dim>(
+/// [`final_json`] with the body families' states under `families` (by section), the
+/// NSCDD solver's under `nscdd`, and the contacts from `records` ([`contact_records`]
+/// of every process) when given, else from the world: [`write_final_json`] as text.
+pub fn final_json_of<D: Dim, N: Serialize>(
     w: &World<D>,
     families: Option<&serde_json::Map<String, serde_json::Value>>,
-    nscdd: Option<&serde_json::Value>,
+    nscdd: Option<&N>,
     records: Option<&[f64]>,
 ) -> String {
-    let b = &w.bodies;
-    let bodies = (0..b.len())
-        .map(|k| {
-            let s = b.shape[k];
-            BodyOut::<D> {
-                id: k as u32,
-                name: w.names[k].as_deref(),
-                kind: w.kind_name(k),
-                material: &w.materials[b.material[k] as usize].name,
-                position: b.pos[k],
-                rotation: D::rot_to_vec(&b.rot[k]),
-                quaternion: (D::N == 3).then_some(b.rot[k]),
-                velocity: b.vel[k],
-                fixed: w.fixed[k],
-                shape: w.shapes[s.kind as usize].describe(s.index),
-            }
-        })
-        .collect();
+    let mut out = Vec::new();
+    write_final_json(&mut out, w, families, nscdd, records).expect("writing to memory");
+    String::from_utf8(out).expect("serde_json writes UTF-8")
+}
+
+/// Writes [`final_json_of`] to `out` as it is made: no copy of the state (a 55 000-
+/// sphere state is ≈ 140 MB of text) is held in memory, only the contacts' records.
+pub fn write_final_json<D: Dim, N: Serialize>(
+    out: impl std::io::Write,
+    w: &World<D>,
+    families: Option<&serde_json::Map<String, serde_json::Value>>,
+    nscdd: Option<&N>,
+    records: Option<&[f64]>,
+) -> std::io::Result<()> {
     let mut own = Vec::new();
     let records = records.unwrap_or_else(|| {
         contact_records(w, 0..w.contacts.len(), &mut own);
@@ -180,20 +191,23 @@ pub fn final_json_of<D: Dim>(
             }
         })
         .collect();
+    drop(own);
     // in key order (candidate, antagonist, feature): the same list whichever
     // process held which contact
     contacts.sort_unstable_by_key(|c| (c.bodies, c.feature));
-    let mut s = serde_json::to_string_pretty(&FinalOut {
+    use std::io::Write as _;
+    let mut out = std::io::BufWriter::with_capacity(1 << 16, out);
+    let state = FinalOut {
         dimension: D::N as u8,
         step: w.step,
         time: w.t,
         box_h0: w.box_h0,
-        bodies,
+        bodies: BodiesOut(w),
         contacts,
         families,
         nscdd,
-    })
-    .expect("plain data serializes");
-    s.push('\n');
-    s
+    };
+    serde_json::to_writer_pretty(&mut out, &state).map_err(std::io::Error::from)?;
+    out.write_all(b"\n")?;
+    out.flush()
 }

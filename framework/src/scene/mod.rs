@@ -47,7 +47,7 @@ pub struct Scene<D: Dim = D2> {
     pub families: Vec<Box<dyn crate::family::SceneFamily<D>>>,
     /// A restarted scene: the NSCDD state of the saved run ([`restart_scene`]),
     /// given to the solver of the same decomposition at the first step.
-    pub dd_state: Option<serde_json::Value>,
+    pub dd_state: Option<crate::dd::NscddState>,
 }
 
 /// A loaded 3D scene.

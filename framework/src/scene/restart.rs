@@ -103,9 +103,14 @@ pub fn restart_scene<D: Dim>(scene: &mut super::Scene<D>, path: &Path) -> Result
     let (text, file) = read_state(path)?;
     restart_str(&mut scene.world, &text, &file)?;
     let ck = StateChecks { text: &text, file: &file };
-    let saved = serde_json::from_str::<serde_json::Value>(&text).unwrap_or_default();
-    scene.dd_state = saved.get("nscdd").cloned();
-    let states = saved.get("families").and_then(|f| f.as_object()).cloned().unwrap_or_default();
+    // the state's other parts, each read into its type (the rest of the file is
+    // skipped, never held as a JSON tree)
+    let part = |key: &str, e: serde_json::Error| ck.err(Some(e.line()), key.into(), format!("not a saved `{key}` state: {e}"));
+    scene.dd_state = serde_json::from_str::<SavedNscdd>(&text).map_err(|e| part("nscdd", e))?.nscdd;
+    let states = serde_json::from_str::<SavedFamilies>(&text)
+        .map_err(|e| part("families", e))?
+        .families
+        .unwrap_or_default();
     for (name, _) in &states {
         if !scene.families.iter().any(|f| f.section() == name) {
             let msg = format!("the state holds `{name}` bodies, the scene none: a restart needs the scene that wrote it");
@@ -127,13 +132,31 @@ pub fn restart_scene<D: Dim>(scene: &mut super::Scene<D>, path: &Path) -> Result
     Ok(())
 }
 
+/// The NSCDD solver's part of a saved state.
+#[derive(Deserialize)]
+struct SavedNscdd {
+    #[serde(default)]
+    nscdd: Option<crate::dd::NscddState>,
+}
+
+/// The body families' part of a saved state (their states by section).
+#[derive(Deserialize)]
+struct SavedFamilies {
+    #[serde(default)]
+    families: Option<serde_json::Map<String, serde_json::Value>>,
+}
+
+/// The dimension a saved state declares (2 when it declares none).
+#[derive(Deserialize)]
+struct SavedHead {
+    #[serde(default)]
+    dimension: Option<u64>,
+}
+
 /// [`restart`] from the text of a saved state; `file` names it in messages.
 pub fn restart_str<D: Dim>(w: &mut World<D>, text: &str, file: &str) -> Result<(), InputError> {
     let ck = StateChecks { text, file };
-    let dimension = serde_json::from_str::<serde_json::Value>(text)
-        .ok()
-        .and_then(|v| v.get("dimension").and_then(|d| d.as_u64()))
-        .unwrap_or(2);
+    let dimension = serde_json::from_str::<SavedHead>(text).ok().and_then(|h| h.dimension).unwrap_or(2);
     if dimension != D::N as u64 {
         return Err(ck.err(
             ck.line_of("dimension", 0),
