@@ -197,6 +197,8 @@ fn two_and_four_ranks_give_the_one_process_result_3d() {
             (cpu("cpu_seconds") - cpu("compute_cpu_seconds") - cpu("wait_cpu_seconds")).abs() < 1e-9,
             "{r}"
         );
+        // its peak memory: a few MiB at least, less than this machine's
+        assert!(cpu("peak_rss_mib") > 1.0 && cpu("peak_rss_mib") < 1e6, "{r}");
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
