@@ -57,6 +57,7 @@ pub mod partition;
 mod rank_balance;
 mod rank_link;
 mod rank_reduce;
+mod rank_share;
 mod rank_totals;
 pub mod ranks;
 mod reactions;
@@ -82,10 +83,9 @@ pub use transport::{InProcess, Transport, TransportStats};
 
 use crate::engine::{ContactStage, Diverged};
 use crate::norms::{Norms, Sums, VANISHING};
-use crate::solver::anderson::InOrder;
 use crate::solver::SolveReport;
 use gluing::GluePartial;
-use schemes::{glue_stage, GlueBuffers};
+use schemes::GlueBuffers;
 
 /// NSCDD settings.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -379,6 +379,8 @@ impl<D: Family> NscddOf<D> {
     fn solve(&mut self, w: &mut D::World, fams: &mut [&mut dyn Attached<D>], rep: &mut DdStepReport) {
         let set = self.settings.clone();
         let sv = D::solver(w).clone();
+        // (the step count already counts this step)
+        let next_repartitions = self.repartitions();
         let d = &mut self.last;
         self.transport.resize(d.subs.len());
         self.transport.reset_stats();
@@ -422,41 +424,23 @@ impl<D: Family> NscddOf<D> {
         let stages = if let Some(rs) = self.ranks.as_mut() {
             let hybrid = (threads, &mut self.workers);
             let mixer = (sv.method == crate::solver::Method::Anderson).then_some(&mut self.mixer);
-            let (stages, stats) = ranks::iterate(rs, d, set.scheme, (per, sv.relaxation), max_stages, k, hybrid, mixer, |s, g| {
-                converged(s, g, rep)
-            });
+            // bodies stepped per rank, the subdomains kept on their ranks next step:
+            // only the copies of the bodies this rank steps come back (`rank_share`)
+            let active = D::active(w).filter(|_| self.local.now && !next_repartitions);
+            let (stages, stats) = ranks::iterate(
+                rs,
+                d,
+                set.scheme,
+                (per, sv.relaxation, max_stages, k),
+                hybrid,
+                (mixer, active),
+                |s, g| converged(s, g, rep),
+            );
             rep.exchange = stats;
             stages
         } else {
-            let (iface, transport, bufs, mixer) = (&d.iface, &mut self.transport, &mut self.bufs, &mut self.mixer);
-            let anderson = sv.method == crate::solver::Method::Anderson;
-            let stages = team::with_team(&mut d.subs, (threads, &|_| true), iface, &mut self.workers, |team| {
-                if iface.fresh.iter().any(|&f| f) {
-                    team.with_all(|subs| glue_stage(subs, iface, set.scheme, transport, true, bufs));
-                }
-                if anderson {
-                    team.with_all(|subs| mixer.start(subs, &|_| true));
-                }
-                let (stages, ok) = crate::solver::check_loop(max_stages, k, |check| {
-                    // sweeps and gluing; with `check`, the sums reduced in subdomain order
-                    let (sums, parts) = team.stage(per, sv.relaxation, check, set.scheme, transport, bufs);
-                    let done = check && {
-                        let mut g = GluePartial::default();
-                        for p in &parts {
-                            g.merge(p);
-                        }
-                        converged(&sums, &g, rep)
-                    };
-                    if anderson && !done {
-                        team.with_all(|subs| mixer.after(subs, &|_| true, &mut InOrder));
-                    }
-                    done
-                });
-                if anderson && !ok {
-                    team.with_all(|subs| mixer.give_up(subs, &|_| true));
-                }
-                stages
-            });
+            let here = (&mut self.transport, &mut self.bufs, &mut self.mixer, &mut self.workers);
+            let stages = schemes::iterate_here(d, here, (&set, &sv), (threads, per, max_stages, k), |s, g| converged(s, g, rep));
             rep.exchange = self.transport.stats();
             stages
         };

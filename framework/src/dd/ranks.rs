@@ -373,8 +373,13 @@ impl RankState {
         (sums, g)
     }
 
-    /// Every subdomain's impulses, copy velocities and F_Γ from its rank to all.
-    fn share_results<D: Family>(&mut self, d: &mut Decomposition<D>) {
+    /// Every subdomain's impulses, copy velocities and F_Γ from its rank to all; with
+    /// `active` (bodies stepped per rank, no repartition next), only the copy
+    /// velocities of those bodies ([`RankState::share_requested`]).
+    fn share_results<D: Family>(&mut self, d: &mut Decomposition<D>, active: Option<&[u32]>) {
+        if let (Some(active), true) = (active, self.local) {
+            return self.share_requested(d, active);
+        }
         let ndof = super::subdomain::dofs::<D>();
         let me = self.cluster.rank();
         let t0 = Instant::now();
@@ -434,11 +439,9 @@ pub(super) fn iterate<D: Family>(
     st: &mut RankState,
     d: &mut Decomposition<D>,
     scheme: Scheme,
-    (per, omega): (u32, f64),
-    max_stages: u32,
-    k: u32,
+    (per, omega, max_stages, k): (u32, f64, u32, u32),
     (threads, workers): (usize, &mut super::team::Workers),
-    mut mixer: Option<&mut super::anderson::StageMixer>,
+    (mut mixer, active): (Option<&mut super::anderson::StageMixer>, Option<&[u32]>),
     mut converged: impl FnMut(&Sums, &GluePartial) -> bool,
 ) -> (u32, TransportStats) {
     let t0 = Instant::now();
@@ -485,7 +488,7 @@ pub(super) fn iterate<D: Family>(
         }
         (stages, ok)
     });
-    st.share_results(d);
+    st.share_results(d, active);
     let t = &mut st.totals;
     t.steps += 1;
     t.sent.messages += st.link.stats.messages;

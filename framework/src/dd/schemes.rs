@@ -245,3 +245,49 @@ fn centralized<D: Family>(
     }
     parts
 }
+
+/// The NSCDD iteration in this process (every subdomain here): at most `max_stages`
+/// stages of `per` sweeps and one gluing, a check every `k` stages (the sums
+/// reduced in subdomain order); returns the stages run.
+pub(super) fn iterate_here<D: Family>(
+    d: &mut super::partition::Decomposition<D>,
+    (transport, bufs, mixer, workers): (
+        &mut super::InProcess,
+        &mut GlueBuffers,
+        &mut super::anderson::StageMixer,
+        &mut super::team::Workers,
+    ),
+    (set, sv): (&super::DdSettings, &crate::solver::SolverSettings),
+    (threads, per, max_stages, k): (usize, u32, u32, u32),
+    mut converged: impl FnMut(&crate::norms::Sums, &GluePartial) -> bool,
+) -> u32 {
+    let iface = &d.iface;
+    let anderson = sv.method == crate::solver::Method::Anderson;
+    super::team::with_team(&mut d.subs, (threads, &|_| true), iface, workers, |team| {
+        if iface.fresh.iter().any(|&f| f) {
+            team.with_all(|subs| glue_stage(subs, iface, set.scheme, transport, true, bufs));
+        }
+        if anderson {
+            team.with_all(|subs| mixer.start(subs, &|_| true));
+        }
+        let (stages, ok) = crate::solver::check_loop(max_stages, k, |check| {
+            // sweeps and gluing; with `check`, the sums reduced in subdomain order
+            let (sums, parts) = team.stage(per, sv.relaxation, check, set.scheme, transport, bufs);
+            let done = check && {
+                let mut g = GluePartial::default();
+                for p in &parts {
+                    g.merge(p);
+                }
+                converged(&sums, &g)
+            };
+            if anderson && !done {
+                team.with_all(|subs| mixer.after(subs, &|_| true, &mut crate::solver::anderson::InOrder));
+            }
+            done
+        });
+        if anderson && !ok {
+            team.with_all(|subs| mixer.give_up(subs, &|_| true));
+        }
+        stages
+    })
+}
