@@ -426,14 +426,15 @@ impl<D: Family> NscddOf<D> {
             let mixer = (sv.method == crate::solver::Method::Anderson).then_some(&mut self.mixer);
             // bodies stepped per rank, the subdomains kept on their ranks next step:
             // only the copies of the bodies this rank steps come back (`rank_share`)
-            let active = D::active(w).filter(|_| self.local.now && !next_repartitions);
+            // (the same choice on every rank: the all-gathers that follow are collective)
+            let requests = (self.local.now && !next_repartitions).then(|| D::active(w));
             let (stages, stats) = ranks::iterate(
                 rs,
                 d,
                 set.scheme,
                 (per, sv.relaxation, max_stages, k),
                 hybrid,
-                (mixer, active),
+                (mixer, requests),
                 |s, g| converged(s, g, rep),
             );
             rep.exchange = stats;

@@ -23,17 +23,17 @@ use super::partition::Decomposition;
 use super::ranks::RankState;
 
 impl RankState {
-    /// The copy velocities that the bodies `active` (this rank's, ascending) have
-    /// in other ranks' subdomains, from those ranks, into the shells (module docs).
-    /// Collective.
-    pub(super) fn share_requested<D: Family>(&mut self, d: &mut Decomposition<D>, active: &[u32]) {
+    /// The copy velocities that the bodies `active` (this rank's, ascending; `None`:
+    /// every body) have in other ranks' subdomains, from those ranks, into the
+    /// shells (module docs). Collective.
+    pub(super) fn share_requested<D: Family>(&mut self, d: &mut Decomposition<D>, active: Option<&[u32]>) {
         let ndof = super::subdomain::dofs::<D>();
         let me = self.cluster.rank();
         let mut ask = Vec::new();
         for s in d.subs.iter_mut().filter(|s| self.rank_of[s.id as usize] != me) {
             s.vel.resize(s.body_global.len(), D::V::default());
             for (l, g) in s.body_global.iter().enumerate() {
-                if active.binary_search(g).is_ok() {
+                if active.is_none_or(|a| a.binary_search(g).is_ok()) {
                     ask.extend([f64::from(s.id), l as f64]);
                 }
             }

@@ -374,10 +374,11 @@ impl RankState {
     }
 
     /// Every subdomain's impulses, copy velocities and F_Γ from its rank to all; with
-    /// `active` (bodies stepped per rank, no repartition next), only the copy
-    /// velocities of those bodies ([`RankState::share_requested`]).
-    fn share_results<D: Family>(&mut self, d: &mut Decomposition<D>, active: Option<&[u32]>) {
-        if let (Some(active), true) = (active, self.local) {
+    /// `requests` (contacts held per rank, no repartition next), only the copy
+    /// velocities of the bodies this rank steps (`Some(None)`: all of them;
+    /// [`RankState::share_requested`]).
+    fn share_results<D: Family>(&mut self, d: &mut Decomposition<D>, requests: Option<Option<&[u32]>>) {
+        if let (Some(active), true) = (requests, self.local) {
             return self.share_requested(d, active);
         }
         let ndof = super::subdomain::dofs::<D>();
@@ -441,7 +442,7 @@ pub(super) fn iterate<D: Family>(
     scheme: Scheme,
     (per, omega, max_stages, k): (u32, f64, u32, u32),
     (threads, workers): (usize, &mut super::team::Workers),
-    (mut mixer, active): (Option<&mut super::anderson::StageMixer>, Option<&[u32]>),
+    (mut mixer, requests): (Option<&mut super::anderson::StageMixer>, Option<Option<&[u32]>>),
     mut converged: impl FnMut(&Sums, &GluePartial) -> bool,
 ) -> (u32, TransportStats) {
     let t0 = Instant::now();
@@ -488,7 +489,7 @@ pub(super) fn iterate<D: Family>(
         }
         (stages, ok)
     });
-    st.share_results(d, active);
+    st.share_results(d, requests);
     let t = &mut st.totals;
     t.steps += 1;
     t.sent.messages += st.link.stats.messages;
