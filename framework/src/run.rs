@@ -371,7 +371,11 @@ pub fn run_on<D: Dim>(
     let steps = w.time.steps;
     let mut values = vec![];
     // a restarted world continues from its saved step
+    let frame_after = |s: u64| (scene.output.every > 0 && s % scene.output.every == 0) || s == steps;
     for s in (w.step + 1)..=steps {
+        if let Some(n) = dd.as_mut() {
+            n.skip_view(!frame_after(s));
+        }
         let mut refs: Vec<&mut dyn SceneFamily<D>> = fams.iter_mut().map(|f| &mut **f).collect();
         let (rep, dd_rep) = match crate::family::step(w, &mut refs, dd.as_mut()) {
             Ok(r) => r,
@@ -381,7 +385,7 @@ pub fn run_on<D: Dim>(
             }
         };
         let t0 = Instant::now();
-        if (scene.output.every > 0 && s % scene.output.every == 0) || s == steps {
+        if frame_after(s) {
             write_frame(&mut writers, fams, w, &dd, frame).map_err(io(dir, "an output frame"))?;
             frame += 1;
             hist.flush().map_err(io(dir, "history.csv"))?;

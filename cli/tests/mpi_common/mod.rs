@@ -39,11 +39,31 @@ pub fn args(scene: &Path, out: &Path, extra: &[&str]) -> Vec<String> {
 /// (`/tmp/ompi.HOST.UID`) is made by every job, and two jobs started at the same
 /// moment by parallel tests can fail on it (`mkdir … File exists`).
 pub fn session_dir() -> PathBuf {
+    static STALE: std::sync::Once = std::sync::Once::new();
+    STALE.call_once(remove_stale_session_dirs);
     static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let k = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let d = std::env::temp_dir().join(format!("nscdd-ompi-{}-{k}", std::process::id()));
     std::fs::create_dir_all(&d).expect("session dir");
     d
+}
+
+/// The session directories of test processes that have ended (OpenMPI leaves them
+/// behind; a process is gone when `/proc` has no entry for its id): removed once
+/// per test process. Elsewhere than on Linux nothing is removed.
+fn remove_stale_session_dirs() {
+    let (Ok(entries), true) = (std::fs::read_dir(std::env::temp_dir()), Path::new("/proc/self").exists()) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let Some(pid) = name.strip_prefix("nscdd-ompi-").and_then(|r| r.split('-').next()) else {
+            continue;
+        };
+        if pid.parse::<u32>().is_ok() && !Path::new("/proc").join(pid).exists() {
+            let _ = std::fs::remove_dir_all(e.path());
+        }
+    }
 }
 
 /// `mpirun` with the settings a root container needs; `apps` are the programs of an

@@ -42,6 +42,8 @@ pub(super) struct Local {
     /// With contacts held per rank: each body's subdomain for the outputs
     /// ([`body_subdomains`]).
     pub body_sub: Vec<i32>,
+    /// The step in progress needs no `body_sub` (no output frame after it).
+    pub skip_view: bool,
     /// A distributed repartition's grid and number of contacts, for the partition.
     pub new_grid: Option<(Grid, usize)>,
     /// The bodies this rank steps ([`super::owned`]).

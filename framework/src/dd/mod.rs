@@ -280,6 +280,14 @@ impl<D: Family> NscddOf<D> {
         self.ranks.as_mut()
     }
 
+    /// Whether the next steps may leave out what only the outputs' view
+    /// ([`NscddOf::view`]) reads: on ranks with contacts held per rank, each body's
+    /// subdomain (a collective count over the ranks). Every rank sets the same; a run
+    /// sets it for the steps after which it writes no frame.
+    pub fn skip_view(&mut self, skip: bool) {
+        self.local.skip_view = skip;
+    }
+
     /// Re-partitions every `k` steps (see [`Nscdd::repartition_every`]).
     pub fn with_repartition_every(mut self, k: u32) -> Self {
         self.repartition_every = k;
@@ -451,7 +459,8 @@ impl<D: Family> NscddOf<D> {
         attach::write_back(d, w);
         self.store.keep(&d.subs);
         rep.solve.residual = attach::write_back_families(d, w, fams, self.ranks.as_mut());
-        if let (true, Some(rs)) = (self.local.now, self.ranks.as_mut()) {
+        self.local.body_sub.clear();
+        if let (true, false, Some(rs)) = (self.local.now, self.local.skip_view, self.ranks.as_mut()) {
             self.local.body_sub = local::body_subdomains(rs, d, D::n_bodies(w));
         }
     }
