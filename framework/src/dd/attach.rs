@@ -173,17 +173,35 @@ pub(super) fn write_back_families<D: Family>(
 /// immovable body copied several times takes its copies' velocity (the same in
 /// every copy: impulses never move it).
 pub fn write_back<D: Family>(d: &super::partition::Decomposition<D>, w: &mut D::World) {
-    for s in &d.subs {
+    write_back_held(d, w, None);
+}
+
+/// [`write_back`]; with `held` (contacts held per rank, the step's end by
+/// requests: the own subdomains and the other ranks' copies received, (subdomain,
+/// local body)), only those copies are read (the others' bodies are not stepped
+/// here).
+pub(super) fn write_back_held<D: Family>(
+    d: &super::partition::Decomposition<D>,
+    w: &mut D::World,
+    held: Option<(&dyn Fn(u32) -> bool, &[(u32, u32)])>,
+) {
+    let one = |w: &mut D::World, s: &super::Subdomain<D>, l: usize, g: usize| {
+        if d.mult[g] == 1 || !D::movable(w, g) {
+            D::vel_mut(w)[g] = s.vel[l];
+        }
+    };
+    for s in d.subs.iter().filter(|s| held.is_none_or(|(own, _)| own(s.id))) {
         let c = D::contacts_mut(w);
         for (la, &ga) in s.contact_global.iter().enumerate() {
             D::copy_r(c, ga as usize, &s.contacts, la);
         }
         for (l, &g) in s.body_global.iter().enumerate() {
-            let g = g as usize;
-            if d.mult[g] == 1 || !D::movable(w, g) {
-                D::vel_mut(w)[g] = s.vel[l];
-            }
+            one(w, s, l, g as usize);
         }
+    }
+    for &(s, l) in held.map_or(&[][..], |(_, got)| got) {
+        let s = &d.subs[s as usize];
+        one(w, s, l as usize, s.body_global[l as usize] as usize);
     }
     let ifc = &d.iface;
     let vel = D::vel_mut(w);

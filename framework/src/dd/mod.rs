@@ -456,7 +456,17 @@ impl<D: Family> NscddOf<D> {
         self.choice.record(self.steps, t0.elapsed().as_secs_f64(), stages);
         rep.stages = stages;
         rep.solve.sweeps = stages * per;
-        attach::write_back(d, w);
+        // the step's end by requests: the own subdomains and the copies received
+        // are read (the store keeps every subdomain's F_Γ: a copy without an entry
+        // would be glued as new at the next step)
+        match self.ranks.as_mut().and_then(|rs| rs.answered.take().map(|a| (a, rs))) {
+            Some((got, rs)) => {
+                let (rank_of, me) = (&rs.rank_of, rs.cluster.rank());
+                attach::write_back_held(d, w, Some((&|s: u32| rank_of[s as usize] == me, &got)));
+                rs.answered = Some(got);
+            }
+            None => attach::write_back(d, w),
+        }
         self.store.keep(&d.subs);
         rep.solve.residual = attach::write_back_families(d, w, fams, self.ranks.as_mut());
         self.local.body_sub.clear();

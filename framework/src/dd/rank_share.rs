@@ -11,7 +11,9 @@
 //!           once each, in (subdomain, body) order: one all-gather of those copies
 //! ```
 //!
-//! Both lists are as long as the rank boundaries (the halos), not the sample. The
+//! Both lists are as long as the rank boundaries (the halos), not the sample; the
+//! write-back then reads the own subdomains and the copies received only
+//! (`attach::write_back_held`). The
 //! other ranks' F_Γ are left as they were: a rank glues and warm-starts only its own
 //! subdomains' copies, and before a repartition (when subdomains change ranks) the
 //! whole results are shared instead ([`RankState::share_results`]). Every copy a
@@ -54,11 +56,15 @@ impl RankState {
             answer.extend_from_slice(sub.vel[l as usize].as_ref());
         }
         let (_, got) = self.all_gather_any(&answer);
+        let mut answered = self.answered.take().unwrap_or_default();
+        answered.clear();
         for x in got.chunks_exact(2 + ndof) {
             let (s, l) = (x[0] as usize, x[1] as usize);
             if self.rank_of[s] != me {
                 d.subs[s].vel[l].as_mut().copy_from_slice(&x[2..]);
+                answered.push((s as u32, l as u32));
             }
         }
+        self.answered = Some(answered);
     }
 }

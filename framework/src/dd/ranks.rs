@@ -97,6 +97,10 @@ pub struct RankState {
     /// The step runs with contacts held per rank ([`super::local`]): the other
     /// ranks' subdomains are shells without contacts, their impulses not exchanged.
     pub(super) local: bool,
+    /// After a step whose end came by requests ([`RankState::share_requested`]):
+    /// the other ranks' copies (subdomain, local body) this rank received, the only
+    /// ones of their subdomains up to date here.
+    pub(super) answered: Option<Vec<(u32, u32)>>,
     /// The process's CPU seconds and the cluster's waits when the rank's run started
     /// (after loading).
     pub(super) cpu_start: f64,
@@ -120,6 +124,7 @@ impl RankState {
             parts: Vec::new(),
             totals: RankTotals::default(),
             local: false,
+            answered: None,
             cpu_start: super::cluster::cpu_seconds(false),
             wait_start,
         }
@@ -381,6 +386,7 @@ impl RankState {
         if let (Some(active), true) = (requests, self.local) {
             return self.share_requested(d, active);
         }
+        self.answered = None;
         let ndof = super::subdomain::dofs::<D>();
         let me = self.cluster.rank();
         let t0 = Instant::now();
