@@ -232,9 +232,6 @@ impl<D: Dim> Detector<D> {
         self.pairs.clear();
         self.boxes((bodies, among), shapes);
         self.mark_inside(region, alert, among);
-        if let Some(list) = among {
-            self.keep_only(list);
-        }
         let mut cell = self.cell_size(alert);
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for (b, a) in self.aabb.iter().enumerate() {
@@ -328,23 +325,9 @@ impl<D: Dim> Detector<D> {
         }
     }
 
-    /// Only the bodies of `list` stay inside.
-    fn keep_only(&mut self, list: &[u32]) {
-        let mut keep = std::mem::take(&mut self.fill);
-        keep.clear();
-        keep.resize(self.inside.len(), 0);
-        for &b in list {
-            keep[b as usize] = 1;
-        }
-        for (x, k) in self.inside.iter_mut().zip(&keep) {
-            *x &= *k != 0;
-        }
-        self.fill = keep;
-    }
-
     /// Which bodies enter the broad phase: all, or those whose box grown by `alert`
-    /// meets the region, and the bodies of the pairs it names.
-    /// Only the bodies `among` are looked at (`None`: all).
+    /// meets the region, and the bodies of the pairs it names; only bodies `among`
+    /// (ascending; `None`: all).
     fn mark_inside(&mut self, region: Option<&Region>, alert: f64, among: Option<&[u32]>) {
         self.inside.clear();
         let meets = |a: &Aabb<D>| {
@@ -364,7 +347,7 @@ impl<D: Dim> Detector<D> {
         }
         let Some(r) = region else { return };
         for p in &r.pairs {
-            for &b in p {
+            for &b in p.iter().filter(|b| among.is_none_or(|l| l.binary_search(b).is_ok())) {
                 if let Some(x) = self.inside.get_mut(b as usize) {
                     *x = true;
                 }
