@@ -93,13 +93,10 @@ pub(crate) fn save_state_text(dir: &Path, name: &str, text: &str) -> Result<(), 
     save_state_with(dir, name, |f| f.write_all(text.as_bytes()))
 }
 
-/// [`save_state_text`], the file's text written by `write` as it is made.
+/// [`save_state_text`], the file's text written by `write` as it is made
+/// ([`crate::output::write_atomic`]).
 fn save_state_with(dir: &Path, name: &str, write: impl FnOnce(&mut std::fs::File) -> std::io::Result<()>) -> Result<(), RunError> {
-    let tmp = dir.join(format!(".{name}.tmp"));
-    let mut f = std::fs::File::create(&tmp).map_err(io(dir, name))?;
-    write(&mut f).map_err(io(dir, name))?;
-    drop(f);
-    std::fs::rename(&tmp, dir.join(name)).map_err(io(dir, name))
+    crate::output::write_atomic(&dir.join(name), |tmp| write(&mut std::fs::File::create(tmp)?)).map_err(io(dir, name))
 }
 
 /// The outputs of a run: written by one process only (rank 0 of a multi-process
