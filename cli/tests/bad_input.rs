@@ -218,35 +218,6 @@ fn missing_file() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// A light disk pushed by an imposed force that jumps to 1e308 N at t = 5.05 ms:
-/// h f / m = 1e-3 × 1e308 / 3.1e-9 overflows, so step 6 gives an infinite velocity.
-const DIVERGING: &str = r#"[time]
-step = 1e-3
-steps = 20
-
-[[materials]]
-name = "grain"
-density = 1e-3
-
-[[laws]]
-materials = ["grain", "grain"]
-friction = 0.3
-
-[[bodies]]
-shape = "halfplane"
-material = "grain"
-position = [0.0, 0.0]
-fixed = true
-
-[[bodies]]
-name = "rocket"
-shape = "disk"
-material = "grain"
-position = [0.0, 0.001]
-radius = 1e-3
-drive.x = { force = { table = [[0.0, 0.0], [0.005, 0.0], [0.0051, 1e308]] } }
-"#;
-
 #[test]
 fn a_diverging_run_stops_and_keeps_its_history() {
     let dir = scratch("diverge");

@@ -3,7 +3,9 @@
 //! README's test command installs it).
 #![cfg(feature = "mpi")]
 
+mod common;
 mod mpi_common;
+use common::DIVERGING;
 use mpi_common::*;
 
 /// A grain that only one rank steps diverges between two repartitions: every rank
@@ -45,38 +47,9 @@ fn a_diverging_body_stepped_by_one_rank_stops_every_rank() {
 #[test]
 fn a_diverging_body_stops_every_rank_and_keeps_the_outputs() {
     let dir = scratch("diverge");
-    let scene = write(
-        &dir,
-        "diverge.toml",
-        r#"[time]
-step = 1e-3
-steps = 20
-[[materials]]
-name = "grain"
-density = 1e-3
-[[laws]]
-materials = ["grain", "grain"]
-friction = 0.3
-[[bodies]]
-shape = "halfplane"
-material = "grain"
-position = [0.0, 0.0]
-fixed = true
-[[bodies]]
-name = "rocket"
-shape = "disk"
-material = "grain"
-position = [0.0, 0.001]
-radius = 1e-3
-drive.x = { force = { table = [[0.0, 0.0], [0.005, 0.0], [0.0051, 1e308]] } }
-[[bodies]]
-name = "bystander"
-shape = "disk"
-material = "grain"
-position = [0.1, 0.001]
-radius = 1e-3
-"#,
-    );
+    // the scene of the one-process test (`common::DIVERGING`) and a grain far away
+    let bystander = "[[bodies]]\nname = \"bystander\"\nshape = \"disk\"\nmaterial = \"grain\"\nposition = [0.1, 0.001]\nradius = 1e-3\n";
+    let scene = write(&dir, "diverge.toml", &format!("{DIVERGING}\n{bystander}"));
     let out = dir.join("out");
     let o = mpirun(&[(2, args(&scene, &out, &["--subdomains", "2x1"]))]);
     let err = text(&o.stderr);
