@@ -78,6 +78,10 @@ pub trait SceneFamily<D: Dim>: Attached<Rigid<D>> + Any + Send {
     fn one_domain(&mut self) -> Option<&mut dyn ContactStage<World<D>>> {
         None
     }
+    /// Once after the scene is loaded, before any step (and before a restart's state
+    /// is read): the family may change the world bodies it shares with its own (the
+    /// continuum family gives each grain of its overlap band its share of the mass).
+    fn share_world(&mut self, _w: &mut World<D>) {}
     /// The end of a step, after the world's positions: the family's own (u⁺ = u⁻ +
     /// h((1 − θ)V⁻ + θV⁺)); a failure is a divergence naming the step.
     fn update(&mut self, w: &World<D>) -> Result<(), Diverged>;

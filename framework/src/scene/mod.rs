@@ -252,6 +252,8 @@ impl<D: SceneDim> Scene<D> {
                 }
                 cx.err(&path, e.message)
             })?;
+            let mut fam = fam;
+            fam.share_world(&mut scene.world);
             scene.families.push(fam);
         }
         Ok(scene)

@@ -9,7 +9,7 @@ import warnings
 import numpy as np
 import skfem
 from skfem import Basis, BilinearForm, ElementTetP1, ElementTriP1, ElementVector, MeshTet, MeshTri, asm
-from skfem.helpers import dot
+from skfem.helpers import ddot, dot, sym_grad, trace
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
 # an overflow or a NaN in a mesh or its matrices is an error (naming the scene's key),
@@ -81,10 +81,12 @@ def _csr_out(a, perm):
     )
 
 
-def assemble(dim, points, cells, young, poisson, density, plane_stress):
+def assemble(dim, points, cells, young, poisson, density, plane_stress, scale=None):
     """Consistent mass M (density rho) and stiffness K of linear elasticity.
 
     2D: plane strain, or plane stress with lambda* = 2 lambda mu / (lambda + 2 mu).
+    `scale` (bytes of one float64 per cell, optional): both forms weighted by it,
+    cell by cell (a continuum region's share of an overlap band).
     Returns the CSR arrays of M and K in nscdd's node-major dof order.
     """
     points = np.frombuffer(points, dtype="<f8").reshape(-1, dim)
@@ -93,13 +95,29 @@ def assemble(dim, points, cells, young, poisson, density, plane_stress):
     lam, mu = lame_parameters(young, poisson)
     if dim == 2 and plane_stress:
         lam = 2.0 * lam * mu / (lam + 2.0 * mu)
-    K = asm(linear_elasticity(lam, mu), basis)
+    if scale is None:
+        K = asm(linear_elasticity(lam, mu), basis)
 
-    @BilinearForm
-    def mass(u, v, w):
-        return density * dot(u, v)
+        @BilinearForm
+        def mass(u, v, w):
+            return density * dot(u, v)
 
-    M = asm(mass, basis)
+        M = asm(mass, basis)
+    else:
+        s = np.frombuffer(scale, dtype="<f8")
+        s = np.ascontiguousarray(np.repeat(s[:, None], basis.X.shape[-1], axis=1))
+
+        @BilinearForm
+        def stiffness(u, v, w):
+            e_u, e_v = sym_grad(u), sym_grad(v)
+            return w["s"] * (lam * trace(e_u) * trace(e_v) + 2.0 * mu * ddot(e_u, e_v))
+
+        @BilinearForm
+        def mass(u, v, w):
+            return w["s"] * density * dot(u, v)
+
+        K = asm(stiffness, basis, s=s)
+        M = asm(mass, basis, s=s)
     # basis.nodal_dofs[c, i]: the dof of component c at node i
     order = np.asarray(basis.nodal_dofs).T.reshape(-1)
     perm = np.empty_like(order)

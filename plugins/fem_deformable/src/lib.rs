@@ -8,6 +8,7 @@ pub mod bench;
 pub mod body;
 pub mod contact2;
 pub mod contact3;
+pub mod continuum;
 pub mod family;
 pub mod family2;
 pub mod family3;
@@ -23,7 +24,7 @@ pub mod stage3;
 use nscdd::dim::{D2, D3};
 use nscdd::registry::{Plugin, Registry};
 
-/// The plugin: the `[[deformable]]` section in 2D and 3D scenes.
+/// The plugin: the `[[deformable]]` and `[[continuum]]` sections in 2D and 3D scenes.
 pub struct FemPlugin;
 
 impl Plugin for FemPlugin {
@@ -33,5 +34,7 @@ impl Plugin for FemPlugin {
     fn build(&self, reg: &mut Registry) {
         reg.add_family::<D2>(family::SECTION, Box::new(family::DeformableKind));
         reg.add_family::<D3>(family::SECTION, Box::new(family::DeformableKind));
+        reg.add_family::<D2>(continuum::SECTION, Box::new(continuum::scene::ContinuumKind));
+        reg.add_family::<D3>(continuum::SECTION, Box::new(continuum::scene::ContinuumKind));
     }
 }

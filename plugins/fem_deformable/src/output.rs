@@ -8,14 +8,20 @@ use std::path::Path;
 
 /// `deformable.pvd`: the series of the frames `(t, frame)` of `bodies` bodies.
 pub fn write_pvd(dir: &Path, bodies: usize, frames: &[(f64, u32)]) -> std::io::Result<()> {
+    write_series(dir, "deformable", bodies, frames)
+}
+
+/// `{prefix}.pvd`: the series of the frames `(t, frame)` of `bodies` bodies, whose
+/// files are `{prefix}{body}_{frame}.vtu`.
+pub fn write_series(dir: &Path, prefix: &str, bodies: usize, frames: &[(f64, u32)]) -> std::io::Result<()> {
     let mut pvd = String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n");
     for (t, f) in frames {
         for bi in 0..bodies {
-            let _ = writeln!(pvd, "<DataSet timestep=\"{t}\" part=\"{bi}\" file=\"deformable{bi}_{f:05}.vtu\"/>");
+            let _ = writeln!(pvd, "<DataSet timestep=\"{t}\" part=\"{bi}\" file=\"{prefix}{bi}_{f:05}.vtu\"/>");
         }
     }
     pvd.push_str("</Collection>\n</VTKFile>\n");
-    nscdd::output::write_atomic(&dir.join("deformable.pvd"), |tmp| std::fs::write(tmp, pvd))
+    nscdd::output::write_atomic(&dir.join(format!("{prefix}.pvd")), |tmp| std::fs::write(tmp, pvd))
 }
 
 /// One deformable body as a VTK XML unstructured grid (ASCII): current node

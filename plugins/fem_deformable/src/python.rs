@@ -179,13 +179,27 @@ pub struct Assembled {
 /// M (consistent mass, density ρ) and K (linear elasticity, E, ν; 2D plane strain,
 /// or plane stress) by scikit-fem, in node-major dof order.
 pub fn assemble(mesh: &RawMesh, young: f64, poisson: f64, density: f64, plane_stress: bool) -> Result<Assembled, PyError> {
+    assemble_scaled(mesh, young, poisson, density, plane_stress, None)
+}
+
+/// [`assemble`] with both forms weighted cell by cell by `scale` (one number per
+/// cell: a continuum region's share of its overlap band, [`crate::continuum`]).
+pub fn assemble_scaled(
+    mesh: &RawMesh,
+    young: f64,
+    poisson: f64,
+    density: f64,
+    plane_stress: bool,
+    scale: Option<&[f64]>,
+) -> Result<Assembled, PyError> {
     Python::attach(|py| {
         let m = module(py)?;
         let p = PyBytes::new(py, &f64_bytes(&mesh.points));
         let c = PyBytes::new(py, &i64_bytes(&mesh.cells));
+        let s = scale.map(|s| PyBytes::new(py, &f64_bytes(s)));
         let r = m
             .getattr("assemble")
-            .and_then(|f| f.call1((mesh.dim, p, c, young, poisson, density, plane_stress)))
+            .and_then(|f| f.call1((mesh.dim, p, c, young, poisson, density, plane_stress, s)))
             .map_err(|e| err(py, e))?;
         type Arr = (Vec<u8>, Vec<u8>, Vec<u8>);
         let (mm, kk, ver): (Arr, Arr, String) = r.extract().map_err(|e| err(py, e))?;

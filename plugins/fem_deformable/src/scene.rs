@@ -134,7 +134,7 @@ pub fn load3_str(text: &str, file: &str, registry: &Registry) -> Result<FeScene3
 
 /// Reads a file entry into a [`DeformableSpec`]; an error names the key serde
 /// complained about when it says which.
-fn spec_of(i: usize, e: &toml::Table) -> Result<DeformableSpec, EntryError> {
+pub fn spec_of(i: usize, e: &toml::Table) -> Result<DeformableSpec, EntryError> {
     DeformableSpec::deserialize(toml::Value::Table(e.clone())).map_err(|x| {
         let msg = x.message().to_string();
         let key = msg.split('`').nth(1).filter(|k| !k.contains(' ')).unwrap_or("");
@@ -218,6 +218,23 @@ pub fn build(
     dir: &Path,
     memory: &mut dyn FnMut(f64) -> Result<(), String>,
 ) -> Result<FeBody, (&'static str, String)> {
+    build_scaled(s, materials, dim, dir, memory, &|_| Ok(None))
+}
+
+/// A cell-by-cell weight of M and K (None: 1 everywhere), from the mesh; an error
+/// names its key.
+pub type CellScale<'a> = &'a dyn Fn(&Mesh) -> Result<Option<Vec<f64>>, (&'static str, String)>;
+
+/// [`build`] with M and K weighted cell by cell by `scale` (a continuum region's
+/// share of its overlap band, [`crate::continuum`]).
+pub fn build_scaled(
+    s: &DeformableSpec,
+    materials: &[Material],
+    dim: usize,
+    dir: &Path,
+    memory: &mut dyn FnMut(f64) -> Result<(), String>,
+    scale: CellScale<'_>,
+) -> Result<FeBody, (&'static str, String)> {
     let mat = materials
         .iter()
         .position(|m| m.name == s.material)
@@ -250,7 +267,8 @@ pub fn build(
         plane_stress,
         rayleigh: s.rayleigh,
     };
-    let a = python::assemble(
+    let weights = scale(&mesh)?;
+    let a = python::assemble_scaled(
         &crate::python::RawMesh {
             dim,
             points: mesh.x0.clone(),
@@ -260,6 +278,7 @@ pub fn build(
         el.poisson,
         el.density,
         plane_stress,
+        weights.as_deref(),
     )
     .map_err(|e| ("mesh", e.0))?;
     let mut body = FeBody::new(s.name.clone(), mesh, el, mat as u16, &a.m, &a.k, a.skfem_version).map_err(|m| ("mesh", m))?;

@@ -1,0 +1,278 @@
+//! The continuum regions as a body family of the NSCDD stage ([`nscdd::dd::attach`]):
+//! their ties are the family's "contacts", given a subdomain like any contact (by
+//! geometry, or by model in subdomains of their own), and solved in that
+//! subdomain's sweep beside its rigid contacts.
+//!
+//! A tied grain is a world body: when its contacts and its tie lie in different
+//! subdomains, it is an interface body whose copies the one gluing stage glues
+//! (F_Γ, A_ΓE the copy's twist). A continuum region is an entity as a deformable
+//! body is ([`crate::family2`]): its copy in subdomain E holds the region's tie
+//! nodes with M̂_E = M̂/m (block m G), A_ΓE picks their velocities, and the gluing
+//! takes the copies to their mean. V⁺ = V_free − M̂⁻¹ Σ_p N(ξ_p)ᵀ λ_p.
+
+use super::ties::{self, TieSet};
+use crate::body::FeBody;
+use crate::nodes::{fill_set, NodeSet};
+use nscdd::dd::{Attached, EntityInfo, LocalPart, Rigid};
+use nscdd::dim::Dim;
+use nscdd::norms::Sums;
+use nscdd::world::World;
+use std::any::Any;
+use std::marker::PhantomData;
+
+/// The continuum regions of a scene and their ties (module docs). `N` is the
+/// dimension's (2 or 3).
+pub struct Continuum<D: Dim, const N: usize> {
+    pub bodies: Vec<FeBody>,
+    /// The ties: grain = world body, body = region, k = node index in `sets[body]`.
+    pub ties: TieSet<N>,
+    /// Each tie's grain share w_p of its mass (the partition of unity).
+    pub weight: Vec<f64>,
+    /// Each region's tie nodes (fixed), G among them and their velocities.
+    pub sets: Vec<NodeSet<N>>,
+    /// The tied grains' V⁻ and V_free of the step (the world's warm start moves
+    /// them before the ties are built).
+    grain_begin: Vec<[f64; N]>,
+    grain_free: Vec<[f64; N]>,
+    /// The tied grains' centres at the step's start (the ties' points).
+    centre: Vec<[f64; N]>,
+    /// A failure inside the step (a refactorization), reported after it.
+    pub error: Option<String>,
+    /// The VTK frames written, (t, frame).
+    pub frames: Vec<(f64, u32)>,
+    _d: PhantomData<D>,
+}
+
+impl<D: Dim, const N: usize> Continuum<D, N> {
+    /// Regions with their ties (`ties.k` holding mesh node ids, turned here into
+    /// indices of each region's tie node set).
+    pub fn new(bodies: Vec<FeBody>, mut ties: TieSet<N>, weight: Vec<f64>) -> Self {
+        assert_eq!(D::N, N, "the continuum family's N is the dimension's");
+        let mut nodes: Vec<Vec<u32>> = vec![vec![]; bodies.len()];
+        for (b, k) in ties.body.iter().zip(&ties.k) {
+            nodes[*b as usize].extend(&k[..=N]);
+        }
+        let mut sets = vec![NodeSet::default(); bodies.len()];
+        for (ns, set) in nodes.iter_mut().zip(&mut sets) {
+            ns.sort_unstable();
+            ns.dedup();
+            set.nodes = ns.clone();
+        }
+        for (b, k) in ties.body.iter().zip(&mut ties.k) {
+            let set = &sets[*b as usize];
+            for q in 0..=N {
+                k[q] = set.nodes.binary_search(&k[q]).expect("a tie node is in its region's set") as u32;
+            }
+        }
+        Continuum {
+            bodies,
+            ties,
+            weight,
+            sets,
+            grain_begin: vec![],
+            grain_free: vec![],
+            centre: vec![],
+            error: None,
+            frames: vec![],
+            _d: PhantomData,
+        }
+    }
+
+    /// Free velocities of the regions (factoring M̂ if h or θ changed) and the tied
+    /// grains' V⁻ and V_free.
+    pub fn begin_step(&mut self, w: &World<D>) -> Result<(), String> {
+        crate::stage2::free_velocities(&mut self.bodies, w.time.h, w.time.theta)?;
+        let begin = w.velocity_begin();
+        self.grain_begin.clear();
+        self.grain_free.clear();
+        for &g in &self.ties.grain {
+            self.grain_begin.push(ties::grain_velocity::<D, N>(&begin[g as usize]));
+            self.grain_free.push(ties::grain_velocity::<D, N>(&w.bodies.vel[g as usize]));
+        }
+        Ok(())
+    }
+
+    /// The node sets at V_free (G filled once: the tie nodes and M̂ do not change)
+    /// and each tie's target, u_free and W_p.
+    pub fn build(&mut self, w: &World<D>) {
+        for (set, body) in self.sets.iter_mut().zip(&mut self.bodies) {
+            if set.g.is_empty() && !set.nodes.is_empty() {
+                let nodes = set.nodes.clone();
+                fill_set(set, body, &nodes, 1.0);
+            }
+            for (v, &nd) in set.v.iter_mut().zip(&set.nodes) {
+                *v = std::array::from_fn(|c| body.v_free[N * nd as usize + c]);
+            }
+        }
+        let (h, theta) = (w.time.h, w.time.theta);
+        let t = &mut self.ties;
+        self.centre.clear();
+        for a in 0..t.len() {
+            let (g, b) = (t.grain[a] as usize, t.body[a] as usize);
+            let (body, set) = (&self.bodies[b], &self.sets[b]);
+            let (mut x_c, mut v_c) = ([0.0; N], [0.0; N]);
+            for q in 0..=N {
+                let nd = set.nodes[t.k[a][q] as usize] as usize;
+                let p = body.position(nd);
+                for c in 0..N {
+                    x_c[c] += t.xi[a][q] * p[c];
+                    v_c[c] += t.xi[a][q] * body.v_begin[N * nd + c];
+                }
+            }
+            let x_p: [f64; N] = std::array::from_fn(|c| w.bodies.pos[g].as_ref()[c]);
+            self.centre.push(x_p);
+            let v_c_free = ties::point_velocity(set, &t.k[a], &t.xi[a]);
+            for c in 0..N {
+                let gap = x_p[c] - x_c[c];
+                let u_begin = self.grain_begin[a][c] - v_c[c];
+                t.target[a][c] = -(gap + h * (1.0 - theta) * u_begin) / (h * theta);
+                t.u_free[a][c] = self.grain_free[a][c] - v_c_free[c];
+            }
+        }
+        ties::refresh_delassus::<D, N>(t, &self.sets, &w.bodies.inv_mass);
+    }
+
+    /// V⁺ = V_free − M̂⁻¹ Σ_p N(ξ_p)ᵀ λ_p of every region, and the sets' velocities.
+    pub fn finish_velocities(&mut self) {
+        let mut f: Vec<Vec<f64>> = self.bodies.iter().map(|b| vec![0.0; b.n_dofs()]).collect();
+        let t = &self.ties;
+        for a in 0..t.len() {
+            let b = t.body[a] as usize;
+            for q in 0..=N {
+                let nd = self.sets[b].nodes[t.k[a][q] as usize] as usize;
+                for c in 0..N {
+                    f[b][N * nd + c] -= t.xi[a][q] * t.r[a][c];
+                }
+            }
+        }
+        for ((body, mut dv), set) in self.bodies.iter_mut().zip(f).zip(&mut self.sets) {
+            body.solve_in_place(&mut dv);
+            body.v = body.v_free.iter().zip(&dv).map(|(a, b)| a + b).collect();
+            for (v, &nd) in set.v.iter_mut().zip(&set.nodes) {
+                *v = std::array::from_fn(|c| body.v[N * nd as usize + c]);
+            }
+        }
+    }
+}
+
+/// The continuum's share of one subdomain: its ties there, a copy of each region
+/// they touch (its tie nodes), and the grains' local copies.
+#[derive(Default)]
+pub struct ContinuumPart<D: Dim, const N: usize> {
+    fe: Vec<u32>,
+    sets: Vec<NodeSet<N>>,
+    ties: TieSet<N>,
+    global: Vec<u32>,
+    _d: PhantomData<D>,
+}
+
+impl<D: Dim, const N: usize> LocalPart<Rigid<D>> for ContinuumPart<D, N> {
+    fn len(&self) -> usize {
+        self.ties.len()
+    }
+    fn entities(&self) -> &[u32] {
+        &self.fe
+    }
+    fn prepare(&mut self, inv: &[D::InvMass], mult: &[u32]) {
+        for (set, &m) in self.sets.iter_mut().zip(mult) {
+            if m > 1 {
+                let m = m as f64;
+                set.g.iter_mut().for_each(|g| *g *= m);
+            }
+        }
+        ties::refresh_delassus::<D, N>(&mut self.ties, &self.sets, inv);
+    }
+    fn warm_start(&mut self, vel: &mut [D::Twist], inv: &[D::InvMass]) {
+        ties::warm_start::<D, N>(&self.ties, &mut self.sets, vel, inv);
+    }
+    fn sweep(&mut self, vel: &mut [D::Twist], inv: &[D::InvMass], omega: f64, sums: Option<&mut Sums>) {
+        ties::sweep::<D, N>(&mut self.ties, &mut self.sets, vel, inv, omega, sums);
+    }
+    fn entity_velocity(&self, e: usize, out: &mut Vec<f64>) {
+        out.extend(self.sets[e].v.iter().flatten());
+    }
+    fn glue_entity(&mut self, e: usize, dv: &[f64]) {
+        for (v, d) in self.sets[e].v.iter_mut().zip(dv.chunks_exact(N)) {
+            for c in 0..N {
+                v[c] += d[c];
+            }
+        }
+    }
+    fn pack(&self, out: &mut Vec<f64>) {
+        out.extend(self.ties.r.iter().flatten());
+    }
+    fn packed_len(&self) -> usize {
+        N * self.ties.len()
+    }
+    fn unpack(&mut self, values: &[f64]) {
+        for (r, x) in self.ties.r.iter_mut().zip(values.chunks_exact(N)) {
+            r.copy_from_slice(x);
+        }
+    }
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+}
+
+impl<D: Dim, const N: usize> Attached<Rigid<D>> for Continuum<D, N> {
+    fn after_free_velocity(&mut self, w: &World<D>) {
+        if let Err(e) = self.begin_step(w) {
+            self.error = Some(e);
+        }
+    }
+    fn build(&mut self, w: &mut World<D>) {
+        Continuum::build(self, w);
+    }
+    fn points(&self, out: &mut Vec<[f64; 3]>) {
+        // the tie's point is the grain's centre (its subdomain by geometry)
+        out.extend(self.centre.iter().map(|x| {
+            let mut p = [0.0; 3];
+            p[..N].copy_from_slice(x);
+            p
+        }));
+    }
+    fn n_entities(&self) -> usize {
+        self.bodies.len()
+    }
+    fn entity(&self, e: u32) -> EntityInfo {
+        let n = self.sets[e as usize].len();
+        EntityInfo {
+            dofs: (N * n) as u32,
+            space: (N * n) as u32,
+            rho2: 0.0,
+            weight: 1.0 / n.max(1) as f64,
+        }
+    }
+    fn split(&self, _w: &World<D>, owner: &[u32], copy: &mut dyn FnMut(u32, u32) -> u32) -> Vec<(u32, Box<dyn LocalPart<Rigid<D>>>)> {
+        let t = &self.ties;
+        let make = |p: &mut ContinuumPart<D, N>, b: u32| {
+            p.fe.push(b);
+            p.sets.push(self.sets[b as usize].clone());
+        };
+        let parts = crate::family2::split_by(owner, self.bodies.len(), make, |s, part: &mut ContinuumPart<D, N>, list, entity| {
+            for &a in list {
+                let b = entity(part, t.body[a as usize]);
+                part.ties.push_from(t, a as usize, copy(s, t.grain[a as usize]), b);
+                part.global.push(a);
+            }
+        });
+        parts
+            .into_iter()
+            .map(|(s, p)| (s, Box::new(p) as Box<dyn LocalPart<Rigid<D>>>))
+            .collect()
+    }
+    fn write_back(&mut self, _w: &mut World<D>, parts: &[(u32, &dyn LocalPart<Rigid<D>>)]) {
+        for (_, p) in parts {
+            let Some(p) = p.as_any().downcast_ref::<ContinuumPart<D, N>>() else {
+                continue;
+            };
+            for (l, &g) in p.global.iter().enumerate() {
+                self.ties.r[g as usize] = p.ties.r[l];
+            }
+        }
+        self.finish_velocities();
+    }
+    fn residual_parts(&self, w: &World<D>) -> (f64, f64) {
+        ties::residual_parts::<D, N>(&self.ties, &self.sets, &w.bodies.vel)
+    }
+}

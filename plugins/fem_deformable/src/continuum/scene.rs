@@ -1,0 +1,337 @@
+//! The `[[continuum]]` section ([`super`] for its keys): the regions built by
+//! scikit-fem with their cells weighted by the band, the grains tied to them, and
+//! the family's outputs and saved state (`families.continuum`: per region u and V,
+//! per tie its grain and λ).
+
+use super::ties::TieSet;
+use super::{Continuum, SECTION};
+use crate::body::FeBody;
+use crate::mesh::{gradients, Mesh};
+use nscdd::dd::{Family, Rigid};
+use nscdd::dim::{Dim, D2, D3};
+use nscdd::engine::Diverged;
+use nscdd::family::{EntryError, FamilyContext, FamilyKind, SceneFamily};
+use nscdd::world::World;
+use serde::{Deserialize, Serialize};
+use std::any::Any;
+use std::path::Path;
+
+/// Builds the continuum regions of a scene's `[[continuum]]` entries.
+pub struct ContinuumKind;
+
+impl FamilyKind<D2> for ContinuumKind {
+    fn load(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D2>) -> Result<Box<dyn SceneFamily<D2>>, EntryError> {
+        Ok(Box::new(load::<D2, 2>(entries, cx)?))
+    }
+}
+
+impl FamilyKind<D3> for ContinuumKind {
+    fn load(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D3>) -> Result<Box<dyn SceneFamily<D3>>, EntryError> {
+        Ok(Box::new(load::<D3, 3>(entries, cx)?))
+    }
+}
+
+/// The overlap band: along the unit `normal`, the continuum's weight α is 1 at
+/// s = n·x = `continuum`, 0 at s = `discrete`, linear between, clamped to [0, 1].
+#[derive(Deserialize, Debug, Clone, Copy)]
+#[serde(deny_unknown_fields)]
+pub struct Band {
+    pub normal: [f64; 3],
+    pub continuum: f64,
+    pub discrete: f64,
+}
+
+impl Band {
+    /// α(x), the continuum's weight.
+    pub fn alpha(&self, x: &[f64]) -> f64 {
+        let s: f64 = x.iter().zip(&self.normal).map(|(a, b)| a * b).sum();
+        ((self.discrete - s) / (self.discrete - self.continuum)).clamp(0.0, 1.0)
+    }
+}
+
+fn band_of(i: usize, e: &toml::Table, dim: usize) -> Result<Band, EntryError> {
+    let at = |key: &str, message: String| EntryError {
+        index: Some(i),
+        key: key.into(),
+        message,
+    };
+    let v = e
+        .get("band")
+        .ok_or_else(|| at("band", "missing: `band = { normal, continuum, discrete }`".into()))?;
+    let normal_len = v.get("normal").and_then(|n| n.as_array()).map(|a| a.len());
+    if normal_len.is_some_and(|n| n != dim) {
+        return Err(at("band", format!("`normal` needs {dim} numbers in {dim}D")));
+    }
+    let mut t = v.clone();
+    if let Some(n) = t.get_mut("normal").and_then(|n| n.as_array_mut()) {
+        n.resize(3, toml::Value::Float(0.0));
+    }
+    let mut b = Band::deserialize(t).map_err(|x| at("band", x.message().to_string()))?;
+    let len = b.normal.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if !(len > 0.0 && len.is_finite()) {
+        return Err(at("band", "`normal` must be a finite nonzero vector".into()));
+    }
+    b.normal = b.normal.map(|x| x / len);
+    if !(b.continuum.is_finite() && b.discrete.is_finite() && b.continuum != b.discrete) {
+        return Err(at(
+            "band",
+            "`continuum` and `discrete` must be two different finite positions".into(),
+        ));
+    }
+    Ok(b)
+}
+
+/// Regions and ties of the entries (module docs).
+fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, D>) -> Result<Continuum<D, N>, EntryError> {
+    let w = cx.world;
+    let (mut bodies, mut ties, mut weight) = (Vec::new(), TieSet::<N>::default(), Vec::new());
+    let mut tied = vec![false; w.bodies.len()];
+    let mut held = 0.0;
+    for (i, e) in entries.iter().enumerate() {
+        let at = |key: &str, message: String| EntryError {
+            index: Some(i),
+            key: key.into(),
+            message,
+        };
+        let band = band_of(i, e, N)?;
+        let mut rest = e.clone();
+        rest.remove("band");
+        let spec = crate::scene::spec_of(i, &rest)?;
+        let mut memory = |nodes: f64| {
+            let bytes = crate::scene::mesh_bytes(N, nodes);
+            cx.check_memory(held + bytes, &format!("a continuum region of about {nodes:.0} nodes"))
+                .map(|()| held += bytes)
+        };
+        let scale = |m: &Mesh| cell_weights(m, &band).map(Some).map_err(|msg| ("band", msg));
+        let mut b = crate::scene::build_scaled(&spec, &w.materials, N, cx.dir, &mut memory, &scale).map_err(|(k, m)| at(k, m))?;
+        b.set_gravity(&w.gravity.as_ref()[..N]);
+        b.factorize(w.time.h, w.time.theta).map_err(|m| at("", m))?;
+        let body = bodies.len() as u32;
+        for g in 0..w.bodies.len() {
+            if tied[g] || !Rigid::<D>::is_grain(w, g) || !w.bodies.movable(g) {
+                continue;
+            }
+            let x = &w.bodies.pos[g].as_ref()[..N];
+            let alpha = band.alpha(x);
+            if alpha <= 0.0 {
+                continue;
+            }
+            let Some((cell, xi)) = locate(&b.mesh, x) else { continue };
+            if alpha >= 1.0 {
+                return Err(at("band", format!("body {g} (a grain) lies in the continuum part of the region, beyond the band: grains belong to the discrete part and the band")));
+            }
+            let mut k = [0u32; 4];
+            k[..=N].copy_from_slice(b.mesh.cell(cell));
+            tied[g] = true;
+            ties.grain.push(g as u32);
+            ties.body.push(body);
+            ties.k.push(k);
+            ties.xi.push(xi);
+            ties.w.push([[0.0; N]; N]);
+            ties.inv_w.push([[0.0; N]; N]);
+            ties.target.push([0.0; N]);
+            ties.r.push([0.0; N]);
+            ties.u_free.push([0.0; N]);
+            weight.push(1.0 - alpha);
+        }
+        bodies.push(b);
+    }
+    Ok(Continuum::new(bodies, ties, weight))
+}
+
+/// α at each cell's centroid; every cell must have α > 0 (a cell wholly on the
+/// discrete side would have neither mass nor stiffness).
+fn cell_weights(m: &Mesh, band: &Band) -> Result<Vec<f64>, String> {
+    let (d, nv) = (m.dim, m.dim + 1);
+    let mut out = Vec::with_capacity(m.n_cells());
+    for e in 0..m.n_cells() {
+        let mut c = [0.0; 3];
+        for &k in m.cell(e) {
+            for (x, y) in c.iter_mut().zip(m.node(k as usize)) {
+                *x += y / nv as f64;
+            }
+        }
+        let a = band.alpha(&c[..d]);
+        if !(a > 0.0) {
+            return Err(format!(
+                "cell {e} (centroid {:?}) lies on the discrete side of the band: the mesh must end at the band's discrete edge",
+                &c[..d]
+            ));
+        }
+        out.push(a);
+    }
+    Ok(out)
+}
+
+/// The cell holding point x and its barycentric coordinates (reference mesh).
+pub fn locate(m: &Mesh, x: &[f64]) -> Option<(usize, [f64; 4])> {
+    let (d, nv) = (m.dim, m.dim + 1);
+    for e in 0..m.n_cells() {
+        let c = m.cell(e);
+        let g = gradients(d, &m.x0, c);
+        let mut centroid = [0.0; 3];
+        for &k in c {
+            for (y, z) in centroid.iter_mut().zip(m.node(k as usize)) {
+                *y += z / nv as f64;
+            }
+        }
+        let mut xi = [0.0; 4];
+        for q in 0..nv {
+            xi[q] = 1.0 / nv as f64 + (0..d).map(|j| g[q][j] * (x[j] - centroid[j])).sum::<f64>();
+        }
+        if xi[..nv].iter().all(|&l| l >= -1e-12) {
+            return Some((e, xi));
+        }
+    }
+    None
+}
+
+#[derive(Serialize, Deserialize)]
+struct RegionState {
+    #[serde(default)]
+    name: Option<String>,
+    displacement: Vec<f64>,
+    velocity: Vec<f64>,
+}
+
+#[derive(Serialize, Deserialize)]
+struct TieState {
+    grain: u32,
+    weight: f64,
+    r: Vec<f64>,
+}
+
+#[derive(Serialize, Deserialize)]
+struct State {
+    regions: Vec<RegionState>,
+    ties: Vec<TieState>,
+}
+
+impl<D: Dim, const N: usize> Continuum<D, N> {
+    fn save(&self) -> serde_json::Value {
+        let s = State {
+            regions: self
+                .bodies
+                .iter()
+                .map(|b| RegionState {
+                    name: b.name.clone(),
+                    displacement: b.u.clone(),
+                    velocity: b.v.clone(),
+                })
+                .collect(),
+            ties: (0..self.ties.len())
+                .map(|a| TieState {
+                    grain: self.ties.grain[a],
+                    weight: self.weight[a],
+                    r: self.ties.r[a].to_vec(),
+                })
+                .collect(),
+        };
+        serde_json::to_value(s).expect("plain data")
+    }
+
+    fn load_saved(&mut self, v: &serde_json::Value) -> Result<(), String> {
+        let s = State::deserialize(v).map_err(|e| format!("not a state of continuum regions: {e}"))?;
+        let same = s.regions.len() == self.bodies.len()
+            && s.regions
+                .iter()
+                .zip(&self.bodies)
+                .all(|(r, b)| r.displacement.len() == b.u.len() && r.velocity.len() == b.v.len())
+            && s.ties.len() == self.ties.len()
+            && s.ties.iter().zip(&self.ties.grain).all(|(t, &g)| t.grain == g && t.r.len() == N);
+        if !same {
+            return Err("the state's continuum regions or ties are not the scene's: a restart needs the scene that wrote it".into());
+        }
+        let finite = |x: &[f64]| x.iter().all(|y| y.is_finite());
+        if !s.regions.iter().all(|r| finite(&r.displacement) && finite(&r.velocity)) || !s.ties.iter().all(|t| finite(&t.r)) {
+            return Err("non-finite numbers in the continuum state".into());
+        }
+        for (b, r) in self.bodies.iter_mut().zip(s.regions) {
+            b.u = r.displacement;
+            b.v = r.velocity;
+        }
+        for (r, t) in self.ties.r.iter_mut().zip(s.ties) {
+            r.copy_from_slice(&t.r);
+        }
+        Ok(())
+    }
+
+    /// Σ |λ_p| over the ties (N·s): the coupling's impulse.
+    pub fn tie_impulse(&self) -> f64 {
+        self.ties.r.iter().map(|r| r.iter().map(|x| x * x).sum::<f64>().sqrt()).sum()
+    }
+}
+
+impl<D: Dim, const N: usize> SceneFamily<D> for Continuum<D, N> {
+    fn section(&self) -> &'static str {
+        SECTION
+    }
+    fn describe(&self) -> String {
+        let nodes: usize = self.bodies.iter().map(|b| b.mesh.n_nodes()).sum();
+        format!(
+            "{} continuum region(s) ({nodes} nodes), {} tied grains",
+            self.bodies.len(),
+            self.ties.len()
+        )
+    }
+    fn share_world(&mut self, w: &mut World<D>) {
+        for (&g, &wp) in self.ties.grain.iter().zip(&self.weight) {
+            w.bodies.mass[g as usize] *= wp;
+            w.bodies.refresh_inverse(g as usize);
+        }
+    }
+    fn update(&mut self, w: &World<D>) -> Result<(), Diverged> {
+        if let Some(e) = self.error.take() {
+            return Err(Diverged {
+                step: w.step,
+                body: 0,
+                message: e,
+            });
+        }
+        crate::stage2::update_bodies(&mut self.bodies, w.time.h, w.time.theta, w.step)
+    }
+    fn contacts(&self) -> usize {
+        self.ties.len()
+    }
+    fn history_columns(&self) -> Vec<String> {
+        [
+            "continuum_ties",
+            "tie_impulse",
+            "kinetic_continuum",
+            "elastic_continuum",
+            "load_potential_continuum",
+        ]
+        .map(String::from)
+        .to_vec()
+    }
+    fn history_values(&self, out: &mut Vec<f64>) {
+        out.push(self.ties.len() as f64);
+        out.push(self.tie_impulse());
+        out.push(self.bodies.iter().map(FeBody::kinetic_energy).sum());
+        out.push(self.bodies.iter().map(FeBody::elastic_energy).sum());
+        out.push(self.bodies.iter().map(FeBody::load_potential).sum());
+    }
+    fn write_frame(&mut self, dir: &Path, frame: u32, t: f64) -> std::io::Result<()> {
+        for (bi, b) in self.bodies.iter().enumerate() {
+            let path = dir.join(format!("continuum{bi}_{frame:05}.vtu"));
+            nscdd::output::write_atomic(&path, |tmp| std::fs::write(tmp, crate::output::vtu(b)))?;
+        }
+        self.frames.push((t, frame));
+        Ok(())
+    }
+    fn finish(&mut self, dir: &Path) -> std::io::Result<()> {
+        crate::output::write_series(dir, "continuum", self.bodies.len(), &self.frames)
+    }
+    fn save_state(&self) -> serde_json::Value {
+        self.save()
+    }
+    fn load_state(&mut self, state: &serde_json::Value) -> Result<(), String> {
+        self.load_saved(state)
+    }
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+    fn as_any_mut(&mut self) -> &mut dyn Any {
+        self
+    }
+}
