@@ -24,18 +24,19 @@ use std::marker::PhantomData;
 /// dimension's (2 or 3).
 pub struct Continuum<D: Dim, const N: usize> {
     pub bodies: Vec<FeBody>,
-    /// The ties: grain = world body, body = region, k = node index in `sets[body]`.
+    /// The ties ([`ties`]): grains by world id, nodes by index in `sets[body]`.
     pub ties: TieSet<N>,
-    /// Each tie's grain share w_p of its mass (the partition of unity).
-    pub weight: Vec<f64>,
+    /// The band's grains and their share w_p of their mass (the partition of
+    /// unity), ascending grain.
+    pub band: Vec<(u32, f64)>,
     /// Each region's tie nodes (fixed), G among them and their velocities.
     pub sets: Vec<NodeSet<N>>,
-    /// The tied grains' V⁻ and V_free of the step (the world's warm start moves
-    /// them before the ties are built).
+    /// Per entry of `ties.grain`: the grain's V⁻ and V_free of the step (the world's
+    /// warm start moves the grains before the ties are built).
     grain_begin: Vec<[f64; N]>,
     grain_free: Vec<[f64; N]>,
-    /// The tied grains' centres at the step's start (the ties' points).
-    centre: Vec<[f64; N]>,
+    /// Each tie's point at the step's start, Σ c_ai x_i (its subdomain by geometry).
+    point: Vec<[f64; N]>,
     /// A failure inside the step (a refactorization), reported after it.
     pub error: Option<String>,
     /// The VTK frames written, (t, frame).
@@ -44,13 +45,13 @@ pub struct Continuum<D: Dim, const N: usize> {
 }
 
 impl<D: Dim, const N: usize> Continuum<D, N> {
-    /// Regions with their ties (`ties.k` holding mesh node ids, turned here into
-    /// indices of each region's tie node set).
-    pub fn new(bodies: Vec<FeBody>, mut ties: TieSet<N>, weight: Vec<f64>) -> Self {
+    /// Regions with their ties (`ties.node` holding mesh node ids, turned here into
+    /// indices of each region's tie node set) and band grains.
+    pub fn new(bodies: Vec<FeBody>, mut ties: TieSet<N>, band: Vec<(u32, f64)>) -> Self {
         assert_eq!(D::N, N, "the continuum family's N is the dimension's");
         let mut nodes: Vec<Vec<u32>> = vec![vec![]; bodies.len()];
-        for (b, k) in ties.body.iter().zip(&ties.k) {
-            nodes[*b as usize].extend(&k[..=N]);
+        for a in 0..ties.len() {
+            nodes[ties.body[a] as usize].extend(&ties.node[ties.nodes(a)]);
         }
         let mut sets = vec![NodeSet::default(); bodies.len()];
         for (ns, set) in nodes.iter_mut().zip(&mut sets) {
@@ -58,20 +59,20 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
             ns.dedup();
             set.nodes = ns.clone();
         }
-        for (b, k) in ties.body.iter().zip(&mut ties.k) {
-            let set = &sets[*b as usize];
-            for q in 0..=N {
-                k[q] = set.nodes.binary_search(&k[q]).expect("a tie node is in its region's set") as u32;
+        for a in 0..ties.len() {
+            let set = &sets[ties.body[a] as usize];
+            for j in ties.nodes(a) {
+                ties.node[j] = set.nodes.binary_search(&ties.node[j]).expect("a tie node is in its region's set") as u32;
             }
         }
         Continuum {
             bodies,
             ties,
-            weight,
+            band,
             sets,
             grain_begin: vec![],
             grain_free: vec![],
-            centre: vec![],
+            point: vec![],
             error: None,
             frames: vec![],
             _d: PhantomData,
@@ -93,7 +94,7 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
     }
 
     /// The node sets at V_free (G filled once: the tie nodes and M̂ do not change)
-    /// and each tie's target, u_free and W_p.
+    /// and each tie's point, target, u_free and W_a.
     pub fn build(&mut self, w: &World<D>) {
         for (set, body) in self.sets.iter_mut().zip(&mut self.bodies) {
             if set.g.is_empty() && !set.nodes.is_empty() {
@@ -106,42 +107,50 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
         }
         let (h, theta) = (w.time.h, w.time.theta);
         let t = &mut self.ties;
-        self.centre.clear();
+        self.point.clear();
         for a in 0..t.len() {
-            let (g, b) = (t.grain[a] as usize, t.body[a] as usize);
+            let b = t.body[a] as usize;
             let (body, set) = (&self.bodies[b], &self.sets[b]);
-            let (mut x_c, mut v_c) = ([0.0; N], [0.0; N]);
-            for q in 0..=N {
-                let nd = set.nodes[t.k[a][q] as usize] as usize;
-                let p = body.position(nd);
-                for c in 0..N {
-                    x_c[c] += t.xi[a][q] * p[c];
-                    v_c[c] += t.xi[a][q] * body.v_begin[N * nd + c];
+            // Σ c x, Σ c v⁻, Σ c v_free over the grains; minus Σ b (x, V⁻, V_free) over the nodes
+            let (mut x, mut gap, mut ub, mut uf) = ([0.0; N], [0.0; N], [0.0; N], [0.0; N]);
+            for i in t.grains(a) {
+                let p = w.bodies.pos[t.grain[i] as usize];
+                for d in 0..N {
+                    x[d] += t.c[i] * p.as_ref()[d];
+                    ub[d] += t.c[i] * self.grain_begin[i][d];
+                    uf[d] += t.c[i] * self.grain_free[i][d];
                 }
             }
-            let x_p: [f64; N] = std::array::from_fn(|c| w.bodies.pos[g].as_ref()[c]);
-            self.centre.push(x_p);
-            let v_c_free = ties::point_velocity(set, &t.k[a], &t.xi[a]);
-            for c in 0..N {
-                let gap = x_p[c] - x_c[c];
-                let u_begin = self.grain_begin[a][c] - v_c[c];
-                t.target[a][c] = -(gap + h * (1.0 - theta) * u_begin) / (h * theta);
-                t.u_free[a][c] = self.grain_free[a][c] - v_c_free[c];
+            gap.copy_from_slice(&x);
+            for j in t.nodes(a) {
+                let l = t.node[j] as usize;
+                let nd = set.nodes[l] as usize;
+                let p = body.position(nd);
+                for d in 0..N {
+                    gap[d] -= t.b[j] * p[d];
+                    ub[d] -= t.b[j] * body.v_begin[N * nd + d];
+                    uf[d] -= t.b[j] * set.v[l][d];
+                }
             }
+            self.point.push(x);
+            for d in 0..N {
+                t.target[a][d] = -(gap[d] + h * (1.0 - theta) * ub[d]) / (h * theta);
+            }
+            t.u_free[a] = uf;
         }
         ties::refresh_delassus::<D, N>(t, &self.sets, &w.bodies.inv_mass);
     }
 
-    /// V⁺ = V_free − M̂⁻¹ Σ_p N(ξ_p)ᵀ λ_p of every region, and the sets' velocities.
+    /// V⁺ = V_free − M̂⁻¹ Σ_a Σ_l b_al λ_a of every region, and the sets' velocities.
     pub fn finish_velocities(&mut self) {
         let mut f: Vec<Vec<f64>> = self.bodies.iter().map(|b| vec![0.0; b.n_dofs()]).collect();
         let t = &self.ties;
         for a in 0..t.len() {
             let b = t.body[a] as usize;
-            for q in 0..=N {
-                let nd = self.sets[b].nodes[t.k[a][q] as usize] as usize;
+            for j in t.nodes(a) {
+                let nd = self.sets[b].nodes[t.node[j] as usize] as usize;
                 for c in 0..N {
-                    f[b][N * nd + c] -= t.xi[a][q] * t.r[a][c];
+                    f[b][N * nd + c] -= t.b[j] * t.r[a][c];
                 }
             }
         }
@@ -225,7 +234,7 @@ impl<D: Dim, const N: usize> Attached<Rigid<D>> for Continuum<D, N> {
     }
     fn points(&self, out: &mut Vec<[f64; 3]>) {
         // the tie's point is the grain's centre (its subdomain by geometry)
-        out.extend(self.centre.iter().map(|x| {
+        out.extend(self.point.iter().map(|x| {
             let mut p = [0.0; 3];
             p[..N].copy_from_slice(x);
             p
@@ -252,7 +261,7 @@ impl<D: Dim, const N: usize> Attached<Rigid<D>> for Continuum<D, N> {
         let parts = crate::family2::split_by(owner, self.bodies.len(), make, |s, part: &mut ContinuumPart<D, N>, list, entity| {
             for &a in list {
                 let b = entity(part, t.body[a as usize]);
-                part.ties.push_from(t, a as usize, copy(s, t.grain[a as usize]), b);
+                part.ties.push_from(t, a as usize, &mut |g| copy(s, g), b);
                 part.global.push(a);
             }
         });

@@ -81,10 +81,34 @@ fn band_of(i: usize, e: &toml::Table, dim: usize) -> Result<Band, EntryError> {
     Ok(b)
 }
 
+/// How the band's grains are tied ([`super::ties`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Coupling {
+    /// One tie per grain: v_p = N(ξ_p) V.
+    Grain,
+    /// One tie per node: the grains' mass-weighted mean velocity around each node.
+    Node,
+}
+
+fn coupling_of(i: usize, e: &toml::Table) -> Result<Coupling, EntryError> {
+    match e.get("coupling").map(|v| v.as_str()) {
+        None | Some(Some("node")) => Ok(Coupling::Node),
+        Some(Some("grain")) => Ok(Coupling::Grain),
+        Some(_) => Err(EntryError {
+            index: Some(i),
+            key: "coupling".into(),
+            message: "`node` (one tie per band node, the default) or `grain` (one tie per band grain)".into(),
+        }),
+    }
+}
+
+/// A band grain: world id, cell, barycentric coordinates, share w_p of its mass.
+type BandGrain = (u32, usize, [f64; 4], f64);
+
 /// Regions and ties of the entries (module docs).
 fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, D>) -> Result<Continuum<D, N>, EntryError> {
     let w = cx.world;
-    let (mut bodies, mut ties, mut weight) = (Vec::new(), TieSet::<N>::default(), Vec::new());
+    let (mut bodies, mut ties, mut band_all) = (Vec::new(), TieSet::<N>::default(), Vec::new());
     let mut tied = vec![false; w.bodies.len()];
     let mut held = 0.0;
     for (i, e) in entries.iter().enumerate() {
@@ -94,8 +118,10 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
             message,
         };
         let band = band_of(i, e, N)?;
+        let coupling = coupling_of(i, e)?;
         let mut rest = e.clone();
         rest.remove("band");
+        rest.remove("coupling");
         let spec = crate::scene::spec_of(i, &rest)?;
         let mut memory = |nodes: f64| {
             let bytes = crate::scene::mesh_bytes(N, nodes);
@@ -106,7 +132,7 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
         let mut b = crate::scene::build_scaled(&spec, &w.materials, N, cx.dir, &mut memory, &scale).map_err(|(k, m)| at(k, m))?;
         b.set_gravity(&w.gravity.as_ref()[..N]);
         b.factorize(w.time.h, w.time.theta).map_err(|m| at("", m))?;
-        let body = bodies.len() as u32;
+        let mut grains: Vec<BandGrain> = Vec::new();
         for g in 0..w.bodies.len() {
             if tied[g] || !Rigid::<D>::is_grain(w, g) || !w.bodies.movable(g) {
                 continue;
@@ -120,23 +146,63 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
             if alpha >= 1.0 {
                 return Err(at("band", format!("body {g} (a grain) lies in the continuum part of the region, beyond the band: grains belong to the discrete part and the band")));
             }
-            let mut k = [0u32; 4];
-            k[..=N].copy_from_slice(b.mesh.cell(cell));
             tied[g] = true;
-            ties.grain.push(g as u32);
-            ties.body.push(body);
-            ties.k.push(k);
-            ties.xi.push(xi);
-            ties.w.push([[0.0; N]; N]);
-            ties.inv_w.push([[0.0; N]; N]);
-            ties.target.push([0.0; N]);
-            ties.r.push([0.0; N]);
-            ties.u_free.push([0.0; N]);
-            weight.push(1.0 - alpha);
+            grains.push((g as u32, cell, xi, 1.0 - alpha));
         }
+        let body = bodies.len() as u32;
+        let mass = |g: u32, wp: f64| wp * w.bodies.mass[g as usize];
+        push_ties(&mut ties, body, &b.mesh, &grains, coupling, &mass);
+        band_all.extend(grains.iter().map(|x| (x.0, x.3)));
         bodies.push(b);
     }
-    Ok(Continuum::new(bodies, ties, weight))
+    band_all.sort_unstable_by_key(|x| x.0);
+    Ok(Continuum::new(bodies, ties, band_all))
+}
+
+/// The ties of one region's band grains (mesh node ids; [`super::ties`] for the two
+/// couplings). `mass(g, w_p)`: the grain's band mass m̃.
+fn push_ties<const N: usize>(
+    ties: &mut TieSet<N>,
+    body: u32,
+    mesh: &Mesh,
+    grains: &[BandGrain],
+    coupling: Coupling,
+    mass: &dyn Fn(u32, f64) -> f64,
+) {
+    let nodes_of = |cell: usize| mesh.cell(cell);
+    match coupling {
+        Coupling::Grain => {
+            for &(g, cell, xi, _) in grains {
+                ties.push(body, [(g, 1.0)], (0..=N).map(|q| (nodes_of(cell)[q], xi[q])));
+            }
+        }
+        Coupling::Node => {
+            // each grain to the node of its cell with the largest weight N_k(ξ_p)
+            // (the lower node id on a tie): the nodes' grain sets are disjoint, so
+            // the ties are independent (no redundant multipliers)
+            let mut per_node: std::collections::BTreeMap<u32, Vec<usize>> = Default::default();
+            for (ip, &(_, cell, xi, _)) in grains.iter().enumerate() {
+                let nodes = nodes_of(cell);
+                let q = (0..=N)
+                    .max_by(|&a, &b| xi[a].total_cmp(&xi[b]).then(nodes[b].cmp(&nodes[a])))
+                    .unwrap_or(0);
+                per_node.entry(nodes[q]).or_default().push(ip);
+            }
+            for list in per_node.values() {
+                let m: Vec<f64> = list.iter().map(|&ip| mass(grains[ip].0, grains[ip].3)).collect();
+                let s: f64 = m.iter().sum();
+                let mut b: std::collections::BTreeMap<u32, f64> = Default::default();
+                for (&ip, &mp) in list.iter().zip(&m) {
+                    let (_, cell, xi, _) = grains[ip];
+                    for q in 0..=N {
+                        *b.entry(nodes_of(cell)[q]).or_default() += mp / s * xi[q];
+                    }
+                }
+                let gs: Vec<(u32, f64)> = list.iter().zip(&m).map(|(&ip, &mp)| (grains[ip].0, mp / s)).collect();
+                ties.push(body, gs, b);
+            }
+        }
+    }
 }
 
 /// α at each cell's centroid; every cell must have α > 0 (a cell wholly on the
@@ -195,16 +261,12 @@ struct RegionState {
 }
 
 #[derive(Serialize, Deserialize)]
-struct TieState {
-    grain: u32,
-    weight: f64,
-    r: Vec<f64>,
-}
-
-#[derive(Serialize, Deserialize)]
 struct State {
     regions: Vec<RegionState>,
-    ties: Vec<TieState>,
+    /// The band's grains and their share of their mass (to read).
+    band: Vec<(u32, f64)>,
+    /// The ties' impulses λ (the next step's warm start).
+    ties: Vec<Vec<f64>>,
 }
 
 impl<D: Dim, const N: usize> Continuum<D, N> {
@@ -219,13 +281,8 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
                     velocity: b.v.clone(),
                 })
                 .collect(),
-            ties: (0..self.ties.len())
-                .map(|a| TieState {
-                    grain: self.ties.grain[a],
-                    weight: self.weight[a],
-                    r: self.ties.r[a].to_vec(),
-                })
-                .collect(),
+            band: self.band.clone(),
+            ties: self.ties.r.iter().map(|r| r.to_vec()).collect(),
         };
         serde_json::to_value(s).expect("plain data")
     }
@@ -237,13 +294,15 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
                 .iter()
                 .zip(&self.bodies)
                 .all(|(r, b)| r.displacement.len() == b.u.len() && r.velocity.len() == b.v.len())
+            && s.band.len() == self.band.len()
+            && s.band.iter().zip(&self.band).all(|(a, b)| a.0 == b.0)
             && s.ties.len() == self.ties.len()
-            && s.ties.iter().zip(&self.ties.grain).all(|(t, &g)| t.grain == g && t.r.len() == N);
+            && s.ties.iter().all(|r| r.len() == N);
         if !same {
             return Err("the state's continuum regions or ties are not the scene's: a restart needs the scene that wrote it".into());
         }
         let finite = |x: &[f64]| x.iter().all(|y| y.is_finite());
-        if !s.regions.iter().all(|r| finite(&r.displacement) && finite(&r.velocity)) || !s.ties.iter().all(|t| finite(&t.r)) {
+        if !s.regions.iter().all(|r| finite(&r.displacement) && finite(&r.velocity)) || !s.ties.iter().all(|r| finite(r)) {
             return Err("non-finite numbers in the continuum state".into());
         }
         for (b, r) in self.bodies.iter_mut().zip(s.regions) {
@@ -251,7 +310,7 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
             b.v = r.velocity;
         }
         for (r, t) in self.ties.r.iter_mut().zip(s.ties) {
-            r.copy_from_slice(&t.r);
+            r.copy_from_slice(&t);
         }
         Ok(())
     }
@@ -275,7 +334,7 @@ impl<D: Dim, const N: usize> SceneFamily<D> for Continuum<D, N> {
         )
     }
     fn share_world(&mut self, w: &mut World<D>) {
-        for (&g, &wp) in self.ties.grain.iter().zip(&self.weight) {
+        for &(g, wp) in &self.band {
             w.bodies.mass[g as usize] *= wp;
             w.bodies.refresh_inverse(g as usize);
         }

@@ -1,31 +1,49 @@
-//! The ties of an overlap band: one bilateral constraint per grain,
-//! v_p − N(ξ_p) V = ū_p (docs/CONTINUUM.md), its multiplier λ_p (an impulse,
-//! N·s) acting +λ_p on the grain's centre and −λ_p on the continuum's material
-//! point ξ_p (its D + 1 element nodes with the weights N_k(ξ_p)).
+//! The ties of an overlap band (docs/CONTINUUM.md): bilateral constraints on
+//! velocities, each of the form
+//!
+//! ```text
+//! u_a = Σ_i c_ai v_i − Σ_l b_al V_l = ū_a        (N components)
+//! ```
+//!
+//! over grains i (their translational velocities v_i) and the continuum's tie
+//! nodes l (V_l). Its multiplier λ_a (an impulse, N·s) acts +c_ai λ_a on grain i and
+//! −b_al λ_a on node l (the constraint's transpose). Two couplings fill it:
+//!
+//! - **per grain** (`coupling = "grain"`): one tie per band grain p, c = 1 on p,
+//!   b_l = N_l(ξ_p) on the D + 1 nodes of its cell: v_p = N(ξ_p) V;
+//! - **per node** (`coupling = "node"`, the default): each band grain is given to
+//!   the node k of its cell with the largest N_k(ξ_p); one tie per node holding
+//!   grains, c_kp = m̃_p / Σ_q m̃_q over its grains (m̃ their band masses),
+//!   b_kl = Σ_p c_kp N_l(ξ_p): the mass-weighted mean velocity of node k's grains
+//!   equals the continuum's mean at them. The grains' sets are disjoint, so the
+//!   ties are independent; the grains of a set may move relative to one another.
 //!
 //! A tie is solved as a contact with the bilateral law: its Delassus block
-//! W_p = M̂_p⁻¹ (the grain's translational block) + Σ_kl N_k N_l G_kl (the continuum's,
-//! through the block G of M̂⁻¹ among the tie nodes, [`crate::nodes::NodeSet`]) is
-//! positive definite whatever the mesh and the grains, and the NLGS update is
-//! λ_p ← λ_p − W_p⁻¹ (u_p − ū_p). The target closes the tie's gap
-//! g_p = x_p − Σ N_k x_k within the step, ū = −(g + h(1 − θ) u⁻)/(hθ), so that
-//! the grain stays on its material point (no drift).
+//! W_a = Σ_i c_ai² M̂_i⁻¹ (translational blocks) + Σ_ll' b_al b_al' G_ll' (the
+//! block G of M̂⁻¹ among the tie nodes, [`crate::nodes::NodeSet`]) is positive
+//! definite, and the NLGS update is λ_a ← λ_a − W_a⁻¹ (u_a − ū_a). The target
+//! closes the tie's gap g_a = Σ c_ai x_i − Σ b_al x_l within the step,
+//! ū = −(g + h(1 − θ) u⁻)/(hθ), so that the grains stay (on average, per node) on
+//! their material points.
 
 use crate::nodes::NodeSet;
 use nscdd::dim::Dim;
 use nscdd::norms::Sums;
 
-/// Ties of one step, one `Vec` per field: the grain (world body, or local copy in
-/// a subdomain's part), the continuum body (or local entity), the element nodes
-/// (indices in the body's [`NodeSet`]; `N + 1` used) and their weights, W_p and
-/// W_p⁻¹, the target ū, the impulse λ, u_free (for the residual), the grain's
-/// discrete weight w_p.
-#[derive(Clone, Debug, Default)]
+/// Ties of one step (module docs), one `Vec` per field: the continuum body (or
+/// local entity) of each, its grains `grain[g_start[a]..g_start[a + 1]]` (world
+/// bodies, or local copies in a subdomain's part) with their c, its nodes
+/// `node[n_start[a]..n_start[a + 1]]` (indices in the body's [`NodeSet`]) with their
+/// b, W_a and W_a⁻¹, the target ū, the impulse λ, u_free (for the residual).
+#[derive(Clone, Debug)]
 pub struct TieSet<const N: usize> {
-    pub grain: Vec<u32>,
     pub body: Vec<u32>,
-    pub k: Vec<[u32; 4]>,
-    pub xi: Vec<[f64; 4]>,
+    pub g_start: Vec<u32>,
+    pub grain: Vec<u32>,
+    pub c: Vec<f64>,
+    pub n_start: Vec<u32>,
+    pub node: Vec<u32>,
+    pub b: Vec<f64>,
     pub w: Vec<[[f64; N]; N]>,
     pub inv_w: Vec<[[f64; N]; N]>,
     pub target: Vec<[f64; N]>,
@@ -33,38 +51,71 @@ pub struct TieSet<const N: usize> {
     pub u_free: Vec<[f64; N]>,
 }
 
-impl<const N: usize> TieSet<N> {
-    pub fn len(&self) -> usize {
-        self.grain.len()
-    }
-    pub fn is_empty(&self) -> bool {
-        self.grain.is_empty()
-    }
-    /// Appends tie `a` of `src` with its grain and body renamed.
-    pub fn push_from(&mut self, src: &Self, a: usize, grain: u32, body: u32) {
-        self.grain.push(grain);
-        self.body.push(body);
-        self.k.push(src.k[a]);
-        self.xi.push(src.xi[a]);
-        self.w.push(src.w[a]);
-        self.inv_w.push(src.inv_w[a]);
-        self.target.push(src.target[a]);
-        self.r.push(src.r[a]);
-        self.u_free.push(src.u_free[a]);
+impl<const N: usize> Default for TieSet<N> {
+    fn default() -> Self {
+        TieSet {
+            body: vec![],
+            g_start: vec![0],
+            grain: vec![],
+            c: vec![],
+            n_start: vec![0],
+            node: vec![],
+            b: vec![],
+            w: vec![],
+            inv_w: vec![],
+            target: vec![],
+            r: vec![],
+            u_free: vec![],
+        }
     }
 }
 
-/// The continuum's velocity at a tie's material point: Σ_k N_k v_k.
-#[inline(always)]
-pub fn point_velocity<const N: usize>(set: &NodeSet<N>, k: &[u32; 4], xi: &[f64; 4]) -> [f64; N] {
-    let mut u = [0.0; N];
-    for q in 0..=N {
-        let v = set.v[k[q] as usize];
-        for c in 0..N {
-            u[c] += xi[q] * v[c];
-        }
+impl<const N: usize> TieSet<N> {
+    pub fn len(&self) -> usize {
+        self.body.len()
     }
-    u
+    pub fn is_empty(&self) -> bool {
+        self.body.is_empty()
+    }
+    pub fn grains(&self, a: usize) -> std::ops::Range<usize> {
+        self.g_start[a] as usize..self.g_start[a + 1] as usize
+    }
+    pub fn nodes(&self, a: usize) -> std::ops::Range<usize> {
+        self.n_start[a] as usize..self.n_start[a + 1] as usize
+    }
+    /// Appends a tie of `body` over `grains` (id, c) and `nodes` (set index, b), at
+    /// rest.
+    pub fn push(&mut self, body: u32, grains: impl IntoIterator<Item = (u32, f64)>, nodes: impl IntoIterator<Item = (u32, f64)>) {
+        self.body.push(body);
+        for (g, c) in grains {
+            self.grain.push(g);
+            self.c.push(c);
+        }
+        self.g_start.push(self.grain.len() as u32);
+        for (l, b) in nodes {
+            self.node.push(l);
+            self.b.push(b);
+        }
+        self.n_start.push(self.node.len() as u32);
+        self.w.push([[0.0; N]; N]);
+        self.inv_w.push([[0.0; N]; N]);
+        self.target.push([0.0; N]);
+        self.r.push([0.0; N]);
+        self.u_free.push([0.0; N]);
+    }
+    /// Appends tie `a` of `src` with its grains renamed by `grain` and its body
+    /// `body`.
+    pub fn push_from(&mut self, src: &Self, a: usize, grain: &mut dyn FnMut(u32) -> u32, body: u32) {
+        let gs = src.grains(a).map(|i| (grain(src.grain[i]), src.c[i]));
+        let ns = src.nodes(a).map(|j| (src.node[j], src.b[j]));
+        self.push(body, gs.collect::<Vec<_>>(), ns);
+        let k = self.len() - 1;
+        self.w[k] = src.w[a];
+        self.inv_w[k] = src.inv_w[a];
+        self.target[k] = src.target[a];
+        self.r[k] = src.r[a];
+        self.u_free[k] = src.u_free[a];
+    }
 }
 
 /// The grain's translational velocity (the first N values of its twist).
@@ -73,42 +124,69 @@ pub fn grain_velocity<D: Dim, const N: usize>(v: &D::Twist) -> [f64; N] {
     std::array::from_fn(|c| v.as_ref()[c])
 }
 
-/// u_p = v_p − N(ξ_p) V.
+/// u_a = Σ c_ai v_i − Σ b_al V_l from the current velocities.
 #[inline(always)]
-pub fn tie_velocity<D: Dim, const N: usize>(v: &D::Twist, set: &NodeSet<N>, k: &[u32; 4], xi: &[f64; 4]) -> [f64; N] {
-    let (a, b) = (grain_velocity::<D, N>(v), point_velocity(set, k, xi));
-    std::array::from_fn(|c| a[c] - b[c])
+pub fn tie_velocity<D: Dim, const N: usize>(t: &TieSet<N>, a: usize, vel: &[D::Twist], set: &NodeSet<N>) -> [f64; N] {
+    let mut u = [0.0; N];
+    for i in t.grains(a) {
+        let v = vel[t.grain[i] as usize].as_ref();
+        for c in 0..N {
+            u[c] += t.c[i] * v[c];
+        }
+    }
+    for j in t.nodes(a) {
+        let v = set.v[t.node[j] as usize];
+        for c in 0..N {
+            u[c] -= t.b[j] * v[c];
+        }
+    }
+    u
 }
 
-/// Applies the impulse increment Δλ: +Δλ at the grain's centre, −Δλ at the
-/// material point.
+/// Applies the impulse increment Δλ of tie `a` to its grains and nodes.
 #[inline(always)]
-pub fn apply<D: Dim, const N: usize>(set: &mut NodeSet<N>, v: &mut D::Twist, inv: &D::InvMass, k: &[u32; 4], xi: &[f64; 4], dr: [f64; N]) {
-    let mut f = D::Twist::default();
-    f.as_mut()[..N].copy_from_slice(&dr);
-    D::apply_inv(v, inv, &f);
-    for q in 0..=N {
-        set.apply(k[q] as usize, dr.map(|x| -xi[q] * x));
+pub fn apply<D: Dim, const N: usize>(
+    t: &TieSet<N>,
+    a: usize,
+    vel: &mut [D::Twist],
+    inv: &[D::InvMass],
+    set: &mut NodeSet<N>,
+    dr: [f64; N],
+) {
+    for i in t.grains(a) {
+        let g = t.grain[i] as usize;
+        let mut f = D::Twist::default();
+        for c in 0..N {
+            f.as_mut()[c] = t.c[i] * dr[c];
+        }
+        D::apply_inv(&mut vel[g], &inv[g], &f);
+    }
+    for j in t.nodes(a) {
+        set.apply(t.node[j] as usize, dr.map(|x| -t.b[j] * x));
     }
 }
 
-/// W_p: the grain's translational block of M̂⁻¹ (its copy's) plus the material
-/// point's Σ_kl N_k N_l G_kl.
-pub fn delassus<D: Dim, const N: usize>(set: &NodeSet<N>, inv: &D::InvMass, k: &[u32; 4], xi: &[f64; 4]) -> [[f64; N]; N] {
+/// W_a (module docs) from the grains' copies' M̂⁻¹ and the set's G.
+pub fn delassus<D: Dim, const N: usize>(t: &TieSet<N>, a: usize, inv: &[D::InvMass], set: &NodeSet<N>) -> [[f64; N]; N] {
     let mut w = [[0.0; N]; N];
-    for (c, row) in w.iter_mut().enumerate() {
-        let (mut v, mut f) = (D::Twist::default(), D::Twist::default());
-        f.as_mut()[c] = 1.0;
-        D::apply_inv(&mut v, inv, &f);
-        row.copy_from_slice(&v.as_ref()[..N]);
+    for i in t.grains(a) {
+        let c2 = t.c[i] * t.c[i];
+        for (c, row) in w.iter_mut().enumerate() {
+            let (mut v, mut f) = (D::Twist::default(), D::Twist::default());
+            f.as_mut()[c] = 1.0;
+            D::apply_inv(&mut v, &inv[t.grain[i] as usize], &f);
+            for (x, y) in row.iter_mut().zip(v.as_ref()) {
+                *x += c2 * y;
+            }
+        }
     }
-    for p in 0..=N {
-        for q in 0..=N {
-            let b = set.block(k[p] as usize, k[q] as usize);
-            let ww = xi[p] * xi[q];
+    for p in t.nodes(a) {
+        for q in t.nodes(a) {
+            let blk = set.block(t.node[p] as usize, t.node[q] as usize);
+            let bb = t.b[p] * t.b[q];
             for c in 0..N {
                 for d in 0..N {
-                    w[c][d] += ww * b[c][d];
+                    w[c][d] += bb * blk[c][d];
                 }
             }
         }
@@ -116,8 +194,8 @@ pub fn delassus<D: Dim, const N: usize>(set: &NodeSet<N>, inv: &D::InvMass, k: &
     w
 }
 
-/// The inverse of a small symmetric positive definite matrix (Gauss–Jordan; the
-/// ties' W_p, N ≤ 3). None when singular.
+/// The inverse of a small symmetric positive definite matrix (Gauss–Jordan with
+/// partial pivoting; the ties' W_a, N ≤ 3). None when singular.
 pub fn inverse<const N: usize>(a: [[f64; N]; N]) -> Option<[[f64; N]; N]> {
     let mut m = a;
     let mut inv = [[0.0; N]; N];
@@ -152,8 +230,8 @@ pub fn mul<const N: usize>(a: &[[f64; N]; N], x: &[f64; N]) -> [f64; N] {
     std::array::from_fn(|i| (0..N).map(|j| a[i][j] * x[j]).sum())
 }
 
-/// One NLGS sweep over the ties (storage order): λ ← λ − W⁻¹ (u − ū), relaxed by ω;
-/// a check pass adds to `sums` (LMGC90's sums, as a contact's).
+/// One NLGS sweep over the ties (storage order): λ ← λ − ω W⁻¹ (u − ū); a check
+/// pass adds to `sums` (LMGC90's sums, as a contact's).
 pub fn sweep<D: Dim, const N: usize>(
     t: &mut TieSet<N>,
     sets: &mut [NodeSet<N>],
@@ -163,9 +241,8 @@ pub fn sweep<D: Dim, const N: usize>(
     mut sums: Option<&mut Sums>,
 ) {
     for a in 0..t.len() {
-        let (g, b) = (t.grain[a] as usize, t.body[a] as usize);
-        let (k, xi) = (t.k[a], t.xi[a]);
-        let u = tie_velocity::<D, N>(&vel[g], &sets[b], &k, &xi);
+        let set = &mut sets[t.body[a] as usize];
+        let u = tie_velocity::<D, N>(t, a, vel, set);
         let du: [f64; N] = std::array::from_fn(|c| u[c] - t.target[a][c]);
         let r = t.r[a];
         let step = mul(&t.inv_w[a], &du);
@@ -178,27 +255,26 @@ pub fn sweep<D: Dim, const N: usize>(
         }
         if dr.iter().any(|&x| x != 0.0) {
             t.r[a] = rn;
-            apply::<D, N>(&mut sets[b], &mut vel[g], &inv[g], &k, &xi, dr);
+            apply::<D, N>(t, a, vel, inv, set, dr);
         }
     }
 }
 
-/// Warm start: the kept impulses applied to both sides.
+/// Warm start: the kept impulses applied to grains and nodes.
 pub fn warm_start<D: Dim, const N: usize>(t: &TieSet<N>, sets: &mut [NodeSet<N>], vel: &mut [D::Twist], inv: &[D::InvMass]) {
     for a in 0..t.len() {
         if t.r[a].iter().any(|&x| x != 0.0) {
-            let (g, b) = (t.grain[a] as usize, t.body[a] as usize);
-            apply::<D, N>(&mut sets[b], &mut vel[g], &inv[g], &t.k[a], &t.xi[a], t.r[a]);
+            apply::<D, N>(t, a, vel, inv, &mut sets[t.body[a] as usize], t.r[a]);
         }
     }
 }
 
-/// W_p and W_p⁻¹ of every tie from the sets' G and the grains' copies' M̂⁻¹.
+/// W_a and W_a⁻¹ of every tie.
 pub fn refresh_delassus<D: Dim, const N: usize>(t: &mut TieSet<N>, sets: &[NodeSet<N>], inv: &[D::InvMass]) {
     for a in 0..t.len() {
-        let w = delassus::<D, N>(&sets[t.body[a] as usize], &inv[t.grain[a] as usize], &t.k[a], &t.xi[a]);
+        let w = delassus::<D, N>(t, a, inv, &sets[t.body[a] as usize]);
         t.w[a] = w;
-        // W_p ≥ the grain's own M̂⁻¹ > 0 (a tied grain is movable)
+        // W_a ≥ Σ c² M̂⁻¹ > 0: a tie holds movable grains
         t.inv_w[a] = inverse(w).unwrap_or([[0.0; N]; N]);
     }
 }
@@ -208,7 +284,7 @@ pub fn refresh_delassus<D: Dim, const N: usize>(t: &mut TieSet<N>, sets: &[NodeS
 pub fn residual_parts<D: Dim, const N: usize>(t: &TieSet<N>, sets: &[NodeSet<N>], vel: &[D::Twist]) -> (f64, f64) {
     let (mut f2, mut q2) = (0.0, 0.0);
     for a in 0..t.len() {
-        let u = tie_velocity::<D, N>(&vel[t.grain[a] as usize], &sets[t.body[a] as usize], &t.k[a], &t.xi[a]);
+        let u = tie_velocity::<D, N>(t, a, vel, &sets[t.body[a] as usize]);
         for c in 0..N {
             let (f, q) = (u[c] - t.target[a][c], t.u_free[a][c] - t.target[a][c]);
             f2 += f * f;
