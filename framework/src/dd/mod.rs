@@ -404,6 +404,10 @@ impl<D: Family> NscddOf<D> {
         if total == 0 {
             rep.solve.converged = true;
             self.store.keep(&d.subs);
+            // no contact anywhere: the families' V⁺ is their V_free
+            for fam in fams.iter_mut() {
+                fam.write_back(w, &[]);
+            }
             return;
         }
         let per = set.sweeps_per_gluing.max(1);

@@ -70,6 +70,9 @@ pub struct FeBody {
     pub v_free: Vec<f64>,
     /// External load per dof (gravity: M g).
     pub f_ext: Vec<f64>,
+    /// A force of the step beside F_ext (empty: none): a continuum's plastic strains'
+    /// share f_p of the internal force K u − f_p ([`crate::continuum::plastic`]).
+    pub f_plastic: Vec<f64>,
     /// Cached columns of M̂⁻¹, `dim` per node (node-major inside).
     columns: HashMap<u32, Vec<f64>>,
     /// Column solves done since the last refactorization (a measure).
@@ -136,6 +139,7 @@ impl FeBody {
             v_begin: vec![0.0; n],
             v_free: vec![0.0; n],
             f_ext,
+            f_plastic: Vec::new(),
             columns: HashMap::new(),
             solves: 0,
             skfem_version,
@@ -244,9 +248,12 @@ impl FeBody {
         let n = self.n_dofs();
         self.v_begin.clone_from(&self.v);
         let [al, be] = self.elastic.rayleigh;
-        // rhs = h (F_ext − K (u + hθ V) − C V) = h F_ext − h (α M V) − h K (u + (hθ + β) V)
+        // rhs = h (F_ext + f_p − K (u + hθ V) − C V) = h (F_ext + f_p) − h (α M V) − h K (u + (hθ + β) V)
         let mut w: Vec<f64> = (0..n).map(|i| self.u[i] + (h * theta + be) * self.v[i]).collect();
         let mut rhs: Vec<f64> = self.f_ext.iter().map(|f| h * f).collect();
+        for (r, f) in rhs.iter_mut().zip(&self.f_plastic) {
+            *r += h * f;
+        }
         self.mul_add(0.0, -h, &w, &mut rhs);
         if al != 0.0 {
             self.mul_add(-h * al, 0.0, &self.v, &mut rhs);

@@ -392,3 +392,73 @@ fn a_dense_packing_on_the_band_converges() {
         assert!(rep.solve.converged, "step {k}: {:?}", rep.solve);
     }
 }
+
+/// A block of the continuum alone (its band far above), held at its base, under
+/// gravity, 1 m wide and 0.5 m high.
+fn block_scene(plastic: &str) -> String {
+    format!(
+        r#"
+[time]
+step = 2e-3
+theta = 1.0
+steps = 1
+[[materials]]
+name = "ground"
+density = 1600.0
+[[continuum]]
+material = "ground"
+young = 1e6
+poisson = 0.3
+fix = ["bottom"]
+mesh = {{ rectangle = {{ origin = [0.0, 0.0], size = [1.0, 0.5], cells = [20, 10] }} }}
+band = {{ normal = [0.0, 1.0], continuum = 10.0, discrete = 11.0 }}
+{plastic}
+"#
+    )
+}
+
+fn largest_horizontal(c: &Continuum2) -> f64 {
+    c.bodies[0].u.iter().step_by(2).fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+#[test]
+fn a_cohesionless_block_flows_where_an_elastic_one_stands() {
+    let run = |plastic: &str, steps: usize| {
+        let mut r = Run::new(&block_scene(plastic));
+        let mut u = vec![];
+        for _ in 0..steps {
+            r.step();
+            u.push(largest_horizontal(r.cont()));
+        }
+        (r, u)
+    };
+    let (el, ue) = run("", 300);
+    let (dp, ud) = run("plastic = { friction = 30.0 }", 300);
+    let (coh, uc) = run("plastic = { friction = 30.0, cohesion = 1e6 }", 300);
+    println!(
+        "largest horizontal displacement after 0.2, 0.4, 0.6 s: elastic {:.2e} {:.2e} {:.2e}, cohesionless {:.2e} {:.2e} {:.2e}",
+        ue[99], ue[199], ue[299], ud[99], ud[199], ud[299]
+    );
+    // the elastic block (and the strongly cohesive one: bitwise the same, f_p = 0) stands
+    assert_eq!(ue, uc);
+    // (its oscillation about the static state, ≈ 6e-4 m, decays)
+    let late = ue[200..].iter().fold(0.0f64, |m, &x| m.max(x));
+    assert!(late < 1e-3, "the elastic block must stand: {late:e}");
+    assert_eq!(coh.cont().plastic[0].as_ref().unwrap().yielding, 0);
+    // the cohesionless one keeps spreading, far past the elastic displacement
+    let p = dp.cont().plastic[0].as_ref().unwrap();
+    assert!(p.yielding > 0);
+    assert!(ud[299] > 50.0 * late && ud[299] > ud[199] * 1.2, "{:?}", &ud[199..]);
+    // every cell's stress lies on or inside the cone
+    for s in &p.sigma {
+        let pr = (s[0][0] + s[1][1] + s[2][2]) / 3.0;
+        let j2: f64 = 0.5
+            * (0..3)
+                .flat_map(|a| (0..3).map(move |b| (a, b)))
+                .map(|(a, b)| (s[a][b] - if a == b { pr } else { 0.0 }).powi(2))
+                .sum::<f64>();
+        let f = j2.sqrt() + p.eta * pr - p.xi * p.cohesion;
+        assert!(f <= 1e-9 * (pr.abs() + 1.0), "f = {f}");
+    }
+    let _ = el;
+}

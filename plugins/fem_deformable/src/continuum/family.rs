@@ -24,6 +24,8 @@ use std::marker::PhantomData;
 /// dimension's (2 or 3).
 pub struct Continuum<D: Dim, const N: usize> {
     pub bodies: Vec<FeBody>,
+    /// Each region's Drucker–Prager state (None: linear elastic).
+    pub plastic: Vec<Option<super::plastic::Plastic>>,
     /// The ties ([`ties`]): grains by world id, nodes by index in `sets[body]`.
     pub ties: TieSet<N>,
     /// The band's grains and their share w_p of their mass (the partition of
@@ -47,7 +49,7 @@ pub struct Continuum<D: Dim, const N: usize> {
 impl<D: Dim, const N: usize> Continuum<D, N> {
     /// Regions with their ties (`ties.node` holding mesh node ids, turned here into
     /// indices of each region's tie node set) and band grains.
-    pub fn new(bodies: Vec<FeBody>, mut ties: TieSet<N>, band: Vec<(u32, f64)>) -> Self {
+    pub fn new(bodies: Vec<FeBody>, plastic: Vec<Option<super::plastic::Plastic>>, mut ties: TieSet<N>, band: Vec<(u32, f64)>) -> Self {
         assert_eq!(D::N, N, "the continuum family's N is the dimension's");
         let mut nodes: Vec<Vec<u32>> = vec![vec![]; bodies.len()];
         for a in 0..ties.len() {
@@ -67,6 +69,7 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
         }
         Continuum {
             bodies,
+            plastic,
             ties,
             band,
             sets,
@@ -79,9 +82,14 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
         }
     }
 
-    /// Free velocities of the regions (factoring M̂ if h or θ changed) and the tied
-    /// grains' V⁻ and V_free.
+    /// Free velocities of the regions (factoring M̂ if h or θ changed; with the
+    /// plastic strains' force f_p) and the tied grains' V⁻ and V_free.
     pub fn begin_step(&mut self, w: &World<D>) -> Result<(), String> {
+        for (b, p) in self.bodies.iter_mut().zip(&self.plastic) {
+            if let Some(p) = p {
+                p.plastic_force(&b.mesh, &mut b.f_plastic);
+            }
+        }
         crate::stage2::free_velocities(&mut self.bodies, w.time.h, w.time.theta)?;
         let begin = w.velocity_begin();
         self.grain_begin.clear();

@@ -25,6 +25,7 @@
 //! The ties are the family's contacts in the NSCDD stage ([`family`]).
 
 pub mod family;
+pub mod plastic;
 pub mod scene;
 pub mod ties;
 

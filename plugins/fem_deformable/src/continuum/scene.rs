@@ -102,6 +102,38 @@ fn coupling_of(i: usize, e: &toml::Table) -> Result<Coupling, EntryError> {
     }
 }
 
+/// `plastic = { friction, dilatancy, cohesion }` (degrees, degrees, Pa): a
+/// Drucker–Prager continuum ([`super::plastic`]).
+#[derive(Deserialize, Debug, Clone, Copy)]
+#[serde(deny_unknown_fields)]
+struct DpSpec {
+    friction: f64,
+    #[serde(default)]
+    dilatancy: f64,
+    #[serde(default)]
+    cohesion: f64,
+}
+
+fn plastic_of(i: usize, e: &toml::Table) -> Result<Option<DpSpec>, EntryError> {
+    let at = |message: String| EntryError {
+        index: Some(i),
+        key: "plastic".into(),
+        message,
+    };
+    let Some(v) = e.get("plastic") else { return Ok(None) };
+    let d = DpSpec::deserialize(v.clone()).map_err(|x| at(x.message().to_string()))?;
+    if !(d.friction >= 0.0 && d.friction < 90.0) || !(d.dilatancy >= 0.0 && d.dilatancy <= d.friction) {
+        return Err(at(format!(
+            "friction in [0, 90) degrees and dilatancy in [0, friction], got {} and {}",
+            d.friction, d.dilatancy
+        )));
+    }
+    if !(d.cohesion >= 0.0 && d.cohesion.is_finite()) || (d.friction == 0.0 && d.cohesion == 0.0) {
+        return Err(at("cohesion ≥ 0 (and > 0 when friction is 0)".into()));
+    }
+    Ok(Some(d))
+}
+
 /// A band grain: world id, cell, barycentric coordinates, share w_p of its mass.
 type BandGrain = (u32, usize, [f64; 4], f64);
 
@@ -109,6 +141,7 @@ type BandGrain = (u32, usize, [f64; 4], f64);
 fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, D>) -> Result<Continuum<D, N>, EntryError> {
     let w = cx.world;
     let (mut bodies, mut ties, mut band_all) = (Vec::new(), TieSet::<N>::default(), Vec::new());
+    let mut plastic = Vec::new();
     let mut tied = vec![false; w.bodies.len()];
     let mut held = 0.0;
     for (i, e) in entries.iter().enumerate() {
@@ -119,9 +152,11 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
         };
         let band = band_of(i, e, N)?;
         let coupling = coupling_of(i, e)?;
+        let dp = plastic_of(i, e)?;
         let mut rest = e.clone();
         rest.remove("band");
         rest.remove("coupling");
+        rest.remove("plastic");
         let spec = crate::scene::spec_of(i, &rest)?;
         let mut memory = |nodes: f64| {
             let bytes = crate::scene::mesh_bytes(N, nodes);
@@ -132,6 +167,24 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
         let mut b = crate::scene::build_scaled(&spec, &w.materials, N, cx.dir, &mut memory, &scale).map_err(|(k, m)| at(k, m))?;
         b.set_gravity(&w.gravity.as_ref()[..N]);
         b.factorize(w.time.h, w.time.theta).map_err(|m| at("", m))?;
+        if dp.is_some() && b.elastic.plane_stress {
+            return Err(at(
+                "plastic",
+                "the Drucker–Prager continuum is in plane strain (no `plane = \"stress\"`)".into(),
+            ));
+        }
+        plastic.push(dp.map(|d| {
+            let alpha = cell_weights(&b.mesh, &band).expect("checked at assembly");
+            super::plastic::Plastic::new(
+                &b.mesh,
+                d.friction,
+                d.dilatancy,
+                d.cohesion,
+                b.elastic.young,
+                b.elastic.poisson,
+                &alpha,
+            )
+        }));
         let mut grains: Vec<BandGrain> = Vec::new();
         for g in 0..w.bodies.len() {
             if tied[g] || !Rigid::<D>::is_grain(w, g) || !w.bodies.movable(g) {
@@ -156,7 +209,7 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
         bodies.push(b);
     }
     band_all.sort_unstable_by_key(|x| x.0);
-    Ok(Continuum::new(bodies, ties, band_all))
+    Ok(Continuum::new(bodies, plastic, ties, band_all))
 }
 
 /// The ties of one region's band grains (mesh node ids; [`super::ties`] for the two
@@ -258,6 +311,9 @@ struct RegionState {
     name: Option<String>,
     displacement: Vec<f64>,
     velocity: Vec<f64>,
+    /// Drucker–Prager regions: each cell's plastic strain (xx, yy, zz, xy, yz, xz).
+    #[serde(default)]
+    plastic_strain: Vec<f64>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -275,10 +331,17 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
             regions: self
                 .bodies
                 .iter()
-                .map(|b| RegionState {
+                .zip(&self.plastic)
+                .map(|(b, p)| RegionState {
                     name: b.name.clone(),
                     displacement: b.u.clone(),
                     velocity: b.v.clone(),
+                    plastic_strain: p.as_ref().map_or_else(Vec::new, |p| {
+                        p.eps_p
+                            .iter()
+                            .flat_map(|e| [e[0][0], e[1][1], e[2][2], e[0][1], e[1][2], e[0][2]])
+                            .collect()
+                    }),
                 })
                 .collect(),
             band: self.band.clone(),
@@ -302,12 +365,22 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
             return Err("the state's continuum regions or ties are not the scene's: a restart needs the scene that wrote it".into());
         }
         let finite = |x: &[f64]| x.iter().all(|y| y.is_finite());
-        if !s.regions.iter().all(|r| finite(&r.displacement) && finite(&r.velocity)) || !s.ties.iter().all(|r| finite(r)) {
+        if !s
+            .regions
+            .iter()
+            .all(|r| finite(&r.displacement) && finite(&r.velocity) && finite(&r.plastic_strain))
+            || !s.ties.iter().all(|r| finite(r))
+        {
             return Err("non-finite numbers in the continuum state".into());
         }
-        for (b, r) in self.bodies.iter_mut().zip(s.regions) {
+        for ((b, r), p) in self.bodies.iter_mut().zip(s.regions).zip(&mut self.plastic) {
             b.u = r.displacement;
             b.v = r.velocity;
+            if let Some(p) = p {
+                for (e, x) in p.eps_p.iter_mut().zip(r.plastic_strain.chunks_exact(6)) {
+                    *e = [[x[0], x[3], x[5]], [x[3], x[1], x[4]], [x[5], x[4], x[2]]];
+                }
+            }
         }
         for (r, t) in self.ties.r.iter_mut().zip(s.ties) {
             r.copy_from_slice(&t);
@@ -347,7 +420,13 @@ impl<D: Dim, const N: usize> SceneFamily<D> for Continuum<D, N> {
                 message: e,
             });
         }
-        crate::stage2::update_bodies(&mut self.bodies, w.time.h, w.time.theta, w.step)
+        crate::stage2::update_bodies(&mut self.bodies, w.time.h, w.time.theta, w.step)?;
+        for (b, p) in self.bodies.iter().zip(&mut self.plastic) {
+            if let Some(p) = p {
+                p.update(&b.mesh, &b.u);
+            }
+        }
+        Ok(())
     }
     fn contacts(&self) -> usize {
         self.ties.len()
@@ -367,8 +446,12 @@ impl<D: Dim, const N: usize> SceneFamily<D> for Continuum<D, N> {
         out.push(self.ties.len() as f64);
         out.push(self.tie_impulse());
         out.push(self.bodies.iter().map(FeBody::kinetic_energy).sum());
-        out.push(self.bodies.iter().map(FeBody::elastic_energy).sum());
+        let elastic = |(b, p): (&FeBody, &Option<super::plastic::Plastic>)| {
+            p.as_ref().map_or_else(|| b.elastic_energy(), |p| p.elastic_energy(&b.mesh, &b.u))
+        };
+        out.push(self.bodies.iter().zip(&self.plastic).map(elastic).sum());
         out.push(self.bodies.iter().map(FeBody::load_potential).sum());
+        out.push(self.plastic.iter().flatten().map(|p| p.yielding as f64).sum());
     }
     fn write_frame(&mut self, dir: &Path, frame: u32, t: f64) -> std::io::Result<()> {
         for (bi, b) in self.bodies.iter().enumerate() {

@@ -1,0 +1,241 @@
+//! A pressure-dependent elastoplastic continuum: Drucker–Prager matched to
+//! Mohr–Coulomb in plane strain (docs/CONTINUUM.md), per cell of linear
+//! elements (constant strain), integrated implicitly.
+//!
+//! With p = tr σ / 3 (tension positive) and J₂ = ½ s:s (s the deviator):
+//!
+//! ```text
+//! f(σ) = √J₂ + η p − ξ c ≤ 0,      g(σ) = √J₂ + η̄ p (flow potential)
+//! η = 3 tan φ / √(9 + 12 tan² φ),  ξ = 3 / √(9 + 12 tan² φ),  η̄: the same with ψ
+//! ```
+//!
+//! φ the friction angle, ψ the dilatancy angle (ψ = φ: associative), c the
+//! cohesion. At the end of each step the trial stress σ_tr = D(ε(u⁺) − ε_p) is
+//! projected by the backward-Euler return mapping (closed form on the cone,
+//! Δγ = f(σ_tr)/(G + K η η̄); to the apex p = ξc/η where the cone's return would
+//! cross it), and ε_p = ε − D⁻¹σ. The momentum balance uses the elastic stiffness
+//! (M̂ is factored once) and the plastic strains of the step's start: the internal
+//! force is K u − f_p, f_p = Σ_e α_e A_e Bᵀ D ε_p (α_e the cell's band weight).
+
+use crate::mesh::{gradients, signed_measure, Mesh};
+
+/// Drucker–Prager parameters and the per-cell state (module docs).
+#[derive(Clone, Debug)]
+pub struct Plastic {
+    pub eta: f64,
+    pub eta_bar: f64,
+    pub xi: f64,
+    pub cohesion: f64,
+    lam: f64,
+    mu: f64,
+    /// Per cell: shape-function gradients (D + 1 rows), α_e A_e, plastic strain and
+    /// stress (3 × 3 tensors, tension positive).
+    grad: Vec<[[f64; 3]; 4]>,
+    weight: Vec<f64>,
+    pub eps_p: Vec<[[f64; 3]; 3]>,
+    pub sigma: Vec<[[f64; 3]; 3]>,
+    /// Cells that yielded in the last update.
+    pub yielding: usize,
+}
+
+/// η or ξ of Drucker–Prager's plane-strain match of Mohr–Coulomb for angle `deg`.
+fn dp(deg: f64) -> (f64, f64) {
+    let t = deg.to_radians().tan();
+    let den = (9.0 + 12.0 * t * t).sqrt();
+    (3.0 * t / den, 3.0 / den)
+}
+
+impl Plastic {
+    /// Angles φ, ψ in degrees, cohesion c (Pa), elastic E, ν; `alpha`: each cell's
+    /// band weight.
+    pub fn new(mesh: &Mesh, friction: f64, dilatancy: f64, cohesion: f64, young: f64, poisson: f64, alpha: &[f64]) -> Plastic {
+        let (eta, xi) = dp(friction);
+        let (eta_bar, _) = dp(dilatancy);
+        let mu = young / (2.0 * (1.0 + poisson));
+        let lam = young * poisson / ((1.0 + poisson) * (1.0 - 2.0 * poisson));
+        let d = mesh.dim;
+        let mut grad = Vec::with_capacity(mesh.n_cells());
+        let mut weight = Vec::with_capacity(mesh.n_cells());
+        for e in 0..mesh.n_cells() {
+            let c = mesh.cell(e);
+            let g = gradients(d, &mesh.x0, c);
+            let mut gg = [[0.0; 3]; 4];
+            gg[..=d].copy_from_slice(&g);
+            grad.push(gg);
+            weight.push(alpha[e] * signed_measure(d, &mesh.x0, c).abs());
+        }
+        let n = mesh.n_cells();
+        Plastic {
+            eta,
+            eta_bar,
+            xi,
+            cohesion,
+            lam,
+            mu,
+            grad,
+            weight,
+            eps_p: vec![[[0.0; 3]; 3]; n],
+            sigma: vec![[[0.0; 3]; 3]; n],
+            yielding: 0,
+        }
+    }
+
+    /// The strain of cell e (3 × 3, the plane's zz = 0 in 2D).
+    fn strain(&self, mesh: &Mesh, e: usize, u: &[f64]) -> [[f64; 3]; 3] {
+        let d = mesh.dim;
+        let mut du = [[0.0; 3]; 3];
+        for (i, &k) in mesh.cell(e).iter().enumerate() {
+            for a in 0..d {
+                for b in 0..d {
+                    du[a][b] += u[d * k as usize + a] * self.grad[e][i][b];
+                }
+            }
+        }
+        std::array::from_fn(|a| std::array::from_fn(|b| 0.5 * (du[a][b] + du[b][a])))
+    }
+
+    fn stress_of(&self, eps_e: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+        let tr = eps_e[0][0] + eps_e[1][1] + eps_e[2][2];
+        std::array::from_fn(|a| std::array::from_fn(|b| 2.0 * self.mu * eps_e[a][b] + if a == b { self.lam * tr } else { 0.0 }))
+    }
+
+    /// f_p = Σ_e α_e A_e Bᵀ D ε_p (node-major, the mesh's dofs): the force that the
+    /// plastic strains take off the elastic K u.
+    pub fn plastic_force(&self, mesh: &Mesh, out: &mut Vec<f64>) {
+        let d = mesh.dim;
+        out.clear();
+        out.resize(d * mesh.n_nodes(), 0.0);
+        for e in 0..mesh.n_cells() {
+            let s = self.stress_of(&self.eps_p[e]);
+            for (i, &k) in mesh.cell(e).iter().enumerate() {
+                for a in 0..d {
+                    let f: f64 = (0..d).map(|b| s[a][b] * self.grad[e][i][b]).sum();
+                    out[d * k as usize + a] += self.weight[e] * f;
+                }
+            }
+        }
+    }
+
+    /// The return mapping of every cell at displacement u (module docs).
+    pub fn update(&mut self, mesh: &Mesh, u: &[f64]) {
+        self.yielding = 0;
+        for e in 0..mesh.n_cells() {
+            let eps = self.strain(mesh, e, u);
+            let ee: [[f64; 3]; 3] = std::array::from_fn(|a| std::array::from_fn(|b| eps[a][b] - self.eps_p[e][a][b]));
+            let trial = self.stress_of(&ee);
+            let (sigma, yielded) = self.project(&trial);
+            if yielded {
+                self.yielding += 1;
+                // ε_p = ε − D⁻¹ σ
+                let ee_new = self.compliance(&sigma);
+                self.eps_p[e] = std::array::from_fn(|a| std::array::from_fn(|b| eps[a][b] - ee_new[a][b]));
+            }
+            self.sigma[e] = sigma;
+        }
+    }
+
+    /// D⁻¹ σ.
+    fn compliance(&self, s: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+        let k = self.lam + 2.0 * self.mu / 3.0;
+        let p = (s[0][0] + s[1][1] + s[2][2]) / 3.0;
+        std::array::from_fn(|a| {
+            std::array::from_fn(|b| {
+                let dev = s[a][b] - if a == b { p } else { 0.0 };
+                dev / (2.0 * self.mu) + if a == b { p / (3.0 * k) } else { 0.0 }
+            })
+        })
+    }
+
+    /// The closest-point return of a trial stress; whether it yielded.
+    pub fn project(&self, tr: &[[f64; 3]; 3]) -> ([[f64; 3]; 3], bool) {
+        let p = (tr[0][0] + tr[1][1] + tr[2][2]) / 3.0;
+        let s: [[f64; 3]; 3] = std::array::from_fn(|a| std::array::from_fn(|b| tr[a][b] - if a == b { p } else { 0.0 }));
+        let j2 = 0.5 * s.iter().flatten().map(|x| x * x).sum::<f64>();
+        let q = j2.sqrt();
+        let f = q + self.eta * p - self.xi * self.cohesion;
+        if f <= 0.0 {
+            return (*tr, false);
+        }
+        let (g, k) = (self.mu, self.lam + 2.0 * self.mu / 3.0);
+        let dgamma = f / (g + k * self.eta * self.eta_bar);
+        let out = if q - g * dgamma >= 0.0 {
+            let scale = if q > 0.0 { 1.0 - g * dgamma / q } else { 0.0 };
+            let pn = p - k * self.eta_bar * dgamma;
+            std::array::from_fn(|a| std::array::from_fn(|b| scale * s[a][b] + if a == b { pn } else { 0.0 }))
+        } else {
+            // the apex: p = ξ c / η (no shear left)
+            let pa = if self.eta > 0.0 { self.xi * self.cohesion / self.eta } else { p };
+            std::array::from_fn(|a| std::array::from_fn(|b| if a == b { pa } else { 0.0 }))
+        };
+        (out, true)
+    }
+
+    /// Σ_e ½ α_e A_e σ:(ε − ε_p), the elastic energy stored.
+    pub fn elastic_energy(&self, mesh: &Mesh, u: &[f64]) -> f64 {
+        (0..mesh.n_cells())
+            .map(|e| {
+                let eps = self.strain(mesh, e, u);
+                let s = self.stress_of(&std::array::from_fn(|a| std::array::from_fn(|b| eps[a][b] - self.eps_p[e][a][b])));
+                let mut w = 0.0;
+                for a in 0..3 {
+                    for b in 0..3 {
+                        w += s[a][b] * (eps[a][b] - self.eps_p[e][a][b]);
+                    }
+                }
+                0.5 * self.weight[e] * w
+            })
+            .sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn material(phi: f64, psi: f64, c: f64) -> Plastic {
+        let (eta, xi) = dp(phi);
+        let (eta_bar, _) = dp(psi);
+        Plastic {
+            eta,
+            eta_bar,
+            xi,
+            cohesion: c,
+            lam: 1e6,
+            mu: 1e6,
+            grad: vec![],
+            weight: vec![],
+            eps_p: vec![],
+            sigma: vec![],
+            yielding: 0,
+        }
+    }
+
+    fn f(m: &Plastic, s: &[[f64; 3]; 3]) -> f64 {
+        let p = (s[0][0] + s[1][1] + s[2][2]) / 3.0;
+        let j2 = 0.5
+            * (0..3)
+                .flat_map(|a| (0..3).map(move |b| (a, b)))
+                .map(|(a, b)| (s[a][b] - if a == b { p } else { 0.0 }).powi(2))
+                .sum::<f64>();
+        j2.sqrt() + m.eta * p - m.xi * m.cohesion
+    }
+
+    #[test]
+    fn the_return_lands_on_the_cone() {
+        let m = material(30.0, 30.0, 1e3);
+        // compression with shear: yields onto the cone
+        let tr = [[-1e5, 8e4, 0.0], [8e4, -2e5, 0.0], [0.0, 0.0, -1.5e5]];
+        let (s, y) = m.project(&tr);
+        assert!(y && f(&m, &tr) > 0.0);
+        assert!(f(&m, &s).abs() < 1e-9 * 1e5, "f = {}", f(&m, &s));
+        // associative: the return is along D ∂f, the pressure drops by K η Δγ
+        // elastic states are left alone
+        let el = [[-1e5, 1e3, 0.0], [1e3, -1e5, 0.0], [0.0, 0.0, -1e5]];
+        assert_eq!(m.project(&el), (el, false));
+        // tension beyond the apex goes to it: p = ξ c / η, no shear
+        let ten = [[1e6, 1e3, 0.0], [1e3, 1e6, 0.0], [0.0, 0.0, 1e6]];
+        let (s, y) = m.project(&ten);
+        let pa = m.xi * m.cohesion / m.eta;
+        assert!(y && (s[0][0] - pa).abs() < 1e-9 && s[0][1] == 0.0);
+    }
+}
