@@ -438,6 +438,7 @@ impl<D: Dim, const N: usize> SceneFamily<D> for Continuum<D, N> {
             "kinetic_continuum",
             "elastic_continuum",
             "load_potential_continuum",
+            "yielding_cells",
         ]
         .map(String::from)
         .to_vec()
