@@ -390,7 +390,11 @@ pub fn run_on<D: Dim>(
         let t_out = t0.elapsed().as_secs_f64();
         values.clear();
         fams.iter().for_each(|f| f.history_values(&mut values));
-        debug_assert_eq!(values.len(), columns.len(), "the families' history values and columns differ in number");
+        debug_assert_eq!(
+            values.len(),
+            columns.len(),
+            "the families' history values and columns differ in number"
+        );
         hist.row_dd(w, &rep, dd_rep.as_ref(), t_out, &values)
             .map_err(io(dir, "history.csv"))?;
         if scene.output.checkpoint_every > 0 && s % scene.output.checkpoint_every == 0 && s != steps {

@@ -23,8 +23,14 @@ struct Run {
 impl Run {
     fn new(text: &str) -> Run {
         let mut s = Scene::<D3>::load_str(text, "test.toml", &registry()).unwrap_or_else(|e| panic!("{e}"));
-        let cfg = s.decomposition.clone().or(nscdd::family::needs_nscdd(false, &mut s.families).then(DdConfig::default));
-        Run { dd: cfg.map(|c| c.solver_of()), s }
+        let cfg = s
+            .decomposition
+            .clone()
+            .or(nscdd::family::needs_nscdd(false, &mut s.families).then(DdConfig::default));
+        Run {
+            dd: cfg.map(|c| c.solver_of()),
+            s,
+        }
     }
     fn step(&mut self) -> nscdd::engine::StepReport {
         let mut fams: Vec<&mut dyn SceneFamily<D3>> = self.s.families.iter_mut().map(|f| &mut **f).collect();
@@ -57,8 +63,14 @@ fn columns(velocity: Option<[f64; 3]>, theta: f64, extra: &str) -> String {
             }
         }
     }
-    let fix = if velocity.is_some() { String::new() } else { "fix = [\"bottom\"]".into() };
-    let vel = velocity.map(|v| format!("velocity = [{}, {}, {}]", v[0], v[1], v[2])).unwrap_or_default();
+    let fix = if velocity.is_some() {
+        String::new()
+    } else {
+        "fix = [\"bottom\"]".into()
+    };
+    let vel = velocity
+        .map(|v| format!("velocity = [{}, {}, {}]", v[0], v[1], v[2]))
+        .unwrap_or_default();
     let _ = write!(
         s,
         "[[continuum]]\nmaterial = \"ground\"\nyoung = 2e6\npoisson = 0.25\n{fix}\n{vel}\n\
@@ -113,7 +125,11 @@ fn subdomains_agree_with_one_domain() {
     let umax = u0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     for dec in ["[decomposition]\nnx = 2\nny = 2", "[decomposition]\nby_model = true\nnx = 2"] {
         let (p, u) = run(&columns(None, 0.5, dec), 30);
-        let dp = p.iter().zip(&p0).flat_map(|(a, b)| (0..3).map(move |d| (a[d] - b[d]).abs())).fold(0.0f64, f64::max);
+        let dp = p
+            .iter()
+            .zip(&p0)
+            .flat_map(|(a, b)| (0..3).map(move |d| (a[d] - b[d]).abs()))
+            .fold(0.0f64, f64::max);
         let du = u.iter().zip(&u0).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
         println!("{dec:?}: spheres {dp:e} m, block {du:e} m (largest displacement {umax:e})");
         assert!(dp < 1e-3 * umax && du < 1e-3 * umax);
