@@ -17,7 +17,7 @@ fn every_example_scene_checks() {
             continue;
         }
         let text = std::fs::read_to_string(&path).unwrap();
-        if text.contains("[[deformable]]") && !cfg!(feature = "fem") {
+        if (text.contains("[[deformable]]") || text.contains("[[continuum]]")) && !cfg!(feature = "fem") {
             continue;
         }
         let out = Command::new(BIN).arg("check").arg(&path).output().unwrap();

@@ -401,8 +401,9 @@ impl<D: Dim, const N: usize> SceneFamily<D> for Continuum<D, N> {
     fn describe(&self) -> String {
         let nodes: usize = self.bodies.iter().map(|b| b.mesh.n_nodes()).sum();
         format!(
-            "{} continuum region(s) ({nodes} nodes), {} tied grains",
+            "{} continuum region(s) ({nodes} nodes), {} band grains, {} ties",
             self.bodies.len(),
+            self.band.len(),
             self.ties.len()
         )
     }
