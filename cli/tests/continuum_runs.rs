@@ -8,7 +8,10 @@ mod common;
 /// The footing example shortened to `steps` steps (no VTK), with `extra` appended.
 fn footing(steps: u32, output: &str, extra: &str) -> String {
     let src = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/scenes/footing.toml")).unwrap();
-    assert!(src.contains("duration = 2.0") && src.contains("[output]\nevery = 50\n"), "the footing example changed");
+    assert!(
+        src.contains("duration = 2.0") && src.contains("[output]\nevery = 50\n"),
+        "the footing example changed"
+    );
     let s = src
         .replace("duration = 2.0", &format!("steps = {steps}"))
         .replace("[output]\nevery = 50\n", &format!("[output]\nvtk = false\n{output}"));

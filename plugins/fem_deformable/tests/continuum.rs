@@ -462,3 +462,43 @@ fn a_cohesionless_block_flows_where_an_elastic_one_stands() {
     }
     let _ = el;
 }
+
+/// Sides: a traction adds its resultant to F_ext, a driven side moves at its
+/// velocity, and the driven sides' reactions balance the weight once at rest.
+#[test]
+fn driven_and_loaded_sides() {
+    let text = block_scene("").replace(
+        "fix = [\"bottom\"]",
+        "drive = { bottom = [0.0, 0.0], top = [0.0, -0.002] }\nload = { left = [2000.0, 0.0], right = [-2000.0, 0.0] }\nrayleigh = [60.0, 0.0]",
+    );
+    let mut r = Run::new(&text);
+    {
+        let b = &r.cont().bodies[0];
+        let left: f64 = (0..b.mesh.n_nodes())
+            .filter(|&k| b.mesh.node(k)[0] < 1e-9)
+            .map(|k| b.f_ext[2 * k])
+            .sum();
+        // 2 kPa on a 0.5 m side, its held corner nodes' shares included
+        assert!((left - 2000.0 * 0.5).abs() < 1e-9, "{left}");
+    }
+    for _ in 0..400 {
+        r.step();
+    }
+    let c = r.cont();
+    let b = &c.bodies[0];
+    let top = b.mesh.n_nodes() - 1;
+    assert!((b.u[2 * top + 1] + 0.002 * 0.8).abs() < 1e-12, "the top moved {}", b.u[2 * top + 1]);
+    let weight: f64 = -b.f_ext.iter().skip(1).step_by(2).sum::<f64>();
+    let bottom = nscdd_fem_deformable::continuum::sides::reaction(b, &c.driven[0][0]);
+    let top = nscdd_fem_deformable::continuum::sides::reaction(b, &c.driven[0][1]);
+    // the mass-proportional damping's drag on the free nodes, α M V (the block is
+    // being compressed: its nodes move down)
+    let mut cv = vec![0.0; b.n_dofs()];
+    b.mul_add(60.0, 0.0, &b.v, &mut cv);
+    let drag: f64 = (1..b.n_dofs()).step_by(2).filter(|&i| !b.fixed[i]).map(|i| cv[i]).sum();
+    println!("weight {weight:.2} N/m, drag {drag:.2}, reactions bottom {bottom:?}, top {top:?}");
+    assert!((bottom[1] + top[1] - weight - drag).abs() < 1e-3 * weight, "vertical balance");
+    assert!((bottom[0] + top[0]).abs() < 1e-3 * weight, "horizontal balance");
+    // compressed: the top pushes down on the block
+    assert!(top[1] < 0.0);
+}

@@ -26,6 +26,8 @@ pub struct Continuum<D: Dim, const N: usize> {
     pub bodies: Vec<FeBody>,
     /// Each region's Drucker–Prager state (None: linear elastic).
     pub plastic: Vec<Option<super::plastic::Plastic>>,
+    /// Each region's driven sides ([`super::sides`]).
+    pub driven: Vec<Vec<super::sides::Driven>>,
     /// The ties ([`ties`]): grains by world id, nodes by index in `sets[body]`.
     pub ties: TieSet<N>,
     /// The band's grains and their share w_p of their mass (the partition of
@@ -67,9 +69,11 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
                 ties.node[j] = set.nodes.binary_search(&ties.node[j]).expect("a tie node is in its region's set") as u32;
             }
         }
+        let driven = vec![vec![]; bodies.len()];
         Continuum {
             bodies,
             plastic,
+            driven,
             ties,
             band,
             sets,
@@ -85,10 +89,11 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
     /// Free velocities of the regions (factoring M̂ if h or θ changed; with the
     /// plastic strains' force f_p) and the tied grains' V⁻ and V_free.
     pub fn begin_step(&mut self, w: &World<D>) -> Result<(), String> {
-        for (b, p) in self.bodies.iter_mut().zip(&self.plastic) {
+        for ((b, p), dr) in self.bodies.iter_mut().zip(&self.plastic).zip(&self.driven) {
             if let Some(p) = p {
                 p.plastic_force(&b.mesh, &mut b.f_plastic);
             }
+            super::sides::set_velocities(b, dr);
         }
         crate::stage2::free_velocities(&mut self.bodies, w.time.h, w.time.theta)?;
         let begin = w.velocity_begin();

@@ -27,6 +27,7 @@
 pub mod family;
 pub mod plastic;
 pub mod scene;
+pub mod sides;
 pub mod ties;
 
 pub use family::Continuum;

@@ -141,7 +141,7 @@ type BandGrain = (u32, usize, [f64; 4], f64);
 fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, D>) -> Result<Continuum<D, N>, EntryError> {
     let w = cx.world;
     let (mut bodies, mut ties, mut band_all) = (Vec::new(), TieSet::<N>::default(), Vec::new());
-    let mut plastic = Vec::new();
+    let (mut plastic, mut driven) = (Vec::new(), Vec::new());
     let mut tied = vec![false; w.bodies.len()];
     let mut held = 0.0;
     for (i, e) in entries.iter().enumerate() {
@@ -153,10 +153,12 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
         let band = band_of(i, e, N)?;
         let coupling = coupling_of(i, e)?;
         let dp = plastic_of(i, e)?;
+        let drives = super::sides::sides_of(i, e, "drive", N)?;
+        let loads = super::sides::sides_of(i, e, "load", N)?;
         let mut rest = e.clone();
-        rest.remove("band");
-        rest.remove("coupling");
-        rest.remove("plastic");
+        for k in ["band", "coupling", "plastic", "drive", "load"] {
+            rest.remove(k);
+        }
         let spec = crate::scene::spec_of(i, &rest)?;
         let mut memory = |nodes: f64| {
             let bytes = crate::scene::mesh_bytes(N, nodes);
@@ -166,6 +168,8 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
         let scale = |m: &Mesh| cell_weights(m, &band).map(Some).map_err(|msg| ("band", msg));
         let mut b = crate::scene::build_scaled(&spec, &w.materials, N, cx.dir, &mut memory, &scale).map_err(|(k, m)| at(k, m))?;
         b.set_gravity(&w.gravity.as_ref()[..N]);
+        super::sides::load(&mut b, &loads, &|x| band.alpha(x)).map_err(|m| at("load", m))?;
+        driven.push(super::sides::drive(&mut b, &drives).map_err(|m| at("drive", m))?);
         b.factorize(w.time.h, w.time.theta).map_err(|m| at("", m))?;
         if dp.is_some() && b.elastic.plane_stress {
             return Err(at(
@@ -209,7 +213,9 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
         bodies.push(b);
     }
     band_all.sort_unstable_by_key(|x| x.0);
-    Ok(Continuum::new(bodies, plastic, ties, band_all))
+    let mut c = Continuum::new(bodies, plastic, ties, band_all);
+    c.driven = driven;
+    Ok(c)
 }
 
 /// The ties of one region's band grains (mesh node ids; [`super::ties`] for the two
@@ -388,6 +394,19 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
         Ok(())
     }
 
+    /// `{region}_{side}_fx`, `_fy`[, `_fz`] of each driven side (the region's name,
+    /// else `continuum{i}`).
+    fn driven_columns(&self) -> Vec<String> {
+        let mut out = vec![];
+        for (i, (b, dr)) in self.bodies.iter().zip(&self.driven).enumerate() {
+            let name = b.name.clone().unwrap_or_else(|| format!("continuum{i}"));
+            for s in dr {
+                out.extend(["fx", "fy", "fz"][..N].iter().map(|c| format!("{name}_{}_{c}", s.side)));
+            }
+        }
+        out
+    }
+
     /// Σ |λ_p| over the ties (N·s): the coupling's impulse.
     pub fn tie_impulse(&self) -> f64 {
         self.ties.r.iter().map(|r| r.iter().map(|x| x * x).sum::<f64>().sqrt()).sum()
@@ -442,7 +461,9 @@ impl<D: Dim, const N: usize> SceneFamily<D> for Continuum<D, N> {
             "yielding_cells",
         ]
         .map(String::from)
-        .to_vec()
+        .into_iter()
+        .chain(self.driven_columns())
+        .collect()
     }
     fn history_values(&self, out: &mut Vec<f64>) {
         out.push(self.ties.len() as f64);
@@ -454,6 +475,11 @@ impl<D: Dim, const N: usize> SceneFamily<D> for Continuum<D, N> {
         out.push(self.bodies.iter().zip(&self.plastic).map(elastic).sum());
         out.push(self.bodies.iter().map(FeBody::load_potential).sum());
         out.push(self.plastic.iter().flatten().map(|p| p.yielding as f64).sum());
+        for (b, dr) in self.bodies.iter().zip(&self.driven) {
+            for s in dr {
+                out.extend(super::sides::reaction(b, s));
+            }
+        }
     }
     fn write_frame(&mut self, dir: &Path, frame: u32, t: f64) -> std::io::Result<()> {
         for (bi, b) in self.bodies.iter().enumerate() {

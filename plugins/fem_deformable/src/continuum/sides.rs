@@ -1,0 +1,150 @@
+//! The sides of a continuum region (docs/CONTINUUM.md): a side moved at a
+//! prescribed velocity (`drive = { top = [vx, vy] }`: its nodes held on that
+//! velocity, as a platen), a traction on a side (`load = { left = [tx, ty] }`, in Pa:
+//! force per unit area, weighted by the band's α at each facet, the continuum's
+//! share of the boundary), and the reaction of a driven side for the history.
+
+use crate::body::FeBody;
+use crate::mesh::{signed_measure, Mesh};
+use crate::scene::fixed_nodes;
+use nscdd::family::EntryError;
+
+/// A driven side: its name, its nodes' degrees of freedom and the velocity.
+#[derive(Clone, Debug)]
+pub struct Driven {
+    pub side: String,
+    pub dofs: Vec<usize>,
+    pub velocity: Vec<f64>,
+}
+
+/// `drive` and `load` of entry `i` (tables of side → vector of `dim` numbers).
+pub fn sides_of(i: usize, e: &toml::Table, key: &str, dim: usize) -> Result<Vec<(String, Vec<f64>)>, EntryError> {
+    let at = |message: String| EntryError {
+        index: Some(i),
+        key: key.into(),
+        message,
+    };
+    let Some(v) = e.get(key) else { return Ok(vec![]) };
+    let t = v
+        .as_table()
+        .ok_or_else(|| at(format!("`{key} = {{ side = [{dim} numbers], … }}`")))?;
+    let mut out = vec![];
+    for (side, x) in t {
+        let xs: Vec<f64> = x
+            .as_array()
+            .map(|a| a.iter().filter_map(|y| y.as_float().or(y.as_integer().map(|n| n as f64))).collect())
+            .unwrap_or_default();
+        if xs.len() != dim || !xs.iter().all(|y| y.is_finite()) {
+            return Err(at(format!("side `{side}`: {dim} finite numbers")));
+        }
+        out.push((side.clone(), xs));
+    }
+    Ok(out)
+}
+
+/// Holds the driven sides' nodes on their velocities (the body's `fixed` dofs,
+/// their V set); errors name the side.
+pub fn drive(b: &mut FeBody, sides: &[(String, Vec<f64>)]) -> Result<Vec<Driven>, String> {
+    let d = b.dim();
+    let mut out = vec![];
+    for (side, v) in sides {
+        let nodes = fixed_nodes(&b.mesh, std::slice::from_ref(side))?;
+        b.fix_nodes(&nodes);
+        let dofs: Vec<usize> = nodes.iter().flat_map(|&k| (0..d).map(move |c| d * k as usize + c)).collect();
+        out.push(Driven {
+            side: side.clone(),
+            dofs,
+            velocity: v.clone(),
+        });
+    }
+    set_velocities(b, &out);
+    Ok(out)
+}
+
+/// V of the driven degrees of freedom (before each step's free velocity: M̂'s held
+/// rows keep it).
+pub fn set_velocities(b: &mut FeBody, driven: &[Driven]) {
+    let d = b.dim();
+    for s in driven {
+        for &i in &s.dofs {
+            b.v[i] = s.velocity[i % d];
+        }
+    }
+}
+
+/// Adds the tractions of `sides` to F_ext: each boundary facet on a side gets
+/// α(facet centroid) × t × its measure, shared equally by its nodes.
+pub fn load(b: &mut FeBody, sides: &[(String, Vec<f64>)], alpha: &dyn Fn(&[f64]) -> f64) -> Result<(), String> {
+    let d = b.dim();
+    for (side, t) in sides {
+        let nodes = fixed_nodes(&b.mesh, std::slice::from_ref(side))?;
+        let m: &Mesh = &b.mesh;
+        let mut f = vec![0.0; b.n_dofs()];
+        let mut area = 0.0;
+        for s in 0..m.n_facets() {
+            let fct = m.facet(s);
+            if !fct.iter().all(|k| nodes.binary_search(k).is_ok()) {
+                continue;
+            }
+            let a = facet_measure(m, fct);
+            let mut c = [0.0; 3];
+            for &k in fct {
+                for (x, y) in c.iter_mut().zip(m.node(k as usize)) {
+                    *x += y / d as f64;
+                }
+            }
+            let w = alpha(&c[..d]) * a / d as f64;
+            area += a;
+            for &k in fct {
+                for (cc, tc) in t.iter().enumerate() {
+                    f[d * k as usize + cc] += w * tc;
+                }
+            }
+        }
+        if !(area > 0.0) {
+            return Err(format!("side `{side}` has no boundary facet"));
+        }
+        for (x, y) in b.f_ext.iter_mut().zip(&f) {
+            *x += y;
+        }
+    }
+    Ok(())
+}
+
+/// Length (2D) or area (3D) of a boundary facet.
+fn facet_measure(m: &Mesh, f: &[u32]) -> f64 {
+    let d = m.dim;
+    let p = |k: u32| m.node(k as usize).to_vec();
+    if d == 2 {
+        let (a, b) = (p(f[0]), p(f[1]));
+        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
+    } else {
+        let (a, b, c) = (p(f[0]), p(f[1]), p(f[2]));
+        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        let w = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
+        0.5 * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt()
+    }
+}
+
+/// The force a driven side applies to the region (N, or N/m in 2D), its static
+/// part: Σ over the side's degrees of freedom of K u − f_p − F_ext (the internal
+/// force the side holds against the loads).
+pub fn reaction(b: &FeBody, s: &Driven) -> Vec<f64> {
+    let d = b.dim();
+    let mut f: Vec<f64> = b.f_ext.iter().map(|x| -x).collect();
+    b.mul_add(0.0, 1.0, &b.u, &mut f);
+    for (x, y) in f.iter_mut().zip(&b.f_plastic) {
+        *x -= y;
+    }
+    let mut r = vec![0.0; d];
+    for &i in &s.dofs {
+        r[i % d] += f[i];
+    }
+    r
+}
+
+/// Cells' measures, for tests.
+pub fn volume(m: &Mesh) -> f64 {
+    (0..m.n_cells()).map(|e| signed_measure(m.dim, &m.x0, m.cell(e)).abs()).sum()
+}
