@@ -132,6 +132,15 @@ pub fn load3_str(text: &str, file: &str, registry: &Registry) -> Result<FeScene3
     typed(text, file, registry)
 }
 
+/// The error of entry `i` of a family's section at `key` (empty: the entry).
+pub fn entry_error(i: usize, key: &str, message: impl Into<String>) -> EntryError {
+    EntryError {
+        index: Some(i),
+        key: key.into(),
+        message: message.into(),
+    }
+}
+
 /// Reads a file entry into a [`DeformableSpec`]; an error names the key serde
 /// complained about when it says which.
 pub fn spec_of(i: usize, e: &toml::Table) -> Result<DeformableSpec, EntryError> {
@@ -161,11 +170,7 @@ pub fn bodies_from(
     // bytes of the bodies before entry i
     let mut held = 0.0;
     for (i, e) in entries.iter().enumerate() {
-        let at = |key: &str, message: String| EntryError {
-            index: Some(i),
-            key: key.into(),
-            message,
-        };
+        let at = |key: &str, message: String| entry_error(i, key, message);
         let spec = spec_of(i, e)?;
         let mut check = |nodes: f64| {
             let bytes = mesh_bytes(dim, nodes);

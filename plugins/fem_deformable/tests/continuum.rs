@@ -188,29 +188,28 @@ fn a_uniform_strain_rate_passes_the_band_with_no_force() {
     }
 }
 
+/// The time, solver, materials and law of the gravity scenes below.
+fn header(theta: f64, tol: f64) -> String {
+    format!(
+        "[time]\nstep = 2e-3\ntheta = {theta}\nsteps = 1\n[solver]\ntolerance = {tol}\nmax_sweeps = 100000\n\
+         [[materials]]\nname = \"grain\"\ndensity = 2600.0\n[[materials]]\nname = \"ground\"\ndensity = 1600.0\n\
+         [[laws]]\nmaterials = [\"grain\", \"grain\"]\nfriction = 0.5\n"
+    )
+}
+
+/// The foundation under them: 1 × 0.6 m held at its base, the band 0 < y < 0.2.
+fn foundation(young: f64, extra: &str) -> String {
+    format!(
+        "[[continuum]]\nmaterial = \"ground\"\nyoung = {young}\npoisson = 0.25\nfix = [\"bottom\"]\n\
+         mesh = {{ rectangle = {{ origin = [0.0, -0.4], size = [1.0, 0.6], cells = [10, 12] }} }}\n\
+         band = {{ normal = [0.0, 1.0], continuum = 0.0, discrete = 0.2 }}\n{extra}\n"
+    )
+}
+
 /// Columns of four touching disks (radius 0.025, 0.1 apart) in the band of a
 /// continuum foundation held at its base, under gravity, all tied.
 fn columns_scene(theta: f64, extra: &str) -> String {
-    let mut s = format!(
-        r#"
-[time]
-step = 2e-3
-theta = {theta}
-steps = 1
-[solver]
-tolerance = 1e-8
-max_sweeps = 100000
-[[materials]]
-name = "grain"
-density = 2600.0
-[[materials]]
-name = "ground"
-density = 1600.0
-[[laws]]
-materials = ["grain", "grain"]
-friction = 0.5
-"#
-    );
+    let mut s = header(theta, 1e-8);
     for j in 0..4 {
         for i in 0..10 {
             let (x, y) = (0.05 + 0.1 * i as f64, 0.025 + 0.05 * j as f64);
@@ -220,46 +219,14 @@ friction = 0.5
             );
         }
     }
-    let _ = write!(
-        s,
-        r#"
-[[continuum]]
-material = "ground"
-young = 2e6
-poisson = 0.25
-fix = ["bottom"]
-mesh = {{ rectangle = {{ origin = [0.0, -0.4], size = [1.0, 0.6], cells = [10, 12] }} }}
-band = {{ normal = [0.0, 1.0], continuum = 0.0, discrete = 0.2 }}
-{extra}
-"#
-    );
-    s
+    s + &foundation(2e6, extra)
 }
 
 /// A hexagonal packing of touching disks (radius 0.025) on a continuum foundation
 /// held at its base, under gravity: rows 0–4 in the band (tied), rows 5–7 above it,
 /// each one grain shorter at both ends (every grain rests on two).
-fn hex_scene(theta: f64, young: f64, extra: &str) -> String {
-    let mut s = format!(
-        r#"
-[time]
-step = 2e-3
-theta = {theta}
-steps = 1
-[solver]
-tolerance = 1e-5
-max_sweeps = 100000
-[[materials]]
-name = "grain"
-density = 2600.0
-[[materials]]
-name = "ground"
-density = 1600.0
-[[laws]]
-materials = ["grain", "grain"]
-friction = 0.5
-"#
-    );
+fn hex_scene(theta: f64, young: f64, tol: f64) -> String {
+    let mut s = header(theta, tol).replace("max_sweeps = 100000", "max_sweeps = 20000");
     let dy = 0.05 * 3f64.sqrt() / 2.0;
     for j in 0..8usize {
         let odd = j % 2;
@@ -272,20 +239,7 @@ friction = 0.5
             );
         }
     }
-    let _ = write!(
-        s,
-        r#"
-[[continuum]]
-material = "ground"
-young = {young}
-poisson = 0.25
-fix = ["bottom"]
-mesh = {{ rectangle = {{ origin = [0.0, -0.4], size = [1.0, 0.6], cells = [10, 12] }} }}
-band = {{ normal = [0.0, 1.0], continuum = 0.0, discrete = 0.2 }}
-{extra}
-"#
-    );
-    s
+    s + &foundation(young, "")
 }
 
 /// Σ of the vertical reactions at the region's held nodes: (K u − F_ext)_y there
@@ -383,9 +337,7 @@ fn threads_are_bitwise_identical() {
 /// through contacts does, docs/CONTINUUM.md).
 #[test]
 fn a_dense_packing_on_the_band_converges() {
-    let text = hex_scene(0.5, 2e6, "")
-        .replace("tolerance = 1e-5", "tolerance = 1.666e-4")
-        .replace("max_sweeps = 100000", "max_sweeps = 20000");
+    let text = hex_scene(0.5, 2e6, 1.666e-4);
     let mut r = Run::new(&text);
     for k in 0..30 {
         let rep = r.step();

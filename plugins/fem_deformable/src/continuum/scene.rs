@@ -7,6 +7,7 @@ use super::ties::TieSet;
 use super::{Continuum, SECTION};
 use crate::body::FeBody;
 use crate::mesh::{gradients, Mesh};
+use crate::scene::entry_error;
 use nscdd::dd::{Family, Rigid};
 use nscdd::dim::{Dim, D2, D3};
 use nscdd::engine::Diverged;
@@ -50,11 +51,7 @@ impl Band {
 }
 
 fn band_of(i: usize, e: &toml::Table, dim: usize) -> Result<Band, EntryError> {
-    let at = |key: &str, message: String| EntryError {
-        index: Some(i),
-        key: key.into(),
-        message,
-    };
+    let at = |key: &str, message: String| entry_error(i, key, message);
     let v = e
         .get("band")
         .ok_or_else(|| at("band", "missing: `band = { normal, continuum, discrete }`".into()))?;
@@ -94,11 +91,11 @@ fn coupling_of(i: usize, e: &toml::Table) -> Result<Coupling, EntryError> {
     match e.get("coupling").map(|v| v.as_str()) {
         None | Some(Some("node")) => Ok(Coupling::Node),
         Some(Some("grain")) => Ok(Coupling::Grain),
-        Some(_) => Err(EntryError {
-            index: Some(i),
-            key: "coupling".into(),
-            message: "`node` (one tie per band node, the default) or `grain` (one tie per band grain)".into(),
-        }),
+        Some(_) => Err(entry_error(
+            i,
+            "coupling",
+            "`node` (one tie per band node, the default) or `grain` (one tie per band grain)",
+        )),
     }
 }
 
@@ -115,11 +112,7 @@ struct DpSpec {
 }
 
 fn plastic_of(i: usize, e: &toml::Table) -> Result<Option<DpSpec>, EntryError> {
-    let at = |message: String| EntryError {
-        index: Some(i),
-        key: "plastic".into(),
-        message,
-    };
+    let at = |message: String| entry_error(i, "plastic", message);
     let Some(v) = e.get("plastic") else { return Ok(None) };
     let d = DpSpec::deserialize(v.clone()).map_err(|x| at(x.message().to_string()))?;
     if !(d.friction >= 0.0 && d.friction < 90.0) || !(d.dilatancy >= 0.0 && d.dilatancy <= d.friction) {
@@ -145,11 +138,7 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
     let mut tied = vec![false; w.bodies.len()];
     let mut held = 0.0;
     for (i, e) in entries.iter().enumerate() {
-        let at = |key: &str, message: String| EntryError {
-            index: Some(i),
-            key: key.into(),
-            message,
-        };
+        let at = |key: &str, message: String| entry_error(i, key, message);
         let band = band_of(i, e, N)?;
         let coupling = coupling_of(i, e)?;
         let dp = plastic_of(i, e)?;

@@ -19,11 +19,7 @@ pub struct Driven {
 
 /// `drive` and `load` of entry `i` (tables of side → vector of `dim` numbers).
 pub fn sides_of(i: usize, e: &toml::Table, key: &str, dim: usize) -> Result<Vec<(String, Vec<f64>)>, EntryError> {
-    let at = |message: String| EntryError {
-        index: Some(i),
-        key: key.into(),
-        message,
-    };
+    let at = |message: String| crate::scene::entry_error(i, key, message);
     let Some(v) = e.get(key) else { return Ok(vec![]) };
     let t = v
         .as_table()
