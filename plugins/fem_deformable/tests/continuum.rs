@@ -454,3 +454,31 @@ fn driven_and_loaded_sides() {
     // compressed: the top pushes down on the block
     assert!(top[1] < 0.0);
 }
+
+/// A side loaded, then driven from `drive_from` (every driven side of the entry
+/// starts then): at the switch it is held, its traction taken off F_ext, and its
+/// reaction takes over the load it carried.
+#[test]
+fn a_side_loaded_then_driven() {
+    let text = block_scene("").replace(
+        "fix = [\"bottom\"]",
+        "fix = [\"bottom\"]\ndrive = { top = [0.0, 0.0] }\ndrive_from = 0.4\nload = { top = [0.0, -2000.0] }\nrayleigh = [60.0, 0.0]",
+    );
+    let mut r = Run::new(&text);
+    for _ in 0..199 {
+        r.step();
+    }
+    // t = 0.398 s: the top is still free under its load
+    assert!(!r.cont().driven[0][0].held);
+    for _ in 0..201 {
+        r.step();
+    }
+    let c = r.cont();
+    let b = &c.bodies[0];
+    assert!(c.driven[0][0].held);
+    let top_r = nscdd_fem_deformable::continuum::sides::reaction(b, &c.driven[0][0]);
+    println!("reaction of the held top {top_r:?}");
+    // the held top now carries the 2 kPa × 1 m it was loaded with (the block near rest)
+    assert!((top_r[1] + 2000.0).abs() < 0.05 * 2000.0, "{top_r:?}");
+    assert!(top_r[0].abs() < 0.01 * 2000.0);
+}

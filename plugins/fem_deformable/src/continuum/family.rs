@@ -89,11 +89,14 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
     /// Free velocities of the regions (factoring M̂ if h or θ changed; with the
     /// plastic strains' force f_p) and the tied grains' V⁻ and V_free.
     pub fn begin_step(&mut self, w: &World<D>) -> Result<(), String> {
-        for ((b, p), dr) in self.bodies.iter_mut().zip(&self.plastic).zip(&self.driven) {
+        for (((b, p), dr), set) in self.bodies.iter_mut().zip(&self.plastic).zip(&mut self.driven).zip(&mut self.sets) {
             if let Some(p) = p {
                 p.plastic_force(&b.mesh, &mut b.f_plastic);
             }
-            super::sides::set_velocities(b, dr);
+            if super::sides::start(b, dr, w.t) {
+                // M̂ changes: the tie nodes' G is filled again from the new factor
+                set.g.clear();
+            }
         }
         crate::stage2::free_velocities(&mut self.bodies, w.time.h, w.time.theta)?;
         let begin = w.velocity_begin();

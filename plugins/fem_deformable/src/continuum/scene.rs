@@ -143,9 +143,17 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
         let coupling = coupling_of(i, e)?;
         let dp = plastic_of(i, e)?;
         let drives = super::sides::sides_of(i, e, "drive", N)?;
+        let from = match e.get("drive_from") {
+            None => 0.0,
+            Some(v) => v
+                .as_float()
+                .or(v.as_integer().map(|n| n as f64))
+                .filter(|x| x.is_finite() && *x >= 0.0)
+                .ok_or_else(|| at("drive_from", "a time ≥ 0 (s)".into()))?,
+        };
         let loads = super::sides::sides_of(i, e, "load", N)?;
         let mut rest = e.clone();
-        for k in ["band", "coupling", "plastic", "drive", "load"] {
+        for k in ["band", "coupling", "plastic", "drive", "drive_from", "load"] {
             rest.remove(k);
         }
         let spec = crate::scene::spec_of(i, &rest)?;
@@ -157,8 +165,8 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
         let scale = |m: &Mesh| cell_weights(m, &band).map(Some).map_err(|msg| ("band", msg));
         let mut b = crate::scene::build_scaled(&spec, &w.materials, N, cx.dir, &mut memory, &scale).map_err(|(k, m)| at(k, m))?;
         b.set_gravity(&w.gravity.as_ref()[..N]);
-        super::sides::load(&mut b, &loads, &|x| band.alpha(x)).map_err(|m| at("load", m))?;
-        driven.push(super::sides::drive(&mut b, &drives).map_err(|m| at("drive", m))?);
+        let shares = super::sides::load(&mut b, &loads, &|x| band.alpha(x)).map_err(|m| at("load", m))?;
+        driven.push(super::sides::drive(&mut b, &drives, from, &shares).map_err(|m| at("drive", m))?);
         b.factorize(w.time.h, w.time.theta).map_err(|m| at("", m))?;
         if dp.is_some() && b.elastic.plane_stress {
             return Err(at(

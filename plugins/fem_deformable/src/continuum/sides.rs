@@ -9,12 +9,21 @@ use crate::mesh::{signed_measure, Mesh};
 use crate::scene::fixed_nodes;
 use nscdd::family::EntryError;
 
-/// A driven side: its name, its nodes' degrees of freedom and the velocity.
+/// A driven side: its name, its nodes, their degrees of freedom, the velocity and
+/// the time it starts (before it, the side is free, under its `load` if any: a
+/// force-controlled consolidation, then a platen).
 #[derive(Clone, Debug)]
 pub struct Driven {
     pub side: String,
+    pub nodes: Vec<u32>,
     pub dofs: Vec<usize>,
     pub velocity: Vec<f64>,
+    pub from: f64,
+    pub held: bool,
+    /// The side's own traction (F_ext's share, dof and value), taken off F_ext
+    /// when the side is held (a held side carries no load: its reaction is the
+    /// platen's).
+    pub traction: Vec<(usize, f64)>,
 }
 
 /// `drive` and `load` of entry `i` (tables of side → vector of `dim` numbers).
@@ -38,39 +47,67 @@ pub fn sides_of(i: usize, e: &toml::Table, key: &str, dim: usize) -> Result<Vec<
     Ok(out)
 }
 
-/// Holds the driven sides' nodes on their velocities (the body's `fixed` dofs,
-/// their V set); errors name the side.
-pub fn drive(b: &mut FeBody, sides: &[(String, Vec<f64>)]) -> Result<Vec<Driven>, String> {
+/// The driven sides (from time `from`, with the side's own traction of `loads` to
+/// take off F_ext then); errors name the side. Those driven from the start are held
+/// at once ([`start`]).
+pub fn drive(
+    b: &mut FeBody,
+    sides: &[(String, Vec<f64>)],
+    from: f64,
+    loads: &[(String, Vec<(usize, f64)>)],
+) -> Result<Vec<Driven>, String> {
     let d = b.dim();
     let mut out = vec![];
     for (side, v) in sides {
         let nodes = fixed_nodes(&b.mesh, std::slice::from_ref(side))?;
-        b.fix_nodes(&nodes);
         let dofs: Vec<usize> = nodes.iter().flat_map(|&k| (0..d).map(move |c| d * k as usize + c)).collect();
         out.push(Driven {
             side: side.clone(),
+            nodes,
             dofs,
             velocity: v.clone(),
+            from,
+            held: false,
+            traction: loads.iter().find(|l| &l.0 == side).map_or_else(Vec::new, |l| l.1.clone()),
         });
     }
-    set_velocities(b, &out);
+    start(b, &mut out, 0.0);
     Ok(out)
 }
 
-/// V of the driven degrees of freedom (before each step's free velocity: M̂'s held
-/// rows keep it).
-pub fn set_velocities(b: &mut FeBody, driven: &[Driven]) {
+/// At time `t` (a step's start): holds the sides whose drive has started (their
+/// nodes fixed: M̂ is refactored at the next free velocity; returns whether one
+/// started) and sets the held degrees of freedom's V (M̂'s held rows keep it).
+pub fn start(b: &mut FeBody, driven: &mut [Driven], t: f64) -> bool {
     let d = b.dim();
-    for s in driven {
-        for &i in &s.dofs {
-            b.v[i] = s.velocity[i % d];
+    let mut started = false;
+    for s in driven.iter_mut() {
+        if !s.held && t >= s.from {
+            b.fix_nodes(&s.nodes);
+            for &(i, f) in &s.traction {
+                b.f_ext[i] -= f;
+            }
+            s.held = true;
+            started = true;
+        }
+        if s.held {
+            for &i in &s.dofs {
+                b.v[i] = s.velocity[i % d];
+            }
         }
     }
+    started
 }
 
 /// Adds the tractions of `sides` to F_ext: each boundary facet on a side gets
-/// α(facet centroid) × t × its measure, shared equally by its nodes.
-pub fn load(b: &mut FeBody, sides: &[(String, Vec<f64>)], alpha: &dyn Fn(&[f64]) -> f64) -> Result<(), String> {
+/// α(facet centroid) × t × its measure, shared equally by its nodes. Returns each
+/// side's nonzero shares (side, [(dof, force)]).
+pub fn load(
+    b: &mut FeBody,
+    sides: &[(String, Vec<f64>)],
+    alpha: &dyn Fn(&[f64]) -> f64,
+) -> Result<Vec<(String, Vec<(usize, f64)>)>, String> {
+    let mut shares = vec![];
     let d = b.dim();
     for (side, t) in sides {
         let nodes = fixed_nodes(&b.mesh, std::slice::from_ref(side))?;
@@ -103,8 +140,12 @@ pub fn load(b: &mut FeBody, sides: &[(String, Vec<f64>)], alpha: &dyn Fn(&[f64])
         for (x, y) in b.f_ext.iter_mut().zip(&f) {
             *x += y;
         }
+        shares.push((
+            side.clone(),
+            f.iter().enumerate().filter(|x| *x.1 != 0.0).map(|(i, &y)| (i, y)).collect(),
+        ));
     }
-    Ok(())
+    Ok(shares)
 }
 
 /// Length (2D) or area (3D) of a boundary facet.
