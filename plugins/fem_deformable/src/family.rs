@@ -168,10 +168,18 @@ fn describe(bodies: &[FeBody]) -> String {
     format!("{n} deformable bod{} ({nodes} nodes)", if n == 1 { "y" } else { "ies" })
 }
 
-/// One VTK unstructured grid per body (`deformable{i}_{frame}.vtu`).
-fn write_frame(bodies: &[FeBody], frames: &mut Vec<(f64, u32)>, dir: &Path, frame: u32, t: f64) -> std::io::Result<()> {
+/// One VTK unstructured grid per body (`{prefix}{i}_{frame}.vtu`), the frame
+/// recorded for the `.pvd` series.
+pub(crate) fn write_frame(
+    bodies: &[FeBody],
+    prefix: &str,
+    frames: &mut Vec<(f64, u32)>,
+    dir: &Path,
+    frame: u32,
+    t: f64,
+) -> std::io::Result<()> {
     for (bi, b) in bodies.iter().enumerate() {
-        let path = dir.join(format!("deformable{bi}_{frame:05}.vtu"));
+        let path = dir.join(format!("{prefix}{bi}_{frame:05}.vtu"));
         nscdd::output::write_atomic(&path, |tmp| std::fs::write(tmp, crate::output::vtu(b)))?;
     }
     frames.push((t, frame));
@@ -217,7 +225,7 @@ macro_rules! scene_family {
                 history_values(&self.bodies, self.contacts.len(), out)
             }
             fn write_frame(&mut self, dir: &Path, frame: u32, t: f64) -> std::io::Result<()> {
-                write_frame(&self.bodies, &mut self.frames, dir, frame, t)
+                write_frame(&self.bodies, "deformable", &mut self.frames, dir, frame, t)
             }
             fn finish(&mut self, dir: &Path) -> std::io::Result<()> {
                 crate::output::write_pvd(dir, self.bodies.len(), &self.frames)

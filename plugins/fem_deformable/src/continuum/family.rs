@@ -110,7 +110,7 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
     }
 
     /// The node sets at V_free (G filled once: the tie nodes and M̂ do not change)
-    /// and each tie's point, target, u_free and W_a.
+    /// and each tie's point, target and u_free.
     pub fn build(&mut self, w: &World<D>) {
         for (set, body) in self.sets.iter_mut().zip(&mut self.bodies) {
             if set.g.is_empty() && !set.nodes.is_empty() {
@@ -154,7 +154,7 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
             }
             t.u_free[a] = uf;
         }
-        ties::refresh_delassus::<D, N>(t, &self.sets, &w.bodies.inv_mass);
+        // W_a is made by each subdomain's part from its copies' M̂_E⁻¹ (`prepare`)
     }
 
     /// V⁺ = V_free − M̂⁻¹ Σ_a Σ_l b_al λ_a of every region, and the sets' velocities.

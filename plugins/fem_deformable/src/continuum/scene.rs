@@ -162,8 +162,16 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
             cx.check_memory(held + bytes, &format!("a continuum region of about {nodes:.0} nodes"))
                 .map(|()| held += bytes)
         };
-        let scale = |m: &Mesh| cell_weights(m, &band).map(Some).map_err(|msg| ("band", msg));
+        // each cell's gradients and centroid and its α, made once with the mesh
+        let made: std::cell::RefCell<(Vec<CellFrame>, Vec<f64>)> = Default::default();
+        let scale = |m: &Mesh| {
+            let frames = cell_frames(m);
+            let alpha = cell_weights(&frames, m.dim, &band).map_err(|msg| ("band", msg))?;
+            *made.borrow_mut() = (frames, alpha.clone());
+            Ok(Some(alpha))
+        };
         let mut b = crate::scene::build_scaled(&spec, &w.materials, N, cx.dir, &mut memory, &scale).map_err(|(k, m)| at(k, m))?;
+        let (frames, alpha) = made.into_inner();
         b.set_gravity(&w.gravity.as_ref()[..N]);
         let shares = super::sides::load(&mut b, &loads, &|x| band.alpha(x)).map_err(|m| at("load", m))?;
         driven.push(super::sides::drive(&mut b, &drives, from, &shares).map_err(|m| at("drive", m))?);
@@ -175,7 +183,6 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
             ));
         }
         plastic.push(dp.map(|d| {
-            let alpha = cell_weights(&b.mesh, &band).expect("checked at assembly");
             super::plastic::Plastic::new(
                 &b.mesh,
                 d.friction,
@@ -196,7 +203,7 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
             if alpha <= 0.0 {
                 continue;
             }
-            let Some((cell, xi)) = locate(&b.mesh, x) else { continue };
+            let Some((cell, xi)) = locate(&frames, N, x) else { continue };
             if alpha >= 1.0 {
                 return Err(at("band", format!("body {g} (a grain) lies in the continuum part of the region, beyond the band: grains belong to the discrete part and the band")));
             }
@@ -261,18 +268,33 @@ fn push_ties<const N: usize>(
     }
 }
 
+/// A cell's shape-function gradients (D + 1 rows) and centroid, reference mesh.
+pub type CellFrame = ([[f64; 3]; 4], [f64; 3]);
+
+/// The [`CellFrame`] of every cell.
+pub fn cell_frames(m: &Mesh) -> Vec<CellFrame> {
+    let (d, nv) = (m.dim, m.dim + 1);
+    (0..m.n_cells())
+        .map(|e| {
+            let c = m.cell(e);
+            let mut g = [[0.0; 3]; 4];
+            g[..nv].copy_from_slice(&gradients(d, &m.x0, c));
+            let mut centroid = [0.0; 3];
+            for &k in c {
+                for (y, z) in centroid.iter_mut().zip(m.node(k as usize)) {
+                    *y += z / nv as f64;
+                }
+            }
+            (g, centroid)
+        })
+        .collect()
+}
+
 /// α at each cell's centroid; every cell must have α > 0 (a cell wholly on the
 /// discrete side would have neither mass nor stiffness).
-fn cell_weights(m: &Mesh, band: &Band) -> Result<Vec<f64>, String> {
-    let (d, nv) = (m.dim, m.dim + 1);
-    let mut out = Vec::with_capacity(m.n_cells());
-    for e in 0..m.n_cells() {
-        let mut c = [0.0; 3];
-        for &k in m.cell(e) {
-            for (x, y) in c.iter_mut().zip(m.node(k as usize)) {
-                *x += y / nv as f64;
-            }
-        }
+fn cell_weights(frames: &[CellFrame], d: usize, band: &Band) -> Result<Vec<f64>, String> {
+    let mut out = Vec::with_capacity(frames.len());
+    for (e, (_, c)) in frames.iter().enumerate() {
         let a = band.alpha(&c[..d]);
         if !(a > 0.0) {
             return Err(format!(
@@ -285,18 +307,11 @@ fn cell_weights(m: &Mesh, band: &Band) -> Result<Vec<f64>, String> {
     Ok(out)
 }
 
-/// The cell holding point x and its barycentric coordinates (reference mesh).
-pub fn locate(m: &Mesh, x: &[f64]) -> Option<(usize, [f64; 4])> {
-    let (d, nv) = (m.dim, m.dim + 1);
-    for e in 0..m.n_cells() {
-        let c = m.cell(e);
-        let g = gradients(d, &m.x0, c);
-        let mut centroid = [0.0; 3];
-        for &k in c {
-            for (y, z) in centroid.iter_mut().zip(m.node(k as usize)) {
-                *y += z / nv as f64;
-            }
-        }
+/// The cell holding point x and its barycentric coordinates (`frames` of a mesh of
+/// dimension `d`).
+pub fn locate(frames: &[CellFrame], d: usize, x: &[f64]) -> Option<(usize, [f64; 4])> {
+    let nv = d + 1;
+    for (e, (g, centroid)) in frames.iter().enumerate() {
         let mut xi = [0.0; 4];
         for q in 0..nv {
             xi[q] = 1.0 / nv as f64 + (0..d).map(|j| g[q][j] * (x[j] - centroid[j])).sum::<f64>();
@@ -473,18 +488,11 @@ impl<D: Dim, const N: usize> SceneFamily<D> for Continuum<D, N> {
         out.push(self.bodies.iter().map(FeBody::load_potential).sum());
         out.push(self.plastic.iter().flatten().map(|p| p.yielding as f64).sum());
         for (b, dr) in self.bodies.iter().zip(&self.driven) {
-            for s in dr {
-                out.extend(super::sides::reaction(b, s));
-            }
+            out.extend(super::sides::reactions(b, dr).into_iter().flatten());
         }
     }
     fn write_frame(&mut self, dir: &Path, frame: u32, t: f64) -> std::io::Result<()> {
-        for (bi, b) in self.bodies.iter().enumerate() {
-            let path = dir.join(format!("continuum{bi}_{frame:05}.vtu"));
-            nscdd::output::write_atomic(&path, |tmp| std::fs::write(tmp, crate::output::vtu(b)))?;
-        }
-        self.frames.push((t, frame));
-        Ok(())
+        crate::family::write_frame(&self.bodies, "continuum", &mut self.frames, dir, frame, t)
     }
     fn finish(&mut self, dir: &Path) -> std::io::Result<()> {
         crate::output::write_series(dir, "continuum", self.bodies.len(), &self.frames)

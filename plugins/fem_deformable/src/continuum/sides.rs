@@ -5,7 +5,7 @@
 //! share of the boundary), and the reaction of a driven side for the history.
 
 use crate::body::FeBody;
-use crate::mesh::{signed_measure, Mesh};
+use crate::mesh::Mesh;
 use crate::scene::fixed_nodes;
 use nscdd::family::EntryError;
 
@@ -164,24 +164,29 @@ fn facet_measure(m: &Mesh, f: &[u32]) -> f64 {
     }
 }
 
-/// The force a driven side applies to the region (N, or N/m in 2D), its static
-/// part: Σ over the side's degrees of freedom of K u − f_p − F_ext (the internal
-/// force the side holds against the loads).
-pub fn reaction(b: &FeBody, s: &Driven) -> Vec<f64> {
+/// The forces the driven sides `driven` apply to the region (N, or N/m in 2D),
+/// their static part: Σ over each side's degrees of freedom of K u − f_p − F_ext
+/// (the internal force the side holds against the loads; K u made once).
+pub fn reactions(b: &FeBody, driven: &[Driven]) -> Vec<Vec<f64>> {
     let d = b.dim();
     let mut f: Vec<f64> = b.f_ext.iter().map(|x| -x).collect();
     b.mul_add(0.0, 1.0, &b.u, &mut f);
     for (x, y) in f.iter_mut().zip(&b.f_plastic) {
         *x -= y;
     }
-    let mut r = vec![0.0; d];
-    for &i in &s.dofs {
-        r[i % d] += f[i];
-    }
-    r
+    driven
+        .iter()
+        .map(|s| {
+            let mut r = vec![0.0; d];
+            for &i in &s.dofs {
+                r[i % d] += f[i];
+            }
+            r
+        })
+        .collect()
 }
 
-/// Cells' measures, for tests.
-pub fn volume(m: &Mesh) -> f64 {
-    (0..m.n_cells()).map(|e| signed_measure(m.dim, &m.x0, m.cell(e)).abs()).sum()
+/// [`reactions`] of one side.
+pub fn reaction(b: &FeBody, s: &Driven) -> Vec<f64> {
+    reactions(b, std::slice::from_ref(s)).swap_remove(0)
 }
