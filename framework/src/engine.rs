@@ -21,7 +21,7 @@ use crate::dim::joint::Joint;
 use crate::dim::{Dim, Vector};
 use crate::drive::Imposed;
 use crate::law::{LawInput, LawStep};
-use crate::model::ContactKey;
+use crate::model::{ContactKey, Contacts};
 use crate::solver::nlgs;
 use crate::solver::SolveReport;
 use crate::world::PrevContact;
@@ -341,9 +341,34 @@ pub(crate) fn build_from_raw<D: Dim>(w: &mut World<D>) {
     }
     // ū, μ and the joints: each law once, on all the contacts of its pairs
     s.laws.run(&w.laws, &step, &mut c.target, &mut c.joint);
-    c.block.extend(s.w.iter().zip(&c.target).map(|(wb, t)| D::block(*wb, t.mu)));
+    c.compliant = s.laws.compliance(&w.laws, &step, &mut c.compliance);
+    if c.compliant && !w.contact_shares.is_empty() {
+        share_compliance(&w.contact_shares, c, &mut s.share);
+    }
+    if c.compliant {
+        let blocks = s.w.iter().zip(&c.target).zip(&c.compliance);
+        c.block
+            .extend(blocks.map(|((wb, t), &cc)| D::block(D::with_compliance(*wb, cc), t.mu)));
+    } else {
+        c.block.extend(s.w.iter().zip(&c.target).map(|(wb, t)| D::block(*wb, t.mu)));
+    }
     std::mem::swap(&mut w.contacts, &mut s.next);
     w.contacts.apply_all(&mut w.bodies.vel, &w.bodies.inv_mass);
+}
+
+/// Each compliant contact's c divided by its weight in the world's `shares` (a
+/// weight below 10⁻¹² counts as 10⁻¹²: the contact all but vanishes).
+fn share_compliance<D: Dim>(shares: &[crate::world::ContactShare<D>], c: &mut Contacts<D>, weight: &mut Vec<f64>) {
+    weight.clear();
+    weight.resize(c.len(), 1.0);
+    for share in shares {
+        share(&c.bodies, &c.point, weight);
+    }
+    for (c, w) in c.compliance.iter_mut().zip(weight.iter()) {
+        if *c > 0.0 && *w < 1.0 {
+            *c /= w.max(1e-12);
+        }
+    }
 }
 
 /// Failure of bonded joints on the converged impulses: a joint whose strength is

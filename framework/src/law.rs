@@ -22,7 +22,9 @@
 //! `cohesion`, `tensile_strength`, `bond_gap`): a mortar joint between 3D rigid
 //! bodies that carries tension up to `tensile_strength` and shear up to
 //! `cohesion + μ σ_n` (stresses, Pa) until it fails, then acts as `coulomb` with
-//! e = 0 for ever (see `dim::joint`).
+//! e = 0 for ever (see `dim::joint`), and `compliant` (keys `stiffness`, `damping`,
+//! `friction`): a normal spring and dashpot, solved implicitly as a normal
+//! compliance c added to W_nn ([`Compliant`]).
 //!
 //! A law is a registered type: a [`LawDef`] (name and parameter parser, added by
 //! [`crate::registry::Registry::add_law`]) makes, for each pair of materials of a
@@ -121,6 +123,11 @@ pub trait Law: Send + Sync + std::fmt::Debug {
     fn bonds(&self) -> bool {
         false
     }
+    /// The normal compliance c ≥ 0 of this law's contacts over a step of `step`:
+    /// their normal law is `u_n + c r_n ≥ ū ⊥ r_n ≥ 0` (0: rigid, the default).
+    fn compliance(&self, _step: &LawStep) -> f64 {
+        0.0
+    }
 }
 
 /// A law kind: its name and the parser of its parameters (the keys of a
@@ -148,6 +155,50 @@ impl Law for Coulomb {
                 mu: self.mu,
             };
         }
+    }
+}
+
+/// A compliant contact (law `compliant`): a linear spring of stiffness k and a
+/// dashpot d in the normal direction, Coulomb friction μ (LMGC90's
+/// `ELASTIC_REPELL_CLB` with a dashpot). The normal impulse over the step is
+///
+/// ```text
+/// r_n = h max(0, −k g_θ − d u_n⁺),   g_θ = (1 − θ) g + θ g⁺ = g + hθ((1 − θ) u_n⁻ + θ u_n⁺),
+/// ```
+///
+/// the spring taken at the θ-point of the gap (θ = ½: the midpoint rule, which
+/// keeps the energy of an undamped contact). Solved for u_n⁺ it is
+/// `u_n + c r_n ≥ ū ⊥ r_n ≥ 0` with
+///
+/// ```text
+/// c = 1 / (h (hθ² k + d)),   ū = −k (g + hθ(1 − θ) u_n⁻) / (hθ² k + d).
+/// ```
+///
+/// A resting contact under a load F sinks by F/k; two bodies of reduced mass m
+/// stay in contact for π √(m/k) (d = 0).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Compliant {
+    /// Friction coefficient μ ≥ 0.
+    pub mu: f64,
+    /// Normal stiffness k > 0 (N/m; in 2D per unit thickness, Pa).
+    pub k: f64,
+    /// Normal damping d ≥ 0 (N·s/m; in 2D per unit thickness).
+    pub d: f64,
+}
+
+impl Law for Compliant {
+    fn contacts(&self, step: &LawStep, inputs: &[LawInput], target: &mut [Target], _joint: &mut [Joint]) {
+        let (h, th) = (step.h, step.theta);
+        let s = h * th * th * self.k + self.d;
+        for (c, t) in inputs.iter().zip(target) {
+            *t = Target {
+                u_target: -self.k * (c.gap + h * th * (1.0 - th) * c.un_begin) / s,
+                mu: self.mu,
+            };
+        }
+    }
+    fn compliance(&self, step: &LawStep) -> f64 {
+        1.0 / (step.h * (step.h * step.theta * step.theta * self.k + self.d))
     }
 }
 
@@ -268,6 +319,23 @@ impl LawBatches {
     }
 }
 
+impl LawBatches {
+    /// Each contact's compliance ([`Law::compliance`], one call per law) into
+    /// `out` (contact order) and true; false and `out` empty when no law is
+    /// compliant.
+    pub fn compliance(&self, laws: &[Option<Arc<dyn Law>>], step: &LawStep, out: &mut Vec<f64>) -> bool {
+        out.clear();
+        // a law's c that is not a finite number ≥ 0 (a plugin's bug) counts as rigid
+        let of = |l: &Arc<dyn Law>| Some(l.compliance(step)).filter(|c| c.is_finite() && *c > 0.0).unwrap_or(0.0);
+        if laws.iter().all(|l| l.as_ref().is_none_or(|l| of(l) == 0.0)) {
+            return false;
+        }
+        let per: Vec<f64> = laws.iter().map(|l| l.as_ref().map_or(0.0, of)).collect();
+        out.extend(self.slot.iter().map(|&s| per[s as usize]));
+        true
+    }
+}
+
 /// The target normal velocity ū of the law (see the module docs).
 #[inline]
 pub fn target_velocity(gap: f64, un_begin: f64, un_free: f64, h: f64, theta: f64, e: f64) -> f64 {
@@ -306,6 +374,23 @@ fn parse_frictionless(t: &toml::Table) -> Result<Arc<dyn Law>, ParamError> {
         mu: 0.0,
         e: restitution(t)?,
     }))
+}
+
+fn parse_compliant(t: &toml::Table) -> Result<Arc<dyn Law>, ParamError> {
+    only_keys(t, &["friction", "stiffness", "damping"])?;
+    let mu = number(t, "friction", Some(0.0))?;
+    if mu < 0.0 {
+        return Err(ParamError::new("friction", format!("μ must be ≥ 0, got {mu}")));
+    }
+    let k = number(t, "stiffness", None)?;
+    if !(k > 0.0 && k.is_finite()) {
+        return Err(ParamError::new("stiffness", format!("must be > 0 (N/m), got {k}")));
+    }
+    let d = number(t, "damping", Some(0.0))?;
+    if !(d >= 0.0 && d.is_finite()) {
+        return Err(ParamError::new("damping", format!("must be ≥ 0 (N·s/m), got {d}")));
+    }
+    Ok(Arc::new(Compliant { mu, k, d }))
 }
 
 fn parse_mohr_coulomb(t: &toml::Table) -> Result<Arc<dyn Law>, ParamError> {
@@ -354,8 +439,8 @@ fn parse_mohr_coulomb(t: &toml::Table) -> Result<Arc<dyn Law>, ParamError> {
     }))
 }
 
-/// The framework's own laws: `coulomb`, `frictionless`, `mohr_coulomb`.
-pub(crate) fn builtin() -> [LawDef; 3] {
+/// The framework's own laws: `coulomb`, `frictionless`, `mohr_coulomb`, `compliant`.
+pub(crate) fn builtin() -> [LawDef; 4] {
     [
         LawDef {
             name: "coulomb",
@@ -368,6 +453,10 @@ pub(crate) fn builtin() -> [LawDef; 3] {
         LawDef {
             name: "mohr_coulomb",
             parse: parse_mohr_coulomb,
+        },
+        LawDef {
+            name: "compliant",
+            parse: parse_compliant,
         },
     ]
 }

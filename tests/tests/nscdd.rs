@@ -563,3 +563,46 @@ fn timing_threads() {
         }
     }
 }
+
+/// The pile with `compliant` contacts (k = 10⁵ N/m, a dashpot): subdomains glue
+/// compliant contacts like rigid ones (each part's blocks hold W + c e_n e_nᵀ), so
+/// the split agrees with one domain to the solver's tolerance, and threads change
+/// no bit.
+#[test]
+fn compliant_pile_split_2x2_matches_one_domain_and_threads_agree() {
+    let text = pile_text().replace(
+        "friction = 0.3",
+        "law = \"compliant\"\nstiffness = 1e5\ndamping = 100.0\nfriction = 0.3",
+    );
+    let reg = nscdd_rigid_disks::registry();
+    let load = || {
+        let mut s = nscdd::scene::load_str(&text, "pile.toml", &reg).unwrap();
+        for _ in 0..30 {
+            assert!(s.world.step().unwrap().solve.converged);
+        }
+        s
+    };
+    assert!(load().world.contacts.compliant);
+    let (mut a, mut b) = (load(), load());
+    let mut n = Nscdd::new(dd(2, 2));
+    for _ in 0..5 {
+        assert!(a.world.step().unwrap().solve.converged);
+        let rep = dd_step(&mut n, &mut b);
+        let (gmax, grms) = impulse_gap(&a, &b);
+        println!(
+            "compliant 2×2: impulses max rel. gap {gmax:.3e}, RMS {grms:.3e}, {} interface bodies",
+            rep.interface_bodies
+        );
+        assert!(rep.interface_bodies > 5);
+        assert!(gmax < 10.0 * TOL && grms < 2.0 * TOL, "impulse gaps {gmax:e} {grms:e}");
+    }
+    let mut c = load();
+    let mut n2 = Nscdd::new(DdSettings { threads: 2, ..dd(2, 2) });
+    let mut d = load();
+    let mut n1 = Nscdd::new(dd(2, 2));
+    for _ in 0..5 {
+        dd_step(&mut n2, &mut c);
+        dd_step(&mut n1, &mut d);
+    }
+    same_state(&c, &d, "compliant 2×2, 2 threads");
+}

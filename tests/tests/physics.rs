@@ -12,7 +12,10 @@
 //! - [`impacts`]: Newton's cradle (Moreau's simultaneous impact law) and a
 //!   bouncing ball (rest time, energy conservation with θ = ½, e = 1);
 //! - [`pressure`]: a pressure drive on a wall of a 2D box sample (wall force σ H);
-//! - [`determinism`]: bitwise-identical reruns.
+//! - [`determinism`]: bitwise-identical reruns;
+//! - [`compliant`]: the `compliant` law against a mass on a spring (static sink
+//!   m g / k, contact time π √(m/k), restitution of a damping ratio, the chain's
+//!   wave speed).
 
 mod common;
 
@@ -33,3 +36,6 @@ mod pressure;
 
 #[path = "physics/plugin_law.rs"]
 mod plugin_law;
+
+#[path = "physics/compliant.rs"]
+mod compliant;

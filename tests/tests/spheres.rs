@@ -414,3 +414,55 @@ seed = 9
         let _ = std::fs::remove_dir_all(d);
     }
 }
+
+/// The `compliant` law in 3D: a sphere resting on a plane sinks by m g / k, and
+/// after an undamped bounce on it (no gravity, θ = ½) leaves at its incoming speed.
+#[test]
+fn compliant_sphere_sinks_by_its_weight_over_k_and_bounces_back() {
+    let k = 1e6;
+    let m = RHO * 4.0 / 3.0 * std::f64::consts::PI * R.powi(3);
+    let text = |gravity: &str, damping: f64, z: f64| {
+        format!(
+            r#"
+dimension = 3
+{gravity}
+[time]
+step = 1e-4
+theta = 0.5
+steps = 100
+[solver]
+tolerance = 1e-12
+max_sweeps = 10000
+[[materials]]
+name = "m"
+density = {RHO:?}
+[[laws]]
+materials = ["m", "m"]
+law = "compliant"
+stiffness = {k:?}
+damping = {damping:?}
+friction = 0.5
+[[bodies]]
+shape = "plane"
+material = "m"
+position = [0.0, 0.0, 0.0]
+fixed = true
+[[bodies]]
+shape = "sphere"
+material = "m"
+radius = {R:?}
+position = [0.0, 0.0, {z:?}]
+"#
+        )
+    };
+    let mut s = load(&text("", (k * m).sqrt(), R));
+    steps(&mut s, 5000);
+    rel("gap at rest", s.world.bodies.pos[1][2] - R, -m * G / k, 1e-9);
+    let mut s = load(&text("gravity = [0.0, 0.0, 0.0]", 0.0, R + 1e-3));
+    let v = 0.1;
+    s.world.bodies.vel[1] = [0.0, 0.0, -v, 0.0, 0.0, 0.0];
+    steps(&mut s, 2000);
+    // the 2D bounce's bound: O(ω h)
+    let omega = (k / m).sqrt();
+    rel("speed after", s.world.bodies.vel[1][2], v, omega * 1e-4);
+}

@@ -187,6 +187,11 @@ impl Dim for D2 {
         w[0]
     }
     #[inline]
+    fn with_compliance(mut w: [f64; 3], c: f64) -> [f64; 3] {
+        w[0] += c;
+        w
+    }
+    #[inline]
     fn block(w: [f64; 3], mu: f64) -> Block2 {
         Block2 {
             w,

@@ -336,6 +336,11 @@ impl Dim for D3 {
         w[0]
     }
     #[inline]
+    fn with_compliance(mut w: Sym3, c: f64) -> Sym3 {
+        w[0] += c;
+        w
+    }
+    #[inline]
     fn block(w: Sym3, _mu: f64) -> Block3 {
         Block3 {
             w,

@@ -206,6 +206,8 @@ pub trait Dim: sealed::Sealed + Copy + Default + Debug + PartialEq + Send + Sync
     fn delassus(f: &Self::Frame, inv_i: &Self::InvMass, inv_j: &Self::InvMass) -> Self::W;
     /// W_nn, the normal entry of a block (a contact with W_nn ≤ 0 moves nothing).
     fn w_nn(w: &Self::W) -> f64;
+    /// W + c e_n e_nᵀ: the block of a contact with normal compliance c.
+    fn with_compliance(w: Self::W, c: f64) -> Self::W;
     /// The block of W with the local solver's precomputed data for friction μ.
     fn block(w: Self::W, mu: f64) -> Self::Block;
     /// W_αα r.

@@ -124,6 +124,10 @@ pub fn problem_with(w: &World2, shares: &[FamilyShare]) -> FcProblem {
     for c in contrib.iter_mut().filter(|c| c.0 == c.1) {
         c.2[2] = c.2[1];
     }
+    if c.compliant {
+        let compliant = c.compliance.iter().enumerate().filter(|x| *x.1 > 0.0);
+        contrib.extend(compliant.map(|(a, &cc)| (a as u32, a as u32, [cc, 0.0, 0.0, 0.0])));
+    }
     let mut g0 = 0;
     while g0 < inc.len() {
         let body = inc[g0].0;
@@ -220,6 +224,11 @@ pub fn problem_with3(w: &crate::world::World3, shares: &[FamilyShare]) -> FcProb
     let rows = |h: &[f64]| -> [[f64; 6]; 3] { std::array::from_fn(|k| std::array::from_fn(|l| h[6 * k + l])) };
     let block = |v: &[f64]| -> [[f64; 3]; 3] { std::array::from_fn(|p| std::array::from_fn(|q| v[3 * p + q])) };
     let (finc, mut contrib) = family_parts(shares, &off, rows, block);
+    if c.compliant {
+        let compliant = c.compliance.iter().enumerate().filter(|x| *x.1 > 0.0);
+        let diag = |cc: f64| std::array::from_fn(|p| std::array::from_fn(|q| if p + q == 0 { cc } else { 0.0 }));
+        contrib.extend(compliant.map(|(a, &cc)| (a as u32, a as u32, diag(cc))));
+    }
     inc.extend(finc);
     inc.sort_unstable_by_key(|x| (x.0, x.1)); // (body, contact): unique keys
     let mut g0 = 0;

@@ -46,6 +46,15 @@ pub struct Contacts<D: Dim> {
     pub key: Vec<ContactKey>,
     /// Strengths of bonded joints (zero for other contacts).
     pub joint: Vec<Joint>,
+    /// Normal compliance c ≥ 0 of each contact (law `compliant`: the normal law is
+    /// u_n + c r_n ≥ ū ⊥ r_n ≥ 0), added to W_nn in its `block`; one per contact
+    /// when `compliant`, else empty (rigid contacts, the common case, carry none).
+    #[serde(default)]
+    pub compliance: Vec<f64>,
+    /// Whether some contact has c > 0 (set by whoever fills `compliance`: the
+    /// contact build, [`Contacts::push_from`]).
+    #[serde(default)]
+    pub compliant: bool,
 }
 
 macro_rules! each_field {
@@ -72,6 +81,8 @@ impl<D: Dim> Contacts<D> {
     }
     pub fn clear(&mut self) {
         each_field!(self, clear);
+        self.compliance.clear();
+        self.compliant = false;
     }
     /// Room for `n` more contacts in every field.
     pub fn reserve(&mut self, n: usize) {
@@ -90,6 +101,11 @@ impl<D: Dim> Contacts<D> {
         self.point.push(other.point[a]);
         self.key.push(other.key[a]);
         self.joint.push(other.joint[a]);
+        if other.compliant {
+            // contacts come from one source: all compliant or none
+            self.compliance.push(other.compliance[a]);
+            self.compliant = true;
+        }
     }
 
     /// Whether some contact is a bonded joint (the sweep then takes the joint path).
@@ -138,6 +154,11 @@ impl<D: Dim> Contacts<D> {
         for a in 0..self.len() {
             let [i, j] = self.bodies[a];
             let w = D::delassus(&self.frame[a], &inv[i as usize], &inv[j as usize]);
+            let w = if self.compliant {
+                D::with_compliance(w, self.compliance[a])
+            } else {
+                w
+            };
             self.block[a] = D::block(w, self.target[a].mu);
         }
     }

@@ -185,6 +185,9 @@ impl crate::law::Law for GuardedLaw {
     fn bonds(&self) -> bool {
         self.guard.0.call(|| self.inner.bonds())
     }
+    fn compliance(&self, step: &crate::law::LawStep) -> f64 {
+        self.guard.0.call(|| self.inner.compliance(step))
+    }
 }
 
 pub(crate) struct GuardedWriter<D: Dim> {

@@ -97,6 +97,7 @@ pub(crate) fn load_parsed<D: SceneDim>(cx: &Ctx, sf: SceneFile<BodySpec<D>>, reg
         step: 0,
         contacts: Default::default(),
         reaction: vec![D::Twist::zero(); n],
+        contact_shares: vec![],
         scratch: Default::default(),
     };
     Ok(Scene {

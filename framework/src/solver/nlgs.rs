@@ -81,7 +81,9 @@ struct Hot<'a, D: Dim> {
     block: &'a [D::Block],
     target: &'a [Target],
     r: &'a mut [D::Local],
+    /// The cold law data, read only on the `COLD` path (empty slices otherwise).
     joint: &'a [Joint],
+    compliance: &'a [f64],
 }
 
 /// One NLGS sweep; accumulates the check sums when `sums` is given (an updating
@@ -107,7 +109,8 @@ fn pass<D: Dim>(
     sums: Option<&mut Sums>,
     update: bool,
 ) {
-    let joints = c.any_bonded();
+    // bonded joints or compliant contacts: the path that reads their cold data
+    let cold = c.compliant || c.any_bonded();
     let m = c.len();
     let mut h = Hot::<D> {
         bodies: &c.bodies[..m],
@@ -116,12 +119,13 @@ fn pass<D: Dim>(
         target: &c.target[..m],
         r: &mut c.r[..m],
         joint: &c.joint[..m],
+        compliance: if cold && c.compliant { &c.compliance[..m] } else { &[] },
     };
     let relax = omega != 1.0;
     let mut none = Sums::default();
     macro_rules! go {
         ($check:literal, $update:literal, $s:expr) => {
-            match (relax, joints) {
+            match (relax, cold) {
                 (false, false) => run::<D, $check, $update, false, false>(&mut h, order, vel, inv, omega, $s),
                 (true, false) => run::<D, $check, $update, true, false>(&mut h, order, vel, inv, omega, $s),
                 (false, true) => run::<D, $check, $update, false, true>(&mut h, order, vel, inv, omega, $s),
@@ -137,7 +141,7 @@ fn pass<D: Dim>(
 }
 
 #[inline(always)]
-fn run<D: Dim, const CHECK: bool, const UPDATE: bool, const RELAX: bool, const JOINTS: bool>(
+fn run<D: Dim, const CHECK: bool, const UPDATE: bool, const RELAX: bool, const COLD: bool>(
     h: &mut Hot<'_, D>,
     order: &[u32],
     vel: &mut [D::Twist],
@@ -147,20 +151,22 @@ fn run<D: Dim, const CHECK: bool, const UPDATE: bool, const RELAX: bool, const J
 ) {
     if order.is_empty() {
         for a in 0..h.bodies.len() {
-            visit::<D, CHECK, UPDATE, RELAX, JOINTS>(h, a, vel, inv, omega, sums);
+            visit::<D, CHECK, UPDATE, RELAX, COLD>(h, a, vel, inv, omega, sums);
         }
     } else {
         for &a in order {
-            visit::<D, CHECK, UPDATE, RELAX, JOINTS>(h, a as usize, vel, inv, omega, sums);
+            visit::<D, CHECK, UPDATE, RELAX, COLD>(h, a as usize, vel, inv, omega, sums);
         }
     }
 }
 
 /// Solves contact α with the others' impulses fixed and updates its two bodies:
 /// u = H_αᵀ V, u0 = u − W_αα r_α, r_α ← local solution, V += M̂⁻¹ H_α Δr_α (with
-/// `UPDATE`; without, only the check sums).
+/// `UPDATE`; without, only the check sums). With `COLD`, bonded joints take the
+/// joint solver and a contact of compliance c, whose block holds W_αα + c e_n e_nᵀ,
+/// gets u0 = u − W_αα r_α: the local solution then obeys u_n + c r_n ≥ ū ⊥ r_n ≥ 0.
 #[inline(always)]
-fn visit<D: Dim, const CHECK: bool, const UPDATE: bool, const RELAX: bool, const JOINTS: bool>(
+fn visit<D: Dim, const CHECK: bool, const UPDATE: bool, const RELAX: bool, const COLD: bool>(
     h: &mut Hot<'_, D>,
     a: usize,
     vel: &mut [D::Twist],
@@ -175,9 +181,12 @@ fn visit<D: Dim, const CHECK: bool, const UPDATE: bool, const RELAX: bool, const
     let r = h.r[a];
     let blk = &h.block[a];
     let wr_old = D::w_mul(blk, &r);
-    let u0 = u.sub(&wr_old);
+    let mut u0 = u.sub(&wr_old);
+    if COLD && !h.compliance.is_empty() {
+        u0.as_mut()[0] += h.compliance[a] * r.as_ref()[0];
+    }
     let t = h.target[a];
-    let mut rn = if JOINTS && h.joint[a].bonded() {
+    let mut rn = if COLD && h.joint[a].bonded() {
         D::solve_joint(blk, &u0, t.u_target, t.mu, &h.joint[a], &r)
     } else {
         D::solve(blk, &u0, t.u_target, t.mu, &r)
@@ -256,6 +265,9 @@ pub fn residual_parts_of<D: Dim>(c: &Contacts<D>, vel: &[D::Twist], which: impl 
         let t = c.target[a];
         let mut u = c.local_velocity(a, vel);
         u[0] -= t.u_target;
+        if c.compliant {
+            u[0] += c.compliance[a] * c.r[a][0];
+        }
         let jt = c.joint[a];
         f2 += if jt.bonded() {
             D::joint_natural_map_sq(&c.r[a], &u, t.mu, &jt)

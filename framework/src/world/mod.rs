@@ -76,8 +76,19 @@ pub struct World<D: Dim> {
     pub contacts: Contacts<D>,
     /// Contact impulse resultant per body over the last step, Σ ±H r (N·s).
     pub reaction: Vec<D::Twist>,
+    /// Shares of the contacts' elastic energy that the world keeps, set by body
+    /// families that take the rest (a continuum region's overlap band): each step,
+    /// every share gives a weight w ∈ (0, 1] per contact (from its bodies and
+    /// point) and a compliant contact's stiffness and damping are multiplied by
+    /// the product, i.e. its compliance c divided by it. Empty: w = 1.
+    pub contact_shares: Vec<ContactShare<D>>,
     pub(crate) scratch: Scratch<D>,
 }
+
+/// A share of the contacts' stiffness ([`World::contact_shares`]): multiplies
+/// `weight[a]` by the world's share of contact a between `bodies[a]` at
+/// `point[a]`; one call per step for all the contacts.
+pub type ContactShare<D> = Arc<dyn Fn(&[[u32; 2]], &[<D as Dim>::Point], &mut [f64]) + Send + Sync>;
 
 /// The 2D world.
 pub type World2 = World<D2>;
@@ -96,6 +107,8 @@ pub(crate) struct Scratch<D: Dim> {
     pub laws: LawBatches,
     /// W_αα of the contacts being built.
     pub w: Vec<D::W>,
+    /// The contacts' weights of [`World::contact_shares`].
+    pub share: Vec<f64>,
     /// Detection restricted to this part of space (a rank's subdomains).
     pub region: Option<crate::detect::Region>,
     /// Last step's contacts held by other processes that this one may meet again
@@ -117,6 +130,7 @@ impl<D: Dim> Default for Scratch<D> {
             next: Contacts::default(),
             laws: LawBatches::default(),
             w: vec![],
+            share: vec![],
             region: None,
             extra_prev: vec![],
             active: None,

@@ -39,6 +39,7 @@ impl FamilyKind<D2> for DeformableKind {
             &cx.world.time,
             &|b, w| cx.check_memory(b, w),
         )?;
+        crate::scene::refuse_compliant(&bodies, cx.world)?;
         Ok(Box::new(Deformables2::new(bodies, cx.world.alert)))
     }
 }
@@ -54,6 +55,7 @@ impl FamilyKind<D3> for DeformableKind {
             &cx.world.time,
             &|b, w| cx.check_memory(b, w),
         )?;
+        crate::scene::refuse_compliant(&bodies, cx.world)?;
         Ok(Box::new(Deformables3::new(bodies, cx.world.alert)))
     }
 }

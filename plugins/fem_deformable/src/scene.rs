@@ -188,6 +188,29 @@ pub fn bodies_from(
     Ok(bodies)
 }
 
+/// A law with a compliance ([`nscdd::law::Law::compliance`], law `compliant`)
+/// between a deformable body's material and any material is refused, naming the
+/// body's `material`: the deformable contacts' sweep solves rigid contacts only.
+pub fn refuse_compliant<D: nscdd::dim::Dim>(bodies: &[FeBody], w: &World<D>) -> Result<(), EntryError> {
+    let step = nscdd::law::LawStep {
+        h: w.time.h,
+        theta: w.time.theta,
+        first: true,
+    };
+    for (i, b) in bodies.iter().enumerate() {
+        for (j, other) in w.materials.iter().enumerate() {
+            if w.law(b.material, j as u16).is_some_and(|l| l.compliance(&step) > 0.0) {
+                let msg = format!(
+                    "the law between materials `{}` and `{}` is compliant, which deformable bodies' contacts do not take (they are rigid: use `coulomb` or `frictionless` for this pair)",
+                    w.materials[b.material as usize].name, other.name
+                );
+                return Err(entry_error(i, "material", msg));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Bytes a deformable body of `nodes` nodes holds while it is built and run (its
 /// mesh, M, K, the factor of M̂ and Python's assembly arrays): measured with
 /// `nscdd check` (peak memory of a rectangle of 100² and 300² cells, 2.6 kB per

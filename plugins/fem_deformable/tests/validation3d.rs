@@ -413,6 +413,10 @@ fn input_errors_3d_name_the_key() {
     assert_eq!(e.key, "deformable[0].velocity", "{e}");
     let e = load_err("fix = [\"north\"]\nmesh = { box = { origin = [0.0, 0.0, 0.0], size = [1.0, 1.0, 1.0], cells = [1, 1, 1] } }");
     assert!(e.to_string().contains("front"), "{e}");
+    // deformable contacts are rigid: a compliant law on their material is refused
+    let e = load_err("mesh = { box = { origin = [0.0, 0.0, 0.0], size = [1.0, 1.0, 1.0], cells = [1, 1, 1] } }\n[[laws]]\nmaterials = [\"solid\", \"ground\"]\nlaw = \"compliant\"\nstiffness = 1e6");
+    assert_eq!(e.key, "deformable[0].material", "{e}");
+    assert!(e.to_string().contains("compliant"), "{e}");
 }
 
 /// Two stacks of two spheres on a deformable block (fixed at its base, resting on

@@ -33,6 +33,9 @@ pub struct Continuum<D: Dim, const N: usize> {
     /// The band's grains and their share w_p of their mass (the partition of
     /// unity), ascending grain.
     pub band: Vec<(u32, f64)>,
+    /// Each region's band, and the region of each band grain (grain, region).
+    pub bands: Vec<super::scene::Band>,
+    pub band_region: Vec<(u32, u32)>,
     /// Each region's tie nodes (fixed), G among them and their velocities.
     pub sets: Vec<NodeSet<N>>,
     /// Per entry of `ties.grain`: the grain's V⁻ and V_free of the step (the world's
@@ -76,6 +79,8 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
             driven,
             ties,
             band,
+            bands: vec![],
+            band_region: vec![],
             sets,
             grain_begin: vec![],
             grain_free: vec![],

@@ -134,6 +134,7 @@ type BandGrain = (u32, usize, [f64; 4], f64);
 fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, D>) -> Result<Continuum<D, N>, EntryError> {
     let w = cx.world;
     let (mut bodies, mut ties, mut band_all) = (Vec::new(), TieSet::<N>::default(), Vec::new());
+    let (mut bands, mut band_region) = (Vec::new(), Vec::new());
     let (mut plastic, mut driven) = (Vec::new(), Vec::new());
     let mut tied = vec![false; w.bodies.len()];
     let mut held = 0.0;
@@ -214,11 +215,15 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
         let mass = |g: u32, wp: f64| wp * w.bodies.mass[g as usize];
         push_ties(&mut ties, body, &b.mesh, &grains, coupling, &mass);
         band_all.extend(grains.iter().map(|x| (x.0, x.3)));
+        band_region.extend(grains.iter().map(|x| (x.0, bodies.len() as u32)));
+        bands.push(band);
         bodies.push(b);
     }
     band_all.sort_unstable_by_key(|x| x.0);
     let mut c = Continuum::new(bodies, plastic, ties, band_all);
     c.driven = driven;
+    c.bands = bands;
+    c.band_region = band_region;
     Ok(c)
 }
 
@@ -443,6 +448,22 @@ impl<D: Dim, const N: usize> SceneFamily<D> for Continuum<D, N> {
             w.bodies.mass[g as usize] *= wp;
             w.bodies.refresh_inverse(g as usize);
         }
+        // the contacts of a band grain keep the share 1 − α(x) of their stiffness
+        // at their point (compliant laws: docs/CONTINUUM.md, energy)
+        let mut region = vec![u32::MAX; w.bodies.len()];
+        for &(g, r) in &self.band_region {
+            region[g as usize] = r;
+        }
+        let bands = self.bands.clone();
+        w.contact_shares.push(std::sync::Arc::new(move |bodies, points, weight| {
+            for ((b, p), wt) in bodies.iter().zip(points).zip(weight.iter_mut()) {
+                let of = |i: u32| region.get(i as usize).copied().unwrap_or(u32::MAX);
+                let r = of(b[0]).min(of(b[1]));
+                if r != u32::MAX {
+                    *wt *= 1.0 - bands[r as usize].alpha(&p.as_ref()[..N]);
+                }
+            }
+        }));
     }
     fn update(&mut self, w: &World<D>) -> Result<(), Diverged> {
         if let Some(e) = self.error.take() {
