@@ -184,10 +184,14 @@ impl FeBody {
     /// Holds the given nodes fixed (all their components).
     pub fn fix_nodes(&mut self, nodes: &[u32]) {
         let d = self.dim();
-        for &k in nodes {
-            for c in 0..d {
-                self.fixed[d * k as usize + c] = true;
-            }
+        let dofs: Vec<usize> = nodes.iter().flat_map(|&k| (0..d).map(move |c| d * k as usize + c)).collect();
+        self.fix_dofs(&dofs);
+    }
+
+    /// Fixes degrees of freedom (node-major indices); M̂ is factored again.
+    pub fn fix_dofs(&mut self, dofs: &[usize]) {
+        for &i in dofs {
+            self.fixed[i] = true;
         }
         self.factor = None;
         self.columns.clear();

@@ -482,3 +482,81 @@ fn a_side_loaded_then_driven() {
     assert!((top_r[1] + 2000.0).abs() < 0.05 * 2000.0, "{top_r:?}");
     assert!(top_r[0].abs() < 0.01 * 2000.0);
 }
+
+/// `initial_stress`: a block under an isotropic 10 kPa on its four sides stands
+/// still when it starts at that stress (elastic or Drucker–Prager, which then
+/// never yields: σ_zz = ν (σ_xx + σ_yy) keeps it inside the cone), and is
+/// compressed by σ/E without it.
+#[test]
+fn an_initial_stress_balances_the_sides_loads() {
+    let loads = "load = { left = [1e4, 0.0], right = [-1e4, 0.0], top = [0.0, -1e4], bottom = [0.0, 1e4] }";
+    let run = |extra: &str| {
+        let text = format!(
+            "gravity = [0.0, 0.0]\n{}",
+            block_scene(&format!("{loads}\n{extra}")).replace("fix = [\"bottom\"]\n", "")
+        );
+        let mut r = Run::new(&text);
+        for _ in 0..100 {
+            r.step();
+        }
+        let u = r.cont().bodies[0].u.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        (r, u)
+    };
+    let (_, free) = run("");
+    let (_, held) = run("initial_stress = [-1e4, -1e4, 0.0]");
+    let (dp, held_dp) = run("initial_stress = [-1e4, -1e4, 0.0]\nplastic = { friction = 16.5, dilatancy = 4.0 }");
+    println!("largest displacement: no initial stress {free:.3e}, elastic {held:.3e}, Drucker–Prager {held_dp:.3e}");
+    // σ/E = 1e-2 (ν = 0.3 in plane strain: ε = (1 + ν)(1 − 2ν) σ / E = 5.2e-3) over 0.5 m
+    assert!(free > 1e-3);
+    assert!(held < 1e-12 && held_dp < 1e-12, "{held:e} {held_dp:e}");
+    assert_eq!(dp.cont().plastic[0].as_ref().unwrap().yielding, 0);
+    // refused where it cannot apply
+    let bad = |extra: &str| {
+        Scene::<nscdd::dim::D2>::load_str(&block_scene(extra), "t.toml", &registry())
+            .err()
+            .expect("refused")
+    };
+    assert_eq!(bad("initial_stress = [1.0, 2.0]").key, "continuum[0].initial_stress");
+    assert_eq!(
+        bad("initial_stress = [-1.0, -1.0, 0.0]\nplane = \"stress\"").key,
+        "continuum[0].initial_stress"
+    );
+}
+
+/// A drive's `"free"` component: the block squeezed between frictionless platens
+/// (`["free", v]`) spreads sideways freely (no horizontal reaction), where held
+/// platens hold it.
+#[test]
+fn free_components_of_a_drive_make_rollers() {
+    let run = |drive: &str| {
+        let text = format!("gravity = [0.0, 0.0]\n{}", block_scene("").replace("fix = [\"bottom\"]", drive));
+        let mut r = Run::new(&text);
+        for _ in 0..200 {
+            r.step();
+        }
+        let c = r.cont();
+        let b = &c.bodies[0];
+        // the bottom-left and bottom-right corners' horizontal displacements
+        let corner = |x: f64| {
+            (0..b.mesh.n_nodes())
+                .find(|&k| b.mesh.node(k)[1] < 1e-9 && (b.mesh.node(k)[0] - x).abs() < 1e-9)
+                .unwrap()
+        };
+        let spread = b.u[2 * corner(1.0)] - b.u[2 * corner(0.0)];
+        let r = nscdd_fem_deformable::continuum::sides::reaction(b, &c.driven[0][0]);
+        (spread, r)
+    };
+    let (rolled, r_rolled) = run("drive = { bottom = [\"free\", 0.0], top = [\"free\", -0.002] }");
+    let (held, _) = run("drive = { bottom = [0.0, 0.0], top = [0.0, -0.002] }");
+    println!("bottom spread: rollers {rolled:.3e} m, held {held:.3e} m; rollers' bottom reaction {r_rolled:?}");
+    // the held base does not spread; on rollers it does (plane strain Poisson:
+    // ν/(1 − ν) of the 0.8 mm squeeze over 0.5 m, times the 1 m width, at rest
+    // (θ = 1 damps the squeeze's vibration) to 2 %)
+    assert!(held.abs() < 1e-12, "{held:e}");
+    let poisson = 0.3 / 0.7 * 0.0008 / 0.5 * 1.0;
+    assert!((rolled - poisson).abs() < 0.02 * poisson, "{rolled:e} vs {poisson:e}");
+    assert_eq!(r_rolled[0], 0.0);
+    assert!(r_rolled[1] > 0.0);
+    let bad = Scene::<nscdd::dim::D2>::load_str(&block_scene("drive = { top = [\"free\", \"free\"] }"), "t.toml", &registry());
+    assert_eq!(bad.err().expect("refused").key, "continuum[0].drive");
+}

@@ -127,6 +127,24 @@ fn plastic_of(i: usize, e: &toml::Table) -> Result<Option<DpSpec>, EntryError> {
     Ok(Some(d))
 }
 
+/// `initial_stress` (Pa, tension positive): 2D `[xx, yy, xy]` (plane strain:
+/// zz = ν (xx + yy)), 3D `[xx, yy, zz, xy, yz, xz]`, as a 3 × 3 tensor.
+fn initial_stress_of(i: usize, e: &toml::Table, dim: usize) -> Result<Option<[[f64; 3]; 3]>, EntryError> {
+    let Some(v) = e.get("initial_stress") else { return Ok(None) };
+    let n = if dim == 2 { 3 } else { 6 };
+    let what = if dim == 2 { "[xx, yy, xy]" } else { "[xx, yy, zz, xy, yz, xz]" };
+    let s: Vec<f64> = v
+        .as_array()
+        .map(|a| a.iter().filter_map(|x| x.as_float().or(x.as_integer().map(|k| k as f64))).collect())
+        .filter(|a: &Vec<f64>| a.len() == n && a.len() == v.as_array().map_or(0, |b| b.len()) && a.iter().all(|x| x.is_finite()))
+        .ok_or_else(|| entry_error(i, "initial_stress", format!("{n} numbers {what} (Pa, tension positive)")))?;
+    let t = match dim {
+        2 => [[s[0], s[2], 0.0], [s[2], s[1], 0.0], [0.0, 0.0, f64::NAN]],
+        _ => [[s[0], s[3], s[5]], [s[3], s[1], s[4]], [s[5], s[4], s[2]]],
+    };
+    Ok(Some(t))
+}
+
 /// A band grain: world id, cell, barycentric coordinates, share w_p of its mass.
 type BandGrain = (u32, usize, [f64; 4], f64);
 
@@ -143,6 +161,7 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
         let band = band_of(i, e, N)?;
         let coupling = coupling_of(i, e)?;
         let dp = plastic_of(i, e)?;
+        let sigma0 = initial_stress_of(i, e, N)?;
         let drives = super::sides::sides_of(i, e, "drive", N)?;
         let from = match e.get("drive_from") {
             None => 0.0,
@@ -154,7 +173,7 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
         };
         let loads = super::sides::sides_of(i, e, "load", N)?;
         let mut rest = e.clone();
-        for k in ["band", "coupling", "plastic", "drive", "drive_from", "load"] {
+        for k in ["band", "coupling", "plastic", "drive", "drive_from", "load", "initial_stress"] {
             rest.remove(k);
         }
         let spec = crate::scene::spec_of(i, &rest)?;
@@ -177,23 +196,28 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
         let shares = super::sides::load(&mut b, &loads, &|x| band.alpha(x)).map_err(|m| at("load", m))?;
         driven.push(super::sides::drive(&mut b, &drives, from, &shares).map_err(|m| at("drive", m))?);
         b.factorize(w.time.h, w.time.theta).map_err(|m| at("", m))?;
-        if dp.is_some() && b.elastic.plane_stress {
+        let (el, stressed) = (b.elastic, dp.is_some() || sigma0.is_some());
+        if stressed && el.plane_stress {
+            let key = if dp.is_some() { "plastic" } else { "initial_stress" };
             return Err(at(
-                "plastic",
-                "the Drucker–Prager continuum is in plane strain (no `plane = \"stress\"`)".into(),
+                key,
+                "the Drucker–Prager and prestressed continuum is in plane strain (no `plane = \"stress\"`)".into(),
             ));
         }
-        plastic.push(dp.map(|d| {
-            super::plastic::Plastic::new(
-                &b.mesh,
-                d.friction,
-                d.dilatancy,
-                d.cohesion,
-                b.elastic.young,
-                b.elastic.poisson,
-                &alpha,
-            )
+        // an elastic region with an initial stress: a cone it never leaves (c = ∞)
+        let dp = dp.or(sigma0.map(|_| DpSpec {
+            friction: 0.0,
+            dilatancy: 0.0,
+            cohesion: f64::INFINITY,
         }));
+        let mut p = dp.map(|d| super::plastic::Plastic::new(&b.mesh, d.friction, d.dilatancy, d.cohesion, el.young, el.poisson, &alpha));
+        if let (Some(p), Some(mut s0)) = (p.as_mut(), sigma0) {
+            if s0[2][2].is_nan() {
+                s0[2][2] = el.poisson * (s0[0][0] + s0[1][1]);
+            }
+            p.prestress(&s0);
+        }
+        plastic.push(p);
         let mut grains: Vec<BandGrain> = Vec::new();
         for g in 0..w.bodies.len() {
             if tied[g] || !Rigid::<D>::is_grain(w, g) || !w.bodies.movable(g) {

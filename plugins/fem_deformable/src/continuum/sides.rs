@@ -1,6 +1,7 @@
 //! The sides of a continuum region (docs/CONTINUUM.md): a side moved at a
 //! prescribed velocity (`drive = { top = [vx, vy] }`: its nodes held on that
-//! velocity, as a platen), a traction on a side (`load = { left = [tx, ty] }`, in Pa:
+//! velocity, as a platen; a component `"free"` leaves that direction free, a
+//! frictionless platen or roller), a traction on a side (`load = { left = [tx, ty] }`, in Pa:
 //! force per unit area, weighted by the band's α at each facet, the continuum's
 //! share of the boundary), and the reaction of a driven side for the history.
 
@@ -26,7 +27,8 @@ pub struct Driven {
     pub traction: Vec<(usize, f64)>,
 }
 
-/// `drive` and `load` of entry `i` (tables of side → vector of `dim` numbers).
+/// `drive` and `load` of entry `i` (tables of side → vector of `dim` numbers; a
+/// drive's component may be `"free"`, read as NaN).
 pub fn sides_of(i: usize, e: &toml::Table, key: &str, dim: usize) -> Result<Vec<(String, Vec<f64>)>, EntryError> {
     let at = |message: String| crate::scene::entry_error(i, key, message);
     let Some(v) = e.get(key) else { return Ok(vec![]) };
@@ -35,12 +37,25 @@ pub fn sides_of(i: usize, e: &toml::Table, key: &str, dim: usize) -> Result<Vec<
         .ok_or_else(|| at(format!("`{key} = {{ side = [{dim} numbers], … }}`")))?;
     let mut out = vec![];
     for (side, x) in t {
+        let free = |y: &toml::Value| key == "drive" && y.as_str() == Some("free");
         let xs: Vec<f64> = x
             .as_array()
-            .map(|a| a.iter().filter_map(|y| y.as_float().or(y.as_integer().map(|n| n as f64))).collect())
+            .map(|a| {
+                let num = |y: &toml::Value| y.as_float().or(y.as_integer().map(|n| n as f64));
+                a.iter()
+                    .filter_map(|y| {
+                        if free(y) {
+                            Some(f64::NAN)
+                        } else {
+                            num(y).filter(|v| v.is_finite())
+                        }
+                    })
+                    .collect()
+            })
             .unwrap_or_default();
-        if xs.len() != dim || !xs.iter().all(|y| y.is_finite()) {
-            return Err(at(format!("side `{side}`: {dim} finite numbers")));
+        if xs.len() != dim || x.as_array().is_none_or(|a| a.len() != dim) || xs.iter().all(|y| y.is_nan()) {
+            let what = if key == "drive" { " (or \"free\", not all)" } else { "" };
+            return Err(at(format!("side `{side}`: {dim} finite numbers{what}")));
         }
         out.push((side.clone(), xs));
     }
@@ -60,15 +75,21 @@ pub fn drive(
     let mut out = vec![];
     for (side, v) in sides {
         let nodes = fixed_nodes(&b.mesh, std::slice::from_ref(side))?;
-        let dofs: Vec<usize> = nodes.iter().flat_map(|&k| (0..d).map(move |c| d * k as usize + c)).collect();
+        // the driven components only ("free" ones: NaN)
+        let dofs: Vec<usize> = nodes
+            .iter()
+            .flat_map(|&k| (0..d).map(move |c| d * k as usize + c))
+            .filter(|&i| !v[i % d].is_nan())
+            .collect();
+        let traction = loads.iter().find(|l| &l.0 == side).map_or_else(Vec::new, |l| l.1.clone());
         out.push(Driven {
             side: side.clone(),
+            traction: traction.into_iter().filter(|x| dofs.binary_search(&x.0).is_ok()).collect(),
             nodes,
             dofs,
             velocity: v.clone(),
             from,
             held: false,
-            traction: loads.iter().find(|l| &l.0 == side).map_or_else(Vec::new, |l| l.1.clone()),
         });
     }
     start(b, &mut out, 0.0);
@@ -83,7 +104,7 @@ pub fn start(b: &mut FeBody, driven: &mut [Driven], t: f64) -> bool {
     let mut started = false;
     for s in driven.iter_mut() {
         if !s.held && t >= s.from {
-            b.fix_nodes(&s.nodes);
+            b.fix_dofs(&s.dofs);
             for &(i, f) in &s.traction {
                 b.f_ext[i] -= f;
             }

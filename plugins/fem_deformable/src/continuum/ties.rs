@@ -49,7 +49,16 @@ pub struct TieSet<const N: usize> {
     pub target: Vec<[f64; N]>,
     pub r: Vec<[f64; N]>,
     pub u_free: Vec<[f64; N]>,
+    /// Each tie's N columns −Σ_l b_al G_{·l} over its body's tie nodes (node-major,
+    /// `col[col_start[a]..col_start[a + 1]]`), made with W_a when they fit
+    /// ([`COLUMNS_MAX`]): a tie's impulse then moves the nodes through one column
+    /// per component instead of one per node and component. Empty: not made.
+    pub col: Vec<f64>,
+    pub col_start: Vec<usize>,
 }
+
+/// The most values the ties' columns may take (8 · 10⁶: 64 MB).
+pub const COLUMNS_MAX: usize = 8_000_000;
 
 impl<const N: usize> Default for TieSet<N> {
     fn default() -> Self {
@@ -66,6 +75,8 @@ impl<const N: usize> Default for TieSet<N> {
             target: vec![],
             r: vec![],
             u_free: vec![],
+            col: vec![],
+            col_start: vec![],
         }
     }
 }
@@ -86,6 +97,7 @@ impl<const N: usize> TieSet<N> {
     /// Appends a tie of `body` over `grains` (id, c) and `nodes` (set index, b), at
     /// rest.
     pub fn push(&mut self, body: u32, grains: impl IntoIterator<Item = (u32, f64)>, nodes: impl IntoIterator<Item = (u32, f64)>) {
+        self.col_start.clear();
         self.body.push(body);
         for (g, c) in grains {
             self.grain.push(g);
@@ -160,6 +172,21 @@ pub fn apply<D: Dim, const N: usize>(
             f.as_mut()[c] = t.c[i] * dr[c];
         }
         D::apply_inv(&mut vel[g], &inv[g], &f);
+    }
+    if t.col_start.len() == t.len() + 1 {
+        let col = &t.col[t.col_start[a]..t.col_start[a + 1]];
+        let nd = col.len() / N;
+        for (d, &x) in dr.iter().enumerate() {
+            if x != 0.0 {
+                let cd = &col[d * nd..(d + 1) * nd];
+                for (v, g) in set.v.iter_mut().zip(cd.chunks_exact(N)) {
+                    for c in 0..N {
+                        v[c] += g[c] * x;
+                    }
+                }
+            }
+        }
+        return;
     }
     for j in t.nodes(a) {
         set.apply(t.node[j] as usize, dr.map(|x| -t.b[j] * x));
@@ -276,6 +303,35 @@ pub fn refresh_delassus<D: Dim, const N: usize>(t: &mut TieSet<N>, sets: &[NodeS
         t.w[a] = w;
         // W_a ≥ Σ c² M̂⁻¹ > 0: a tie holds movable grains
         t.inv_w[a] = inverse(w).unwrap_or([[0.0; N]; N]);
+    }
+    make_columns(t, sets);
+}
+
+/// The ties' columns ([`TieSet::col`]) when they fit in [`COLUMNS_MAX`] values.
+fn make_columns<const N: usize>(t: &mut TieSet<N>, sets: &[NodeSet<N>]) {
+    t.col.clear();
+    t.col_start.clear();
+    let size = |a: usize| N * N * sets[t.body[a] as usize].len();
+    if (0..t.len()).map(size).sum::<usize>() > COLUMNS_MAX {
+        return;
+    }
+    t.col_start.push(0);
+    for a in 0..t.len() {
+        let set = &sets[t.body[a] as usize];
+        let nd = N * set.len();
+        let at = t.col.len();
+        t.col.resize(at + N * nd, 0.0);
+        let (nodes, b) = (&t.node[t.nodes(a)], &t.b[t.nodes(a)]);
+        for d in 0..N {
+            let out = &mut t.col[at + d * nd..at + (d + 1) * nd];
+            for (&l, &bl) in nodes.iter().zip(b) {
+                let r0 = (N * l as usize + d) * nd;
+                for (o, g) in out.iter_mut().zip(&set.g[r0..r0 + nd]) {
+                    *o -= bl * g;
+                }
+            }
+        }
+        t.col_start.push(t.col.len());
     }
 }
 
