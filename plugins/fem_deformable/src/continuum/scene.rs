@@ -145,6 +145,37 @@ fn initial_stress_of(i: usize, e: &toml::Table, dim: usize) -> Result<Option<[[f
     Ok(Some(t))
 }
 
+/// A region's Drucker–Prager state (None: elastic), at its initial stress if any
+/// (an elastic region with one gets a cone it never leaves, c = ∞).
+fn plastic_state(
+    b: &FeBody,
+    dp: Option<DpSpec>,
+    sigma0: Option<[[f64; 3]; 3]>,
+    alpha: &[f64],
+) -> Result<Option<super::plastic::Plastic>, (&'static str, String)> {
+    let el = b.elastic;
+    if (dp.is_some() || sigma0.is_some()) && el.plane_stress {
+        let key = if dp.is_some() { "plastic" } else { "initial_stress" };
+        return Err((
+            key,
+            "the Drucker–Prager and prestressed continuum is in plane strain (no `plane = \"stress\"`)".into(),
+        ));
+    }
+    let dp = dp.or(sigma0.map(|_| DpSpec {
+        friction: 0.0,
+        dilatancy: 0.0,
+        cohesion: f64::INFINITY,
+    }));
+    let mut p = dp.map(|d| super::plastic::Plastic::new(&b.mesh, d.friction, d.dilatancy, d.cohesion, el.young, el.poisson, alpha));
+    if let (Some(p), Some(mut s0)) = (p.as_mut(), sigma0) {
+        if s0[2][2].is_nan() {
+            s0[2][2] = el.poisson * (s0[0][0] + s0[1][1]);
+        }
+        p.prestress(&s0);
+    }
+    Ok(p)
+}
+
 /// A band grain: world id, cell, barycentric coordinates, share w_p of its mass.
 type BandGrain = (u32, usize, [f64; 4], f64);
 
@@ -196,28 +227,7 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
         let shares = super::sides::load(&mut b, &loads, &|x| band.alpha(x)).map_err(|m| at("load", m))?;
         driven.push(super::sides::drive(&mut b, &drives, from, &shares).map_err(|m| at("drive", m))?);
         b.factorize(w.time.h, w.time.theta).map_err(|m| at("", m))?;
-        let (el, stressed) = (b.elastic, dp.is_some() || sigma0.is_some());
-        if stressed && el.plane_stress {
-            let key = if dp.is_some() { "plastic" } else { "initial_stress" };
-            return Err(at(
-                key,
-                "the Drucker–Prager and prestressed continuum is in plane strain (no `plane = \"stress\"`)".into(),
-            ));
-        }
-        // an elastic region with an initial stress: a cone it never leaves (c = ∞)
-        let dp = dp.or(sigma0.map(|_| DpSpec {
-            friction: 0.0,
-            dilatancy: 0.0,
-            cohesion: f64::INFINITY,
-        }));
-        let mut p = dp.map(|d| super::plastic::Plastic::new(&b.mesh, d.friction, d.dilatancy, d.cohesion, el.young, el.poisson, &alpha));
-        if let (Some(p), Some(mut s0)) = (p.as_mut(), sigma0) {
-            if s0[2][2].is_nan() {
-                s0[2][2] = el.poisson * (s0[0][0] + s0[1][1]);
-            }
-            p.prestress(&s0);
-        }
-        plastic.push(p);
+        plastic.push(plastic_state(&b, dp, sigma0, &alpha).map_err(|(k, m)| at(k, m))?);
         let mut grains: Vec<BandGrain> = Vec::new();
         for g in 0..w.bodies.len() {
             if tied[g] || !Rigid::<D>::is_grain(w, g) || !w.bodies.movable(g) {
