@@ -2,7 +2,7 @@
 """The biaxial test with continuum outer parts against its all-discrete reference
 (docs/CONTINUUM.md): sin φ(ε1) and times.
 
-Usage: continuum_biaxial.py OUT_DIR [--young E ...] [--example]
+Usage: continuum_biaxial.py OUT_DIR [--young E ...] [--hardening PHI0 KAPPA_H [PHI]] [--example]
 
 For seeds 7 and 11: runs examples/scenes/biaxial.toml (2000 disks, 0.3 s of
 isotropic compaction at 10 kPa, then the top wall at 0.05 m/s), and its
@@ -19,11 +19,14 @@ bottom side on a frictionless base. Prints sin φ at ε1 = 0.5 … 9.5 % (means 
 ±0.25 %), each run's time and sweeps, and the RMS distances; plots
 docs/continuum_biaxial.png (matplotlib: scripts/biaxial_study.sh installs it in
 .venv-docs). `--young`: the regions' E (Pa; default 4e5 6e5 8e5: E at 1 %, 60 σ3,
-E50 of scripts/identify_continuum.py on the two seeds). `--example`: writes
+E50 of scripts/identify_continuum.py on the two seeds). `--hardening PHI0 KAPPA_H [PHI]`: the regions' friction angle grows from
+PHI0 to PHI (default 15.1°) with the plastic shear strain (half-way at
+KAPPA_H). `--example`: writes
 examples/scenes/biaxial_continuum.toml (seed 7, E = 6e5) and stops.
 Needs target/release/nscdd built with the `fem` feature and NSCDD_PYTHON_ENV.
 """
 import csv
+import itertools
 import json
 import os
 import subprocess
@@ -35,6 +38,8 @@ NSCDD = os.path.join(ROOT, "target", "release", "nscdd")
 S3, V = 1e4, 0.05
 Y1, Y2, BW, CELL = 0.2, 0.3, 0.05, 0.025
 PHI = 15.1
+# friction hardening (--hardening PHI0 KAPPA_H [PHI]): None, or (φ0, κ_h)
+HARD = None
 
 
 def run(scene, out):
@@ -54,13 +59,18 @@ name = "{name}"
 material = "ground"
 young = {young!r}
 poisson = {nu!r}
-plastic = {{ friction = {PHI!r}, dilatancy = 4.0 }}
+plastic = {plastic()}
 initial_stress = [{-S3!r}, {-S3!r}, 0.0]
 load = {{ left = [{S3!r}, 0.0], right = [{-S3!r}, 0.0] }}
 drive = {drive}
 mesh = {{ rectangle = {{ origin = [0.0, {y0!r}], size = [{width!r}, {y1 - y0!r}], cells = [{nx}, {ny}] }} }}
 band = {{ normal = [0.0, 1.0], continuum = {band_c!r}, discrete = {band_d!r} }}
 """
+
+
+def plastic():
+    h = "" if HARD is None else f", initial_friction = {HARD[0]!r}, hardening_strain = {HARD[1]!r}"
+    return f"{{ friction = {PHI!r}, dilatancy = 4.0{h} }}"
 
 
 def right_walls(width):
@@ -195,7 +205,14 @@ def main():
     if len(sys.argv) < 2:
         sys.exit(__doc__)
     out = sys.argv[1]
-    youngs = [float(x) for x in sys.argv[sys.argv.index("--young") + 1 :] if not x.startswith("--")] if "--young" in sys.argv else [4e5, 6e5, 8e5]
+    youngs = [float(x) for x in itertools.takewhile(lambda a: not a.startswith("--"), sys.argv[sys.argv.index("--young") + 1 :])] if "--young" in sys.argv else [4e5, 6e5, 8e5]
+    if "--hardening" in sys.argv:
+        global HARD, PHI
+        i = sys.argv.index("--hardening")
+        args = [float(x) for x in sys.argv[i + 1 : i + 4] if not x.startswith("--")]
+        HARD = (args[0], args[1])
+        if len(args) > 2:
+            PHI = args[2]
     os.makedirs(out, exist_ok=True)
     base = open(os.path.join(ROOT, "examples", "scenes", "biaxial.toml")).read()
     curves, times = {}, {}

@@ -36,6 +36,28 @@ pub struct Plastic {
     pub sigma: Vec<[[f64; 3]; 3]>,
     /// Cells that yielded in the last update.
     pub yielding: usize,
+    /// Friction hardening (None: perfectly plastic), and each cell's accumulated
+    /// plastic shear strain κ = Σ Δγ.
+    pub hardening: Option<Hardening>,
+    pub kappa: Vec<f64>,
+}
+
+/// Friction hardening: the mobilized friction angle grows with the accumulated
+/// plastic shear strain κ from φ0 to φ,
+/// sin φ_m(κ) = sin φ0 + (sin φ − sin φ0) κ / (κ + κ_h).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hardening {
+    pub sin0: f64,
+    pub sin_peak: f64,
+    pub kappa_h: f64,
+}
+
+impl Hardening {
+    /// (η, ξ) at κ.
+    fn cone(&self, kappa: f64) -> (f64, f64) {
+        let s = self.sin0 + (self.sin_peak - self.sin0) * kappa / (kappa + self.kappa_h);
+        dp(s.clamp(0.0, 1.0 - 1e-12).asin().to_degrees())
+    }
 }
 
 /// η or ξ of Drucker–Prager's plane-strain match of Mohr–Coulomb for angle `deg`.
@@ -77,7 +99,21 @@ impl Plastic {
             eps_p: vec![[[0.0; 3]; 3]; n],
             sigma: vec![[[0.0; 3]; 3]; n],
             yielding: 0,
+            hardening: None,
+            kappa: vec![0.0; n],
         }
+    }
+
+    /// The same material hardening from φ0 (degrees) to its friction angle with
+    /// the plastic shear strain κ_h ([`Hardening`]).
+    pub fn with_hardening(mut self, friction: f64, initial: f64, kappa_h: f64) -> Plastic {
+        let sin = |deg: f64| deg.to_radians().sin();
+        self.hardening = Some(Hardening {
+            sin0: sin(initial),
+            sin_peak: sin(friction),
+            kappa_h,
+        });
+        self
     }
 
     /// An initial stress σ0 in every cell: the eigenstrain ε_p = −D⁻¹σ0, so that
@@ -134,7 +170,14 @@ impl Plastic {
             let eps = self.strain(mesh, e, u);
             let ee: [[f64; 3]; 3] = std::array::from_fn(|a| std::array::from_fn(|b| eps[a][b] - self.eps_p[e][a][b]));
             let trial = self.stress_of(&ee);
-            let (sigma, yielded) = self.project(&trial);
+            let (sigma, yielded) = match self.hardening {
+                None => self.project(&trial),
+                Some(h) => {
+                    let (sigma, yielded, dgamma) = self.project_hardening(&trial, &h, self.kappa[e]);
+                    self.kappa[e] += dgamma;
+                    (sigma, yielded)
+                }
+            };
             if yielded {
                 self.yielding += 1;
                 // ε_p = ε − D⁻¹ σ
@@ -181,6 +224,43 @@ impl Plastic {
         (out, true)
     }
 
+    /// The return of a trial stress on the cone of κ_n + Δγ (the implicit hardening:
+    /// r(Δγ) = √J₂_tr − GΔγ + η(κ)(p_tr − Kη̄Δγ) − ξ(κ)c = 0, r decreasing, solved
+    /// by bisection to 1e-14 of its bracket [0, √J₂_tr/G]; past the bracket's end,
+    /// the apex); (σ, yielded, Δγ).
+    pub fn project_hardening(&self, tr: &[[f64; 3]; 3], h: &Hardening, kappa: f64) -> ([[f64; 3]; 3], bool, f64) {
+        let p = (tr[0][0] + tr[1][1] + tr[2][2]) / 3.0;
+        let s: [[f64; 3]; 3] = std::array::from_fn(|a| std::array::from_fn(|b| tr[a][b] - if a == b { p } else { 0.0 }));
+        let q = (0.5 * s.iter().flatten().map(|x| x * x).sum::<f64>()).sqrt();
+        let (g, k) = (self.mu, self.lam + 2.0 * self.mu / 3.0);
+        let r = |dg: f64| {
+            let (eta, xi) = h.cone(kappa + dg);
+            (q - g * dg) + eta * (p - k * self.eta_bar * dg) - xi * self.cohesion
+        };
+        if r(0.0) <= 0.0 {
+            return (*tr, false, 0.0);
+        }
+        let hi = q / g;
+        if r(hi) > 0.0 {
+            let (eta, xi) = h.cone(kappa + hi);
+            let pa = if eta > 0.0 { xi * self.cohesion / eta } else { p };
+            return (std::array::from_fn(|a| std::array::from_fn(|b| if a == b { pa } else { 0.0 })), true, hi);
+        }
+        let (mut lo, mut up) = (0.0, hi);
+        while up - lo > 1e-14 * hi {
+            let mid = 0.5 * (lo + up);
+            if r(mid) > 0.0 {
+                lo = mid;
+            } else {
+                up = mid;
+            }
+        }
+        let dg = 0.5 * (lo + up);
+        let scale = if q > 0.0 { (1.0 - g * dg / q).max(0.0) } else { 0.0 };
+        let pn = p - k * self.eta_bar * dg;
+        (std::array::from_fn(|a| std::array::from_fn(|b| scale * s[a][b] + if a == b { pn } else { 0.0 })), true, dg)
+    }
+
     /// Σ_e ½ α_e A_e σ:(ε − ε_p), the elastic energy stored.
     pub fn elastic_energy(&self, mesh: &Mesh, u: &[f64]) -> f64 {
         (0..mesh.n_cells())
@@ -218,6 +298,8 @@ mod tests {
             eps_p: vec![],
             sigma: vec![],
             yielding: 0,
+            hardening: None,
+            kappa: vec![],
         }
     }
 
@@ -248,5 +330,35 @@ mod tests {
         let (s, y) = m.project(&ten);
         let pa = m.xi * m.cohesion / m.eta;
         assert!(y && (s[0][0] - pa).abs() < 1e-9 && s[0][1] == 0.0);
+    }
+
+    #[test]
+    fn the_hardening_return_lands_on_the_cone_of_its_strain() {
+        let m = material(30.0, 10.0, 0.0);
+        let h = Hardening { sin0: 0.2, sin_peak: 0.5, kappa_h: 1e-2 };
+        let tr = [[-1e5, 8e4, 0.0], [8e4, -2e5, 0.0], [0.0, 0.0, -1.5e5]];
+        for kappa in [0.0, 1e-3, 1e-1, 1e3] {
+            let (s, y, dg) = m.project_hardening(&tr, &h, kappa);
+            assert!(y && dg > 0.0);
+            // on the cone of κ + Δγ
+            let (eta, xi) = h.cone(kappa + dg);
+            let at = Plastic { eta, xi, ..m.clone() };
+            assert!(f(&at, &s).abs() < 1e-8 * 1e5, "κ {kappa}: f = {}", f(&at, &s));
+        }
+        // hardened to its peak, the return is the perfectly plastic one of φ = 30°
+        let (s, _, _) = m.project_hardening(&tr, &Hardening { sin0: 0.5, sin_peak: 0.5, kappa_h: 1e-2 }, 0.0);
+        let (sp, _) = m.project(&tr);
+        for a in 0..3 {
+            for b in 0..3 {
+                assert!((s[a][b] - sp[a][b]).abs() < 1e-6, "{:?} against {:?}", s, sp);
+            }
+        }
+        // the mobilized angle grows with κ: more hardening, less plastic strain
+        let (_, _, dg0) = m.project_hardening(&tr, &h, 0.0);
+        let (_, _, dg1) = m.project_hardening(&tr, &h, 1.0);
+        assert!(dg1 < dg0);
+        // elastic states are left alone
+        let el = [[-1e5, 1e3, 0.0], [1e3, -1e5, 0.0], [0.0, 0.0, -1e5]];
+        assert_eq!(m.project_hardening(&el, &h, 0.0), (el, false, 0.0));
     }
 }

@@ -109,6 +109,13 @@ struct DpSpec {
     dilatancy: f64,
     #[serde(default)]
     cohesion: f64,
+    /// Friction hardening: the mobilized angle grows from `initial_friction` to
+    /// `friction` with the plastic shear strain (`hardening_strain`: κ_h, where
+    /// half of the rise is reached in sin φ).
+    #[serde(default)]
+    initial_friction: Option<f64>,
+    #[serde(default)]
+    hardening_strain: Option<f64>,
 }
 
 fn plastic_of(i: usize, e: &toml::Table) -> Result<Option<DpSpec>, EntryError> {
@@ -123,6 +130,16 @@ fn plastic_of(i: usize, e: &toml::Table) -> Result<Option<DpSpec>, EntryError> {
     }
     if !(d.cohesion >= 0.0 && d.cohesion.is_finite()) || (d.friction == 0.0 && d.cohesion == 0.0) {
         return Err(at("cohesion ≥ 0 (and > 0 when friction is 0)".into()));
+    }
+    match (d.initial_friction, d.hardening_strain) {
+        (None, None) => {}
+        (Some(f0), Some(k)) if (0.0..=d.friction).contains(&f0) && k > 0.0 && k.is_finite() => {}
+        _ => {
+            return Err(at(format!(
+                "hardening takes both initial_friction in [0, friction] (degrees) and hardening_strain > 0, got {:?} and {:?}",
+                d.initial_friction, d.hardening_strain
+            )))
+        }
     }
     Ok(Some(d))
 }
@@ -165,8 +182,16 @@ fn plastic_state(
         friction: 0.0,
         dilatancy: 0.0,
         cohesion: f64::INFINITY,
+        initial_friction: None,
+        hardening_strain: None,
     }));
-    let mut p = dp.map(|d| super::plastic::Plastic::new(&b.mesh, d.friction, d.dilatancy, d.cohesion, el.young, el.poisson, alpha));
+    let mut p = dp.map(|d| {
+        let p = super::plastic::Plastic::new(&b.mesh, d.friction, d.dilatancy, d.cohesion, el.young, el.poisson, alpha);
+        match (d.initial_friction, d.hardening_strain) {
+            (Some(f0), Some(k)) => p.with_hardening(d.friction, f0, k),
+            _ => p,
+        }
+    });
     if let (Some(p), Some(mut s0)) = (p.as_mut(), sigma0) {
         if s0[2][2].is_nan() {
             s0[2][2] = el.poisson * (s0[0][0] + s0[1][1]);
@@ -371,6 +396,9 @@ struct RegionState {
     /// Drucker–Prager regions: each cell's plastic strain (xx, yy, zz, xy, yz, xz).
     #[serde(default)]
     plastic_strain: Vec<f64>,
+    /// Hardening regions: each cell's accumulated plastic shear strain κ.
+    #[serde(default)]
+    hardening_strain: Vec<f64>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -399,6 +427,7 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
                             .flat_map(|e| [e[0][0], e[1][1], e[2][2], e[0][1], e[1][2], e[0][2]])
                             .collect()
                     }),
+                    hardening_strain: p.as_ref().filter(|p| p.hardening.is_some()).map_or_else(Vec::new, |p| p.kappa.clone()),
                 })
                 .collect(),
             band: self.band.clone(),
@@ -425,7 +454,7 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
         if !s
             .regions
             .iter()
-            .all(|r| finite(&r.displacement) && finite(&r.velocity) && finite(&r.plastic_strain))
+            .all(|r| finite(&r.displacement) && finite(&r.velocity) && finite(&r.plastic_strain) && finite(&r.hardening_strain))
             || !s.ties.iter().all(|r| finite(r))
         {
             return Err("non-finite numbers in the continuum state".into());
@@ -436,6 +465,9 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
             if let Some(p) = p {
                 for (e, x) in p.eps_p.iter_mut().zip(r.plastic_strain.chunks_exact(6)) {
                     *e = [[x[0], x[3], x[5]], [x[3], x[1], x[4]], [x[5], x[4], x[2]]];
+                }
+                for (k, x) in p.kappa.iter_mut().zip(&r.hardening_strain) {
+                    *k = *x;
                 }
             }
         }
