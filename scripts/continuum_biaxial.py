@@ -239,10 +239,11 @@ def main():
         for e in youngs:
             s, width, height, n = hybrid_scene(final, e)
             name = f"hyb_{seed}_{e:g}"
+            label = f"hybrid {seed} E={e:g}" + ("" if HARD is None else f" φ {HARD[0]:g}→{PHI:g}° κh {HARD[1]:g}")
             open(os.path.join(out, name + ".toml"), "w").write(s)
             t, sw = run(os.path.join(out, name + ".toml"), os.path.join(out, name))
-            curves[f"hybrid {seed} E={e:g}"] = hybrid_curve(os.path.join(out, name, "history.csv"), width, height)
-            times[f"hybrid {seed} E={e:g}"] = (t, sw, t)
+            curves[label] = hybrid_curve(os.path.join(out, name, "history.csv"), width, height)
+            times[label] = (t, sw, t)
             print(f"{name}: {n} grains, {t:.1f} s, {sw} sweeps", flush=True)
     names = list(curves)
     print("eps1   " + " ".join(f"{n:>20}" for n in names))

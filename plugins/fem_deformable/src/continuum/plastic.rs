@@ -225,9 +225,9 @@ impl Plastic {
     }
 
     /// The return of a trial stress on the cone of κ_n + Δγ (the implicit hardening:
-    /// r(Δγ) = √J₂_tr − GΔγ + η(κ)(p_tr − Kη̄Δγ) − ξ(κ)c = 0, r decreasing, solved
-    /// by bisection to 1e-14 of its bracket [0, √J₂_tr/G]; past the bracket's end,
-    /// the apex); (σ, yielded, Δγ).
+    /// r(Δγ) = √J₂_tr − GΔγ + η(κ)(p_tr − Kη̄Δγ) − ξ(κ)c = 0, solved in its bracket
+    /// [0, √J₂_tr/G] by [`illinois`]; past the bracket's end, the apex);
+    /// (σ, yielded, Δγ).
     pub fn project_hardening(&self, tr: &[[f64; 3]; 3], h: &Hardening, kappa: f64) -> ([[f64; 3]; 3], bool, f64) {
         let p = (tr[0][0] + tr[1][1] + tr[2][2]) / 3.0;
         let s: [[f64; 3]; 3] = std::array::from_fn(|a| std::array::from_fn(|b| tr[a][b] - if a == b { p } else { 0.0 }));
@@ -246,16 +246,7 @@ impl Plastic {
             let pa = if eta > 0.0 { xi * self.cohesion / eta } else { p };
             return (std::array::from_fn(|a| std::array::from_fn(|b| if a == b { pa } else { 0.0 })), true, hi);
         }
-        let (mut lo, mut up) = (0.0, hi);
-        while up - lo > 1e-14 * hi {
-            let mid = 0.5 * (lo + up);
-            if r(mid) > 0.0 {
-                lo = mid;
-            } else {
-                up = mid;
-            }
-        }
-        let dg = 0.5 * (lo + up);
+        let dg = illinois(r, hi, 1e-14 * (q + p.abs() + self.cohesion));
         let scale = if q > 0.0 { (1.0 - g * dg / q).max(0.0) } else { 0.0 };
         let pn = p - k * self.eta_bar * dg;
         (std::array::from_fn(|a| std::array::from_fn(|b| scale * s[a][b] + if a == b { pn } else { 0.0 })), true, dg)
@@ -277,6 +268,36 @@ impl Plastic {
             })
             .sum()
     }
+}
+
+/// The root of r in [0, hi] where r(0) > 0 ≥ r(hi): regula falsi with the
+/// Illinois modification (superlinear, the bracket kept), until |r| ≤ `tol` or the
+/// bracket is 1e-15 of hi (at most 200 steps).
+fn illinois(r: impl Fn(f64) -> f64, hi: f64, tol: f64) -> f64 {
+    let (mut a, mut fa, mut b, mut fb) = (0.0, r(0.0), hi, r(hi));
+    let mut side = 0;
+    let mut c = b;
+    for _ in 0..200 {
+        c = (a * fb - b * fa) / (fb - fa);
+        let fc = r(c);
+        if fc.abs() <= tol || b - a <= 1e-15 * hi {
+            break;
+        }
+        if fc > 0.0 {
+            (a, fa) = (c, fc);
+            if side == 1 {
+                fb *= 0.5;
+            }
+            side = 1;
+        } else {
+            (b, fb) = (c, fc);
+            if side == -1 {
+                fa *= 0.5;
+            }
+            side = -1;
+        }
+    }
+    c
 }
 
 #[cfg(test)]
