@@ -424,6 +424,67 @@ fn a_cohesionless_block_flows_where_an_elastic_one_stands() {
     let _ = el;
 }
 
+/// Friction hardening: hardened from the start it is the perfectly plastic block;
+/// from a lower angle it yields more, each cell on the cone of its own κ; κ is
+/// saved, so a restart continues bitwise.
+#[test]
+fn a_hardening_block_mobilizes_its_friction_and_restarts_with_it() {
+    let run = |plastic: &str, steps: usize| {
+        let mut r = Run::new(&block_scene(plastic));
+        for _ in 0..steps {
+            r.step();
+        }
+        r
+    };
+    let pp = run("plastic = { friction = 30.0 }", 150);
+    let same = run(
+        "plastic = { friction = 30.0, initial_friction = 30.0, hardening_strain = 0.01 }",
+        150,
+    );
+    let scale = largest_horizontal(pp.cont());
+    let diff = pp.cont().bodies[0]
+        .u
+        .iter()
+        .zip(&same.cont().bodies[0].u)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(diff < 1e-8 * scale, "{diff:e} against {scale:e}");
+    let soft = "plastic = { friction = 30.0, initial_friction = 10.0, hardening_strain = 0.05 }";
+    let h = run(soft, 150);
+    let p = h.cont().plastic[0].as_ref().unwrap();
+    let hard = p.hardening.unwrap();
+    println!(
+        "largest horizontal displacement at 0.3 s: perfectly plastic {scale:.3e}, hardening {:.3e}",
+        largest_horizontal(h.cont())
+    );
+    assert!(largest_horizontal(h.cont()) > 1.1 * scale);
+    assert!(p.kappa.iter().any(|&k| k > 0.0) && p.kappa.iter().all(|&k| k >= 0.0));
+    for (s, &k) in p.sigma.iter().zip(&p.kappa) {
+        let sin = hard.sin0 + (hard.sin_peak - hard.sin0) * k / (k + hard.kappa_h);
+        let t = sin.asin().tan();
+        let den = (9.0 + 12.0 * t * t).sqrt();
+        let pr = (s[0][0] + s[1][1] + s[2][2]) / 3.0;
+        let j2: f64 = 0.5
+            * (0..3)
+                .flat_map(|a| (0..3).map(move |b| (a, b)))
+                .map(|(a, b)| (s[a][b] - if a == b { pr } else { 0.0 }).powi(2))
+                .sum::<f64>();
+        let f = j2.sqrt() + 3.0 * t / den * pr;
+        assert!(f <= 1e-8 * (pr.abs() + 1.0), "f = {f}");
+    }
+    // a restart at step 75 continues bitwise
+    let mut a = run(soft, 75);
+    let state = a.s.families[0].save_state();
+    let mut b = Run::new(&block_scene(soft));
+    b.s.families[0].load_state(&state).unwrap();
+    for _ in 0..75 {
+        a.step();
+        b.step();
+    }
+    assert_eq!(a.cont().bodies[0].u, h.cont().bodies[0].u);
+    assert_eq!(b.cont().bodies[0].u, h.cont().bodies[0].u);
+    assert_eq!(b.cont().plastic[0].as_ref().unwrap().kappa, p.kappa);
+}
+
 /// Sides: a traction adds its resultant to F_ext, a driven side moves at its
 /// velocity, and the driven sides' reactions balance the weight once at rest.
 #[test]

@@ -53,6 +53,21 @@ pub struct Hardening {
 }
 
 impl Hardening {
+    /// Why a scene's `initial_friction` and `hardening_strain` cannot make a
+    /// hardening of `friction`; None: they can (both given, 0 ≤ φ0 ≤ φ, κ_h > 0), or
+    /// neither is given.
+    pub fn check(friction: f64, initial: Option<f64>, kappa_h: Option<f64>) -> Option<String> {
+        let show = |x: Option<f64>| x.map_or("missing".to_string(), |v| v.to_string());
+        match (initial, kappa_h) {
+            (None, None) => None,
+            (Some(f0), Some(k)) if (0.0..=friction).contains(&f0) && k > 0.0 && k.is_finite() => None,
+            (f0, k) => Some(format!(
+                "hardening takes both initial_friction in [0, friction] (degrees) and hardening_strain > 0, got {} and {}",
+                show(f0),
+                show(k)
+            )),
+        }
+    }
     /// (η, ξ) at κ.
     fn cone(&self, kappa: f64) -> (f64, f64) {
         let s = self.sin0 + (self.sin_peak - self.sin0) * kappa / (kappa + self.kappa_h);
@@ -244,12 +259,20 @@ impl Plastic {
         if r(hi) > 0.0 {
             let (eta, xi) = h.cone(kappa + hi);
             let pa = if eta > 0.0 { xi * self.cohesion / eta } else { p };
-            return (std::array::from_fn(|a| std::array::from_fn(|b| if a == b { pa } else { 0.0 })), true, hi);
+            return (
+                std::array::from_fn(|a| std::array::from_fn(|b| if a == b { pa } else { 0.0 })),
+                true,
+                hi,
+            );
         }
         let dg = illinois(r, hi, 1e-14 * (q + p.abs() + self.cohesion));
         let scale = if q > 0.0 { (1.0 - g * dg / q).max(0.0) } else { 0.0 };
         let pn = p - k * self.eta_bar * dg;
-        (std::array::from_fn(|a| std::array::from_fn(|b| scale * s[a][b] + if a == b { pn } else { 0.0 })), true, dg)
+        (
+            std::array::from_fn(|a| std::array::from_fn(|b| scale * s[a][b] + if a == b { pn } else { 0.0 })),
+            true,
+            dg,
+        )
     }
 
     /// Σ_e ½ α_e A_e σ:(ε − ε_p), the elastic energy stored.
@@ -356,7 +379,11 @@ mod tests {
     #[test]
     fn the_hardening_return_lands_on_the_cone_of_its_strain() {
         let m = material(30.0, 10.0, 0.0);
-        let h = Hardening { sin0: 0.2, sin_peak: 0.5, kappa_h: 1e-2 };
+        let h = Hardening {
+            sin0: 0.2,
+            sin_peak: 0.5,
+            kappa_h: 1e-2,
+        };
         let tr = [[-1e5, 8e4, 0.0], [8e4, -2e5, 0.0], [0.0, 0.0, -1.5e5]];
         for kappa in [0.0, 1e-3, 1e-1, 1e3] {
             let (s, y, dg) = m.project_hardening(&tr, &h, kappa);
@@ -367,7 +394,15 @@ mod tests {
             assert!(f(&at, &s).abs() < 1e-8 * 1e5, "κ {kappa}: f = {}", f(&at, &s));
         }
         // hardened to its peak, the return is the perfectly plastic one of φ = 30°
-        let (s, _, _) = m.project_hardening(&tr, &Hardening { sin0: 0.5, sin_peak: 0.5, kappa_h: 1e-2 }, 0.0);
+        let (s, _, _) = m.project_hardening(
+            &tr,
+            &Hardening {
+                sin0: 0.5,
+                sin_peak: 0.5,
+                kappa_h: 1e-2,
+            },
+            0.0,
+        );
         let (sp, _) = m.project(&tr);
         for a in 0..3 {
             for b in 0..3 {

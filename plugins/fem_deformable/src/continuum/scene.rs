@@ -131,15 +131,8 @@ fn plastic_of(i: usize, e: &toml::Table) -> Result<Option<DpSpec>, EntryError> {
     if !(d.cohesion >= 0.0 && d.cohesion.is_finite()) || (d.friction == 0.0 && d.cohesion == 0.0) {
         return Err(at("cohesion ≥ 0 (and > 0 when friction is 0)".into()));
     }
-    match (d.initial_friction, d.hardening_strain) {
-        (None, None) => {}
-        (Some(f0), Some(k)) if (0.0..=d.friction).contains(&f0) && k > 0.0 && k.is_finite() => {}
-        _ => {
-            return Err(at(format!(
-                "hardening takes both initial_friction in [0, friction] (degrees) and hardening_strain > 0, got {:?} and {:?}",
-                d.initial_friction, d.hardening_strain
-            )))
-        }
+    if let Some(m) = super::plastic::Hardening::check(d.friction, d.initial_friction, d.hardening_strain) {
+        return Err(at(m));
     }
     Ok(Some(d))
 }
@@ -427,7 +420,10 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
                             .flat_map(|e| [e[0][0], e[1][1], e[2][2], e[0][1], e[1][2], e[0][2]])
                             .collect()
                     }),
-                    hardening_strain: p.as_ref().filter(|p| p.hardening.is_some()).map_or_else(Vec::new, |p| p.kappa.clone()),
+                    hardening_strain: p
+                        .as_ref()
+                        .filter(|p| p.hardening.is_some())
+                        .map_or_else(Vec::new, |p| p.kappa.clone()),
                 })
                 .collect(),
             band: self.band.clone(),
