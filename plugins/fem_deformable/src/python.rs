@@ -93,6 +93,14 @@ fn module(py: Python<'_>) -> Result<Bound<'_, PyModule>, PyError> {
                 .map_err(|e| err(py, e))?;
         }
     }
+    // NumPy's and SciPy's OpenBLAS start a pool of threads per library that spin
+    // after each call, taking the cores the solver's threads and ranks run on (5 %
+    // of a hybrid run's samples, measured with perf): one thread each, unless the
+    // user set otherwise. OpenBLAS reads this when NumPy first loads it.
+    let environ = py.import("os").and_then(|os| os.getattr("environ")).map_err(|e| err(py, e))?;
+    for var in ["OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"] {
+        environ.call_method1("setdefault", (var, "1")).map_err(|e| err(py, e))?;
+    }
     for pkg in ["skfem", "meshio", "numpy"] {
         if py.import(pkg).is_err() {
             let exe: String = sys.getattr("executable").and_then(|x| x.extract()).unwrap_or_default();
