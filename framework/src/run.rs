@@ -5,13 +5,11 @@ use crate::dd::{NscddOf, Rigid};
 use crate::dim::Dim;
 use crate::engine::StepReport;
 use crate::family::SceneFamily;
-use crate::output::history::History;
 use crate::registry::{Registry, Writer};
 use crate::scene::Scene;
 use crate::world::World;
 use std::io::Write;
 use std::path::Path;
-use std::time::Instant;
 
 /// Why a run stopped early: the library's [`crate::Error`] (`Io`, `Diverged`,
 /// `Ranks`).
@@ -101,7 +99,7 @@ fn save_state_with(dir: &Path, name: &str, write: impl FnOnce(&mut std::fs::File
 
 /// The outputs of a run: written by one process only (rank 0 of a multi-process
 /// run); the others step the same world and write nothing.
-pub(crate) fn history_sink(dir: &Path, root: bool) -> Result<Box<dyn Write>, RunError> {
+pub(crate) fn history_sink(dir: &Path, root: bool) -> Result<Box<dyn Write + Send>, RunError> {
     if !root {
         return Ok(Box::new(std::io::sink()));
     }
@@ -128,7 +126,7 @@ fn stop_requested() -> bool {
 
 /// Whether the run stops after this step: a request on this process or, on several
 /// ranks, on any of them (one collective reduction per step, every rank calls it).
-fn stop_agreed<D: Dim>(dd: &mut Option<NscddOf<Rigid<D>>>) -> bool {
+pub(crate) fn stop_agreed<D: Dim>(dd: &mut Option<NscddOf<Rigid<D>>>) -> bool {
     let mine = stop_requested();
     match dd.as_mut().and_then(|n| n.ranks_mut()) {
         Some(rs) => rs.cluster.min_max(mine as u64).1 > 0,
@@ -193,7 +191,7 @@ pub(crate) fn write_rank_totals<D: crate::dd::Family>(dd: &mut Option<crate::dd:
 
 /// Writes the state on rank 0. Collective on MPI ranks (the NSCDD state is gathered
 /// from every rank): every rank calls it at the same step.
-fn save_state<D: Dim>(
+pub(crate) fn save_state<D: Dim>(
     dir: &Path,
     name: &str,
     w: &mut World<D>,
@@ -241,7 +239,7 @@ pub fn run<D: Dim>(
 
 /// The writers of a run: on rank 0 all of them, on the other MPI ranks the VTK
 /// writer alone (each rank writes its piece of a frame).
-fn writers<D: Dim>(scene: &Scene<D>, registry: &Registry, root: bool) -> Vec<Box<dyn Writer<D>>> {
+pub(crate) fn writers<D: Dim>(scene: &Scene<D>, registry: &Registry, root: bool) -> Vec<Box<dyn Writer<D>>> {
     let mut out: Vec<Box<dyn Writer<D>>> = vec![];
     if !root {
         out.extend(scene.output.vtk.then(|| registry.writer::<D>("vtk")).flatten().map(|make| make()));
@@ -259,7 +257,7 @@ fn writers<D: Dim>(scene: &Scene<D>, registry: &Registry, root: bool) -> Vec<Box
 }
 
 /// The end of the writers' and the families' series (`.pvd`).
-fn finish_outputs<D: Dim>(
+pub(crate) fn finish_outputs<D: Dim>(
     writers: &mut [Box<dyn Writer<D>>],
     fams: &mut [Box<dyn SceneFamily<D>>],
     vtk: bool,
@@ -279,7 +277,7 @@ fn finish_outputs<D: Dim>(
 /// The NSCDD solver of a scene: its decomposition's, or one subdomain where its
 /// body families need NSCDD without one; with a restart's saved state when it is
 /// of the same decomposition.
-fn scene_solver<D: Dim>(scene: &mut Scene<D>, cluster: Option<Box<dyn crate::dd::Cluster>>) -> Result<Option<NscddOf<Rigid<D>>>, RunError> {
+pub(crate) fn scene_solver<D: Dim>(scene: &mut Scene<D>, cluster: Option<Box<dyn crate::dd::Cluster>>) -> Result<Option<NscddOf<Rigid<D>>>, RunError> {
     let one = crate::dd::DdConfig::default();
     let dd_config = scene
         .decomposition
@@ -324,7 +322,8 @@ fn scene_solver<D: Dim>(scene: &mut Scene<D>, cluster: Option<Box<dyn crate::dd:
 /// writes the outputs (the same files as one process, and `ranks.json`), except the
 /// VTK frames, of which every rank writes its piece (`.pvtp` by rank 0). A scene's
 /// body families ([`crate::family`]) step with the world, add their history columns
-/// and VTK frames, and save their state in `final.json` and the checkpoints.
+/// and VTK frames, and save their state in `final.json` and the checkpoints. The
+/// steps are [`crate::runner::Runner`]'s.
 pub fn run_on<D: Dim>(
     scene: &mut Scene<D>,
     registry: &Registry,
@@ -332,92 +331,15 @@ pub fn run_on<D: Dim>(
     cluster: Option<Box<dyn crate::dd::Cluster>>,
     mut on_step: impl FnMut(&World<D>, &StepReport),
 ) -> Result<RunSummary, RunError> {
-    let start = Instant::now();
-    let root = cluster.as_ref().is_none_or(|c| c.rank() == 0);
-    let mut dd = scene_solver(scene, cluster)?;
-    let mut writers = writers(scene, registry, root);
-    let fams = &mut scene.families;
-    let w = &mut scene.world;
-    let columns: Vec<String> = fams.iter().flat_map(|f| f.history_columns()).collect();
-    let mut hist = History::with_columns(history_sink(dir, root)?, w, dd.is_some(), &columns).map_err(io(dir, "history.csv"))?;
-    let vtk = scene.output.vtk && root;
-    let mut frame = 0u32;
-    let write_frame = |writers: &mut Vec<Box<dyn Writer<D>>>,
-                       fams: &mut [Box<dyn SceneFamily<D>>],
-                       w: &World<D>,
-                       dd: &Option<NscddOf<Rigid<D>>>,
-                       frame: u32|
-     -> std::io::Result<()> {
-        let view = dd.as_ref().map(|n| n.view(w));
-        for wr in writers.iter_mut() {
-            match &view {
-                Some(v) => wr.write_dd(w, v, dir, frame)?,
-                None => wr.write(w, dir, frame)?,
-            }
-        }
-        if vtk {
-            for f in fams.iter_mut() {
-                f.write_frame(dir, frame, w.t)?;
-            }
-        }
-        Ok(())
-    };
-    write_frame(&mut writers, fams, w, &dd, frame).map_err(io(dir, "the first output frame"))?;
-    frame += 1;
-    let mut sum = RunSummary::default();
-    let steps = w.time.steps;
-    let mut values = vec![];
+    let mut run = crate::runner::Runner::start(scene, registry, Some(dir), cluster, None)?;
+    let steps = scene.world.time.steps;
     // a restarted world continues from its saved step
-    let frame_after = |s: u64| (scene.output.every > 0 && s % scene.output.every == 0) || s == steps;
-    for s in (w.step + 1)..=steps {
-        if let Some(n) = dd.as_mut() {
-            n.skip_view(!frame_after(s));
-        }
-        let mut refs: Vec<&mut dyn SceneFamily<D>> = fams.iter_mut().map(|f| &mut **f).collect();
-        let (rep, dd_rep) = match crate::family::step(w, &mut refs, dd.as_mut()) {
-            Ok(r) => r,
-            Err(d) => {
-                let _ = hist.flush();
-                return Err(RunError::Diverged(d));
-            }
-        };
-        let t0 = Instant::now();
-        if frame_after(s) {
-            write_frame(&mut writers, fams, w, &dd, frame).map_err(io(dir, "an output frame"))?;
-            frame += 1;
-            hist.flush().map_err(io(dir, "history.csv"))?;
-        }
-        let t_out = t0.elapsed().as_secs_f64();
-        values.clear();
-        fams.iter().for_each(|f| f.history_values(&mut values));
-        debug_assert_eq!(
-            values.len(),
-            columns.len(),
-            "the families' history values and columns differ in number"
-        );
-        hist.row_dd(w, &rep, dd_rep.as_ref(), t_out, &values)
-            .map_err(io(dir, "history.csv"))?;
-        if scene.output.checkpoint_every > 0 && s % scene.output.checkpoint_every == 0 && s != steps {
-            hist.flush().map_err(io(dir, "history.csv"))?;
-            save_state(dir, "checkpoint.json", w, fams, &mut dd)?;
-        }
-        if let Some(r) = &dd_rep {
-            sum.migrations += r.migrations as u64;
-        }
-        sum.record(&rep.solve, w.step, w.solver.tolerance);
-        on_step(w, &rep);
-        if s != steps && stop_agreed(&mut dd) {
-            hist.flush().map_err(io(dir, "history.csv"))?;
-            save_state(dir, "checkpoint.json", w, fams, &mut dd)?;
-            finish_outputs(&mut writers, fams, vtk, dir)?;
-            return Err(RunError::Interrupted(s));
+    for s in (scene.world.step + 1)..=steps {
+        let rep = run.step(scene)?;
+        on_step(&scene.world, &rep);
+        if s != steps && run.stop_agreed() {
+            return Err(run.interrupt(scene));
         }
     }
-    hist.flush().map_err(io(dir, "history.csv"))?;
-    finish_outputs(&mut writers, fams, vtk, dir)?;
-    save_state(dir, "final.json", w, fams, &mut dd)?;
-    // after final.json: the peak memory of each rank counts its writing
-    write_rank_totals(&mut dd, dir)?;
-    sum.wall_seconds = start.elapsed().as_secs_f64();
-    Ok(sum)
+    run.finish(scene)
 }
