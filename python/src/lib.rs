@@ -1,0 +1,469 @@
+//! `nscdd._nscdd`: the Rust half of the `nscdd` Python module (docs/PYTHON.md).
+//! `Simulation` loads a scene (a TOML file, TOML text, or dicts), steps it with
+//! the GIL released, and gives its state as NumPy arrays; `solve_fc` solves one
+//! frictional contact problem. The package `python/nscdd` wraps it (progress bars,
+//! pandas).
+
+mod sim;
+mod toml_of;
+
+use nscdd::dim::{D2, D3};
+use nscdd::registry::Registry;
+use nscdd::scene::AnyScene;
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use sim::Sim;
+use std::path::PathBuf;
+
+pyo3::create_exception!(_nscdd, SceneError, PyValueError, "A scene that cannot be loaded: the message names the file, line and key.");
+pyo3::create_exception!(_nscdd, RunError, PyRuntimeError, "A run that stopped: a diverging body (step and body named), an output that cannot be written.");
+
+/// The built-in plugins: rigid disks and walls (2D), spheres, planes and boxes
+/// (3D), polyhedra.
+fn registry() -> Registry {
+    let mut reg = nscdd_rigid_disks::registry();
+    reg.add_plugin(&nscdd_spheres::SpheresPlugin);
+    reg.add_plugin(&nscdd_polyhedra::PolyhedraPlugin);
+    reg
+}
+
+enum Inner {
+    D2(Sim<D2>),
+    D3(Sim<D3>),
+}
+
+/// `each!(inner, s => expr)`: expr with s the simulation of either dimension.
+macro_rules! each {
+    ($inner:expr, $s:ident => $e:expr) => {
+        match $inner {
+            Inner::D2($s) => $e,
+            Inner::D3($s) => $e,
+        }
+    };
+}
+
+/// Moves a borrow into `Python::detach`: the closure runs on this thread, with the
+/// GIL released; nothing in it touches Python.
+struct AssertSend<T>(T);
+unsafe impl<T> Send for AssertSend<T> {}
+
+fn run_err(e: nscdd::run::RunError) -> PyErr {
+    RunError::new_err(e.to_string())
+}
+
+/// A loaded scene and its run (docs/PYTHON.md).
+///
+/// Simulation(scene, out=None, restart=None): `scene` is a path to a TOML scene
+/// file or a dict of the same keys; `out` a folder for the outputs `nscdd run`
+/// writes (history.csv, VTK frames, checkpoints, final.json), None to write
+/// nothing; `restart` a saved state (final.json or checkpoint.json) to continue.
+#[pyclass(unsendable, module = "nscdd._nscdd")]
+pub struct Simulation {
+    inner: Inner,
+    reg: Registry,
+}
+
+impl Simulation {
+    fn load(text: &str, file: &str, out: Option<PathBuf>, restart: Option<PathBuf>) -> PyResult<Self> {
+        let reg = registry();
+        let any = nscdd::scene::load_any_str(text, file, &reg).map_err(|e| SceneError::new_err(e.to_string()))?;
+        let mut inner = match any {
+            AnyScene::D2(s) => Inner::D2(Sim::new(s, out)),
+            AnyScene::D3(s) => Inner::D3(Sim::new(s, out)),
+        };
+        if let Some(state) = restart {
+            each!(&mut inner, s => nscdd::scene::restart_scene(&mut s.scene, &state))
+                .map_err(|e| SceneError::new_err(e.to_string()))?;
+        }
+        Ok(Simulation { inner, reg })
+    }
+
+    fn array<'py>(py: Python<'py>, (v, width): (Vec<f64>, usize)) -> PyResult<Bound<'py, PyAny>> {
+        let n = v.len() / width.max(1);
+        let a = PyArray1::from_vec(py, v);
+        if width == 1 {
+            Ok(a.into_any())
+        } else {
+            Ok(a.reshape([n, width])?.into_any())
+        }
+    }
+
+    /// `n` steps with the GIL released (stopping early on `stop`).
+    fn steps(&mut self, py: Python<'_>, n: u64) -> PyResult<Option<nscdd::engine::StepReport>> {
+        let cell = AssertSend((&mut self.inner, &self.reg));
+        let res = py.detach(move || {
+            let c = cell;
+            let (inner, reg) = c.0;
+            let stop = || false;
+            AssertSend(each!(inner, s => s.steps(reg, n, &stop)))
+        });
+        res.0.map_err(run_err)
+    }
+
+    fn report<'py>(&self, py: Python<'py>, rep: &nscdd::engine::StepReport) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        let (step, t) = each!(&self.inner, s => (s.scene.world.step, s.scene.world.t));
+        d.set_item("step", step)?;
+        d.set_item("time", t)?;
+        d.set_item("contacts", rep.contacts)?;
+        d.set_item("sweeps", rep.solve.sweeps)?;
+        d.set_item("converged", rep.solve.converged)?;
+        d.set_item("residual", rep.solve.residual)?;
+        Ok(d)
+    }
+}
+
+fn summary_dict<'py>(py: Python<'py>, s: &nscdd::run::RunSummary) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("steps", s.steps)?;
+    d.set_item("total_sweeps", s.total_sweeps)?;
+    d.set_item("unconverged_steps", s.unconverged_steps)?;
+    d.set_item("first_unconverged", s.first_unconverged)?;
+    d.set_item("suspect_steps", s.suspect_steps)?;
+    d.set_item("max_residual", s.max_residual)?;
+    d.set_item("wall_seconds", s.wall_seconds)?;
+    Ok(d)
+}
+
+#[pymethods]
+impl Simulation {
+    #[new]
+    #[pyo3(signature = (scene, out=None, restart=None))]
+    fn new(scene: &Bound<'_, PyAny>, out: Option<PathBuf>, restart: Option<PathBuf>) -> PyResult<Self> {
+        if let Ok(d) = scene.cast::<PyDict>() {
+            let table = toml_of::table(d, "")?;
+            let text = toml::to_string(&table).map_err(|e| SceneError::new_err(format!("the scene dict: {e}")))?;
+            return Self::load(&text, "<scene dict>", out, restart);
+        }
+        let path: PathBuf = scene.extract()?;
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| SceneError::new_err(format!("{}: cannot read the file: {e}", path.display())))?;
+        Self::load(&text, &path.display().to_string(), out, restart)
+    }
+
+    /// A simulation from the text of a TOML scene.
+    #[staticmethod]
+    #[pyo3(signature = (text, out=None, restart=None))]
+    fn from_toml(text: &str, out: Option<PathBuf>, restart: Option<PathBuf>) -> PyResult<Self> {
+        Self::load(text, "<scene text>", out, restart)
+    }
+
+    /// 2 or 3.
+    #[getter]
+    fn dimension(&self) -> usize {
+        match self.inner {
+            Inner::D2(_) => 2,
+            Inner::D3(_) => 3,
+        }
+    }
+    /// Steps done (a restart continues its count).
+    #[getter]
+    fn current_step(&self) -> u64 {
+        each!(&self.inner, s => s.scene.world.step)
+    }
+    /// The scene's last step (`[time] steps`; moved by `run(n)` past it).
+    #[getter]
+    fn total_steps(&self) -> u64 {
+        each!(&self.inner, s => s.scene.world.time.steps)
+    }
+    #[getter]
+    fn time(&self) -> f64 {
+        each!(&self.inner, s => s.scene.world.t)
+    }
+    #[getter]
+    fn n_bodies(&self) -> usize {
+        each!(&self.inner, s => s.scene.world.bodies.len())
+    }
+    /// Whether finish() was called (the run's outputs are closed).
+    #[getter]
+    fn finished(&self) -> bool {
+        each!(&self.inner, s => s.finished)
+    }
+
+    /// One step; its report (step, time, contacts, sweeps, converged, residual).
+    fn step<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let rep = self.steps(py, 1)?.expect("one step");
+        self.report(py, &rep)
+    }
+
+    /// Runs `steps` more steps (default: to the scene's end, then finish()).
+    /// `callback(sim)` after every `every` steps; a progress bar when `progress`
+    /// and tqdm is installed. Ctrl-C stops after the current step, writing
+    /// checkpoint.json (with an output folder), and raises KeyboardInterrupt.
+    /// Returns the run's summary so far.
+    #[pyo3(signature = (steps=None, *, callback=None, every=1, progress=true))]
+    fn run<'py>(
+        slf: &Bound<'py, Self>,
+        steps: Option<u64>,
+        callback: Option<Bound<'py, PyAny>>,
+        every: u64,
+        progress: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let py = slf.py();
+        let to_end = steps.is_none();
+        let total = match steps {
+            Some(n) => n,
+            None => {
+                let b = slf.borrow();
+                b.total_steps().saturating_sub(b.current_step())
+            }
+        };
+        let every = every.max(1);
+        // the GIL is taken back at least every `chunk` steps (signals, progress)
+        let chunk = if callback.is_some() { every } else { 10 };
+        let bar = match progress {
+            true => py.import("tqdm").ok().map(|t| {
+                let kw = PyDict::new(py);
+                let _ = kw.set_item("total", total);
+                let _ = kw.set_item("unit", "step");
+                t.call_method("tqdm", (), Some(&kw))
+            }),
+            false => None,
+        }
+        .transpose()?;
+        let mut done = 0u64;
+        while done < total {
+            let k = chunk.min(total - done);
+            slf.borrow_mut().steps(py, k)?;
+            done += k;
+            if let Some(b) = &bar {
+                b.call_method1("update", (k,))?;
+            }
+            if let Err(e) = py.check_signals() {
+                if let Some(b) = &bar {
+                    b.call_method0("close")?;
+                }
+                if let Some(err) = each!(&mut slf.borrow_mut().inner, s => s.interrupt()) {
+                    return Err(run_err(err));
+                }
+                return Err(e);
+            }
+            if let Some(cb) = &callback {
+                if done % every == 0 || done == total {
+                    cb.call1((slf,))?;
+                }
+            }
+        }
+        if let Some(b) = &bar {
+            b.call_method0("close")?;
+        }
+        let mut this = slf.borrow_mut();
+        if to_end {
+            let reg = registry();
+            let sum = each!(&mut this.inner, s => s.finish(&reg)).map_err(run_err)?;
+            return summary_dict(py, &sum);
+        }
+        let sum = each!(&this.inner, s => s.run.as_ref().map(|r| r.summary().clone())).unwrap_or_default();
+        summary_dict(py, &sum)
+    }
+
+    /// Ends the run: the VTK series and final.json written (with an output
+    /// folder); its summary. No step after it.
+    fn finish<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let sum = each!(&mut self.inner, s => s.finish(&self.reg)).map_err(run_err)?;
+        summary_dict(py, &sum)
+    }
+
+    /// Writes the state as a restart file (the format of final.json):
+    /// `Simulation(scene, restart=path)` continues it bitwise.
+    fn save(&mut self, path: PathBuf) -> PyResult<()> {
+        each!(&mut self.inner, s => s.save(&self.reg, &path)).map_err(run_err)
+    }
+
+    /// Body positions, (n, dim).
+    fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        Self::array(py, each!(&self.inner, s => s.positions()))
+    }
+    /// Translational velocities, (n, dim).
+    fn velocities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        Self::array(py, each!(&self.inner, s => s.velocities()))
+    }
+    /// Angular velocities: (n,) in 2D, (n, 3) in 3D.
+    fn angular_velocities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        Self::array(py, each!(&self.inner, s => s.angular_velocities()))
+    }
+    /// Rotations: the angle (n,) in 2D, rotation vectors (n, 3) in 3D.
+    fn rotations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        Self::array(py, each!(&self.inner, s => s.rotations()))
+    }
+    /// Radii of balls (disks, spheres), the size of other shapes, (n,).
+    fn radii<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        Self::array(py, each!(&self.inner, s => s.radii()))
+    }
+    /// Masses (2D: per unit depth), (n,).
+    fn masses<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        Self::array(py, each!(&self.inner, s => s.masses()))
+    }
+    /// Body names (None for unnamed bodies).
+    fn names(&self) -> Vec<Option<String>> {
+        each!(&self.inner, s => s.scene.world.names.clone())
+    }
+    /// The index of the body named `name`.
+    fn body(&self, name: &str) -> PyResult<usize> {
+        each!(&self.inner, s => s.body(name)).ok_or_else(|| PyValueError::new_err(format!("no body named `{name}`")))
+    }
+
+    /// The contacts of the last step as a dict of arrays: `bodies` (n, 2), `point`,
+    /// `normal`, `r` (local impulse: normal first), `impulse` (world frame) (n, dim),
+    /// `gap` (n,), `bonded` (n,).
+    fn contacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let ((rec, width), dim) = (each!(&self.inner, s => s.contacts()), self.dimension());
+        let n = rec.len() / width;
+        let col = |a: usize, w: usize| -> Vec<f64> { (0..n).flat_map(|i| rec[i * width + a..i * width + a + w].to_vec()).collect() };
+        let d = PyDict::new(py);
+        let bodies: Vec<u32> = col(0, 2).into_iter().map(|x| x as u32).collect();
+        d.set_item("bodies", PyArray1::from_vec(py, bodies).reshape([n, 2])?)?;
+        for (i, name) in ["point", "normal", "r", "impulse"].iter().enumerate() {
+            d.set_item(name, PyArray1::from_vec(py, col(3 + i * dim, dim)).reshape([n, dim])?)?;
+        }
+        d.set_item("gap", PyArray1::from_vec(py, col(3 + 4 * dim, 1)))?;
+        d.set_item("bonded", PyArray1::from_vec(py, col(4 + 4 * dim, 1).into_iter().map(|x| x != 0.0).collect::<Vec<bool>>()))?;
+        Ok(d)
+    }
+
+    /// The history (the columns of history.csv) as a dict of arrays, or with
+    /// `as_frame` as a pandas DataFrame.
+    #[pyo3(signature = (as_frame=false))]
+    fn history<'py>(&mut self, py: Python<'py>, as_frame: bool) -> PyResult<Bound<'py, PyAny>> {
+        let text = each!(&mut self.inner, s => s.history_text());
+        let mut lines = text.lines();
+        let cols: Vec<&str> = lines.next().map(|h| h.split(',').collect()).unwrap_or_default();
+        let mut data: Vec<Vec<f64>> = vec![vec![]; cols.len()];
+        for l in lines {
+            for (c, x) in data.iter_mut().zip(l.split(',')) {
+                c.push(x.parse().unwrap_or(f64::NAN));
+            }
+        }
+        let d = PyDict::new(py);
+        for (c, v) in cols.into_iter().zip(data) {
+            d.set_item(c, PyArray1::from_vec(py, v))?;
+        }
+        if as_frame {
+            return py.import("pandas")?.call_method1("DataFrame", (d,));
+        }
+        Ok(d.into_any())
+    }
+
+    /// Changes the drive of degree of freedom `dof` ("x", "y", "rot"; 3D "z",
+    /// "rx", "ry", "rz") of a driven body (name or index) between steps; `drive`
+    /// in the scene's syntax: {"velocity": -0.01}, {"force": 1e3},
+    /// [{"force": -1e4, "until": 1.0}, {"velocity": -0.01}].
+    fn set_drive(&mut self, body: &Bound<'_, PyAny>, dof: &str, drive: &Bound<'_, PyAny>) -> PyResult<()> {
+        let k = match body.extract::<usize>() {
+            Ok(k) => k,
+            Err(_) => self.body(&body.extract::<String>()?)?,
+        };
+        let v = toml_of::value(drive, "drive")?;
+        let d: nscdd::drive::DofDrive = v
+            .try_into()
+            .map_err(|e: toml::de::Error| PyValueError::new_err(format!("drive: {}", e.message())))?;
+        each!(&mut self.inner, s => s.set_drive(k, dof, d)).map_err(PyValueError::new_err)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<nscdd.Simulation {}D, {} bodies, step {} of {}>",
+            self.dimension(),
+            self.n_bodies(),
+            self.current_step(),
+            self.total_steps()
+        )
+    }
+}
+
+/// Solves u = W r + q with Coulomb's law of friction coefficients mu per contact
+/// (dim = 2 or 3 unknowns each, normal first). W: a dense (n, n) array or a scipy
+/// sparse matrix (given as its COO rows, cols, vals: see the package wrapper).
+/// Returns a dict: r, u, sweeps, converged, residual (natural map), norms.
+#[pyfunction]
+#[pyo3(signature = (rows, cols, vals, q, mu, *, method="nlgs", tol=1e-8, max_sweeps=100_000, norm="natural", check_every=1, r0=None))]
+#[allow(clippy::too_many_arguments)]
+fn _solve_fc_coo<'py>(
+    py: Python<'py>,
+    rows: PyReadonlyArray1<'py, i64>,
+    cols: PyReadonlyArray1<'py, i64>,
+    vals: PyReadonlyArray1<'py, f64>,
+    q: PyReadonlyArray1<'py, f64>,
+    mu: PyReadonlyArray1<'py, f64>,
+    method: &str,
+    tol: f64,
+    max_sweeps: u32,
+    norm: &str,
+    check_every: u32,
+    r0: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    use nscdd::fc::{CooMatrix, FcNorm, FcOptions, FcProblem};
+    let q = q.as_slice()?.to_vec();
+    let mu = mu.as_slice()?.to_vec();
+    let nc = mu.len();
+    if nc == 0 || q.len() % nc != 0 || !(2..=3).contains(&(q.len() / nc)) {
+        return Err(PyValueError::new_err(format!("q has {} values for {nc} contacts: 2 or 3 per contact", q.len())));
+    }
+    let idx = |a: PyReadonlyArray1<'py, i64>| -> PyResult<Vec<usize>> {
+        a.as_slice()?
+            .iter()
+            .map(|&x| usize::try_from(x).map_err(|_| PyValueError::new_err("negative index in W")))
+            .collect()
+    };
+    let w = CooMatrix {
+        n: q.len(),
+        rows: idx(rows)?,
+        cols: idx(cols)?,
+        vals: vals.as_slice()?.to_vec(),
+    };
+    let p = FcProblem {
+        dim: q.len() / nc,
+        nc,
+        w,
+        q,
+        mu,
+        meta: None,
+    };
+    p.validate().map_err(|(k, m)| PyValueError::new_err(format!("{k}: {m}")))?;
+    let method = nscdd::solver::Method::parse(method)
+        .ok_or_else(|| PyValueError::new_err(format!("unknown method `{method}`: nlgs, anderson or newton")))?;
+    let norm = match norm {
+        "natural" => FcNorm::Natural,
+        other => FcNorm::Lmgc(
+            nscdd::norms::Criterion::parse(other)
+                .ok_or_else(|| PyValueError::new_err(format!("unknown norm `{other}`: natural, Quad, Maxm or QM/16")))?,
+        ),
+    };
+    if !(tol > 0.0) || max_sweeps == 0 || check_every == 0 {
+        return Err(PyValueError::new_err("tol > 0, max_sweeps ≥ 1 and check_every ≥ 1"));
+    }
+    let opts = FcOptions {
+        tol,
+        max_sweeps,
+        check_every,
+        norm,
+        method,
+    };
+    let r0 = r0.map(|r| r.as_slice().map(|s| s.to_vec())).transpose()?;
+    if r0.as_ref().is_some_and(|r| r.len() != p.q.len()) {
+        return Err(PyValueError::new_err("r0 has not the length of q"));
+    }
+    let sol = py.detach(|| p.solve_from(r0.as_deref(), &opts));
+    let d = PyDict::new(py);
+    d.set_item("r", PyArray1::from_vec(py, sol.r))?;
+    d.set_item("u", PyArray1::from_vec(py, sol.u))?;
+    d.set_item("sweeps", sol.sweeps)?;
+    d.set_item("converged", sol.converged)?;
+    d.set_item("residual", sol.residual)?;
+    d.set_item("seconds", sol.solve_seconds)?;
+    let norms = serde_json::to_string(&sol.norms).unwrap_or_default();
+    d.set_item("norms", py.import("json")?.call_method1("loads", (norms,))?)?;
+    Ok(d)
+}
+
+#[pymodule]
+fn _nscdd(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Simulation>()?;
+    m.add_function(wrap_pyfunction!(_solve_fc_coo, m)?)?;
+    m.add("SceneError", m.py().get_type::<SceneError>())?;
+    m.add("RunError", m.py().get_type::<RunError>())?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

@@ -1,0 +1,206 @@
+//! One loaded scene and its run, generic over the dimension: what the Python
+//! class `Simulation` holds (lib.rs dispatches on the dimension).
+
+use nscdd::dim::{Coords, Dim};
+use nscdd::registry::Registry;
+use nscdd::run::RunError;
+use nscdd::runner::Runner;
+use nscdd::scene::Scene;
+use std::io::Write;
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+
+/// The history rows of a run, kept in memory (and written to history.csv when the
+/// run has an output folder).
+#[derive(Clone, Default)]
+pub struct Shared(pub Arc<Mutex<Vec<u8>>>);
+
+impl Write for Shared {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0.lock().map_err(|_| std::io::Error::other("the history buffer's lock"))?.extend_from_slice(buf);
+        Ok(buf.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// Both: the file and the memory.
+struct Tee(std::fs::File, Shared);
+
+impl Write for Tee {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0.write_all(buf)?;
+        self.1.write(buf)
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.0.flush()
+    }
+}
+
+/// A scene, its run once started, and its history.
+pub struct Sim<D: Dim> {
+    pub scene: Scene<D>,
+    pub run: Option<Runner<D>>,
+    pub out: Option<PathBuf>,
+    pub history: Shared,
+    pub finished: bool,
+}
+
+impl<D: Dim> Sim<D> {
+    pub fn new(scene: Scene<D>, out: Option<PathBuf>) -> Self {
+        Sim {
+            scene,
+            run: None,
+            out,
+            history: Shared::default(),
+            finished: false,
+        }
+    }
+
+    /// The run, started at the first step (its outputs' first frame).
+    fn runner(&mut self, reg: &Registry) -> Result<&mut Runner<D>, RunError> {
+        if self.finished {
+            return Err(RunError::Io("the run is finished (finish() wrote final.json): load the scene again, or restart from final.json".into()));
+        }
+        if self.run.is_none() {
+            let sink: Box<dyn Write + Send> = match &self.out {
+                Some(dir) => {
+                    std::fs::create_dir_all(dir).map_err(|e| RunError::Io(format!("cannot create {}: {e}", dir.display())))?;
+                    let path = dir.join("history.csv");
+                    let f = std::fs::File::create(&path).map_err(|e| RunError::Io(format!("cannot write {}: {e}", path.display())))?;
+                    Box::new(Tee(f, self.history.clone()))
+                }
+                None => Box::new(self.history.clone()),
+            };
+            self.run = Some(Runner::start(&mut self.scene, reg, self.out.as_deref(), None, Some(sink))?);
+        }
+        Ok(self.run.as_mut().expect("started above"))
+    }
+
+    /// `n` steps (the scene's end moved past them if it comes first); stops early,
+    /// after the step, when `stop` says so.
+    pub fn steps(&mut self, reg: &Registry, n: u64, stop: &dyn Fn() -> bool) -> Result<Option<nscdd::engine::StepReport>, RunError> {
+        let target = self.scene.world.step + n;
+        if target > self.scene.world.time.steps {
+            self.scene.world.time.steps = target;
+        }
+        self.runner(reg)?;
+        let mut last = None;
+        for _ in 0..n {
+            let run = self.run.as_mut().expect("started");
+            last = Some(run.step(&mut self.scene)?);
+            if stop() {
+                break;
+            }
+        }
+        Ok(last)
+    }
+
+    /// The end of the run: the series and final.json (with an output folder).
+    pub fn finish(&mut self, reg: &Registry) -> Result<nscdd::run::RunSummary, RunError> {
+        self.runner(reg)?;
+        let run = self.run.take().expect("started");
+        self.finished = true;
+        run.finish(&mut self.scene)
+    }
+
+    /// Stopped by the user: checkpoint.json and the series written.
+    pub fn interrupt(&mut self) -> Option<RunError> {
+        let run = self.run.as_mut()?;
+        match run.interrupt(&mut self.scene) {
+            RunError::Interrupted(_) => None,
+            e => Some(e),
+        }
+    }
+
+    /// The state as a restart file at `path`.
+    pub fn save(&mut self, reg: &Registry, path: &std::path::Path) -> Result<(), RunError> {
+        self.runner(reg)?;
+        self.run.as_mut().expect("started").save(&mut self.scene, path)
+    }
+
+    /// Flushes the history and returns its text.
+    pub fn history_text(&mut self) -> String {
+        if let Some(r) = self.run.as_mut() {
+            let _ = r.flush();
+        }
+        let buf = self.history.0.lock().map(|b| b.clone()).unwrap_or_default();
+        String::from_utf8_lossy(&buf).into_owned()
+    }
+
+    /// Per body, the `width` values `f` gives.
+    pub fn per_body(&self, width: usize, f: impl Fn(&nscdd::world::World<D>, usize, &mut Vec<f64>)) -> (Vec<f64>, usize) {
+        let w = &self.scene.world;
+        let n = w.bodies.len();
+        let mut out = Vec::with_capacity(n * width);
+        for k in 0..n {
+            f(w, k, &mut out);
+        }
+        (out, width)
+    }
+
+    pub fn positions(&self) -> (Vec<f64>, usize) {
+        self.per_body(D::N, |w, k, o| o.extend_from_slice(w.bodies.pos[k].as_ref()))
+    }
+    pub fn velocities(&self) -> (Vec<f64>, usize) {
+        self.per_body(D::N, |w, k, o| o.extend_from_slice(&w.bodies.vel[k].as_ref()[..D::N]))
+    }
+    pub fn angular_velocities(&self) -> (Vec<f64>, usize) {
+        self.per_body(if D::N == 2 { 1 } else { 3 }, |w, k, o| {
+            o.extend_from_slice(&w.bodies.vel[k].as_ref()[D::N..])
+        })
+    }
+    /// 2D: the angle (rad); 3D: the rotation vector (axis × angle).
+    pub fn rotations(&self) -> (Vec<f64>, usize) {
+        self.per_body(if D::N == 2 { 1 } else { 3 }, |w, k, o| {
+            o.extend_from_slice(D::rot_to_vec(&w.bodies.rot[k]).coords())
+        })
+    }
+    /// The radius of a ball, else the shape's size (as the VTK `radius` array).
+    pub fn radii(&self) -> (Vec<f64>, usize) {
+        self.per_body(1, |w, k, o| {
+            let s = w.bodies.shape[k];
+            let store = &w.shapes[s.kind as usize];
+            o.push(match store.glyph(s.index, w.bodies.pos[k], w.bodies.rot[k]) {
+                nscdd::shape::Glyph::Ball(r) => r,
+                _ => store.size(s.index),
+            });
+        })
+    }
+    pub fn masses(&self) -> (Vec<f64>, usize) {
+        self.per_body(1, |w, k, o| o.push(w.bodies.mass[k]))
+    }
+
+    /// The contacts' records ([`nscdd::output::contact_records`]).
+    pub fn contacts(&self) -> (Vec<f64>, usize) {
+        let w = &self.scene.world;
+        let mut out = vec![];
+        nscdd::output::contact_records(w, 0..w.contacts.len(), &mut out);
+        (out, 3 + 4 * D::N + 2)
+    }
+
+    /// The body named `name`, or of index `name`.
+    pub fn body(&self, name: &str) -> Option<usize> {
+        let w = &self.scene.world;
+        w.names
+            .iter()
+            .position(|n| n.as_deref() == Some(name))
+            .or_else(|| name.parse::<usize>().ok().filter(|&k| k < w.bodies.len()))
+    }
+
+    /// Replaces the drive of degree of freedom `dof` of a driven body.
+    pub fn set_drive(&mut self, body: usize, dof: &str, drive: nscdd::drive::DofDrive) -> Result<(), String> {
+        let names: &[&str] = if D::N == 2 { &["x", "y", "rot"] } else { &["x", "y", "z", "rx", "ry", "rz"] };
+        let slot = names
+            .iter()
+            .position(|&n| n == dof)
+            .ok_or_else(|| format!("unknown degree of freedom `{dof}`: one of {}", names.join(", ")))?;
+        let w = &mut self.scene.world;
+        let d = w.drives.iter_mut().find(|d| d.body as usize == body).ok_or_else(|| {
+            format!("body {body} has no drive in the scene: only a driven body's drives change between steps (give it one in the scene)")
+        })?;
+        d.dof[slot] = Some(drive);
+        Ok(())
+    }
+}
