@@ -231,19 +231,23 @@ impl Simulation {
             if let Some(b) = &bar {
                 b.call_method1("update", (k,))?;
             }
-            if let Err(e) = py.check_signals() {
+            let mut checked = py.check_signals();
+            if let (Ok(()), Some(cb)) = (&checked, &callback) {
+                if done % every == 0 || done == total {
+                    checked = cb.call1((slf,)).map(|_| ());
+                }
+            }
+            if let Err(e) = checked {
                 if let Some(b) = &bar {
                     b.call_method0("close")?;
                 }
-                if let Some(err) = each!(&mut slf.borrow_mut().inner, s => s.interrupt()) {
-                    return Err(run_err(err));
+                // Ctrl-C (here or in the callback): the run's checkpoint and series
+                if e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
+                    if let Some(err) = each!(&mut slf.borrow_mut().inner, s => s.interrupt()) {
+                        return Err(run_err(err));
+                    }
                 }
                 return Err(e);
-            }
-            if let Some(cb) = &callback {
-                if done % every == 0 || done == total {
-                    cb.call1((slf,))?;
-                }
             }
         }
         if let Some(b) = &bar {
