@@ -5,7 +5,8 @@
 #     cargo feature `mpi`: the MPI tests run `mpirun` with oversubscription
 # The default build (`cargo run`) needs none of it: no MPI, no Python, no HDF5.
 #   - a Python virtualenv ./venv with scikit-fem and meshio (deformable bodies, cargo
-#     feature `fem`); Debian's python3-venv and python3-dev if Python cannot make one
+#     feature `fem`); Debian's python3-venv and python3-dev if Python cannot make one;
+#     the nscdd Python module (python/, maturin) and pytest are installed in it
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if ! command -v cargo >/dev/null 2>&1; then
@@ -41,6 +42,11 @@ export PYO3_PYTHON="$PWD/venv/bin/python" NSCDD_PYTHON_ENV="$PWD/venv"
 # Containers often forbid the cross-memory attach OpenMPI uses for large messages.
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_btl_vader_single_copy_mechanism=none
 cargo test --workspace --release --no-fail-fast --features nscdd-cli/hdf5,nscdd-tests/hdf5,nscdd-cli/mpi,nscdd-cli/fem,nscdd-fuzz/fem,nscdd-fuzz/hdf5
+# The Python module (python/, docs/PYTHON.md): built by maturin into the
+# virtualenv (reusing target/), then its pytest suite (which compares a run with
+# target/release/nscdd's, built above).
+venv/bin/pip install -q pytest ./python
+venv/bin/python -m pytest -q python/tests
 # Fuzzing, bounded (docs/RELIABILITY.md): every target 20 s on mutants of its corpus
 # (tests/fuzz/corpus); a panic or a hang fails the run, its input saved in
 # target/fuzz-failures/. The binary was built by the tests above.

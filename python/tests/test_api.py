@@ -273,3 +273,13 @@ def test_solve_fc_takes_sparse_matrices_and_a_warm_start():
         nscdd.solve_fc(W, q, mu, method="pgs")
     with pytest.raises(ValueError, match="contacts"):
         nscdd.solve_fc(W, q[:-1], mu)
+
+
+def test_the_stubs_name_every_method():
+    import re
+
+    stub = (pathlib.Path(nscdd.__file__).parent / "_nscdd.pyi").read_text()
+    named = set(re.findall(r"def (\w+)\(", stub))
+    public = {m for m in dir(nscdd.Simulation) if not m.startswith("_")}
+    assert public <= named, public - named
+    assert (pathlib.Path(nscdd.__file__).parent / "py.typed").exists()
