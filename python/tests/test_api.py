@@ -283,3 +283,14 @@ def test_the_stubs_name_every_method():
     public = {m for m in dir(nscdd.Simulation) if not m.startswith("_")}
     assert public <= named, public - named
     assert (pathlib.Path(nscdd.__file__).parent / "py.typed").exists()
+
+
+@pytest.mark.parametrize("example", ["arch.py", "deposit.py"])
+def test_examples_run(example, tmp_path):
+    """The notebook-ready examples (the two short ones; biaxial.py and
+    mu_sweep.py take 10–40 s and are run by hand)."""
+    import sys
+
+    out = subprocess.run([sys.executable, str(ROOT / "python" / "examples" / example)], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip()
