@@ -41,7 +41,6 @@ pub mod params;
 pub mod plugin;
 pub mod registry;
 pub mod run;
-pub mod runner;
 pub mod scene;
 pub mod shape;
 pub mod solver;

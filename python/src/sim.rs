@@ -4,7 +4,7 @@
 use nscdd::dim::{Coords, Dim};
 use nscdd::registry::Registry;
 use nscdd::run::RunError;
-use nscdd::runner::Runner;
+use nscdd::run::Runner;
 use nscdd::scene::Scene;
 use std::io::Write;
 use std::path::PathBuf;

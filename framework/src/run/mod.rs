@@ -1,6 +1,10 @@
 //! Running a loaded scene (2D or 3D) to its end and writing its outputs in a
 //! directory.
 
+pub mod runner;
+
+pub use runner::Runner;
+
 use crate::dd::{NscddOf, Rigid};
 use crate::dim::Dim;
 use crate::engine::StepReport;
@@ -323,7 +327,7 @@ pub(crate) fn scene_solver<D: Dim>(scene: &mut Scene<D>, cluster: Option<Box<dyn
 /// VTK frames, of which every rank writes its piece (`.pvtp` by rank 0). A scene's
 /// body families ([`crate::family`]) step with the world, add their history columns
 /// and VTK frames, and save their state in `final.json` and the checkpoints. The
-/// steps are [`crate::runner::Runner`]'s.
+/// steps are [`Runner`]'s.
 pub fn run_on<D: Dim>(
     scene: &mut Scene<D>,
     registry: &Registry,
@@ -331,7 +335,7 @@ pub fn run_on<D: Dim>(
     cluster: Option<Box<dyn crate::dd::Cluster>>,
     mut on_step: impl FnMut(&World<D>, &StepReport),
 ) -> Result<RunSummary, RunError> {
-    let mut run = crate::runner::Runner::start(scene, registry, Some(dir), cluster, None)?;
+    let mut run = Runner::start(scene, registry, Some(dir), cluster, None)?;
     let steps = scene.world.time.steps;
     // a restarted world continues from its saved step
     for s in (scene.world.step + 1)..=steps {

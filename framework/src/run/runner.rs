@@ -5,7 +5,7 @@
 //! bits as `nscdd run`.
 //!
 //! ```no_run
-//! use nscdd::runner::Runner;
+//! use nscdd::run::Runner;
 //! let reg = nscdd::registry::Registry::new();
 //! let mut scene = nscdd::scene::load("deposit.toml".as_ref(), &reg).unwrap();
 //! let out = std::path::Path::new("out");
