@@ -84,6 +84,9 @@ class Simulation:
     def contacts(self) -> dict[str, npt.NDArray[Any]]:
         """The last step's contacts: bodies (m, 2), point, normal, r (local impulse,
         normal first), impulse (world frame) (m, dim), gap (m,), bonded (m,)."""
+    def subdomains(self) -> Optional[dict[str, npt.NDArray[Any]]]:
+        """With a decomposition, after a step: bodies (n,) each body's subdomain (−1:
+        no contacts), copies (n,), contacts (m,) each contact's subdomain; else None."""
     def history(self, as_frame: bool = False) -> Any:
         """history.csv's columns as a dict of arrays (as_frame: a pandas DataFrame)."""
     def set_drive(self, body: Union[int, str], dof: str, drive: Union[dict[str, Any], list[dict[str, Any]]]) -> None:

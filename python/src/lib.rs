@@ -67,7 +67,9 @@ pub struct Simulation {
 
 impl Simulation {
     fn load(text: &str, file: &str, out: Option<PathBuf>, restart: Option<PathBuf>) -> PyResult<Self> {
-        let reg = registry();
+        let mut reg = registry();
+        // the plugin libraries the scene names (`[[plugins]]`), before it is read
+        nscdd::plugin::load_for_scene(text, file, &mut reg).map_err(|e| SceneError::new_err(e.to_string()))?;
         let any = nscdd::scene::load_any_str(text, file, &reg).map_err(|e| SceneError::new_err(e.to_string()))?;
         let mut inner = match any {
             AnyScene::D2(s) => Inner::D2(Sim::new(s, out)),
@@ -255,8 +257,8 @@ impl Simulation {
         }
         let mut this = slf.borrow_mut();
         if to_end {
-            let reg = registry();
-            let sum = each!(&mut this.inner, s => s.finish(&reg)).map_err(run_err)?;
+            let Simulation { inner, reg } = &mut *this;
+            let sum = each!(inner, s => s.finish(reg)).map_err(run_err)?;
             return summary_dict(py, &sum);
         }
         let sum = each!(&this.inner, s => s.run.as_ref().map(|r| r.summary().clone())).unwrap_or_default();
@@ -325,6 +327,19 @@ impl Simulation {
         d.set_item("gap", PyArray1::from_vec(py, col(3 + 4 * dim, 1)))?;
         d.set_item("bonded", PyArray1::from_vec(py, col(4 + 4 * dim, 1).into_iter().map(|x| x != 0.0).collect::<Vec<bool>>()))?;
         Ok(d)
+    }
+
+    /// With NSCDD (a `[decomposition]`), after a step: `bodies` (n,) the subdomain
+    /// holding most of each body's contacts (−1: none), `copies` (n,) how many
+    /// subdomains hold a copy of it, `contacts` (m,) each contact's subdomain.
+    /// None without a decomposition or before the first step.
+    fn subdomains<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some((b, m, c)) = each!(&self.inner, s => s.subdomains()) else { return Ok(None) };
+        let d = PyDict::new(py);
+        d.set_item("bodies", PyArray1::from_vec(py, b))?;
+        d.set_item("copies", PyArray1::from_vec(py, m))?;
+        d.set_item("contacts", PyArray1::from_vec(py, c))?;
+        Ok(Some(d))
     }
 
     /// The history (the columns of history.csv) as a dict of arrays, or with

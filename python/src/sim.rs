@@ -180,6 +180,13 @@ impl<D: Dim> Sim<D> {
         (out, 3 + 4 * D::N + 2)
     }
 
+    /// The last step's subdomains: (each body's (−1: no contacts), its number of
+    /// copies, each contact's); None without NSCDD or before the first step.
+    pub fn subdomains(&self) -> Option<(Vec<i32>, Vec<u32>, Vec<u32>)> {
+        let v = self.run.as_ref()?.view(&self.scene)?;
+        Some((v.body_subdomain, v.multiplicity, v.contact_subdomain))
+    }
+
     /// The body named `name`, or of index `name`.
     pub fn body(&self, name: &str) -> Option<usize> {
         let w = &self.scene.world;

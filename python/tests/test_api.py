@@ -294,3 +294,38 @@ def test_examples_run(example, tmp_path):
     out = subprocess.run([sys.executable, str(ROOT / "python" / "examples" / example)], cwd=tmp_path, capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip()
+
+
+def test_subdomain_ids_with_a_decomposition():
+    sim = nscdd.Simulation(deposit(decomposition={"nx": 2, "ny": 1}))
+    assert sim.subdomains() is None
+    sim.run(20, progress=False)
+    d = sim.subdomains()
+    m = len(sim.contacts()["gap"])
+    assert d["contacts"].shape == (m,) and set(d["contacts"]) == {0, 1}
+    assert d["bodies"].shape == (sim.n_bodies,) and d["bodies"].min() >= -1
+    assert np.all(d["copies"][d["bodies"] >= 0] >= 1)
+    # the same scene without a decomposition has none
+    plain = nscdd.Simulation(deposit())
+    plain.step()
+    assert plain.subdomains() is None
+
+
+POLYGONS = ROOT / "target" / "release" / "deps" / "libnscdd_polygons.so"
+
+
+@pytest.mark.skipif(not POLYGONS.exists(), reason="the polygons plugin library is not built")
+def test_a_scene_loads_its_run_time_plugins(tmp_path):
+    s = deposit(steps=10)
+    s["plugins"] = [{"library": str(POLYGONS)}]
+    s["generate"] = []
+    s["bodies"].append({"shape": "polygon", "sides": 5, "radius": 0.01, "material": "grain", "position": [0.15, 0.1]})
+    try:
+        sim = nscdd.Simulation(s)
+    except nscdd.SceneError as e:
+        # the test suite's library is built with the CLI's features (mpi, hdf5):
+        # the module refuses it, naming the key and the features
+        assert "plugins[0].library" in str(e) and "framework features" in str(e), e
+        return
+    sim.run(progress=False)
+    assert sim.positions()[-1, 1] < 0.1

@@ -192,6 +192,12 @@ impl<D: Dim> Runner<D> {
         crate::run::finish_outputs(&mut self.writers, &mut scene.families, self.vtk, &dir)
     }
 
+    /// With NSCDD (a decomposition, or body families): the last step's subdomains
+    /// of the contacts and the bodies ([`crate::dd::DdView`]); None without.
+    pub fn view(&self, scene: &Scene<D>) -> Option<crate::dd::DdView> {
+        self.dd.as_ref().map(|n| n.view(&scene.world))
+    }
+
     /// The run's totals so far.
     pub fn summary(&self) -> &RunSummary {
         &self.sum
