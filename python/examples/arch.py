@@ -6,6 +6,7 @@ voussoirs that turn (relative rotation), and each voussoir's rotation.
 
     python python/examples/arch.py            # writes arch.png
 """
+# %%
 import pathlib
 import tomllib
 
@@ -14,6 +15,7 @@ import numpy as np
 import nscdd
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
+# %% A thin arch, run until its mechanism forms
 s = tomllib.loads((ROOT / "examples" / "scenes" / "arch.toml").read_text())
 s["generate"][0]["thickness"] = 0.09
 s["time"]["duration"] = 0.25
@@ -23,6 +25,7 @@ sim.run()
 x, rot = sim.positions(), sim.rotations()
 
 
+# %% Each voussoir's rotation and the joints that turn
 def matrix(v):
     """Rodrigues: the rotation matrix of a rotation vector."""
     t = np.linalg.norm(v)
@@ -51,6 +54,7 @@ relative = np.array([angle(R[j] @ R[i].T) for i, j in joint])
 hinges = [0.5 * (x[i] + x[j]) for (i, j), a in zip(joint, relative) if a > 0.25 * relative.max()]
 print(f"{len(hinges)} hinges (joints turning by more than a quarter of the largest, {relative.max():.2f}°)")
 
+# %% The picture
 try:
     import matplotlib
 

@@ -4,11 +4,13 @@ sin φ(ε1) and solid fraction plotted from the history.
 
     python python/examples/biaxial.py         # ≈ 7 s; writes biaxial.png
 """
+# %%
 import pathlib
 
 import nscdd
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
+# %% Run the test
 sim = nscdd.Simulation(ROOT / "examples" / "scenes" / "biaxial.toml")
 sim.run()
 h = sim.history()
@@ -16,6 +18,7 @@ load = h["time"] >= 0.3  # the loading phase
 eps1, sin_phi, nu = h["eps1"][load], h["sin_phi"][load], h["solid_fraction"][load]
 print(f"peak sin φ {sin_phi.max():.3f} at ε1 = {100 * eps1[sin_phi.argmax()]:.2f} %")
 
+# %% sin φ(ε1) and the solid fraction
 try:
     import matplotlib
 

@@ -5,6 +5,7 @@ final packing drawn with matplotlib.
     pip install ./python matplotlib tqdm      # from the repository root
     python python/examples/deposit.py         # writes out/deposit_py/ and deposit.png
 """
+# %%
 import pathlib
 
 import numpy as np
@@ -12,6 +13,7 @@ import numpy as np
 import nscdd
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
+# %% Run the scene with a callback every 100 steps
 sim = nscdd.Simulation(ROOT / "examples" / "scenes" / "deposit.toml", out="out/deposit_py")
 energy = []
 
@@ -26,6 +28,7 @@ print(f"{summary['steps']} steps, {summary['total_sweeps']} sweeps, {summary['wa
 h = sim.history()
 print(f"solid fraction {h['solid_fraction'][-1]:.3f}, contacts {int(h['contacts'][-1])}")
 
+# %% The packing and the kinetic energy
 try:
     import matplotlib
 

@@ -8,6 +8,7 @@ Each run loads examples/scenes/biaxial.toml as a dict (tomllib), changes the
 grain–grain law's friction and the sample's seed stays the same, so only μ
 differs. --quick: the loading stops at ε1 ≈ 2 % (the mobilized sin φ there).
 """
+# %%
 import concurrent.futures
 import pathlib
 import sys
@@ -18,6 +19,7 @@ import nscdd
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
+# %% One run per friction coefficient
 def scene(mu, quick):
     s = tomllib.loads((ROOT / "examples" / "scenes" / "biaxial.toml").read_text())
     for law in s["laws"]:
@@ -39,6 +41,7 @@ def peak(mu, quick=False):
     return mu, max(smooth)
 
 
+# %% The sweep, in parallel processes
 if __name__ == "__main__":
     workers = int(sys.argv[sys.argv.index("--workers") + 1]) if "--workers" in sys.argv else 2
     quick = "--quick" in sys.argv

@@ -21,11 +21,14 @@ pyo3::create_exception!(_nscdd, SceneError, PyValueError, "A scene that cannot b
 pyo3::create_exception!(_nscdd, RunError, PyRuntimeError, "A run that stopped: a diverging body (step and body named), an output that cannot be written.");
 
 /// The built-in plugins: rigid disks and walls (2D), spheres, planes and boxes
-/// (3D), polyhedra.
+/// (3D), polyhedra, and with the feature `fem` deformable bodies and continuum
+/// regions (scikit-fem imported from the running Python when a scene has them).
 fn registry() -> Registry {
     let mut reg = nscdd_rigid_disks::registry();
     reg.add_plugin(&nscdd_spheres::SpheresPlugin);
     reg.add_plugin(&nscdd_polyhedra::PolyhedraPlugin);
+    #[cfg(feature = "fem")]
+    reg.add_plugin(&nscdd_fem_deformable::FemPlugin);
     reg
 }
 

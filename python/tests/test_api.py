@@ -329,3 +329,19 @@ def test_a_scene_loads_its_run_time_plugins(tmp_path):
         return
     sim.run(progress=False)
     assert sim.positions()[-1, 1] < 0.1
+
+
+@pytest.mark.skipif(not CLI.exists(), reason="the nscdd command-line program is not built")
+def test_deformable_bodies_bitwise_the_command_lines(tmp_path):
+    """The fem plugin (deformable bodies through scikit-fem, imported in the running
+    Python): the foundation example by model in 2 subdomains."""
+    pytest.importorskip("skfem")
+    text = (ROOT / "examples" / "scenes" / "foundation.toml").read_text().replace("duration = 0.5", "duration = 0.04")
+    scene = tmp_path / "foundation.toml"
+    scene.write_text(text)
+    env = dict(os.environ, NSCDD_PYTHON_ENV=str(pathlib.Path(os.sys.prefix)))
+    subprocess.run([str(CLI), "run", str(scene), "--out", str(tmp_path / "cli"), "--quiet"], check=True, env=env)
+    sim = nscdd.Simulation(str(scene), out=str(tmp_path / "py"))
+    sim.run(progress=False)
+    assert "kinetic_deformable" in sim.history()
+    assert (tmp_path / "cli" / "final.json").read_bytes() == (tmp_path / "py" / "final.json").read_bytes()
