@@ -44,6 +44,12 @@ class Simulation:
     @property
     def n_bodies(self) -> int: ...
     @property
+    def gravity(self) -> list[float]:
+        """The gravity vector (m/s²)."""
+    @gravity.setter
+    def gravity(self, g: list[float]) -> None:
+        """Between steps (scenes without deformable bodies or continuum regions)."""
+    @property
     def finished(self) -> bool:
         """Whether finish() was called."""
     def step(self) -> dict[str, Any]:

@@ -181,6 +181,15 @@ impl Simulation {
     fn n_bodies(&self) -> usize {
         each!(&self.inner, s => s.scene.world.bodies.len())
     }
+    /// The gravity vector (m/s²); settable between steps (rigid scenes).
+    #[getter]
+    fn gravity(&self) -> Vec<f64> {
+        each!(&self.inner, s => s.scene.world.gravity.as_ref().to_vec())
+    }
+    #[setter]
+    fn set_gravity(&mut self, g: Vec<f64>) -> PyResult<()> {
+        each!(&mut self.inner, s => s.set_gravity(&g)).map_err(PyValueError::new_err)
+    }
     /// Whether finish() was called (the run's outputs are closed).
     #[getter]
     fn finished(&self) -> bool {

@@ -196,6 +196,19 @@ impl<D: Dim> Sim<D> {
             .or_else(|| name.parse::<usize>().ok().filter(|&k| k < w.bodies.len()))
     }
 
+    /// Sets the gravity of the rigid bodies (read at every step's free velocity);
+    /// refused with body families, whose loads are assembled once.
+    pub fn set_gravity(&mut self, g: &[f64]) -> Result<(), String> {
+        if g.len() != D::N || !g.iter().all(|x| x.is_finite()) {
+            return Err(format!("gravity takes {} finite numbers, got {g:?}", D::N));
+        }
+        if !self.scene.families.is_empty() {
+            return Err("gravity cannot change in a scene with deformable bodies or continuum regions (their loads are assembled once)".into());
+        }
+        self.scene.world.gravity.as_mut().copy_from_slice(g);
+        Ok(())
+    }
+
     /// Replaces the drive of degree of freedom `dof` of a driven body.
     pub fn set_drive(&mut self, body: usize, dof: &str, drive: nscdd::drive::DofDrive) -> Result<(), String> {
         let names: &[&str] = if D::N == 2 { &["x", "y", "rot"] } else { &["x", "y", "z", "rx", "ry", "rz"] };

@@ -345,3 +345,14 @@ def test_deformable_bodies_bitwise_the_command_lines(tmp_path):
     sim.run(progress=False)
     assert "kinetic_deformable" in sim.history()
     assert (tmp_path / "cli" / "final.json").read_bytes() == (tmp_path / "py" / "final.json").read_bytes()
+
+
+def test_gravity_changes_between_steps():
+    sim = nscdd.Simulation(SPHERES)
+    assert sim.gravity == [0.0, 0.0, -9.81]
+    sim.step()
+    sim.gravity = [0.0, 0.0, 9.81]  # up: the top sphere leaves
+    sim.run(10, progress=False)
+    assert sim.velocities()[2, 2] > 0.05
+    with pytest.raises(ValueError, match="3 finite numbers"):
+        sim.gravity = [0.0, 1.0]
