@@ -82,6 +82,8 @@ class Simulation:
         """The angle (n,) in 2D, rotation vectors (n, 3) in 3D."""
     def radii(self) -> npt.NDArray[np.float64]:
         """(n,) radii of balls, the size of other shapes."""
+    def shapes(self) -> dict[str, Any]:
+        """kinds (the shape kinds' names), kind (n,) each body's index in them, shape (n,) its id within the kind."""
     def masses(self) -> npt.NDArray[np.float64]:
         """(n,) masses (2D: per unit depth)."""
     def names(self) -> list[Optional[str]]: ...

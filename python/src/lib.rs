@@ -310,6 +310,17 @@ impl Simulation {
     fn radii<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         Self::array(py, each!(&self.inner, s => s.radii()))
     }
+    /// Each body's shape: `kinds` (the shape kinds' names: "disk", "wall",
+    /// "sphere", "polyhedron"…), `kind` (n,) an index in them, `shape` (n,) the
+    /// shape's id within its kind.
+    fn shapes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let (names, kind, shape) = each!(&self.inner, s => s.shapes());
+        let d = PyDict::new(py);
+        d.set_item("kinds", names)?;
+        d.set_item("kind", PyArray1::from_vec(py, kind))?;
+        d.set_item("shape", PyArray1::from_vec(py, shape))?;
+        Ok(d)
+    }
     /// Masses (2D: per unit depth), (n,).
     fn masses<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         Self::array(py, each!(&self.inner, s => s.masses()))

@@ -168,6 +168,13 @@ impl<D: Dim> Sim<D> {
             });
         })
     }
+    /// The shape kinds' names, and each body's kind (an index in them) and
+    /// shape id within its kind.
+    pub fn shapes(&self) -> (Vec<&'static str>, Vec<u16>, Vec<u32>) {
+        let w = &self.scene.world;
+        let names = w.shapes.iter().map(|s| s.kind()).collect();
+        (names, w.bodies.shape.iter().map(|s| s.kind).collect(), w.bodies.shape.iter().map(|s| s.index).collect())
+    }
     pub fn masses(&self) -> (Vec<f64>, usize) {
         self.per_body(1, |w, k, o| o.push(w.bodies.mass[k]))
     }

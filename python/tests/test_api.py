@@ -77,6 +77,9 @@ def test_arrays_have_the_bodies_shapes():
     assert r.shape == (n,) and np.all((r[3:] >= 0.008) & (r[3:] <= 0.012))
     assert np.all(sim.masses()[3:] > 0)
     assert sim.names()[:3] == ["floor", "left", "right"] and sim.names()[3] is None
+    sh = sim.shapes()
+    kinds = [sh["kinds"][k] for k in sh["kind"]]
+    assert kinds[:3] == ["wall"] * 3 and set(kinds[3:]) == {"disk"} and sh["shape"].shape == (n,)
     assert sim.body("right") == 2
     # copies: an array kept across steps stays what it was
     x = sim.positions()
