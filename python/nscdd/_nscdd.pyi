@@ -1,7 +1,7 @@
 """Type stubs of nscdd's Rust extension (docs/PYTHON.md)."""
 
 from os import PathLike
-from typing import Any, Callable, Optional, Union
+from typing import Any, Callable, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -47,7 +47,7 @@ class Simulation:
     def gravity(self) -> list[float]:
         """The gravity vector (m/s²)."""
     @gravity.setter
-    def gravity(self, g: list[float]) -> None:
+    def gravity(self, g: "Sequence[float]") -> None:
         """Between steps (scenes without deformable bodies or continuum regions)."""
     @property
     def finished(self) -> bool:
@@ -69,7 +69,7 @@ class Simulation:
         unconverged_steps, first_unconverged, suspect_steps, max_residual,
         wall_seconds."""
     def finish(self) -> dict[str, Any]:
-        """Ends the run (the VTK series and final.json with `out`); its summary."""
+        """Ends the run (a last frame, the VTK series and final.json with `out`); its summary."""
     def save(self, path: Union[str, "PathLike[str]"]) -> None:
         """Writes the state as a restart file."""
     def positions(self) -> npt.NDArray[np.float64]:
@@ -93,8 +93,9 @@ class Simulation:
         """The last step's contacts: bodies (m, 2), point, normal, r (local impulse,
         normal first), impulse (world frame) (m, dim), gap (m,), bonded (m,)."""
     def subdomains(self) -> Optional[dict[str, npt.NDArray[Any]]]:
-        """With a decomposition, after a step: bodies (n,) each body's subdomain (−1:
-        no contacts), copies (n,), contacts (m,) each contact's subdomain; else None."""
+        """With NSCDD (a decomposition or body families), after a step: bodies (n,)
+        each body's subdomain (−1: no contacts), copies (n,), contacts (m,) each
+        contact's subdomain; else None."""
     def history(self, as_frame: bool = False) -> Any:
         """history.csv's columns as a dict of arrays (as_frame: a pandas DataFrame)."""
     def set_drive(self, body: Union[int, str], dof: str, drive: Union[dict[str, Any], list[dict[str, Any]]]) -> None:

@@ -47,10 +47,15 @@ macro_rules! each {
     };
 }
 
-/// Moves a borrow into `Python::detach`: the closure runs on this thread, with the
-/// GIL released; nothing in it touches Python.
-struct AssertSend<T>(T);
-unsafe impl<T> Send for AssertSend<T> {}
+/// The simulation and a step's result moved through `Python::detach`.
+struct Detached<'a>(&'a mut Inner);
+struct Stepped(Result<Option<nscdd::engine::StepReport>, nscdd::run::RunError>);
+// SAFETY: `Python::detach` runs its closure on the calling thread (it only
+// releases the GIL), so nothing crosses threads; `Inner` holds no Python object
+// (the fem plugin takes the GIL again with `Python::attach` where it calls Python).
+// `Send` is asked only to keep GIL-bound references out of the closure.
+unsafe impl Send for Detached<'_> {}
+unsafe impl Send for Stepped {}
 
 fn run_err(e: nscdd::run::RunError) -> PyErr {
     RunError::new_err(e.to_string())
@@ -65,7 +70,8 @@ fn run_err(e: nscdd::run::RunError) -> PyErr {
 #[pyclass(unsendable, module = "nscdd._nscdd")]
 pub struct Simulation {
     inner: Inner,
-    reg: Registry,
+    /// The registry the scene was loaded with (its plugins'), kept with it.
+    _reg: Registry,
 }
 
 impl Simulation {
@@ -73,16 +79,25 @@ impl Simulation {
         let mut reg = registry();
         // the plugin libraries the scene names (`[[plugins]]`), before it is read
         nscdd::plugin::load_for_scene(text, file, &mut reg).map_err(|e| SceneError::new_err(e.to_string()))?;
-        let any = nscdd::scene::load_any_str(text, file, &reg).map_err(|e| SceneError::new_err(e.to_string()))?;
-        let mut inner = match any {
-            AnyScene::D2(s) => Inner::D2(Sim::new(s, out)),
-            AnyScene::D3(s) => Inner::D3(Sim::new(s, out)),
-        };
-        if let Some(state) = restart {
-            each!(&mut inner, s => nscdd::scene::restart_scene(&mut s.scene, &state))
-                .map_err(|e| SceneError::new_err(e.to_string()))?;
+        if let (Some(o), Some(state)) = (&out, &restart) {
+            check_restart_dir(o, state)?;
         }
-        Ok(Simulation { inner, reg })
+        let any = nscdd::scene::load_any_str(text, file, &reg).map_err(|e| SceneError::new_err(e.to_string()))?;
+        let input = |e: nscdd::run::RunError| match e {
+            nscdd::run::RunError::Param(_) | nscdd::run::RunError::Input(_) => SceneError::new_err(e.to_string()),
+            e => run_err(e),
+        };
+        let inner = match any {
+            AnyScene::D2(mut s) => {
+                restarted(&mut s, restart.as_deref())?;
+                Inner::D2(Sim::start(s, &reg, out).map_err(input)?)
+            }
+            AnyScene::D3(mut s) => {
+                restarted(&mut s, restart.as_deref())?;
+                Inner::D3(Sim::start(s, &reg, out).map_err(input)?)
+            }
+        };
+        Ok(Simulation { inner, _reg: reg })
     }
 
     fn array<'py>(py: Python<'py>, (v, width): (Vec<f64>, usize)) -> PyResult<Bound<'py, PyAny>> {
@@ -95,14 +110,12 @@ impl Simulation {
         }
     }
 
-    /// `n` steps with the GIL released (stopping early on `stop`).
+    /// `n` steps with the GIL released.
     fn steps(&mut self, py: Python<'_>, n: u64) -> PyResult<Option<nscdd::engine::StepReport>> {
-        let cell = AssertSend((&mut self.inner, &self.reg));
+        let d = Detached(&mut self.inner);
         let res = py.detach(move || {
-            let c = cell;
-            let (inner, reg) = c.0;
-            let stop = || false;
-            AssertSend(each!(inner, s => s.steps(reg, n, &stop)))
+            let d = d;
+            Stepped(each!(d.0, s => s.steps(n)))
         });
         res.0.map_err(run_err)
     }
@@ -118,6 +131,55 @@ impl Simulation {
         d.set_item("residual", rep.solve.residual)?;
         Ok(d)
     }
+}
+
+/// A scene continued from a saved state.
+fn restarted<D: nscdd::dim::Dim>(s: &mut nscdd::scene::Scene<D>, state: Option<&std::path::Path>) -> PyResult<()> {
+    match state {
+        Some(p) => nscdd::scene::restart_scene(s, p).map_err(|e| SceneError::new_err(e.to_string())),
+        None => Ok(()),
+    }
+}
+
+/// `run`'s steps up to step `end`: the GIL taken back at least every 10 steps
+/// (signals, the bar) and at every `every`-th step for the callback. A callback
+/// that steps the simulation itself moves the count on.
+fn run_loop(slf: &Bound<'_, Simulation>, end: u64, callback: Option<&Bound<'_, PyAny>>, every: u64, bar: Option<&Bound<'_, PyAny>>) -> PyResult<()> {
+    let py = slf.py();
+    loop {
+        let now = slf.borrow().current_step();
+        if now >= end {
+            return Ok(());
+        }
+        let to_callback = every - now % every;
+        let k = (end - now).min(10).min(if callback.is_some() { to_callback } else { u64::MAX });
+        slf.borrow_mut().steps(py, k)?;
+        if let Some(b) = bar {
+            b.call_method1("update", (k,))?;
+        }
+        py.check_signals()?;
+        let now = slf.borrow().current_step();
+        if let Some(cb) = callback {
+            if now % every == 0 || now >= end {
+                cb.call1((slf,))?;
+            }
+        }
+    }
+}
+
+/// A restart's outputs may not go where its state is (they would overwrite it), as
+/// `nscdd run --restart` refuses.
+fn check_restart_dir(out: &std::path::Path, state: &std::path::Path) -> PyResult<()> {
+    let dir_of = |p: &std::path::Path| std::fs::canonicalize(p).ok();
+    let parent = state.parent().map(|p| if p.as_os_str().is_empty() { std::path::Path::new(".") } else { p });
+    if dir_of(out).is_some() && dir_of(out) == parent.and_then(dir_of) {
+        return Err(SceneError::new_err(format!(
+            "out: {} holds the restart file {}; write the continued run elsewhere (its history.csv would be overwritten)",
+            out.display(),
+            state.display()
+        )));
+    }
+    Ok(())
 }
 
 fn summary_dict<'py>(py: Python<'py>, s: &nscdd::run::RunSummary) -> PyResult<Bound<'py, PyDict>> {
@@ -193,7 +255,7 @@ impl Simulation {
     /// Whether finish() was called (the run's outputs are closed).
     #[getter]
     fn finished(&self) -> bool {
-        each!(&self.inner, s => s.finished)
+        each!(&self.inner, s => s.run.finished())
     }
 
     /// One step; its report (step, time, contacts, sweeps, converged, residual).
@@ -216,78 +278,54 @@ impl Simulation {
         progress: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let py = slf.py();
-        let to_end = steps.is_none();
-        let total = match steps {
-            Some(n) => n,
-            None => {
-                let b = slf.borrow();
-                b.total_steps().saturating_sub(b.current_step())
-            }
+        let end = match steps {
+            Some(n) => slf.borrow().current_step() + n,
+            None => slf.borrow().total_steps(),
         };
-        let every = every.max(1);
-        // the GIL is taken back at least every `chunk` steps (signals, progress)
-        let chunk = if callback.is_some() { every } else { 10 };
+        let start = slf.borrow().current_step();
         let bar = match progress {
             true => py.import("tqdm").ok().map(|t| {
                 let kw = PyDict::new(py);
-                let _ = kw.set_item("total", total);
+                let _ = kw.set_item("total", end.saturating_sub(start));
                 let _ = kw.set_item("unit", "step");
                 t.call_method("tqdm", (), Some(&kw))
             }),
             false => None,
         }
         .transpose()?;
-        let mut done = 0u64;
-        while done < total {
-            let k = chunk.min(total - done);
-            slf.borrow_mut().steps(py, k)?;
-            done += k;
-            if let Some(b) = &bar {
-                b.call_method1("update", (k,))?;
-            }
-            let mut checked = py.check_signals();
-            if let (Ok(()), Some(cb)) = (&checked, &callback) {
-                if done % every == 0 || done == total {
-                    checked = cb.call1((slf,)).map(|_| ());
-                }
-            }
-            if let Err(e) = checked {
-                if let Some(b) = &bar {
-                    b.call_method0("close")?;
-                }
-                // Ctrl-C (here or in the callback): the run's checkpoint and series
-                if e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
-                    if let Some(err) = each!(&mut slf.borrow_mut().inner, s => s.interrupt()) {
-                        return Err(run_err(err));
-                    }
-                }
-                return Err(e);
-            }
-        }
+        let res = run_loop(slf, end, callback.as_ref(), every.max(1), bar.as_ref());
         if let Some(b) = &bar {
-            b.call_method0("close")?;
+            let _ = b.call_method0("close");
+        }
+        if let Err(e) = res {
+            // Ctrl-C (between steps, in the callback or the bar): the run's
+            // checkpoint and series
+            if e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
+                if let Some(err) = each!(&mut slf.borrow_mut().inner, s => s.interrupt()) {
+                    return Err(run_err(err));
+                }
+            }
+            return Err(e);
         }
         let mut this = slf.borrow_mut();
-        if to_end {
-            let Simulation { inner, reg } = &mut *this;
-            let sum = each!(inner, s => s.finish(reg)).map_err(run_err)?;
-            return summary_dict(py, &sum);
-        }
-        let sum = each!(&this.inner, s => s.run.as_ref().map(|r| r.summary().clone())).unwrap_or_default();
+        let sum = match steps {
+            None => each!(&mut this.inner, s => s.finish()).map_err(run_err)?,
+            Some(_) => each!(&this.inner, s => s.run.summary()),
+        };
         summary_dict(py, &sum)
     }
 
     /// Ends the run: the VTK series and final.json written (with an output
     /// folder); its summary. No step after it.
     fn finish<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let sum = each!(&mut self.inner, s => s.finish(&self.reg)).map_err(run_err)?;
+        let sum = each!(&mut self.inner, s => s.finish()).map_err(run_err)?;
         summary_dict(py, &sum)
     }
 
     /// Writes the state as a restart file (the format of final.json):
     /// `Simulation(scene, restart=path)` continues it bitwise.
     fn save(&mut self, path: PathBuf) -> PyResult<()> {
-        each!(&mut self.inner, s => s.save(&self.reg, &path)).map_err(run_err)
+        each!(&mut self.inner, s => s.save(&path)).map_err(run_err)
     }
 
     /// Body positions, (n, dim).
@@ -334,9 +372,9 @@ impl Simulation {
         each!(&self.inner, s => s.body(name)).ok_or_else(|| PyValueError::new_err(format!("no body named `{name}`")))
     }
 
-    /// The contacts of the last step as a dict of arrays: `bodies` (n, 2), `point`,
-    /// `normal`, `r` (local impulse: normal first), `impulse` (world frame) (n, dim),
-    /// `gap` (n,), `bonded` (n,).
+    /// The contacts of the last step as a dict of arrays: `bodies` (m, 2), `point`,
+    /// `normal`, `r` (local impulse: normal first), `impulse` (world frame) (m, dim),
+    /// `gap` (m,), `bonded` (m,).
     fn contacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let ((rec, width), dim) = (each!(&self.inner, s => s.contacts()), self.dimension());
         let n = rec.len() / width;
@@ -372,15 +410,36 @@ impl Simulation {
         let text = each!(&mut self.inner, s => s.history_text());
         let mut lines = text.lines();
         let cols: Vec<&str> = lines.next().map(|h| h.split(',').collect()).unwrap_or_default();
-        let mut data: Vec<Vec<f64>> = vec![vec![]; cols.len()];
+        let mut data: Vec<Vec<&str>> = vec![vec![]; cols.len()];
         for l in lines {
             for (c, x) in data.iter_mut().zip(l.split(',')) {
-                c.push(x.parse().unwrap_or(f64::NAN));
+                c.push(x);
             }
         }
+        // the counts as integers, the text of `prevailing` as text, the rest floats
+        const COUNTS: [&str; 11] = [
+            "step",
+            "bodies",
+            "contacts",
+            "active",
+            "sweeps",
+            "converged",
+            "nscdd_iterations",
+            "interface_bodies",
+            "links",
+            "migrations",
+            "subdomains",
+        ];
         let d = PyDict::new(py);
         for (c, v) in cols.into_iter().zip(data) {
-            d.set_item(c, PyArray1::from_vec(py, v))?;
+            let ints = COUNTS.contains(&c).then(|| v.iter().map(|x| x.parse::<i64>()).collect::<Result<Vec<_>, _>>());
+            if let Some(Ok(ints)) = ints {
+                d.set_item(c, PyArray1::from_vec(py, ints))?;
+            } else if let Ok(fl) = v.iter().map(|x| x.parse::<f64>()).collect::<Result<Vec<_>, _>>() {
+                d.set_item(c, PyArray1::from_vec(py, fl))?;
+            } else {
+                d.set_item(c, py.import("numpy")?.call_method1("array", (v,))?)?;
+            }
         }
         if as_frame {
             return py.import("pandas")?.call_method1("DataFrame", (d,));

@@ -38,93 +38,102 @@ impl Write for Tee {
     }
 }
 
-/// A scene, its run once started, and its history.
+/// A scene, its run (started with the simulation: its outputs' first frame), and
+/// its history.
 pub struct Sim<D: Dim> {
     pub scene: Scene<D>,
-    pub run: Option<Runner<D>>,
-    pub out: Option<PathBuf>,
+    pub run: Runner<D>,
     pub history: Shared,
-    pub finished: bool,
+    /// Steps made by this simulation (not counting a restart's).
+    pub stepped: u64,
+    /// A diverged run's message: no step or finish after it.
+    pub failed: Option<String>,
 }
 
 impl<D: Dim> Sim<D> {
-    pub fn new(scene: Scene<D>, out: Option<PathBuf>) -> Self {
-        Sim {
+    /// Starts the run of `scene` (its solver: a setting it cannot use is an error
+    /// here), writing in `out` when given.
+    pub fn start(mut scene: Scene<D>, reg: &Registry, out: Option<PathBuf>) -> Result<Self, RunError> {
+        let history = Shared::default();
+        let sink: Box<dyn Write + Send> = match &out {
+            Some(dir) => {
+                std::fs::create_dir_all(dir).map_err(|e| RunError::Io(format!("cannot create {}: {e}", dir.display())))?;
+                let path = dir.join("history.csv");
+                let f = std::fs::File::create(&path).map_err(|e| RunError::Io(format!("cannot write {}: {e}", path.display())))?;
+                Box::new(Tee(f, history.clone()))
+            }
+            None => Box::new(history.clone()),
+        };
+        let run = Runner::start(&mut scene, reg, out.as_deref(), None, Some(sink))?;
+        Ok(Sim {
             scene,
-            run: None,
-            out,
-            history: Shared::default(),
-            finished: false,
-        }
+            run,
+            history,
+            stepped: 0,
+            failed: None,
+        })
     }
 
-    /// The run, started at the first step (its outputs' first frame).
-    fn runner(&mut self, reg: &Registry) -> Result<&mut Runner<D>, RunError> {
-        if self.finished {
-            return Err(RunError::Io("the run is finished (finish() wrote final.json): load the scene again, or restart from final.json".into()));
+    /// Why the run cannot step: finished or diverged.
+    fn closed(&self) -> Result<(), RunError> {
+        if let Some(m) = &self.failed {
+            return Err(RunError::Io(format!("the run stopped: {m}")));
         }
-        if self.run.is_none() {
-            let sink: Box<dyn Write + Send> = match &self.out {
-                Some(dir) => {
-                    std::fs::create_dir_all(dir).map_err(|e| RunError::Io(format!("cannot create {}: {e}", dir.display())))?;
-                    let path = dir.join("history.csv");
-                    let f = std::fs::File::create(&path).map_err(|e| RunError::Io(format!("cannot write {}: {e}", path.display())))?;
-                    Box::new(Tee(f, self.history.clone()))
-                }
-                None => Box::new(self.history.clone()),
-            };
-            self.run = Some(Runner::start(&mut self.scene, reg, self.out.as_deref(), None, Some(sink))?);
+        if self.run.finished() {
+            return Err(RunError::Io(
+                "the run is finished (finish() wrote final.json): load the scene again, or restart from final.json".into(),
+            ));
         }
-        Ok(self.run.as_mut().expect("started above"))
+        Ok(())
     }
 
-    /// `n` steps (the scene's end moved past them if it comes first); stops early,
-    /// after the step, when `stop` says so.
-    pub fn steps(&mut self, reg: &Registry, n: u64, stop: &dyn Fn() -> bool) -> Result<Option<nscdd::engine::StepReport>, RunError> {
+    /// `n` steps (the scene's end moved past them if it comes first).
+    pub fn steps(&mut self, n: u64) -> Result<Option<nscdd::engine::StepReport>, RunError> {
+        self.closed()?;
         let target = self.scene.world.step + n;
         if target > self.scene.world.time.steps {
             self.scene.world.time.steps = target;
         }
-        self.runner(reg)?;
         let mut last = None;
         for _ in 0..n {
-            let run = self.run.as_mut().expect("started");
-            last = Some(run.step(&mut self.scene)?);
-            if stop() {
-                break;
+            match self.run.step(&mut self.scene) {
+                Ok(r) => last = Some(r),
+                Err(e) => {
+                    self.failed = Some(e.to_string());
+                    return Err(e);
+                }
             }
+            self.stepped += 1;
         }
         Ok(last)
     }
 
-    /// The end of the run: the series and final.json (with an output folder).
-    pub fn finish(&mut self, reg: &Registry) -> Result<nscdd::run::RunSummary, RunError> {
-        self.runner(reg)?;
-        let run = self.run.take().expect("started");
-        self.finished = true;
-        run.finish(&mut self.scene)
+    /// The end of the run: the series and final.json (with an output folder); its
+    /// summary (again, once finished).
+    pub fn finish(&mut self) -> Result<nscdd::run::RunSummary, RunError> {
+        if self.run.finished() {
+            return Ok(self.run.summary());
+        }
+        self.closed()?;
+        self.run.finish(&mut self.scene)
     }
 
     /// Stopped by the user: checkpoint.json and the series written.
     pub fn interrupt(&mut self) -> Option<RunError> {
-        let run = self.run.as_mut()?;
-        match run.interrupt(&mut self.scene) {
+        match self.run.interrupt(&mut self.scene) {
             RunError::Interrupted(_) => None,
             e => Some(e),
         }
     }
 
     /// The state as a restart file at `path`.
-    pub fn save(&mut self, reg: &Registry, path: &std::path::Path) -> Result<(), RunError> {
-        self.runner(reg)?;
-        self.run.as_mut().expect("started").save(&mut self.scene, path)
+    pub fn save(&mut self, path: &std::path::Path) -> Result<(), RunError> {
+        self.run.save(&mut self.scene, path)
     }
 
     /// Flushes the history and returns its text.
     pub fn history_text(&mut self) -> String {
-        if let Some(r) = self.run.as_mut() {
-            let _ = r.flush();
-        }
+        let _ = self.run.flush();
         let buf = self.history.0.lock().map(|b| b.clone()).unwrap_or_default();
         String::from_utf8_lossy(&buf).into_owned()
     }
@@ -188,9 +197,13 @@ impl<D: Dim> Sim<D> {
     }
 
     /// The last step's subdomains: (each body's (−1: no contacts), its number of
-    /// copies, each contact's); None without NSCDD or before the first step.
+    /// copies, each contact's); None without NSCDD or before this simulation's
+    /// first step.
     pub fn subdomains(&self) -> Option<(Vec<i32>, Vec<u32>, Vec<u32>)> {
-        let v = self.run.as_ref()?.view(&self.scene)?;
+        if self.stepped == 0 {
+            return None;
+        }
+        let v = self.run.view(&self.scene)?;
         Some((v.body_subdomain, v.multiplicity, v.contact_subdomain))
     }
 

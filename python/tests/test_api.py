@@ -359,3 +359,46 @@ def test_gravity_changes_between_steps():
     assert sim.velocities()[2, 2] > 0.05
     with pytest.raises(ValueError, match="3 finite numbers"):
         sim.gravity = [0.0, 1.0]
+
+
+def test_review_edge_cases(tmp_path):
+    # a restart may not write where its state is
+    first = nscdd.Simulation(deposit(steps=20), out=str(tmp_path / "a"))
+    first.run(progress=False)
+    with pytest.raises(nscdd.SceneError, match="holds the restart file"):
+        nscdd.Simulation(deposit(steps=40), out=str(tmp_path / "a"), restart=str(tmp_path / "a" / "final.json"))
+    # save and subdomains after the end; the summary is kept
+    assert first.finished
+    first.save(str(tmp_path / "new" / "again.json"))
+    assert json.loads((tmp_path / "new" / "again.json").read_text())["step"] == 20
+    assert first.finish()["steps"] == 20
+    # a setting the scene's run cannot use is a scene error at once
+    with pytest.raises(nscdd.SceneError, match="solver.ordering"):
+        nscdd.Simulation(deposit(solver={"ordering": "scrambled"}, decomposition={"nx": 2}))
+    # finish before the scene's end writes the last frame
+    sim = nscdd.Simulation(deposit(steps=200), out=str(tmp_path / "b"))
+    s = sim.run(25, progress=False)
+    assert s["steps"] == 25 and s["wall_seconds"] > 0
+    sim.finish()
+    frames = sorted(p.name for p in (tmp_path / "b" / "vtk").glob("bodies_*"))
+    assert len(frames) == 2, frames
+    # history: counts as integers, `prevailing` as text
+    dd = nscdd.Simulation(deposit(steps=5, decomposition={"nx": 2}))
+    dd.run(progress=False)
+    h = dd.history()
+    assert h["step"].dtype == np.int64 and h["converged"].dtype == np.int64 and h["time"].dtype == np.float64
+    assert h["prevailing"].dtype.kind == "U"
+    assert len(nscdd.Simulation(deposit()).history()["step"]) == 0
+
+
+def test_a_callback_may_step_the_simulation():
+    seen = []
+
+    def cb(s):
+        seen.append(s.current_step)
+        if s.current_step == 10:
+            s.step()
+
+    sim = nscdd.Simulation(deposit(steps=30))
+    sim.run(callback=cb, every=10, progress=False)
+    assert sim.current_step == 30 and sim.finished and seen[:2] == [10, 20]

@@ -39,6 +39,10 @@ pub struct Runner<D: Dim> {
     columns: usize,
     values: Vec<f64>,
     frame: u32,
+    /// The step of the last frame written.
+    frame_step: Option<u64>,
+    /// `finish` done: the series and final.json written.
+    finished: bool,
     vtk: bool,
     dir: Option<PathBuf>,
     sum: RunSummary,
@@ -79,6 +83,8 @@ impl<D: Dim> Runner<D> {
             columns: columns.len(),
             values: vec![],
             frame: 0,
+            frame_step: None,
+            finished: false,
             vtk: scene.output.vtk && root && dir.is_some(),
             dir: dir.map(Path::to_path_buf),
             sum: RunSummary::default(),
@@ -108,6 +114,7 @@ impl<D: Dim> Runner<D> {
             }
         }
         self.frame += 1;
+        self.frame_step = Some(scene.world.step);
         Ok(())
     }
 
@@ -163,10 +170,15 @@ impl<D: Dim> Runner<D> {
         crate::run::save_state(&dir, name, &mut scene.world, &scene.families, &mut self.dd)
     }
 
-    /// Writes the state as a restart file at `path` (any name, any folder).
+    /// Writes the state as a restart file at `path` (any name; its folder made if
+    /// missing).
     pub fn save(&mut self, scene: &mut Scene<D>, path: &Path) -> Result<(), RunError> {
         let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("state.json");
+        let name = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .ok_or_else(|| RunError::Io(format!("{}: not a file name (UTF-8)", path.display())))?;
+        std::fs::create_dir_all(dir).map_err(io(dir, name))?;
         crate::run::save_state(dir, name, &mut scene.world, &scene.families, &mut self.dd)
     }
 
@@ -198,9 +210,11 @@ impl<D: Dim> Runner<D> {
         self.dd.as_ref().map(|n| n.view(&scene.world))
     }
 
-    /// The run's totals so far.
-    pub fn summary(&self) -> &RunSummary {
-        &self.sum
+    /// The run's totals so far (`wall_seconds` since the start).
+    pub fn summary(&self) -> RunSummary {
+        let mut s = self.sum.clone();
+        s.wall_seconds = self.start.elapsed().as_secs_f64();
+        s
     }
 
     /// The history flushed to its sink.
@@ -208,17 +222,28 @@ impl<D: Dim> Runner<D> {
         self.hist.flush().map_err(io(self.here(), "history.csv"))
     }
 
-    /// The end of the run: history flushed, the series (`.pvd`) and `final.json`
-    /// written (and on ranks `ranks.json`); its summary.
-    pub fn finish(mut self, scene: &mut Scene<D>) -> Result<RunSummary, RunError> {
+    /// Whether [`Runner::finish`] was called.
+    pub fn finished(&self) -> bool {
+        self.finished
+    }
+
+    /// The end of the run: history flushed, a last frame if the current step has
+    /// none (a caller that stops before the scene's last step), the series (`.pvd`)
+    /// and `final.json` written (and on ranks `ranks.json`); its summary. The run
+    /// keeps its state (`save`, `view`) but must not be stepped again.
+    pub fn finish(&mut self, scene: &mut Scene<D>) -> Result<RunSummary, RunError> {
         self.flush()?;
+        if self.frame_step != Some(scene.world.step) {
+            self.write_frame(scene).map_err(io(self.here(), "the last output frame"))?;
+        }
         self.finish_outputs(scene)?;
         if let Some(dir) = self.dir.clone() {
             crate::run::save_state(&dir, "final.json", &mut scene.world, &scene.families, &mut self.dd)?;
             // after final.json: the peak memory of each rank counts its writing
             crate::run::write_rank_totals(&mut self.dd, &dir)?;
         }
+        self.finished = true;
         self.sum.wall_seconds = self.start.elapsed().as_secs_f64();
-        Ok(self.sum)
+        Ok(self.sum.clone())
     }
 }
