@@ -46,6 +46,9 @@ cargo test --workspace --release --no-fail-fast --features nscdd-cli/hdf5,nscdd-
 # virtualenv (reusing target/), then its pytest suite (which compares a run with
 # target/release/nscdd's, built above).
 venv/bin/pip install -q pytest ./python
+# ... and built again with the polygons plugin in one cargo command: run-time
+# plugins loaded from Python (python/tests' plugin test)
+bash scripts/python_with_plugins.sh nscdd-polygons
 venv/bin/python -m pytest -q python/tests
 # Fuzzing, bounded (docs/RELIABILITY.md): every target 20 s on mutants of its corpus
 # (tests/fuzz/corpus); a panic or a hang fails the run, its input saved in

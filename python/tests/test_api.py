@@ -314,24 +314,36 @@ def test_subdomain_ids_with_a_decomposition():
     assert plain.subdomains() is None
 
 
-POLYGONS = ROOT / "target" / "release" / "deps" / "libnscdd_polygons.so"
-
-
-@pytest.mark.skipif(not POLYGONS.exists(), reason="the polygons plugin library is not built")
-def test_a_scene_loads_its_run_time_plugins(tmp_path):
+def polygon_scene(library):
     s = deposit(steps=10)
-    s["plugins"] = [{"library": str(POLYGONS)}]
+    s["plugins"] = [{"library": str(library)}]
     s["generate"] = []
     s["bodies"].append({"shape": "polygon", "sides": 5, "radius": 0.01, "material": "grain", "position": [0.15, 0.1]})
-    try:
-        sim = nscdd.Simulation(s)
-    except nscdd.SceneError as e:
-        # the test suite's library is built with the CLI's features (mpi, hdf5):
-        # the module refuses it, naming the key and the features
-        assert "plugins[0].library" in str(e) and "framework features" in str(e), e
-        return
+    return s
+
+
+# built with the module by scripts/python_with_plugins.sh (scripts/test.sh)
+WITH_MODULE = ROOT / "target" / "python" / "libnscdd_polygons.so"
+# built by `cargo test` with the command line's features
+WITH_CLI = ROOT / "target" / "release" / "deps" / "libnscdd_polygons.so"
+
+
+@pytest.mark.skipif(not WITH_MODULE.exists(), reason="scripts/python_with_plugins.sh nscdd-polygons was not run")
+def test_a_scene_loads_its_run_time_plugins():
+    sim = nscdd.Simulation(polygon_scene(WITH_MODULE))
     sim.run(progress=False)
     assert sim.positions()[-1, 1] < 0.1
+    assert sim.shapes()["kinds"] == ["wall", "polygon"]
+
+
+@pytest.mark.skipif(not WITH_CLI.exists(), reason="the polygons plugin library is not built")
+def test_a_plugin_of_another_build_is_refused():
+    try:
+        nscdd.Simulation(polygon_scene(WITH_CLI))
+    except nscdd.SceneError as e:
+        assert "plugins[0].library" in str(e) and ("framework features" in str(e) or "another build" in str(e)), e
+        return
+    raise AssertionError("the command line's plugin library was loaded by the module")
 
 
 @pytest.mark.skipif(not CLI.exists(), reason="the nscdd command-line program is not built")
