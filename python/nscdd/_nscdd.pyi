@@ -72,12 +72,13 @@ class Simulation:
         """Ends the run (a last frame, the VTK series and final.json with `out`); its summary."""
     def save(self, path: Union[str, "PathLike[str]"]) -> None:
         """Writes the state as a restart file."""
-    def positions(self) -> npt.NDArray[np.float64]:
-        """(n, dim) body positions (a copy)."""
-    def velocities(self) -> npt.NDArray[np.float64]:
-        """(n, dim) translational velocities."""
-    def angular_velocities(self) -> npt.NDArray[np.float64]:
-        """(n,) in 2D, (n, 3) in 3D."""
+    def positions(self, copy: bool = True) -> npt.NDArray[np.float64]:
+        """(n, dim) body positions: a copy, or with copy=False a read-only live view
+        of the simulation's array (the state after the last step, at every step)."""
+    def velocities(self, copy: bool = True) -> npt.NDArray[np.float64]:
+        """(n, dim) translational velocities (copy=False: a live view)."""
+    def angular_velocities(self, copy: bool = True) -> npt.NDArray[np.float64]:
+        """(n,) in 2D, (n, 3) in 3D (copy=False: a live view)."""
     def rotations(self) -> npt.NDArray[np.float64]:
         """The angle (n,) in 2D, rotation vectors (n, 3) in 3D."""
     def radii(self) -> npt.NDArray[np.float64]:

@@ -133,6 +133,27 @@ impl Simulation {
     }
 }
 
+/// A read-only NumPy view of columns `cols` of the simulation's positions (or, with
+/// `twist`, velocities), (n, cols.len()), keeping the simulation alive: it shows
+/// the state after the last step, at every step.
+fn view<'py>(slf: &Bound<'py, Simulation>, twist: bool, cols: std::ops::Range<usize>) -> PyResult<Bound<'py, PyAny>> {
+    let (ptr, n, per) = each!(&slf.borrow().inner, s => s.raw(twist));
+    assert!(cols.end <= per, "columns within a body's values");
+    let shape = numpy::ndarray::ShapeBuilder::strides((n, cols.len()), (per, 1));
+    // SAFETY: `ptr` points at n × per f64 owned by the simulation's world (its
+    // bodies' array, made at load and never reallocated: `Sim::raw`), which the
+    // view's base object (the simulation) keeps alive; the view is read-only, so
+    // NumPy never writes through it. The values change at each step (a live view).
+    let a = unsafe {
+        let v = numpy::ndarray::ArrayView2::from_shape_ptr(shape, ptr.add(cols.start));
+        numpy::PyArray2::<f64>::borrow_from_array(&v, slf.clone().into_any())
+    };
+    let kw = PyDict::new(slf.py());
+    kw.set_item("write", false)?;
+    a.call_method("setflags", (), Some(&kw))?;
+    Ok(a.into_any())
+}
+
 /// A scene continued from a saved state.
 fn restarted<D: nscdd::dim::Dim>(s: &mut nscdd::scene::Scene<D>, state: Option<&std::path::Path>) -> PyResult<()> {
     match state {
@@ -328,17 +349,39 @@ impl Simulation {
         each!(&mut self.inner, s => s.save(&path)).map_err(run_err)
     }
 
-    /// Body positions, (n, dim).
-    fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        Self::array(py, each!(&self.inner, s => s.positions()))
+    /// Body positions, (n, dim): a copy, or with `copy=False` a read-only live
+    /// view of the simulation's own array (docs/PYTHON.md).
+    #[pyo3(signature = (copy=true))]
+    fn positions<'py>(slf: &Bound<'py, Self>, copy: bool) -> PyResult<Bound<'py, PyAny>> {
+        let dim = slf.borrow().dimension();
+        match copy {
+            true => Self::array(slf.py(), each!(&slf.borrow().inner, s => s.positions())),
+            false => view(slf, false, 0..dim),
+        }
     }
-    /// Translational velocities, (n, dim).
-    fn velocities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        Self::array(py, each!(&self.inner, s => s.velocities()))
+    /// Translational velocities, (n, dim); `copy=False`: a live view.
+    #[pyo3(signature = (copy=true))]
+    fn velocities<'py>(slf: &Bound<'py, Self>, copy: bool) -> PyResult<Bound<'py, PyAny>> {
+        let dim = slf.borrow().dimension();
+        match copy {
+            true => Self::array(slf.py(), each!(&slf.borrow().inner, s => s.velocities())),
+            false => view(slf, true, 0..dim),
+        }
     }
-    /// Angular velocities: (n,) in 2D, (n, 3) in 3D.
-    fn angular_velocities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        Self::array(py, each!(&self.inner, s => s.angular_velocities()))
+    /// Angular velocities: (n,) in 2D, (n, 3) in 3D; `copy=False`: a live view.
+    #[pyo3(signature = (copy=true))]
+    fn angular_velocities<'py>(slf: &Bound<'py, Self>, copy: bool) -> PyResult<Bound<'py, PyAny>> {
+        let dim = slf.borrow().dimension();
+        match copy {
+            true => Self::array(slf.py(), each!(&slf.borrow().inner, s => s.angular_velocities())),
+            false => {
+                let v = view(slf, true, dim..if dim == 2 { 3 } else { 6 })?;
+                if dim == 2 {
+                    return v.call_method1("reshape", (-1,));
+                }
+                Ok(v)
+            }
+        }
     }
     /// Rotations: the angle (n,) in 2D, rotation vectors (n, 3) in 3D.
     fn rotations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {

@@ -149,6 +149,20 @@ impl<D: Dim> Sim<D> {
         (out, width)
     }
 
+    /// Where a view of the positions (`twist`: of the velocities, translation then
+    /// rotation) starts: (pointer, bodies, values per body). The arrays are
+    /// `[f64; k]` per body, contiguous; they are made at load and never grow (bodies
+    /// are neither added nor removed while a simulation lives), so the pointer stays
+    /// valid as long as the simulation.
+    pub fn raw(&self, twist: bool) -> (*const f64, usize, usize) {
+        let b = &self.scene.world.bodies;
+        let n = b.pos.len();
+        let per = |size: usize| size / std::mem::size_of::<f64>();
+        match twist {
+            false => (b.pos.as_ptr().cast(), n, per(std::mem::size_of::<D::Point>())),
+            true => (b.vel.as_ptr().cast(), n, per(std::mem::size_of::<D::Twist>())),
+        }
+    }
     pub fn positions(&self) -> (Vec<f64>, usize) {
         self.per_body(D::N, |w, k, o| o.extend_from_slice(w.bodies.pos[k].as_ref()))
     }

@@ -414,3 +414,25 @@ def test_a_callback_may_step_the_simulation():
     sim = nscdd.Simulation(deposit(steps=30))
     sim.run(callback=cb, every=10, progress=False)
     assert sim.current_step == 30 and sim.finished and seen[:2] == [10, 20]
+
+
+def test_live_views_follow_the_simulation_without_copies():
+    sim = nscdd.Simulation(deposit())
+    x, v, w = sim.positions(copy=False), sim.velocities(copy=False), sim.angular_velocities(copy=False)
+    assert x.shape == (sim.n_bodies, 2) and v.shape == (sim.n_bodies, 2) and w.shape == (sim.n_bodies,)
+    assert not x.flags.writeable and not x.flags.owndata
+    with pytest.raises(ValueError):
+        x[3, 1] = 0.0
+    sim.run(20, progress=False)
+    # the views show the state after the last step
+    assert np.array_equal(x, sim.positions()) and np.array_equal(v, sim.velocities())
+    assert np.array_equal(w, sim.angular_velocities())
+    # a view keeps its simulation alive
+    del sim
+    import gc
+
+    gc.collect()
+    assert np.all(np.isfinite(x))
+    s3 = nscdd.Simulation(SPHERES)
+    s3.run(5, progress=False)
+    assert np.array_equal(s3.angular_velocities(copy=False), s3.angular_velocities())
