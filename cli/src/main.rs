@@ -12,7 +12,6 @@ mod run;
 use clap::{Parser, Subcommand};
 use nscdd::dim::{D2, D3};
 use nscdd::fc::{FcNorm, FcOptions};
-use nscdd::norms::Criterion;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -424,12 +423,8 @@ fn solve_fc(a: &SolveFcArgs) -> ExitCode {
             a.method
         ));
     };
-    let norm = match a.norm.as_str() {
-        "natural" => FcNorm::Natural,
-        other => match Criterion::parse(other) {
-            Some(c) => FcNorm::Lmgc(c),
-            None => return input_error(format!("--norm: unknown norm `{other}`; expected natural, Quad, Maxm or QM/16")),
-        },
+    let Some(norm) = FcNorm::parse(&a.norm) else {
+        return input_error(format!("--norm: unknown norm `{}`; expected natural, Quad, Maxm or QM/16", a.norm));
     };
     if !(tol > 0.0) || max_sweeps == 0 || check_every == 0 || a.repeat == 0 {
         return input_error("--tol must be > 0, --max-sweeps, --check-every and --repeat ≥ 1");

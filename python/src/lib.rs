@@ -568,13 +568,7 @@ fn _solve_fc_coo<'py>(
     p.validate().map_err(|(k, m)| PyValueError::new_err(format!("{k}: {m}")))?;
     let method = nscdd::solver::Method::parse(method)
         .ok_or_else(|| PyValueError::new_err(format!("unknown method `{method}`: nlgs, anderson or newton")))?;
-    let norm = match norm {
-        "natural" => FcNorm::Natural,
-        other => FcNorm::Lmgc(
-            nscdd::norms::Criterion::parse(other)
-                .ok_or_else(|| PyValueError::new_err(format!("unknown norm `{other}`: natural, Quad, Maxm or QM/16")))?,
-        ),
-    };
+    let norm = FcNorm::parse(norm).ok_or_else(|| PyValueError::new_err(format!("unknown norm `{norm}`: natural, Quad, Maxm or QM/16")))?;
     if !(tol > 0.0) || max_sweeps == 0 || check_every == 0 {
         return Err(PyValueError::new_err("tol > 0, max_sweeps ≥ 1 and check_every ≥ 1"));
     }

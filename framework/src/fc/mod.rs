@@ -66,6 +66,16 @@ pub enum FcNorm {
     Lmgc(Criterion),
 }
 
+impl FcNorm {
+    /// `"natural"`, or one of LMGC90's criteria (`"Quad"`, `"Maxm"`, `"QM/16"`).
+    pub fn parse(name: &str) -> Option<FcNorm> {
+        match name {
+            "natural" => Some(FcNorm::Natural),
+            other => Criterion::parse(other).map(FcNorm::Lmgc),
+        }
+    }
+}
+
 /// Options of `solve-fc`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FcOptions {
