@@ -17,8 +17,18 @@ use pyo3::types::PyDict;
 use sim::Sim;
 use std::path::PathBuf;
 
-pyo3::create_exception!(_nscdd, SceneError, PyValueError, "A scene that cannot be loaded: the message names the file, line and key.");
-pyo3::create_exception!(_nscdd, RunError, PyRuntimeError, "A run that stopped: a diverging body (step and body named), an output that cannot be written.");
+pyo3::create_exception!(
+    _nscdd,
+    SceneError,
+    PyValueError,
+    "A scene that cannot be loaded: the message names the file, line and key."
+);
+pyo3::create_exception!(
+    _nscdd,
+    RunError,
+    PyRuntimeError,
+    "A run that stopped: a diverging body (step and body named), an output that cannot be written."
+);
 
 /// The built-in plugins: rigid disks and walls (2D), spheres, planes and boxes
 /// (3D), polyhedra, and with the feature `fem` deformable bodies and continuum
@@ -165,7 +175,13 @@ fn restarted<D: nscdd::dim::Dim>(s: &mut nscdd::scene::Scene<D>, state: Option<&
 /// `run`'s steps up to step `end`: the GIL taken back at least every 10 steps
 /// (signals, the bar) and at every `every`-th step for the callback. A callback
 /// that steps the simulation itself moves the count on.
-fn run_loop(slf: &Bound<'_, Simulation>, end: u64, callback: Option<&Bound<'_, PyAny>>, every: u64, bar: Option<&Bound<'_, PyAny>>) -> PyResult<()> {
+fn run_loop(
+    slf: &Bound<'_, Simulation>,
+    end: u64,
+    callback: Option<&Bound<'_, PyAny>>,
+    every: u64,
+    bar: Option<&Bound<'_, PyAny>>,
+) -> PyResult<()> {
     let py = slf.py();
     loop {
         let now = slf.borrow().current_step();
@@ -192,7 +208,9 @@ fn run_loop(slf: &Bound<'_, Simulation>, end: u64, callback: Option<&Bound<'_, P
 /// `nscdd run --restart` refuses.
 fn check_restart_dir(out: &std::path::Path, state: &std::path::Path) -> PyResult<()> {
     let dir_of = |p: &std::path::Path| std::fs::canonicalize(p).ok();
-    let parent = state.parent().map(|p| if p.as_os_str().is_empty() { std::path::Path::new(".") } else { p });
+    let parent = state
+        .parent()
+        .map(|p| if p.as_os_str().is_empty() { std::path::Path::new(".") } else { p });
     if dir_of(out).is_some() && dir_of(out) == parent.and_then(dir_of) {
         return Err(SceneError::new_err(format!(
             "out: {} holds the restart file {}; write the continued run elsewhere (its history.csv would be overwritten)",
@@ -226,8 +244,8 @@ impl Simulation {
             return Self::load(&text, "<scene dict>", out, restart);
         }
         let path: PathBuf = scene.extract()?;
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| SceneError::new_err(format!("{}: cannot read the file: {e}", path.display())))?;
+        let text =
+            std::fs::read_to_string(&path).map_err(|e| SceneError::new_err(format!("{}: cannot read the file: {e}", path.display())))?;
         Self::load(&text, &path.display().to_string(), out, restart)
     }
 
@@ -429,7 +447,10 @@ impl Simulation {
             d.set_item(name, PyArray1::from_vec(py, col(3 + i * dim, dim)).reshape([n, dim])?)?;
         }
         d.set_item("gap", PyArray1::from_vec(py, col(3 + 4 * dim, 1)))?;
-        d.set_item("bonded", PyArray1::from_vec(py, col(4 + 4 * dim, 1).into_iter().map(|x| x != 0.0).collect::<Vec<bool>>()))?;
+        d.set_item(
+            "bonded",
+            PyArray1::from_vec(py, col(4 + 4 * dim, 1).into_iter().map(|x| x != 0.0).collect::<Vec<bool>>()),
+        )?;
         Ok(d)
     }
 
@@ -438,7 +459,9 @@ impl Simulation {
     /// subdomains hold a copy of it, `contacts` (m,) each contact's subdomain.
     /// None without a decomposition or before the first step.
     fn subdomains<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
-        let Some((b, m, c)) = each!(&self.inner, s => s.subdomains()) else { return Ok(None) };
+        let Some((b, m, c)) = each!(&self.inner, s => s.subdomains()) else {
+            return Ok(None);
+        };
         let d = PyDict::new(py);
         d.set_item("bodies", PyArray1::from_vec(py, b))?;
         d.set_item("copies", PyArray1::from_vec(py, m))?;
@@ -475,7 +498,9 @@ impl Simulation {
         ];
         let d = PyDict::new(py);
         for (c, v) in cols.into_iter().zip(data) {
-            let ints = COUNTS.contains(&c).then(|| v.iter().map(|x| x.parse::<i64>()).collect::<Result<Vec<_>, _>>());
+            let ints = COUNTS
+                .contains(&c)
+                .then(|| v.iter().map(|x| x.parse::<i64>()).collect::<Result<Vec<_>, _>>());
             if let Some(Ok(ints)) = ints {
                 d.set_item(c, PyArray1::from_vec(py, ints))?;
             } else if let Ok(fl) = v.iter().map(|x| x.parse::<f64>()).collect::<Result<Vec<_>, _>>() {
@@ -543,7 +568,10 @@ fn _solve_fc_coo<'py>(
     let mu = mu.as_slice()?.to_vec();
     let nc = mu.len();
     if nc == 0 || q.len() % nc != 0 || !(2..=3).contains(&(q.len() / nc)) {
-        return Err(PyValueError::new_err(format!("q has {} values for {nc} contacts: 2 or 3 per contact", q.len())));
+        return Err(PyValueError::new_err(format!(
+            "q has {} values for {nc} contacts: 2 or 3 per contact",
+            q.len()
+        )));
     }
     let idx = |a: PyReadonlyArray1<'py, i64>| -> PyResult<Vec<usize>> {
         a.as_slice()?

@@ -17,7 +17,10 @@ pub struct Shared(pub Arc<Mutex<Vec<u8>>>);
 
 impl Write for Shared {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        self.0.lock().map_err(|_| std::io::Error::other("the history buffer's lock"))?.extend_from_slice(buf);
+        self.0
+            .lock()
+            .map_err(|_| std::io::Error::other("the history buffer's lock"))?
+            .extend_from_slice(buf);
         Ok(buf.len())
     }
     fn flush(&mut self) -> std::io::Result<()> {
@@ -196,7 +199,11 @@ impl<D: Dim> Sim<D> {
     pub fn shapes(&self) -> (Vec<&'static str>, Vec<u16>, Vec<u32>) {
         let w = &self.scene.world;
         let names = w.shapes.iter().map(|s| s.kind()).collect();
-        (names, w.bodies.shape.iter().map(|s| s.kind).collect(), w.bodies.shape.iter().map(|s| s.index).collect())
+        (
+            names,
+            w.bodies.shape.iter().map(|s| s.kind).collect(),
+            w.bodies.shape.iter().map(|s| s.index).collect(),
+        )
     }
     pub fn masses(&self) -> (Vec<f64>, usize) {
         self.per_body(1, |w, k, o| o.push(w.bodies.mass[k]))
@@ -237,7 +244,9 @@ impl<D: Dim> Sim<D> {
             return Err(format!("gravity takes {} finite numbers, got {g:?}", D::N));
         }
         if !self.scene.families.is_empty() {
-            return Err("gravity cannot change in a scene with deformable bodies or continuum regions (their loads are assembled once)".into());
+            return Err(
+                "gravity cannot change in a scene with deformable bodies or continuum regions (their loads are assembled once)".into(),
+            );
         }
         self.scene.world.gravity.as_mut().copy_from_slice(g);
         Ok(())
@@ -245,7 +254,11 @@ impl<D: Dim> Sim<D> {
 
     /// Replaces the drive of degree of freedom `dof` of a driven body.
     pub fn set_drive(&mut self, body: usize, dof: &str, drive: nscdd::drive::DofDrive) -> Result<(), String> {
-        let names: &[&str] = if D::N == 2 { &["x", "y", "rot"] } else { &["x", "y", "z", "rx", "ry", "rz"] };
+        let names: &[&str] = if D::N == 2 {
+            &["x", "y", "rot"]
+        } else {
+            &["x", "y", "z", "rx", "ry", "rz"]
+        };
         let slot = names
             .iter()
             .position(|&n| n == dof)

@@ -281,7 +281,10 @@ pub(crate) fn finish_outputs<D: Dim>(
 /// The NSCDD solver of a scene: its decomposition's, or one subdomain where its
 /// body families need NSCDD without one; with a restart's saved state when it is
 /// of the same decomposition.
-pub(crate) fn scene_solver<D: Dim>(scene: &mut Scene<D>, cluster: Option<Box<dyn crate::dd::Cluster>>) -> Result<Option<NscddOf<Rigid<D>>>, RunError> {
+pub(crate) fn scene_solver<D: Dim>(
+    scene: &mut Scene<D>,
+    cluster: Option<Box<dyn crate::dd::Cluster>>,
+) -> Result<Option<NscddOf<Rigid<D>>>, RunError> {
     let one = crate::dd::DdConfig::default();
     let dd_config = scene
         .decomposition

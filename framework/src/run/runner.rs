@@ -146,7 +146,11 @@ impl<D: Dim> Runner<D> {
         let t_out = t0.elapsed().as_secs_f64();
         self.values.clear();
         scene.families.iter().for_each(|f| f.history_values(&mut self.values));
-        debug_assert_eq!(self.values.len(), self.columns, "the families' history values and columns differ in number");
+        debug_assert_eq!(
+            self.values.len(),
+            self.columns,
+            "the families' history values and columns differ in number"
+        );
         let w = &scene.world;
         self.hist
             .row_dd(w, &rep, dd_rep.as_ref(), t_out, &self.values)
