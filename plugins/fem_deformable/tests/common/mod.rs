@@ -1,4 +1,6 @@
 #![allow(dead_code)]
+pub mod continuum;
+
 use nscdd::registry::Registry;
 use nscdd_fem_deformable::scene::{load_str, FeScene2};
 
