@@ -217,10 +217,7 @@ impl Plastic {
 
     /// The closest-point return of a trial stress; whether it yielded.
     pub fn project(&self, tr: &[[f64; 3]; 3]) -> ([[f64; 3]; 3], bool) {
-        let p = (tr[0][0] + tr[1][1] + tr[2][2]) / 3.0;
-        let s: [[f64; 3]; 3] = std::array::from_fn(|a| std::array::from_fn(|b| tr[a][b] - if a == b { p } else { 0.0 }));
-        let j2 = 0.5 * s.iter().flatten().map(|x| x * x).sum::<f64>();
-        let q = j2.sqrt();
+        let (p, s, q) = invariants(tr);
         let f = q + self.eta * p - self.xi * self.cohesion;
         if f <= 0.0 {
             return (*tr, false);
@@ -230,11 +227,11 @@ impl Plastic {
         let out = if q - g * dgamma >= 0.0 {
             let scale = if q > 0.0 { 1.0 - g * dgamma / q } else { 0.0 };
             let pn = p - k * self.eta_bar * dgamma;
-            std::array::from_fn(|a| std::array::from_fn(|b| scale * s[a][b] + if a == b { pn } else { 0.0 }))
+            stress(scale, &s, pn)
         } else {
             // the apex: p = ξ c / η (no shear left)
             let pa = if self.eta > 0.0 { self.xi * self.cohesion / self.eta } else { p };
-            std::array::from_fn(|a| std::array::from_fn(|b| if a == b { pa } else { 0.0 }))
+            isotropic(pa)
         };
         (out, true)
     }
@@ -244,9 +241,7 @@ impl Plastic {
     /// [0, √J₂_tr/G] by [`illinois`]; past the bracket's end, the apex);
     /// (σ, yielded, Δγ).
     pub fn project_hardening(&self, tr: &[[f64; 3]; 3], h: &Hardening, kappa: f64) -> ([[f64; 3]; 3], bool, f64) {
-        let p = (tr[0][0] + tr[1][1] + tr[2][2]) / 3.0;
-        let s: [[f64; 3]; 3] = std::array::from_fn(|a| std::array::from_fn(|b| tr[a][b] - if a == b { p } else { 0.0 }));
-        let q = (0.5 * s.iter().flatten().map(|x| x * x).sum::<f64>()).sqrt();
+        let (p, s, q) = invariants(tr);
         let (g, k) = (self.mu, self.lam + 2.0 * self.mu / 3.0);
         let r = |dg: f64| {
             let (eta, xi) = h.cone(kappa + dg);
@@ -259,20 +254,12 @@ impl Plastic {
         if r(hi) > 0.0 {
             let (eta, xi) = h.cone(kappa + hi);
             let pa = if eta > 0.0 { xi * self.cohesion / eta } else { p };
-            return (
-                std::array::from_fn(|a| std::array::from_fn(|b| if a == b { pa } else { 0.0 })),
-                true,
-                hi,
-            );
+            return (isotropic(pa), true, hi);
         }
         let dg = illinois(r, hi, 1e-14 * (q + p.abs() + self.cohesion));
         let scale = if q > 0.0 { (1.0 - g * dg / q).max(0.0) } else { 0.0 };
         let pn = p - k * self.eta_bar * dg;
-        (
-            std::array::from_fn(|a| std::array::from_fn(|b| scale * s[a][b] + if a == b { pn } else { 0.0 })),
-            true,
-            dg,
-        )
+        (stress(scale, &s, pn), true, dg)
     }
 
     /// Σ_e ½ α_e A_e σ:(ε − ε_p), the elastic energy stored.
@@ -291,6 +278,24 @@ impl Plastic {
             })
             .sum()
     }
+}
+
+/// p = tr σ / 3, the deviator s and √J₂ of a stress.
+fn invariants(t: &[[f64; 3]; 3]) -> (f64, [[f64; 3]; 3], f64) {
+    let p = (t[0][0] + t[1][1] + t[2][2]) / 3.0;
+    let s: [[f64; 3]; 3] = std::array::from_fn(|a| std::array::from_fn(|b| t[a][b] - if a == b { p } else { 0.0 }));
+    let j2 = 0.5 * s.iter().flatten().map(|x| x * x).sum::<f64>();
+    (p, s, j2.sqrt())
+}
+
+/// The stress `scale` s + p I (a return: the deviator scaled, the pressure moved).
+fn stress(scale: f64, s: &[[f64; 3]; 3], p: f64) -> [[f64; 3]; 3] {
+    std::array::from_fn(|a| std::array::from_fn(|b| scale * s[a][b] + if a == b { p } else { 0.0 }))
+}
+
+/// The isotropic stress p I (the cone's apex).
+fn isotropic(p: f64) -> [[f64; 3]; 3] {
+    std::array::from_fn(|a| std::array::from_fn(|b| if a == b { p } else { 0.0 }))
 }
 
 /// The root of r in [0, hi] where r(0) > 0 ≥ r(hi): regula falsi with the
