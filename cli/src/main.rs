@@ -191,23 +191,6 @@ pub(crate) fn apply_decomposition_to(
     Ok(())
 }
 
-/// A continued run may not write into the directory that holds its restart file
-/// (its history would be overwritten).
-pub(crate) fn check_restart_dir(out: &std::path::Path, state: &std::path::Path) -> Result<(), String> {
-    let dir_of = |p: &std::path::Path| std::fs::canonicalize(p).ok();
-    let parent = state
-        .parent()
-        .map(|p| if p.as_os_str().is_empty() { std::path::Path::new(".") } else { p });
-    if dir_of(out).is_some() && dir_of(out) == parent.and_then(dir_of) {
-        return Err(format!(
-            "--out: {} holds the restart file {}; write the continued run elsewhere (its history.csv would be overwritten)",
-            out.display(),
-            state.display()
-        ));
-    }
-    Ok(())
-}
-
 /// Writes a problem in the JSON exchange format (gzip for `.gz`).
 fn write_problem(p: &nscdd::fc::FcProblem, path: &std::path::Path) -> Result<(), String> {
     use std::io::Write;

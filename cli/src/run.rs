@@ -26,7 +26,7 @@ pub fn run<D: Dim>(mut s: Scene<D>, reg: &Registry, scene: &Path, out: &Path, qu
     let flags = crate::apply_decomposition_to(&mut s.decomposition, movable, D::N == 3, f.subdomains, f.scheme, f.threads).and_then(|()| {
         match f.restart {
             Some(state) => {
-                crate::check_restart_dir(out, state)?;
+                nscdd::scene::restart::check_out_dir(out, state).map_err(|m| format!("--out: {m}"))?;
                 nscdd::scene::restart_scene(&mut s, state).map_err(|e| e.to_string())
             }
             None => Ok(()),

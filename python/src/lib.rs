@@ -4,13 +4,14 @@
 //! frictional contact problem. The package `python/nscdd` wraps it (progress bars,
 //! pandas).
 
+mod fc;
 mod sim;
 mod toml_of;
 
 use nscdd::dim::{D2, D3};
 use nscdd::registry::Registry;
 use nscdd::scene::AnyScene;
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
+use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -90,7 +91,7 @@ impl Simulation {
         // the plugin libraries the scene names (`[[plugins]]`), before it is read
         nscdd::plugin::load_for_scene(text, file, &mut reg).map_err(|e| SceneError::new_err(e.to_string()))?;
         if let (Some(o), Some(state)) = (&out, &restart) {
-            check_restart_dir(o, state)?;
+            nscdd::scene::restart::check_out_dir(o, state).map_err(|m| SceneError::new_err(format!("out: {m}")))?;
         }
         let any = nscdd::scene::load_any_str(text, file, &reg).map_err(|e| SceneError::new_err(e.to_string()))?;
         let input = |e: nscdd::run::RunError| match e {
@@ -164,6 +165,16 @@ fn view<'py>(slf: &Bound<'py, Simulation>, twist: bool, cols: std::ops::Range<us
     Ok(a.into_any())
 }
 
+/// Columns `cols` of the positions (`twist`: velocities): the live [`view`], or a
+/// copy of it.
+fn columns<'py>(slf: &Bound<'py, Simulation>, twist: bool, cols: std::ops::Range<usize>, copy: bool) -> PyResult<Bound<'py, PyAny>> {
+    let v = view(slf, twist, cols)?;
+    match copy {
+        true => v.call_method0("copy"),
+        false => Ok(v),
+    }
+}
+
 /// A scene continued from a saved state.
 fn restarted<D: nscdd::dim::Dim>(s: &mut nscdd::scene::Scene<D>, state: Option<&std::path::Path>) -> PyResult<()> {
     match state {
@@ -202,23 +213,6 @@ fn run_loop(
             }
         }
     }
-}
-
-/// A restart's outputs may not go where its state is (they would overwrite it), as
-/// `nscdd run --restart` refuses.
-fn check_restart_dir(out: &std::path::Path, state: &std::path::Path) -> PyResult<()> {
-    let dir_of = |p: &std::path::Path| std::fs::canonicalize(p).ok();
-    let parent = state
-        .parent()
-        .map(|p| if p.as_os_str().is_empty() { std::path::Path::new(".") } else { p });
-    if dir_of(out).is_some() && dir_of(out) == parent.and_then(dir_of) {
-        return Err(SceneError::new_err(format!(
-            "out: {} holds the restart file {}; write the continued run elsewhere (its history.csv would be overwritten)",
-            out.display(),
-            state.display()
-        )));
-    }
-    Ok(())
 }
 
 fn summary_dict<'py>(py: Python<'py>, s: &nscdd::run::RunSummary) -> PyResult<Bound<'py, PyDict>> {
@@ -372,33 +366,22 @@ impl Simulation {
     #[pyo3(signature = (copy=true))]
     fn positions<'py>(slf: &Bound<'py, Self>, copy: bool) -> PyResult<Bound<'py, PyAny>> {
         let dim = slf.borrow().dimension();
-        match copy {
-            true => Self::array(slf.py(), each!(&slf.borrow().inner, s => s.positions())),
-            false => view(slf, false, 0..dim),
-        }
+        columns(slf, false, 0..dim, copy)
     }
     /// Translational velocities, (n, dim); `copy=False`: a live view.
     #[pyo3(signature = (copy=true))]
     fn velocities<'py>(slf: &Bound<'py, Self>, copy: bool) -> PyResult<Bound<'py, PyAny>> {
         let dim = slf.borrow().dimension();
-        match copy {
-            true => Self::array(slf.py(), each!(&slf.borrow().inner, s => s.velocities())),
-            false => view(slf, true, 0..dim),
-        }
+        columns(slf, true, 0..dim, copy)
     }
     /// Angular velocities: (n,) in 2D, (n, 3) in 3D; `copy=False`: a live view.
     #[pyo3(signature = (copy=true))]
     fn angular_velocities<'py>(slf: &Bound<'py, Self>, copy: bool) -> PyResult<Bound<'py, PyAny>> {
         let dim = slf.borrow().dimension();
-        match copy {
-            true => Self::array(slf.py(), each!(&slf.borrow().inner, s => s.angular_velocities())),
-            false => {
-                let v = view(slf, true, dim..if dim == 2 { 3 } else { 6 })?;
-                if dim == 2 {
-                    return v.call_method1("reshape", (-1,));
-                }
-                Ok(v)
-            }
+        let w = columns(slf, true, dim..if dim == 2 { 3 } else { 6 }, copy)?;
+        match dim {
+            2 => w.call_method1("reshape", (-1,)),
+            _ => Ok(w),
         }
     }
     /// Rotations: the angle (n,) in 2D, rotation vectors (n, 3) in 3D.
@@ -542,92 +525,10 @@ impl Simulation {
     }
 }
 
-/// Solves u = W r + q with Coulomb's law of friction coefficients mu per contact
-/// (dim = 2 or 3 unknowns each, normal first). W: a dense (n, n) array or a scipy
-/// sparse matrix (given as its COO rows, cols, vals: see the package wrapper).
-/// Returns a dict: r, u, sweeps, converged, residual (natural map), norms.
-#[pyfunction]
-#[pyo3(signature = (rows, cols, vals, q, mu, *, method="nlgs", tol=1e-8, max_sweeps=100_000, norm="natural", check_every=1, r0=None))]
-#[allow(clippy::too_many_arguments)]
-fn _solve_fc_coo<'py>(
-    py: Python<'py>,
-    rows: PyReadonlyArray1<'py, i64>,
-    cols: PyReadonlyArray1<'py, i64>,
-    vals: PyReadonlyArray1<'py, f64>,
-    q: PyReadonlyArray1<'py, f64>,
-    mu: PyReadonlyArray1<'py, f64>,
-    method: &str,
-    tol: f64,
-    max_sweeps: u32,
-    norm: &str,
-    check_every: u32,
-    r0: Option<PyReadonlyArray1<'py, f64>>,
-) -> PyResult<Bound<'py, PyDict>> {
-    use nscdd::fc::{CooMatrix, FcNorm, FcOptions, FcProblem};
-    let q = q.as_slice()?.to_vec();
-    let mu = mu.as_slice()?.to_vec();
-    let nc = mu.len();
-    if nc == 0 || q.len() % nc != 0 || !(2..=3).contains(&(q.len() / nc)) {
-        return Err(PyValueError::new_err(format!(
-            "q has {} values for {nc} contacts: 2 or 3 per contact",
-            q.len()
-        )));
-    }
-    let idx = |a: PyReadonlyArray1<'py, i64>| -> PyResult<Vec<usize>> {
-        a.as_slice()?
-            .iter()
-            .map(|&x| usize::try_from(x).map_err(|_| PyValueError::new_err("negative index in W")))
-            .collect()
-    };
-    let w = CooMatrix {
-        n: q.len(),
-        rows: idx(rows)?,
-        cols: idx(cols)?,
-        vals: vals.as_slice()?.to_vec(),
-    };
-    let p = FcProblem {
-        dim: q.len() / nc,
-        nc,
-        w,
-        q,
-        mu,
-        meta: None,
-    };
-    p.validate().map_err(|(k, m)| PyValueError::new_err(format!("{k}: {m}")))?;
-    let method = nscdd::solver::Method::parse(method)
-        .ok_or_else(|| PyValueError::new_err(format!("unknown method `{method}`: nlgs, anderson or newton")))?;
-    let norm = FcNorm::parse(norm).ok_or_else(|| PyValueError::new_err(format!("unknown norm `{norm}`: natural, Quad, Maxm or QM/16")))?;
-    if !(tol > 0.0) || max_sweeps == 0 || check_every == 0 {
-        return Err(PyValueError::new_err("tol > 0, max_sweeps ≥ 1 and check_every ≥ 1"));
-    }
-    let opts = FcOptions {
-        tol,
-        max_sweeps,
-        check_every,
-        norm,
-        method,
-    };
-    let r0 = r0.map(|r| r.as_slice().map(|s| s.to_vec())).transpose()?;
-    if r0.as_ref().is_some_and(|r| r.len() != p.q.len()) {
-        return Err(PyValueError::new_err("r0 has not the length of q"));
-    }
-    let sol = py.detach(|| p.solve_from(r0.as_deref(), &opts));
-    let d = PyDict::new(py);
-    d.set_item("r", PyArray1::from_vec(py, sol.r))?;
-    d.set_item("u", PyArray1::from_vec(py, sol.u))?;
-    d.set_item("sweeps", sol.sweeps)?;
-    d.set_item("converged", sol.converged)?;
-    d.set_item("residual", sol.residual)?;
-    d.set_item("seconds", sol.solve_seconds)?;
-    let norms = serde_json::to_string(&sol.norms).unwrap_or_default();
-    d.set_item("norms", py.import("json")?.call_method1("loads", (norms,))?)?;
-    Ok(d)
-}
-
 #[pymodule]
 fn _nscdd(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Simulation>()?;
-    m.add_function(wrap_pyfunction!(_solve_fc_coo, m)?)?;
+    m.add_function(wrap_pyfunction!(fc::_solve_fc_coo, m)?)?;
     m.add("SceneError", m.py().get_type::<SceneError>())?;
     m.add("RunError", m.py().get_type::<RunError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

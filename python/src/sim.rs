@@ -10,8 +10,8 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
-/// The history rows of a run, kept in memory (and written to history.csv when the
-/// run has an output folder).
+/// The history rows of a run, kept in memory (beside history.csv when the run has
+/// an output folder).
 #[derive(Clone, Default)]
 pub struct Shared(pub Arc<Mutex<Vec<u8>>>);
 
@@ -25,19 +25,6 @@ impl Write for Shared {
     }
     fn flush(&mut self) -> std::io::Result<()> {
         Ok(())
-    }
-}
-
-/// Both: the file and the memory.
-struct Tee(std::fs::File, Shared);
-
-impl Write for Tee {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        self.0.write_all(buf)?;
-        self.1.write(buf)
-    }
-    fn flush(&mut self) -> std::io::Result<()> {
-        self.0.flush()
     }
 }
 
@@ -58,16 +45,7 @@ impl<D: Dim> Sim<D> {
     /// here), writing in `out` when given.
     pub fn start(mut scene: Scene<D>, reg: &Registry, out: Option<PathBuf>) -> Result<Self, RunError> {
         let history = Shared::default();
-        let sink: Box<dyn Write + Send> = match &out {
-            Some(dir) => {
-                std::fs::create_dir_all(dir).map_err(|e| RunError::Io(format!("cannot create {}: {e}", dir.display())))?;
-                let path = dir.join("history.csv");
-                let f = std::fs::File::create(&path).map_err(|e| RunError::Io(format!("cannot write {}: {e}", path.display())))?;
-                Box::new(Tee(f, history.clone()))
-            }
-            None => Box::new(history.clone()),
-        };
-        let run = Runner::start(&mut scene, reg, out.as_deref(), None, Some(sink))?;
+        let run = Runner::start(&mut scene, reg, out.as_deref(), None, Some(Box::new(history.clone())))?;
         Ok(Sim {
             scene,
             run,
@@ -165,17 +143,6 @@ impl<D: Dim> Sim<D> {
             false => (b.pos.as_ptr().cast(), n, per(std::mem::size_of::<D::Point>())),
             true => (b.vel.as_ptr().cast(), n, per(std::mem::size_of::<D::Twist>())),
         }
-    }
-    pub fn positions(&self) -> (Vec<f64>, usize) {
-        self.per_body(D::N, |w, k, o| o.extend_from_slice(w.bodies.pos[k].as_ref()))
-    }
-    pub fn velocities(&self) -> (Vec<f64>, usize) {
-        self.per_body(D::N, |w, k, o| o.extend_from_slice(&w.bodies.vel[k].as_ref()[..D::N]))
-    }
-    pub fn angular_velocities(&self) -> (Vec<f64>, usize) {
-        self.per_body(if D::N == 2 { 1 } else { 3 }, |w, k, o| {
-            o.extend_from_slice(&w.bodies.vel[k].as_ref()[D::N..])
-        })
     }
     /// 2D: the angle (rad); 3D: the rotation vector (axis × angle).
     pub fn rotations(&self) -> (Vec<f64>, usize) {

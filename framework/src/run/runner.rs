@@ -29,9 +29,24 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+/// History rows written to two sinks.
+struct Tee(Box<dyn Write + Send>, Box<dyn Write + Send>);
+
+impl Write for Tee {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0.write_all(buf)?;
+        self.1.write_all(buf)?;
+        Ok(buf.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.0.flush()?;
+        self.1.flush()
+    }
+}
+
 /// A run between two steps (module docs). Outputs go to `dir` when given (as
 /// `nscdd run` writes them: history.csv, frames, checkpoints, final.json); without
-/// one nothing is written but the history rows to the given sink.
+/// one nothing is written but the history rows to the caller's copy.
 pub struct Runner<D: Dim> {
     dd: Option<NscddOf<Rigid<D>>>,
     writers: Vec<Box<dyn Writer<D>>>,
@@ -51,14 +66,14 @@ pub struct Runner<D: Dim> {
 
 impl<D: Dim> Runner<D> {
     /// Starts a run of `scene` (its solver, writers and history; the first frame
-    /// written), as one rank of `cluster` when given. `history`: where the history
-    /// rows go (default: `dir`/history.csv, or nowhere without `dir`).
+    /// written), as one rank of `cluster` when given. The history rows go to
+    /// `dir`/history.csv (nowhere without `dir`) and, when given, to `copy` too.
     pub fn start(
         scene: &mut Scene<D>,
         registry: &Registry,
         dir: Option<&Path>,
         cluster: Option<Box<dyn crate::dd::Cluster>>,
-        history: Option<Box<dyn Write + Send>>,
+        copy: Option<Box<dyn Write + Send>>,
     ) -> Result<Self, RunError> {
         let start = Instant::now();
         let root = cluster.as_ref().is_none_or(|c| c.rank() == 0);
@@ -69,10 +84,13 @@ impl<D: Dim> Runner<D> {
         };
         let w = &scene.world;
         let columns: Vec<String> = scene.families.iter().flat_map(|f| f.history_columns()).collect();
-        let sink: Box<dyn Write + Send> = match (history, dir) {
-            (Some(h), _) => h,
-            (None, Some(d)) => crate::run::history_sink(d, root)?,
-            (None, None) => Box::new(std::io::sink()),
+        let file: Box<dyn Write + Send> = match dir {
+            Some(d) => crate::run::history_sink(d, root)?,
+            None => Box::new(std::io::sink()),
+        };
+        let sink: Box<dyn Write + Send> = match copy {
+            Some(c) => Box::new(Tee(file, c)),
+            None => file,
         };
         let here = dir.unwrap_or(Path::new("."));
         let hist = History::with_columns(sink, w, dd.is_some(), &columns).map_err(io(here, "history.csv"))?;

@@ -94,6 +94,22 @@ fn read_state(path: &Path) -> Result<(String, String), InputError> {
     Ok((text, file))
 }
 
+/// Why a run restarted from `state` may not write its outputs in `out`: `out` is
+/// the folder holding the state (the continued run's history.csv would overwrite
+/// the one it continues). The message names both; the caller names the option.
+pub fn check_out_dir(out: &Path, state: &Path) -> Result<(), String> {
+    let dir_of = |p: &Path| std::fs::canonicalize(p).ok();
+    let parent = state.parent().map(|p| if p.as_os_str().is_empty() { Path::new(".") } else { p });
+    if dir_of(out).is_some() && dir_of(out) == parent.and_then(dir_of) {
+        return Err(format!(
+            "{} holds the restart file {}; write the continued run elsewhere (its history.csv would be overwritten)",
+            out.display(),
+            state.display()
+        ));
+    }
+    Ok(())
+}
+
 /// [`restart`] of a scene: the world's state, then each body family's from the
 /// state's `families` (by section) and the NSCDD state (`nscdd`, used when the run
 /// has the same decomposition: then a decomposed run continues bitwise too). A
