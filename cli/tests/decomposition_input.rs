@@ -170,7 +170,9 @@ fn subdomains_flag_runs_nscdd() {
     let hist = std::fs::read_to_string(out.join("history.csv")).expect("history.csv");
     let head = hist.lines().next().unwrap();
     assert!(
-        head.ends_with(",nscdd_iterations,egluing,egluing_rel,interface_bodies,links,migrations,prevailing,subdomains"),
+        head.ends_with(
+            ",nscdd_iterations,egluing,egluing_rel,interface_bodies,links,migrations,prevailing,subdomains,repartitioned,imbalance"
+        ),
         "{head}"
     );
     assert_eq!(hist.lines().count(), 11);

@@ -466,7 +466,7 @@ impl Simulation {
             }
         }
         // the counts as integers, the text of `prevailing` as text, the rest floats
-        const COUNTS: [&str; 11] = [
+        const COUNTS: [&str; 12] = [
             "step",
             "bodies",
             "contacts",
@@ -478,6 +478,7 @@ impl Simulation {
             "links",
             "migrations",
             "subdomains",
+            "repartitioned",
         ];
         let d = PyDict::new(py);
         for (c, v) in cols.into_iter().zip(data) {

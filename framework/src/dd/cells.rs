@@ -13,8 +13,8 @@ pub(super) fn cell_box(grid: &Grid, c: u32) -> [[f64; 3]; 2] {
     let mut b = [[0.0; 3]; 2];
     for d in 0..3 {
         let h = grid.cell[d];
-        let flat = h.is_nan() || h <= 0.0;
-        let at = |k: u32| grid.origin[d] + k as f64 * h;
+        let flat = grid.flat(d);
+        let at = |k: u32| grid.cut(d, k);
         b[0][d] = if flat || idx[d] == 0 { -inf } else { at(idx[d]) - 1e-6 * h };
         b[1][d] = if flat || idx[d] + 1 == n[d] {
             inf
@@ -43,7 +43,7 @@ pub(super) struct CellIndex {
 impl CellIndex {
     pub fn new(grid: &Grid, rank_of: &[u32]) -> Self {
         CellIndex {
-            grid: *grid,
+            grid: grid.clone(),
             boxes: (0..grid.len() as u32).map(|c| cell_box(grid, c)).collect(),
             rank_of: rank_of.to_vec(),
         }
@@ -54,11 +54,10 @@ impl CellIndex {
     fn range(&self, n: usize, lo: &[f64], hi: &[f64]) -> [[u32; 2]; 3] {
         let dims = [self.grid.nx, self.grid.ny, self.grid.nz];
         std::array::from_fn(|d| {
-            let h = self.grid.cell[d];
-            if d >= n || h.is_nan() || h <= 0.0 {
+            if d >= n || self.grid.flat(d) {
                 return [0, dims[d] - 1];
             }
-            let k = |x: f64| ((x - self.grid.origin[d]) / h).floor();
+            let k = |x: f64| self.grid.axis_index(d, x);
             let (a, b) = (k(lo[d]), k(hi[d]));
             // NaN or beyond: every cell of the axis
             let a = if a.is_nan() || a < 1.0 {

@@ -20,6 +20,8 @@ pub struct Census {
     pub contacts: usize,
     /// Subdomains owning at least one contact.
     pub subdomains: usize,
+    /// Contacts of the largest subdomain.
+    pub largest: usize,
     /// Coordination numbers (NaN when not computed: the world has no box sample).
     pub z: f64,
     pub z_m: f64,
@@ -140,6 +142,7 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
         let per = per_subdomain(ranks, ns, 1 + k, n);
         out.contacts = per.chunks_exact(1 + k).map(|x| x[0] as usize).sum();
         out.subdomains = per.chunks_exact(1 + k).filter(|x| x[0] > 0.0).count();
+        out.largest = per.chunks_exact(1 + k).map(|x| x[0] as usize).max().unwrap_or(0);
         out.add_sums(&per, 1, k, bulk.is_some());
         return out;
     }
@@ -187,6 +190,7 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
     for x in per.chunks_exact(8 + k) {
         out.contacts += x[0] as usize;
         out.subdomains += (x[0] > 0.0) as usize;
+        out.largest = out.largest.max(x[0] as usize);
         (ngg, n_m, sum_m) = (ngg + x[1] as u64, n_m + x[2] as u64, sum_m + x[3] as u64);
         for k in 0..4 {
             b[k] += x[4 + k] as u64;
@@ -209,6 +213,16 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
 }
 
 impl Census {
+    /// The load imbalance of `ns` subdomains: the largest one's contacts over the
+    /// mean (1: balanced; ns: every contact in one subdomain; 1 without contacts).
+    pub fn imbalance(&self, ns: usize) -> f64 {
+        if self.contacts == 0 {
+            1.0
+        } else {
+            self.largest as f64 * ns as f64 / self.contacts as f64
+        }
+    }
+
     /// The cells' [`BodySums`] (`k` values at `at` of each subdomain's `per`, none
     /// when `k` = 0) added in cell order; returns the inner grains without contacts.
     fn add_sums(&mut self, per: &[f64], at: usize, k: usize, bulk: bool) -> Option<u64> {

@@ -154,7 +154,7 @@ impl<D: Family> super::NscddOf<D> {
     /// Whether this step re-partitions over a new grid.
     pub(super) fn repartitions(&self) -> bool {
         let k = self.repartition_every.max(1) as u64;
-        self.grid.is_none() || self.grid_empty || self.steps.is_multiple_of(k)
+        self.grid.is_none() || self.grid_empty || self.steps.is_multiple_of(k) || self.balance.due == Some(self.steps)
     }
 
     /// Before detection: on ranks, with `eligible` (rigid bodies only), the exchange
@@ -234,7 +234,21 @@ impl<D: Family> super::NscddOf<D> {
             }
             total += x[6] as usize;
         }
-        let grid = Grid::from_bounds(glo, ghi, s.nx, s.ny, s.nz);
+        let grid = if self.balanced_grid {
+            // every rank's histogram of its contact points, added (integers: exact)
+            let n = [s.nx, s.ny, s.nz];
+            let mine = Grid::histogram(glo, ghi, n, (0..nc).map(|a| D::point(c, a)));
+            let (_, all) = rs.all_gather_any(&mine);
+            let mut hist = vec![0.0; mine.len()];
+            for x in all.chunks_exact(mine.len().max(1)) {
+                for (t, v) in hist.iter_mut().zip(x) {
+                    *t += v;
+                }
+            }
+            Grid::balanced(glo, ghi, s.nx, s.ny, s.nz, &hist)
+        } else {
+            Grid::from_bounds(glo, ghi, s.nx, s.ny, s.nz)
+        };
         let ns = grid.len();
         let mut loads = vec![0f64; ns];
         for a in 0..nc {

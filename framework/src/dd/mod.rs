@@ -48,6 +48,7 @@ mod census;
 pub mod cluster;
 pub mod family;
 pub mod gluing;
+mod grid;
 mod local;
 #[cfg(feature = "mpi")]
 pub mod mpi;
@@ -126,6 +127,12 @@ pub struct DdConfig {
     /// `by_model = true`: subdomains by model as well as by geometry (scenes with
     /// deformable bodies; run by the deformable-body plugin).
     pub by_model: bool,
+    /// Re-partition between the periodic repartitions too, when the load imbalance
+    /// has grown by this factor since the last one ([`NscddOf::rebalance`]).
+    pub rebalance: Option<f64>,
+    /// `grid = "balanced"`: cuts that split the contact points evenly along each
+    /// axis ([`Grid::balanced`]) instead of uniform cells.
+    pub balanced_grid: bool,
 }
 
 impl Default for DdConfig {
@@ -134,6 +141,8 @@ impl Default for DdConfig {
             dd: DdSettings::default(),
             repartition_every: 1,
             by_model: false,
+            rebalance: None,
+            balanced_grid: false,
         }
     }
 }
@@ -143,6 +152,8 @@ impl DdConfig {
     pub fn solver_of<D: Family>(&self) -> NscddOf<D> {
         let mut s = NscddOf::new(self.dd.clone()).with_repartition_every(self.repartition_every);
         s.by_model = self.by_model;
+        s.rebalance = self.rebalance;
+        s.balanced_grid = self.balanced_grid;
         s
     }
 
@@ -189,6 +200,17 @@ pub struct NscddOf<D: Family> {
     /// repartitions persisting contacts keep their subdomain and new ones go to the
     /// cell of the last grid that holds their point.
     pub repartition_every: u32,
+    /// Load balancing between the periodic repartitions: when the imbalance of a
+    /// step (the largest subdomain's contacts over the mean, from the census, so the
+    /// same for any number of threads or ranks) exceeds this factor times the
+    /// imbalance of the last repartition's step, the step after next re-partitions
+    /// (the next one has already shared its state as a step before no repartition).
+    pub rebalance: Option<f64>,
+    /// Balanced cuts instead of uniform cells ([`Grid::balanced`]).
+    pub balanced_grid: bool,
+    /// The imbalance of the last repartition's step, and the value of `steps` at
+    /// which a re-partition is due.
+    balance: Balance,
     /// Steps done by this solver.
     pub steps: u64,
     /// The grid of the last repartition.
@@ -225,6 +247,30 @@ pub struct NscddOf<D: Family> {
     local: local::Local,
 }
 
+/// The load balance between repartitions ([`NscddOf::rebalance`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Balance {
+    /// The imbalance at the last repartition's step (0: none yet).
+    pub at_repartition: f64,
+    /// A re-partition is due when `steps` reaches this value.
+    pub due: Option<u64>,
+}
+
+impl Balance {
+    /// Takes the census' imbalance of a step (`steps`: the solver's count, this step
+    /// included): a repartition's sets the reference; past `factor` times it, a
+    /// re-partition becomes due at the step after next (unless one is due already).
+    fn observe(&mut self, imbalance: f64, repartitioned: bool, steps: u64, factor: Option<f64>) {
+        if repartitioned {
+            self.at_repartition = imbalance;
+        } else if let Some(f) = factor {
+            if imbalance > f * self.at_repartition && self.due.is_none_or(|d| d < steps) {
+                self.due = Some(steps + 1);
+            }
+        }
+    }
+}
+
 /// NSCDD of 2D rigid bodies.
 pub type Nscdd = NscddOf<Rigid2>;
 /// NSCDD of 3D rigid bodies.
@@ -237,6 +283,9 @@ impl<D: Family> NscddOf<D> {
             store: FGammaStore::default(),
             last: Decomposition::default(),
             repartition_every: 1,
+            rebalance: None,
+            balanced_grid: false,
+            balance: Balance::default(),
             steps: 0,
             grid: None,
             by_model: false,
@@ -309,16 +358,18 @@ impl<D: Family> NscddOf<D> {
             ranges.push(a..self.fam_points.len());
         }
         let repart = self.repartitions();
-        let (grid, owner) = match self.grid {
-            Some(g) if !repart => (g, partition::kept_owners::<D>(c, &g, &self.kept)),
+        let (grid, owner) = match &self.grid {
+            Some(g) if !repart => (g.clone(), partition::kept_owners::<D>(c, g, &self.kept)),
             _ => {
                 let pts = (0..nc).map(|a| D::point(c, a)).chain(self.fam_points.iter().copied());
                 // contacts held per rank: the grid of the distributed repartition
-                let g = match self.local.new_grid {
-                    Some((g, _)) => g,
+                let g = match &self.local.new_grid {
+                    Some((g, _)) => g.clone(),
+                    None if self.balanced_grid => Grid::balanced_over(pts, s.nx, s.ny, s.nz),
                     None => Grid::over(pts, s.nx, s.ny, s.nz),
                 };
-                (g, (0..nc).map(|a| g.cell_of(D::point(c, a))).collect())
+                let owner = (0..nc).map(|a| g.cell_of(D::point(c, a))).collect();
+                (g, owner)
             }
         };
         let models = if self.by_model { 1 + fams.len() } else { 1 };
@@ -333,7 +384,7 @@ impl<D: Family> NscddOf<D> {
         let nb = D::n_bodies(w);
         let before = (repart && self.steps > 0).then(|| partition::body_sets(&self.last, nb));
         if repart {
-            self.grid = Some(grid);
+            self.grid = Some(grid.clone());
             let total = self.local.new_grid.take().map_or(nc, |(_, t)| t);
             self.grid_empty = total + self.fam_points.len() == 0;
         }
@@ -540,6 +591,12 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
             .flatten()
             .map(|grid| census::BodySums { grid });
         let census = census::census(&self.dd.last, w, self.dd.ranks.as_mut(), sums);
+        let imbalance = census.imbalance(self.dd.last.subs.len());
+        self.dd.pending.imbalance = imbalance;
+        // (the next step's repartition is already decided: its state was shared)
+        let (repartitioned, steps, next) = (self.dd.pending.repartitioned, self.dd.steps, self.dd.repartitions());
+        let factor = self.dd.rebalance.filter(|_| !next);
+        self.dd.balance.observe(imbalance, repartitioned, steps, factor);
         self.dd.pending.subdomains = census.subdomains;
         self.dd.pending.census = Some(census);
     }

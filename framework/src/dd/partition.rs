@@ -10,76 +10,9 @@
 
 use super::attach::{Attached, EntityInfo};
 use super::family::Family;
+pub use super::grid::Grid;
 pub use super::owner::{kept_owners, owner_of, OwnerOf};
 use super::subdomain::{Neighbor, Subdomain, OWN};
-
-/// The grid of subdomains over the contact points' bounding box (nz = 1 in 2D,
-/// whose points have z = 0).
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Grid {
-    pub nx: u32,
-    pub ny: u32,
-    pub nz: u32,
-    pub origin: [f64; 3],
-    pub cell: [f64; 3],
-}
-
-impl Grid {
-    pub fn over(points: impl Iterator<Item = [f64; 3]>, nx: u32, ny: u32, nz: u32) -> Grid {
-        let (lo, hi) = Grid::bounds(points);
-        Grid::from_bounds(lo, hi, nx, ny, nz)
-    }
-
-    /// The bounds of the finite points (lo > hi without any).
-    pub fn bounds(points: impl Iterator<Item = [f64; 3]>) -> ([f64; 3], [f64; 3]) {
-        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-        for p in points.filter(|p| p.iter().all(|x| x.is_finite())) {
-            for d in 0..3 {
-                lo[d] = lo[d].min(p[d]);
-                hi[d] = hi[d].max(p[d]);
-            }
-        }
-        (lo, hi)
-    }
-
-    /// The grid over the bounds of [`Grid::bounds`] (of points held by several
-    /// processes: the bounds are exact once merged by min and max).
-    pub fn from_bounds(mut lo: [f64; 3], mut hi: [f64; 3], nx: u32, ny: u32, nz: u32) -> Grid {
-        let n = [nx.max(1), ny.max(1), nz.max(1)];
-        if lo[0] > hi[0] {
-            (lo, hi) = ([0.0; 3], [0.0; 3]);
-        }
-        Grid {
-            nx: n[0],
-            ny: n[1],
-            nz: n[2],
-            origin: lo,
-            cell: std::array::from_fn(|d| (hi[d] - lo[d]) / n[d] as f64),
-        }
-    }
-    pub fn len(&self) -> usize {
-        (self.nx * self.ny * self.nz) as usize
-    }
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-    /// Subdomain id `cx + nx (cy + ny cz)` of a point.
-    pub fn cell_of(&self, p: [f64; 3]) -> u32 {
-        let c = |d: usize, n: u32| {
-            // a flat box (or NaN) puts every point in the first cell
-            if self.cell[d].is_nan() || self.cell[d] <= 0.0 {
-                return 0;
-            }
-            let k = ((p[d] - self.origin[d]) / self.cell[d]).floor();
-            if k >= 0.0 {
-                (k as u32).min(n - 1)
-            } else {
-                0
-            }
-        };
-        c(0, self.nx) + self.nx * (c(1, self.ny) + self.ny * c(2, self.nz))
-    }
-}
 
 /// The interface bodies and their copies, in ascending body id; copy lists in
 /// subdomain order (the chain order).

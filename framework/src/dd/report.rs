@@ -26,6 +26,9 @@ pub struct DdStepReport {
     pub prevailing: Prevailing,
     /// Whether the contact set was re-partitioned over a new grid at this step.
     pub repartitioned: bool,
+    /// The largest subdomain's contacts over the mean ([`super::Census::imbalance`];
+    /// 0 before the census).
+    pub imbalance: f64,
     /// At a repartition: bodies with contacts before and after it whose set of
     /// subdomains changed (0 between repartitions).
     pub migrations: usize,

@@ -25,6 +25,10 @@ pub struct NscddState {
     kept: Vec<(ContactKey, u32)>,
     /// (body, subdomain, F_Γ).
     f_gamma: Vec<(u32, u32, Vec<f64>)>,
+    /// The load balance between repartitions (absent from states written before it:
+    /// none due, the reference taken at the next repartition).
+    #[serde(default)]
+    balance: super::Balance,
 }
 
 impl<D: Family> NscddOf<D> {
@@ -43,8 +47,9 @@ impl<D: Family> NscddOf<D> {
             grid_of: [self.settings.nx, self.settings.ny, self.settings.nz],
             by_model: self.by_model,
             steps: self.steps,
-            grid: self.grid,
+            grid: self.grid.clone(),
             grid_empty: self.grid_empty,
+            balance: self.balance,
             kept,
             f_gamma,
         }
@@ -113,8 +118,13 @@ impl<D: Family> NscddOf<D> {
             x.as_mut().copy_from_slice(&v);
             entries.push((b, e, x));
         }
+        let b = s.balance.at_repartition;
+        if !(b.is_finite() && b >= 0.0) {
+            return Err(format!("balance.at_repartition: a finite number ≥ 0 expected, got {b}"));
+        }
         self.store = FGammaStore::from_entries(entries);
         self.steps = s.steps;
+        self.balance = s.balance;
         self.grid = s.grid;
         self.grid_empty = s.grid_empty;
         self.kept = s.kept;

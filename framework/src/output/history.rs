@@ -37,7 +37,7 @@ pub struct History<W: Write, D: Dim> {
 }
 
 /// The NSCDD columns, after the timings.
-pub const DD_COLUMNS: [&str; 8] = [
+pub const DD_COLUMNS: [&str; 10] = [
     "nscdd_iterations",
     "egluing",
     "egluing_rel",
@@ -46,6 +46,8 @@ pub const DD_COLUMNS: [&str; 8] = [
     "migrations",
     "prevailing",
     "subdomains",
+    "repartitioned",
+    "imbalance",
 ];
 
 /// Column suffixes of a tracked body: position, rotation, force, moment.
@@ -189,7 +191,7 @@ fn box_fields<D: Dim>(w: &World<D>, margin: f64, census: Option<crate::dd::Censu
 pub fn dd_fields(dd: Option<&DdStepReport>) -> String {
     match dd {
         Some(d) => format!(
-            ",{},{:e},{:e},{},{},{},{},{}",
+            ",{},{:e},{:e},{},{},{},{},{},{},{:e}",
             d.stages,
             d.egluing,
             d.egluing_rel,
@@ -197,7 +199,9 @@ pub fn dd_fields(dd: Option<&DdStepReport>) -> String {
             d.links,
             d.migrations,
             d.prevailing.name(),
-            d.subdomains
+            d.subdomains,
+            d.repartitioned as u8,
+            d.imbalance
         ),
         None => ",".repeat(DD_COLUMNS.len()),
     }

@@ -203,6 +203,24 @@ pub(crate) fn decomposition(cx: &Ctx, d: &schema::DecompositionSpec, movable: us
     c.dd.sweeps_per_gluing = int("sweeps_per_gluing", d.sweeps_per_gluing, 1, 1)? as u32;
     c.dd.threads = int("threads", d.threads, 1, 1)? as usize;
     c.repartition_every = int("repartition_every", d.repartition_every, 1, 1)? as u32;
+    if let Some(f) = d.rebalance {
+        if !(f.is_finite() && f > 1.0) {
+            return Err(cx.err(
+                &p("rebalance"),
+                format!("the growth of the load imbalance that triggers a repartition must be a number > 1, got {f}"),
+            ));
+        }
+        if c.repartition_every == 1 {
+            let m = "the subdomains are re-partitioned at every step already (repartition_every = 1): set repartition_every > 1, or remove rebalance";
+            return Err(cx.err(&p("rebalance"), m));
+        }
+        c.rebalance = Some(f);
+    }
+    c.balanced_grid = match d.grid.as_deref() {
+        None | Some("uniform") => false,
+        Some("balanced") => true,
+        Some(g) => return Err(cx.err(&p("grid"), format!("`uniform` or `balanced` expected, got `{g}`"))),
+    };
     if let Some(s) = &d.scheme {
         c.dd.scheme = parse_scheme(s).map_err(|m| cx.err(&p("scheme"), m))?;
     }

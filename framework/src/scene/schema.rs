@@ -81,6 +81,13 @@ pub struct DecompositionSpec {
     pub sweeps_per_gluing: Option<i64>,
     pub threads: Option<i64>,
     pub repartition_every: Option<i64>,
+    /// Re-partition between the periodic repartitions when the load imbalance (the
+    /// largest subdomain's contacts over the mean) has grown by this factor (> 1)
+    /// since the last one.
+    pub rebalance: Option<f64>,
+    /// `"uniform"` (default): equal cells over the contact points' bounding box;
+    /// `"balanced"`: cuts along each axis that split the contact points evenly.
+    pub grid: Option<String>,
 }
 
 #[derive(Deserialize, Debug)]

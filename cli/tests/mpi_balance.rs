@@ -1,0 +1,47 @@
+//! Load balance over MPI ranks (issue 20): the balanced grid's histogram added
+//! over the ranks and the `rebalance` trigger give, on 2 and 4 ranks with contacts
+//! held per rank, bitwise the one-process run.
+#![cfg(feature = "mpi")]
+
+mod mpi_common;
+use mpi_common::*;
+
+#[test]
+fn a_balanced_grid_and_rebalancing_on_ranks_give_the_one_process_result() {
+    let dir = scratch("balance_ranks");
+    let scene = include_str!("balance.rs");
+    let start = "pub const FALL: &str = r#\"";
+    let fall = &scene[scene.find(start).expect("FALL") + start.len()..];
+    let fall = &fall[..fall.find("\"#;").expect("end of FALL")];
+    let fall = fall
+        .replace("nx = 1\nny = 2\n", "nx = 2\nny = 2\n")
+        .replace("rebalance = 1.15", "rebalance = 1.15\ngrid = \"balanced\"");
+    let path = write(&dir, "fall.toml", &fall);
+    let one = dir.join("one");
+    let o = nscdd(&args(&path, &one, &["--threads", "2"]));
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let reference = final_json(&one);
+    let h = std::fs::read_to_string(one.join("history.csv")).unwrap();
+    let col = h.lines().next().unwrap().split(',').position(|c| c == "repartitioned").unwrap();
+    let reparts: Vec<u64> = h
+        .lines()
+        .skip(1)
+        .filter(|l| l.split(',').nth(col) == Some("1"))
+        .map(|l| l.split(',').next().unwrap().parse().unwrap())
+        .collect();
+    assert!(
+        reparts.iter().any(|&s| s > 10 && (s - 1) % 40 != 0),
+        "a triggered repartition: {reparts:?}"
+    );
+    for p in [2, 4] {
+        let out = dir.join(format!("p{p}"));
+        let o = mpirun(&[(p, args(&path, &out, &[]))]);
+        assert!(o.status.success(), "{p} ranks: {}", text(&o.stderr));
+        assert!(final_json(&out) == reference, "{p} ranks: final.json differs from one process");
+        let hp = std::fs::read_to_string(out.join("history.csv")).unwrap();
+        // the repartitions and imbalances of every step (the last two columns)
+        let cols = |t: &str| -> Vec<String> { t.lines().map(|l| l.split(',').skip(col).collect::<Vec<_>>().join(",")).collect() };
+        assert_eq!(cols(&hp), cols(&h), "{p} ranks: repartitions or imbalances differ");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
