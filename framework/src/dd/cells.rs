@@ -14,12 +14,13 @@ pub(super) fn cell_box(grid: &Grid, c: u32) -> [[f64; 3]; 2] {
     for d in 0..3 {
         let h = grid.cell[d];
         let flat = grid.flat(d);
-        let at = |k: u32| grid.cut(d, k);
-        b[0][d] = if flat || idx[d] == 0 { -inf } else { at(idx[d]) - 1e-6 * h };
+        let mut next = idx;
+        next[d] += 1;
+        b[0][d] = if flat || idx[d] == 0 { -inf } else { grid.cut(d, idx) - 1e-6 * h };
         b[1][d] = if flat || idx[d] + 1 == n[d] {
             inf
         } else {
-            at(idx[d] + 1) + 1e-6 * h
+            grid.cut(d, next) + 1e-6 * h
         };
     }
     b
@@ -50,28 +51,48 @@ impl CellIndex {
     }
 
     /// The cell range (per axis, inclusive) that may meet `[lo, hi]` (first `n`
-    /// coordinates): the cells of the corners, widened by one cell each way.
+    /// coordinates): the cells of the corners, widened by one cell each way; along
+    /// a balanced axis, over every slab (row) the axes before it cover.
     fn range(&self, n: usize, lo: &[f64], hi: &[f64]) -> [[u32; 2]; 3] {
-        let dims = [self.grid.nx, self.grid.ny, self.grid.nz];
-        std::array::from_fn(|d| {
-            if d >= n || self.grid.flat(d) {
-                return [0, dims[d] - 1];
+        let g = &self.grid;
+        let dims = [g.nx, g.ny, g.nz];
+        let mut r = [[0u32; 2]; 3];
+        for d in 0..3 {
+            if d >= n || g.flat(d) {
+                r[d] = [0, dims[d] - 1];
+                continue;
             }
-            let k = |x: f64| self.grid.axis_index(d, x);
-            let (a, b) = (k(lo[d]), k(hi[d]));
-            // NaN or beyond: every cell of the axis
-            let a = if a.is_nan() || a < 1.0 {
-                0
-            } else {
-                (a as u32 - 1).min(dims[d] - 1)
+            let one = |i: [u32; 3]| {
+                let k = |x: f64| g.axis_index(d, i, x);
+                let (a, b) = (k(lo[d]), k(hi[d]));
+                // NaN or beyond: every cell of the axis
+                let a = if a.is_nan() || a < 1.0 {
+                    0
+                } else {
+                    (a as u32 - 1).min(dims[d] - 1)
+                };
+                let b = if b.is_nan() {
+                    dims[d] - 1
+                } else {
+                    ((b.max(0.0) as u32).saturating_add(1)).min(dims[d] - 1)
+                };
+                [a, b.max(a)]
             };
-            let b = if b.is_nan() {
-                dims[d] - 1
+            r[d] = if g.cuts[d].is_empty() || d == 0 {
+                one([0; 3])
             } else {
-                ((b.max(0.0) as u32).saturating_add(1)).min(dims[d] - 1)
+                let mut u = [u32::MAX, 0];
+                for x in r[0][0]..=r[0][1] {
+                    let ys = if d == 2 { r[1][0]..=r[1][1] } else { 0..=0 };
+                    for y in ys {
+                        let [a, b] = one([x, y, 0]);
+                        u = [u[0].min(a), u[1].max(b)];
+                    }
+                }
+                u
             };
-            [a, b.max(a)]
-        })
+        }
+        r
     }
 
     /// Calls `f` with the rank of every cell whose box meets `[lo, hi]` (first `n`
@@ -111,7 +132,19 @@ mod tests {
     /// cells finds, for boxes inside, across, on and beyond the cells.
     #[test]
     fn the_index_finds_what_the_region_test_finds() {
-        let grid = Grid::from_bounds([0.0, -1.0, 0.0], [3.0, 1.0, 2.0], 3, 2, 2);
+        the_index_finds_on(&Grid::from_bounds([0.0, -1.0, 0.0], [3.0, 1.0, 2.0], 3, 2, 2));
+        // balanced cuts of points crowded towards a corner: each slab and row its own
+        let pts = (0..3000).map(|k| {
+            let t = k as f64 / 3000.0;
+            [3.0 * t * t, -1.0 + 2.0 * (7.0 * t).fract().powi(3), 2.0 * (13.0 * t).fract().sqrt()]
+        });
+        let g = Grid::balanced_over(pts, 3, 2, 2);
+        assert!(g.cuts.iter().all(|c| !c.is_empty()), "{g:?}");
+        the_index_finds_on(&g);
+    }
+
+    fn the_index_finds_on(grid: &Grid) {
+        let grid = grid.clone();
         let rank_of: Vec<u32> = (0..grid.len() as u32).map(|c| (c * 7) % 5).collect();
         let index = CellIndex::new(&grid, &rank_of);
         let regions: Vec<Region> = (0..5)

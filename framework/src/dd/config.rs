@@ -16,8 +16,8 @@ pub struct DdConfig {
     /// Re-partition between the periodic repartitions too, when the load imbalance
     /// has grown by this factor since the last one ([`NscddOf::rebalance`]).
     pub rebalance: Option<f64>,
-    /// `grid = "balanced"`: cuts that split the contact points evenly along each
-    /// axis ([`Grid::balanced`]) instead of uniform cells.
+    /// `grid = "balanced"`: multi-jagged cuts that split the contact points evenly
+    /// ([`super::Grid::balanced`]) instead of uniform cells.
     pub balanced_grid: bool,
 }
 

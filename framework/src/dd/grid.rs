@@ -1,14 +1,17 @@
 //! The grid of subdomains over the contact points' bounding box: uniform cells, or
-//! cells whose cuts along each axis split the contact points evenly (`[decomposition]
-//! grid = "balanced"`).
+//! balanced cells (`[decomposition] grid = "balanced"`) that split the contact points
+//! evenly by *multi-jagged* cuts (the generalization of recursive coordinate
+//! bisection to an nx × ny × nz grid, as in Zoltan2's MJ): the box is cut along x
+//! into nx slabs of equal counts, each slab along y into ny rows of equal counts (its
+//! own cuts), each row along z into nz cells. A cell is still a box, numbered
+//! `cx + nx (cy + ny cz)`.
 //!
-//! Balanced cuts come from a histogram per axis of [`BINS_PER_CELL`] bins a cell over
-//! the bounds: the k-th cut of an axis with n cells is the first bin edge where the
-//! cumulative count reaches k/n of the points. Counts are integers and the bounds are
-//! exact once merged by min and max, so ranks that each count their own contacts and
-//! add the histograms get the grid of one process, bit for bit. Along each axis
-//! separately: with one axis cut (1 × 1 × 2: the median height of a pile) the cells
-//! hold equal shares up to a bin; with several, a product of balanced marginals.
+//! Cuts come from histograms of [`BINS_PER_CELL`] bins a cell over the bounds, one
+//! per slab (per row along z): the k-th cut of a slab is the first bin edge where the
+//! slab's cumulative count reaches k/n of its points. Counts are integers and the
+//! bounds are exact once merged by min and max, so ranks that each count their own
+//! contacts and add the histograms (one all-gather per cut axis) get the grid of one
+//! process, bit for bit.
 //!
 //! ```
 //! use nscdd::dd::Grid;
@@ -17,15 +20,25 @@
 //! let pts: Vec<[f64; 3]> = (0..100).map(|k| [0.5, if k < 90 { 0.001 * k as f64 } else { 1.0 }, 0.0]).collect();
 //! let (lo, hi) = Grid::bounds(pts.iter().copied());
 //! let uniform = Grid::from_bounds(lo, hi, 1, 2, 1);
-//! let hist = Grid::histogram(lo, hi, [1, 2, 1], pts.iter().copied());
-//! let balanced = Grid::balanced(lo, hi, 1, 2, 1, &hist);
-//! let count = |g: &Grid| pts.iter().filter(|&&p| g.cell_of(p) == 0).count();
-//! assert_eq!(count(&uniform), 90);
+//! let balanced = Grid::balanced_over(pts.iter().copied(), 1, 2, 1);
+//! let count = |pts: &[[f64; 3]], g: &Grid, c: u32| pts.iter().filter(|&&p| g.cell_of(p) == c).count();
+//! assert_eq!(count(&pts, &uniform, 0), 90);
 //! // (up to a bin of the histogram: 1/128 of the height, 8 of the points here)
-//! assert!((count(&balanced) as i64 - 50).abs() <= 8);
+//! assert!((count(&pts, &balanced, 0) as i64 - 50).abs() <= 8);
+//! // 2 × 2: the left half's points low, the right half's high; each half is cut
+//! // at its own median height
+//! let pts: Vec<[f64; 3]> = (0..400).map(|k| {
+//!     let (x, t) = ((k % 2) as f64, (k / 2) as f64 / 200.0);
+//!     [x, if k % 2 == 0 { 0.2 * t } else { 0.8 + 0.2 * t }, 0.0]
+//! }).collect();
+//! let g = Grid::balanced_over(pts.iter().copied(), 2, 2, 1);
+//! for c in 0..4 {
+//!     let n = count(&pts, &g, c);
+//!     assert!((n as i64 - 100).abs() <= 8, "cell {c}: {n}");
+//! }
 //! ```
 
-/// Histogram bins per cell along an axis ([`Grid::histogram`]).
+/// Histogram bins per cell along an axis ([`Grid::balanced`]).
 pub const BINS_PER_CELL: usize = 64;
 
 /// The grid of subdomains over the contact points' bounding box (nz = 1 in 2D,
@@ -38,8 +51,10 @@ pub struct Grid {
     pub origin: [f64; 3],
     /// The size of a uniform cell (the bounds over n), per axis.
     pub cell: [f64; 3],
-    /// The interior cuts of each axis (n − 1 increasing positions), or none: uniform
-    /// cells (states written before balanced grids have none).
+    /// Balanced grids: `cuts[0]` the nx − 1 cuts along x; `cuts[1]` each slab's
+    /// ny − 1 cuts along y, slab after slab; `cuts[2]` each row's (cx + nx cy) nz − 1
+    /// cuts along z. Empty along an axis: uniform cells (states written before
+    /// balanced grids have none).
     #[serde(default, skip_serializing_if = "no_cuts")]
     pub cuts: [Vec<f64>; 3],
 }
@@ -54,11 +69,10 @@ impl Grid {
         Grid::from_bounds(lo, hi, nx, ny, nz)
     }
 
-    /// The grid whose cuts split `points` evenly along each axis (module docs).
+    /// The balanced grid of `points` in one process (module docs).
     pub fn balanced_over(points: impl Iterator<Item = [f64; 3]> + Clone, nx: u32, ny: u32, nz: u32) -> Grid {
         let (lo, hi) = Grid::bounds(points.clone());
-        let hist = Grid::histogram(lo, hi, [nx, ny, nz], points);
-        Grid::balanced(lo, hi, nx, ny, nz, &hist)
+        Grid::balanced(lo, hi, [nx, ny, nz], || points.clone(), |h| h)
     }
 
     /// The bounds of the finite points (lo > hi without any).
@@ -90,64 +104,63 @@ impl Grid {
         }
     }
 
-    /// The bins of each axis' histogram: [`BINS_PER_CELL`] per cell, none along an
-    /// axis of one cell.
-    fn bins(n: [u32; 3]) -> [usize; 3] {
-        n.map(|k| if k > 1 { k as usize * BINS_PER_CELL } else { 0 })
-    }
-
-    /// The histograms of the finite `points` over the bounds `[lo, hi]`, axis after
-    /// axis (counts as f64: exact, and added over ranks as they are).
-    pub fn histogram(lo: [f64; 3], hi: [f64; 3], n: [u32; 3], points: impl Iterator<Item = [f64; 3]>) -> Vec<f64> {
-        let b = Grid::bins(n);
-        let mut h = vec![0.0; b.iter().sum()];
-        for p in points.filter(|p| p.iter().all(|x| x.is_finite())) {
-            let mut at = 0;
-            for d in 0..3 {
-                if b[d] > 0 {
-                    let w = hi[d] - lo[d];
-                    let k = if w > 0.0 {
-                        ((p[d] - lo[d]) / w * b[d] as f64).floor().max(0.0) as usize
-                    } else {
-                        0
-                    };
-                    h[at + k.min(b[d] - 1)] += 1.0;
-                }
-                at += b[d];
-            }
-        }
-        h
-    }
-
-    /// The grid over `[lo, hi]` whose cuts split the counts of `hist` (the added
-    /// [`Grid::histogram`]s of the points) evenly along each axis.
-    pub fn balanced(lo: [f64; 3], hi: [f64; 3], nx: u32, ny: u32, nz: u32, hist: &[f64]) -> Grid {
-        let mut g = Grid::from_bounds(lo, hi, nx, ny, nz);
+    /// The balanced grid over the bounds `[lo, hi]` (module docs) of the points that
+    /// `points()` gives each time it is called; `add` adds a histogram over the
+    /// processes (the identity in one process), once per cut axis.
+    pub fn balanced<I: Iterator<Item = [f64; 3]>>(
+        lo: [f64; 3],
+        hi: [f64; 3],
+        n: [u32; 3],
+        points: impl Fn() -> I,
+        mut add: impl FnMut(Vec<f64>) -> Vec<f64>,
+    ) -> Grid {
+        let mut g = Grid::from_bounds(lo, hi, n[0], n[1], n[2]);
         let n = [g.nx, g.ny, g.nz];
-        let b = Grid::bins(n);
-        let mut at = 0;
         for d in 0..3 {
-            let h = &hist[at..at + b[d]];
-            at += b[d];
-            let total: f64 = h.iter().sum();
-            if b[d] == 0 || total == 0.0 || !(g.cell[d] > 0.0) {
+            if n[d] < 2 || g.flat(d) {
                 continue;
             }
-            let width = g.cell[d] * n[d] as f64 / b[d] as f64;
-            let (mut acc, mut bin, mut prev) = (0.0, 0, 0);
-            for k in 1..n[d] {
-                let share = total * k as f64 / n[d] as f64;
-                while bin < b[d] && acc < share {
-                    acc += h[bin];
-                    bin += 1;
-                }
-                // at least one bin a cell, so that cuts increase strictly
-                let edge = bin.max(prev + 1).min(b[d] - (n[d] - k) as usize);
-                prev = edge;
-                g.cuts[d].push(g.origin[d] + edge as f64 * width);
+            // one histogram per slab (d = 1) or row (d = 2)
+            let (bins, groups) = (n[d] as usize * BINS_PER_CELL, n[..d].iter().product::<u32>() as usize);
+            let width = g.cell[d] * n[d] as f64 / bins as f64;
+            let mut hist = vec![0.0; groups * bins];
+            for p in points().filter(|p| p.iter().all(|x| x.is_finite())) {
+                let k = ((p[d] - g.origin[d]) / width).floor().max(0.0) as usize;
+                hist[g.group(d, p) * bins + k.min(bins - 1)] += 1.0;
             }
+            let hist = add(hist);
+            let mut cuts = Vec::with_capacity(groups * (n[d] as usize - 1));
+            for h in hist.chunks_exact(bins) {
+                cuts.extend(split(h, n[d]).into_iter().map(|e| g.origin[d] + e as f64 * width));
+            }
+            g.cuts[d] = cuts;
         }
         g
+    }
+
+    /// The slab (d = 1) or row (d = 2) of a point, from the cuts of the axes before d.
+    fn group(&self, d: usize, p: [f64; 3]) -> usize {
+        let i = self.index_of(p);
+        match d {
+            0 => 0,
+            1 => i[0] as usize,
+            _ => (i[0] + self.nx * i[1]) as usize,
+        }
+    }
+
+    /// The cuts of axis d in the slab or row of cell indices `i` (empty: uniform).
+    fn row(&self, d: usize, i: [u32; 3]) -> &[f64] {
+        let c = &self.cuts[d];
+        if c.is_empty() {
+            return c;
+        }
+        let m = [self.nx, self.ny, self.nz][d] as usize - 1;
+        let g = match d {
+            0 => 0,
+            1 => i[0] as usize,
+            _ => (i[0] + self.nx * i[1]) as usize,
+        };
+        &c[g * m..(g + 1) * m]
     }
 
     pub fn len(&self) -> usize {
@@ -162,42 +175,74 @@ impl Grid {
         self.cell[d].is_nan() || self.cell[d] <= 0.0
     }
 
-    /// The lower bound of cell k along axis d (k in 1..n: an interior cut).
-    pub fn cut(&self, d: usize, k: u32) -> f64 {
-        match self.cuts[d].get(k as usize - 1) {
+    /// The lower bound of cell `i[d]` along axis d (`i[d]` ≥ 1: an interior cut),
+    /// in the slab or row of `i`.
+    pub fn cut(&self, d: usize, i: [u32; 3]) -> f64 {
+        match self.row(d, i).get(i[d] as usize - 1) {
             Some(&c) => c,
-            None => self.origin[d] + k as f64 * self.cell[d],
+            None => self.origin[d] + i[d] as f64 * self.cell[d],
         }
     }
 
-    /// The cell index of coordinate x along axis d, unclamped above for uniform cells
-    /// (the cells' own count then bounds it), NaN for NaN.
-    pub fn axis_index(&self, d: usize, x: f64) -> f64 {
-        if self.cuts[d].is_empty() {
+    /// The cell index of coordinate x along axis d in the slab or row of `i`,
+    /// unclamped (below 0 or beyond the last cell for uniform cells, −1 below a
+    /// balanced axis), NaN for NaN.
+    pub fn axis_index(&self, d: usize, i: [u32; 3], x: f64) -> f64 {
+        let row = self.row(d, i);
+        if row.is_empty() {
             ((x - self.origin[d]) / self.cell[d]).floor()
         } else if x.is_nan() {
             f64::NAN
         } else if x < self.origin[d] {
             -1.0
         } else {
-            self.cuts[d].partition_point(|&c| c <= x) as f64
+            row.partition_point(|&c| c <= x) as f64
         }
+    }
+
+    /// The cell indices (cx, cy, cz) of a point.
+    pub fn index_of(&self, p: [f64; 3]) -> [u32; 3] {
+        let n = [self.nx, self.ny, self.nz];
+        let mut i = [0u32; 3];
+        for d in 0..3 {
+            // a flat box (or NaN) puts every point in the first cell
+            if self.flat(d) {
+                continue;
+            }
+            let k = self.axis_index(d, i, p[d]);
+            i[d] = if k >= 0.0 { (k as u32).min(n[d] - 1) } else { 0 };
+        }
+        i
     }
 
     /// Subdomain id `cx + nx (cy + ny cz)` of a point.
     pub fn cell_of(&self, p: [f64; 3]) -> u32 {
-        let c = |d: usize, n: u32| {
-            // a flat box (or NaN) puts every point in the first cell
-            if self.flat(d) {
-                return 0;
-            }
-            let k = self.axis_index(d, p[d]);
-            if k >= 0.0 {
-                (k as u32).min(n - 1)
-            } else {
-                0
-            }
-        };
-        c(0, self.nx) + self.nx * (c(1, self.ny) + self.ny * c(2, self.nz))
+        let i = self.index_of(p);
+        i[0] + self.nx * (i[1] + self.ny * i[2])
     }
+}
+
+/// The interior cut edges (in bins) that split the counts `h` into `n` equal shares:
+/// the first edge where the cumulative count reaches k/n, at least one bin a cell
+/// (uniform edges without counts).
+fn split(h: &[f64], n: u32) -> Vec<usize> {
+    let (bins, total) = (h.len(), h.iter().sum::<f64>());
+    let (mut acc, mut bin, mut prev) = (0.0, 0, 0);
+    (1..n)
+        .map(|k| {
+            let edge = if total == 0.0 {
+                k as usize * bins / n as usize
+            } else {
+                let share = total * k as f64 / n as f64;
+                while bin < bins && acc < share {
+                    acc += h[bin];
+                    bin += 1;
+                }
+                bin
+            };
+            let edge = edge.max(prev + 1).min(bins - (n - k) as usize);
+            prev = edge;
+            edge
+        })
+        .collect()
 }

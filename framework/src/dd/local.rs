@@ -235,17 +235,18 @@ impl<D: Family> super::NscddOf<D> {
             total += x[6] as usize;
         }
         let grid = if self.balanced_grid {
-            // every rank's histogram of its contact points, added (integers: exact)
-            let n = [s.nx, s.ny, s.nz];
-            let mine = Grid::histogram(glo, ghi, n, (0..nc).map(|a| D::point(c, a)));
-            let (_, all) = rs.all_gather_any(&mine);
-            let mut hist = vec![0.0; mine.len()];
-            for x in all.chunks_exact(mine.len().max(1)) {
-                for (t, v) in hist.iter_mut().zip(x) {
-                    *t += v;
+            // every rank's histograms of its contact points, added (integers: exact)
+            let add = |mine: Vec<f64>| {
+                let (_, all) = rs.all_gather_any(&mine);
+                let mut sum = vec![0.0; mine.len()];
+                for x in all.chunks_exact(mine.len().max(1)) {
+                    for (t, v) in sum.iter_mut().zip(x) {
+                        *t += v;
+                    }
                 }
-            }
-            Grid::balanced(glo, ghi, s.nx, s.ny, s.nz, &hist)
+                sum
+            };
+            Grid::balanced(glo, ghi, [s.nx, s.ny, s.nz], || (0..nc).map(|a| D::point(c, a)), add)
         } else {
             Grid::from_bounds(glo, ghi, s.nx, s.ny, s.nz)
         };

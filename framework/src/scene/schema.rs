@@ -86,7 +86,7 @@ pub struct DecompositionSpec {
     /// since the last one.
     pub rebalance: Option<f64>,
     /// `"uniform"` (default): equal cells over the contact points' bounding box;
-    /// `"balanced"`: cuts along each axis that split the contact points evenly.
+    /// `"balanced"`: multi-jagged cuts that split the contact points evenly.
     pub grid: Option<String>,
 }
 
