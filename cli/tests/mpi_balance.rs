@@ -45,3 +45,27 @@ fn a_balanced_grid_and_rebalancing_on_ranks_give_the_one_process_result() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Known defect (docs/SCALING.md, "Known defect"): the 4000-sphere pour on 2 × 2 × 2
+/// subdomains, contacts held per rank between repartitions every 100 steps, leaves
+/// the one-process result at step 111 on 2 ranks (two contacts of a grain landing
+/// near a cell corner). Ignored until found; run with `--ignored`.
+#[test]
+#[ignore = "known defect: a held-per-rank pour on 2 x 2 x 2 leaves the one-process result at step 111"]
+fn the_pour_on_2x2x2_subdomains_gives_the_one_process_result() {
+    let dir = scratch("pour_2x2x2");
+    let pile = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../scripts/bench_scenes/pile3d.toml")).expect("pile3d.toml");
+    let scene = format!(
+        "{}\n[decomposition]\nnx = 2\nny = 2\nnz = 2\nrepartition_every = 100\n",
+        pile.replace("steps = 600", "steps = 111")
+    );
+    let path = write(&dir, "pour.toml", &scene);
+    let one = dir.join("one");
+    let o = nscdd(&args(&path, &one, &[]));
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let two = dir.join("two");
+    let o = mpirun(&[(2, args(&path, &two, &[]))]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(final_json(&two) == final_json(&one), "2 ranks: final.json differs from one process");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -57,6 +57,7 @@ mod owned;
 mod owner;
 pub mod partition;
 mod rank_balance;
+mod rank_fresh;
 mod rank_link;
 mod rank_reduce;
 mod rank_share;
@@ -305,6 +306,10 @@ impl<D: Family> NscddOf<D> {
         let mut shells = |subs: &mut [Subdomain<D>]| self.ranks.as_mut().expect("ranks").fill_shells(subs);
         let shells = self.local.now.then_some(&mut shells as &mut dyn FnMut(&mut [Subdomain<D>]));
         self.last = partition::decompose_owned::<D>(w, &self.v_free, grid, owner, ns, &self.store, build.as_deref(), &fo, shells);
+        // contacts held per rank: the other ranks' F_Γ are not kept up to date here
+        if let (true, Some(rs)) = (self.local.now, self.ranks.as_mut()) {
+            rs.fresh_f_gamma(&mut self.last, &self.store);
+        }
         rep.repartitioned = repart;
         if let Some(before) = before {
             let after = partition::body_sets(&self.last, nb);

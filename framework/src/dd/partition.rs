@@ -437,13 +437,7 @@ fn interface<D: Family>(
             })
             .collect();
         if fresh {
-            let ndof = D::V::default().as_ref().len();
-            let mean: Vec<f64> = (0..ndof).map(|d| f.iter().map(|x| x.as_ref()[d]).sum::<f64>() / m as f64).collect();
-            for x in f.iter_mut() {
-                for (v, mu) in x.as_mut().iter_mut().zip(&mean) {
-                    *v -= mu;
-                }
-            }
+            zero_mean(&mut f);
         }
         iface.fresh.push(fresh);
         for (k, &(_, s, l)) in copies.iter().enumerate() {
@@ -462,6 +456,20 @@ fn interface<D: Family>(
     }
     iface.n_rigid = iface.body.len();
     iface
+}
+
+/// The kept F_Γ of a fresh body's copies (zero for its new ones), made to sum to
+/// zero: the mean removed.
+pub(super) fn zero_mean<V: AsRef<[f64]> + AsMut<[f64]>>(f: &mut [V]) {
+    let (m, Some(ndof)) = (f.len(), f.first().map(|x| x.as_ref().len())) else {
+        return;
+    };
+    let mean: Vec<f64> = (0..ndof).map(|d| f.iter().map(|x| x.as_ref()[d]).sum::<f64>() / m as f64).collect();
+    for x in f.iter_mut() {
+        for (v, mu) in x.as_mut().iter_mut().zip(&mean) {
+            *v -= mu;
+        }
+    }
 }
 
 /// Each subdomain's neighbours and the chains of its interface copies.

@@ -1,0 +1,89 @@
+//! The starting F_Γ of a body whose copies changed, on ranks between repartitions.
+//!
+//! A body whose set of copies changed since the last step is *fresh*: its copies
+//! start from their kept F_Γ (zero for a new copy) with the mean removed
+//! ([`super::partition::zero_mean`]). Between repartitions a rank keeps only its
+//! own subdomains' F_Γ up to date (`rank_share`: the other ranks' are not sent), so
+//! the mean over copies held by several ranks needs the others' kept values: each
+//! rank asks, for the fresh bodies with a copy in its subdomains, the kept F_Γ of
+//! their copies in other ranks' subdomains, and each subdomain's rank answers (two
+//! all-gathers as long as the fresh bodies at rank boundaries). Then every rank
+//! starts its copies where one process does, bit for bit.
+
+use super::family::Family;
+use super::partition::{zero_mean, Decomposition, FGammaStore};
+use super::ranks::RankState;
+
+impl RankState {
+    /// Sets the starting F_Γ of this rank's copies of the fresh interface bodies
+    /// from every copy's kept F_Γ, asked of its subdomain's rank (module docs).
+    /// Collective.
+    pub(super) fn fresh_f_gamma<D: Family>(&mut self, d: &mut Decomposition<D>, store: &FGammaStore<D::V>) {
+        let me = self.cluster.rank();
+        let own = |rank_of: &[u32], s: u32| rank_of[s as usize] == me;
+        let iface = &d.iface;
+        let mut bodies = Vec::new();
+        let mut ask = Vec::new();
+        for ib in 0..iface.n_rigid {
+            let ks = iface.copies(ib);
+            if !iface.fresh[ib] || !ks.clone().any(|k| own(&self.rank_of, iface.sub[k])) {
+                continue;
+            }
+            bodies.push(ib);
+            let g = iface.body[ib];
+            for k in ks {
+                let s = iface.sub[k];
+                if !own(&self.rank_of, s) && store.get(g, s).is_some() {
+                    ask.extend([f64::from(g), f64::from(s)]);
+                }
+            }
+        }
+        let (_, asked) = self.all_gather_any(&ask);
+        let mut mine: Vec<(u32, u32)> = asked
+            .chunks_exact(2)
+            .map(|x| (x[0] as u32, x[1] as u32))
+            .filter(|&(_, s)| own(&self.rank_of, s))
+            .collect();
+        mine.sort_unstable();
+        mine.dedup();
+        let mut answer = Vec::new();
+        for &(g, s) in &mine {
+            answer.extend([f64::from(g), f64::from(s)]);
+            answer.extend_from_slice(store.get(g, s).unwrap_or_default().as_ref());
+        }
+        let (_, got) = self.all_gather_any(&answer);
+        let ndof = super::subdomain::dofs::<D>();
+        let mut kept: Vec<((u32, u32), D::V)> = got
+            .chunks_exact(2 + ndof)
+            .map(|x| {
+                let mut v = D::V::default();
+                v.as_mut().copy_from_slice(&x[2..]);
+                ((x[0] as u32, x[1] as u32), v)
+            })
+            .collect();
+        kept.sort_unstable_by_key(|e| e.0);
+        let iface = &d.iface;
+        for ib in bodies {
+            let g = iface.body[ib];
+            let mut f: Vec<D::V> = iface
+                .copies(ib)
+                .map(|k| {
+                    let s = iface.sub[k];
+                    let v = if own(&self.rank_of, s) {
+                        store.get(g, s)
+                    } else {
+                        kept.binary_search_by_key(&(g, s), |e| e.0).ok().map(|p| kept[p].1)
+                    };
+                    v.unwrap_or_default()
+                })
+                .collect();
+            zero_mean(&mut f);
+            for (j, k) in iface.copies(ib).enumerate() {
+                let s = iface.sub[k];
+                if own(&self.rank_of, s) {
+                    d.subs[s as usize].f_gamma[iface.slot[k] as usize] = f[j];
+                }
+            }
+        }
+    }
+}
