@@ -232,7 +232,8 @@ def test_ctrl_c_stops_after_the_step_keeping_a_checkpoint(tmp_path):
 
     def interrupt(s):
         if s.current_step == 30:
-            os.kill(os.getpid(), signal.SIGINT)
+            # to this thread (a process-directed kill may land on a worker thread)
+            signal.raise_signal(signal.SIGINT)
 
     with pytest.raises(KeyboardInterrupt):
         sim.run(callback=interrupt, progress=False)
