@@ -46,12 +46,12 @@ fn a_balanced_grid_and_rebalancing_on_ranks_give_the_one_process_result() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Known defect (docs/SCALING.md, "Known defect"): the 4000-sphere pour on 2 × 2 × 2
-/// subdomains, contacts held per rank between repartitions every 100 steps, leaves
-/// the one-process result at step 111 on 2 ranks (two contacts of a grain landing
-/// near a cell corner). Ignored until found; run with `--ignored`.
+/// The 4000-sphere pour on 2 × 2 × 2 subdomains, contacts held per rank between
+/// repartitions every 100 steps: at step 111 a grain held by subdomains of both
+/// ranks gains a copy (it is fresh), and its copies must start from every copy's
+/// kept F_Γ, the other rank's included (`dd::rank_fresh`); before, the 2-rank run
+/// left the one-process result there.
 #[test]
-#[ignore = "known defect: a held-per-rank pour on 2 x 2 x 2 leaves the one-process result at step 111"]
 fn the_pour_on_2x2x2_subdomains_gives_the_one_process_result() {
     let dir = scratch("pour_2x2x2");
     let pile = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../scripts/bench_scenes/pile3d.toml")).expect("pile3d.toml");

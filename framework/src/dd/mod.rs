@@ -308,7 +308,7 @@ impl<D: Family> NscddOf<D> {
         self.last = partition::decompose_owned::<D>(w, &self.v_free, grid, owner, ns, &self.store, build.as_deref(), &fo, shells);
         // contacts held per rank: the other ranks' F_Γ are not kept up to date here
         if let (true, Some(rs)) = (self.local.now, self.ranks.as_mut()) {
-            rs.fresh_f_gamma(&mut self.last, &self.store);
+            rs.fresh_f_gamma(&mut self.last, &self.store, &self.v_free);
         }
         rep.repartitioned = repart;
         if let Some(before) = before {

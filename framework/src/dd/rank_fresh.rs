@@ -16,9 +16,9 @@ use super::ranks::RankState;
 
 impl RankState {
     /// Sets the starting F_Γ of this rank's copies of the fresh interface bodies
-    /// from every copy's kept F_Γ, asked of its subdomain's rank (module docs).
-    /// Collective.
-    pub(super) fn fresh_f_gamma<D: Family>(&mut self, d: &mut Decomposition<D>, store: &FGammaStore<D::V>) {
+    /// from every copy's kept F_Γ, asked of its subdomain's rank (module docs), and
+    /// the starting velocities of the subdomains holding them again. Collective.
+    pub(super) fn fresh_f_gamma<D: Family>(&mut self, d: &mut Decomposition<D>, store: &FGammaStore<D::V>, v_free: &[D::V]) {
         let me = self.cluster.rank();
         let own = |rank_of: &[u32], s: u32| rank_of[s as usize] == me;
         let iface = &d.iface;
@@ -63,6 +63,7 @@ impl RankState {
             .collect();
         kept.sort_unstable_by_key(|e| e.0);
         let iface = &d.iface;
+        let mut touched = Vec::new();
         for ib in bodies {
             let g = iface.body[ib];
             let mut f: Vec<D::V> = iface
@@ -82,8 +83,15 @@ impl RankState {
                 let s = iface.sub[k];
                 if own(&self.rank_of, s) {
                     d.subs[s as usize].f_gamma[iface.slot[k] as usize] = f[j];
+                    touched.push(s);
                 }
             }
+        }
+        // the copies' starting velocities hold F_Γ (`Subdomain::init_velocities`)
+        touched.sort_unstable();
+        touched.dedup();
+        for s in touched {
+            d.subs[s as usize].init_velocities(v_free);
         }
     }
 }
