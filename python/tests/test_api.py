@@ -235,8 +235,14 @@ def test_ctrl_c_stops_after_the_step_keeping_a_checkpoint(tmp_path):
             # to this thread (a process-directed kill may land on a worker thread)
             signal.raise_signal(signal.SIGINT)
 
-    with pytest.raises(KeyboardInterrupt):
-        sim.run(callback=interrupt, progress=False)
+    # Python's own handler, even where SIGINT was ignored when it started (a
+    # background job of a non-interactive shell)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            sim.run(callback=interrupt, progress=False)
+    finally:
+        signal.signal(signal.SIGINT, previous)
     state = json.loads((tmp_path / "checkpoint.json").read_text())
     assert state["step"] in (30, 31) and sim.current_step == state["step"]
     assert len((tmp_path / "history.csv").read_text().splitlines()) == state["step"] + 1
