@@ -126,7 +126,7 @@ impl Grid {
             let mut hist = vec![0.0; groups * bins];
             for p in points().filter(|p| p.iter().all(|x| x.is_finite())) {
                 let k = ((p[d] - g.origin[d]) / width).floor().max(0.0) as usize;
-                hist[g.group(d, p) * bins + k.min(bins - 1)] += 1.0;
+                hist[g.group(d, g.index_of(p)) * bins + k.min(bins - 1)] += 1.0;
             }
             let hist = add(hist);
             let mut cuts = Vec::with_capacity(groups * (n[d] as usize - 1));
@@ -138,9 +138,9 @@ impl Grid {
         g
     }
 
-    /// The slab (d = 1) or row (d = 2) of a point, from the cuts of the axes before d.
-    fn group(&self, d: usize, p: [f64; 3]) -> usize {
-        let i = self.index_of(p);
+    /// Along axis d, the slab (d = 1) or row (d = 2) of cell indices `i`: the
+    /// histogram and the cuts of axis d that apply there (0 along x).
+    fn group(&self, d: usize, i: [u32; 3]) -> usize {
         match d {
             0 => 0,
             1 => i[0] as usize,
@@ -155,11 +155,7 @@ impl Grid {
             return c;
         }
         let m = [self.nx, self.ny, self.nz][d] as usize - 1;
-        let g = match d {
-            0 => 0,
-            1 => i[0] as usize,
-            _ => (i[0] + self.nx * i[1]) as usize,
-        };
+        let g = self.group(d, i);
         &c[g * m..(g + 1) * m]
     }
 

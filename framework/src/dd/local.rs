@@ -236,16 +236,7 @@ impl<D: Family> super::NscddOf<D> {
         }
         let grid = if self.balanced_grid {
             // every rank's histograms of its contact points, added (integers: exact)
-            let add = |mine: Vec<f64>| {
-                let (_, all) = rs.all_gather_any(&mine);
-                let mut sum = vec![0.0; mine.len()];
-                for x in all.chunks_exact(mine.len().max(1)) {
-                    for (t, v) in sum.iter_mut().zip(x) {
-                        *t += v;
-                    }
-                }
-                sum
-            };
+            let add = |mine: Vec<f64>| rs.all_sum(&mine);
             Grid::balanced(glo, ghi, [s.nx, s.ny, s.nz], || (0..nc).map(|a| D::point(c, a)), add)
         } else {
             Grid::from_bounds(glo, ghi, s.nx, s.ny, s.nz)
@@ -255,13 +246,7 @@ impl<D: Family> super::NscddOf<D> {
         for a in 0..nc {
             loads[grid.cell_of(D::point(c, a)) as usize] += 1.0;
         }
-        let (_, all) = rs.all_gather_any(&loads);
-        let mut sum = vec![0usize; ns];
-        for x in all.chunks_exact(ns) {
-            for (t, v) in sum.iter_mut().zip(x) {
-                *t += *v as usize;
-            }
-        }
+        let sum: Vec<usize> = rs.all_sum(&loads).into_iter().map(|x| x as usize).collect();
         rs.rank_of = super::rank_balance::balanced_ranks(&sum, rs.cluster.size());
         if D::active(w).is_some() {
             let Local { owned, boxes, .. } = &mut self.local;

@@ -19,21 +19,19 @@ impl RankState {
     /// from every copy's kept F_Γ, asked of its subdomain's rank (module docs), and
     /// the starting velocities of the subdomains holding them again. Collective.
     pub(super) fn fresh_f_gamma<D: Family>(&mut self, d: &mut Decomposition<D>, store: &FGammaStore<D::V>, v_free: &[D::V]) {
-        let me = self.cluster.rank();
-        let own = |rank_of: &[u32], s: u32| rank_of[s as usize] == me;
         let iface = &d.iface;
         let mut bodies = Vec::new();
         let mut ask = Vec::new();
         for ib in 0..iface.n_rigid {
             let ks = iface.copies(ib);
-            if !iface.fresh[ib] || !ks.clone().any(|k| own(&self.rank_of, iface.sub[k])) {
+            if !iface.fresh[ib] || !ks.clone().any(|k| self.is_own(iface.sub[k])) {
                 continue;
             }
             bodies.push(ib);
             let g = iface.body[ib];
             for k in ks {
                 let s = iface.sub[k];
-                if !own(&self.rank_of, s) && store.get(g, s).is_some() {
+                if !self.is_own(s) && store.get(g, s).is_some() {
                     ask.extend([f64::from(g), f64::from(s)]);
                 }
             }
@@ -42,7 +40,7 @@ impl RankState {
         let mut mine: Vec<(u32, u32)> = asked
             .chunks_exact(2)
             .map(|x| (x[0] as u32, x[1] as u32))
-            .filter(|&(_, s)| own(&self.rank_of, s))
+            .filter(|&(_, s)| self.is_own(s))
             .collect();
         mine.sort_unstable();
         mine.dedup();
@@ -70,7 +68,7 @@ impl RankState {
                 .copies(ib)
                 .map(|k| {
                     let s = iface.sub[k];
-                    let v = if own(&self.rank_of, s) {
+                    let v = if self.is_own(s) {
                         store.get(g, s)
                     } else {
                         kept.binary_search_by_key(&(g, s), |e| e.0).ok().map(|p| kept[p].1)
@@ -81,7 +79,7 @@ impl RankState {
             zero_mean(&mut f);
             for (j, k) in iface.copies(ib).enumerate() {
                 let s = iface.sub[k];
-                if own(&self.rank_of, s) {
+                if self.is_own(s) {
                     d.subs[s as usize].f_gamma[iface.slot[k] as usize] = f[j];
                     touched.push(s);
                 }

@@ -19,6 +19,19 @@ impl RankState {
         (counts, all)
     }
 
+    /// Every rank's `mine` (the same length on every rank) added element by element,
+    /// ranks in order (counts as f64: exact).
+    pub(super) fn all_sum(&mut self, mine: &[f64]) -> Vec<f64> {
+        let (_, all) = self.all_gather_any(mine);
+        let mut sum = vec![0.0; mine.len()];
+        for x in all.chunks_exact(mine.len().max(1)) {
+            for (t, v) in sum.iter_mut().zip(x) {
+                *t += v;
+            }
+        }
+        sum
+    }
+
     /// As [`RankState::all_gather_any`], into rank 0 only (empty elsewhere).
     pub(super) fn gather_any_on_root(&mut self, mine: &[f64]) -> Vec<f64> {
         let counts = self.lengths(mine.len());
