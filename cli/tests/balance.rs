@@ -58,62 +58,9 @@ spacing = 0.02
 
 /// A lattice of disks falling on a floor between two walls: the contacts appear
 /// at the bottom and rise with the pile; 1 × 2 subdomains, re-partitioned every 40
-/// steps and when the imbalance grows by 15 %.
-pub const FALL: &str = r#"
-[time]
-step = 2e-3
-steps = 200
-[solver]
-tolerance = 1e-4
-max_sweeps = 2000
-check_every = 5
-[output]
-every = 50
-vtk = false
-[decomposition]
-nx = 1
-ny = 2
-repartition_every = 40
-rebalance = 1.15
-[[materials]]
-name = "m"
-density = 1000.0
-[[laws]]
-materials = ["m", "m"]
-friction = 0.3
-[[bodies]]
-name = "floor"
-shape = "wall"
-material = "m"
-position = [0.15, -0.005]
-length = 0.32
-thickness = 0.01
-fixed = true
-[[bodies]]
-shape = "wall"
-material = "m"
-position = [-0.005, 0.3]
-rotation = 1.5707963267948966
-length = 0.62
-thickness = 0.01
-fixed = true
-[[bodies]]
-shape = "wall"
-material = "m"
-position = [0.305, 0.3]
-rotation = 1.5707963267948966
-length = 0.62
-thickness = 0.01
-fixed = true
-[[generate]]
-kind = "square_lattice"
-material = "m"
-radius = 0.01
-origin = [0.02, 0.012]
-nx = 9
-ny = 14
-spacing = 0.032
-"#;
+/// steps and when the imbalance grows by 15 % (`scenes/fall.toml`, shared with
+/// `mpi_balance.rs`).
+const FALL: &str = include_str!("scenes/fall.toml");
 
 fn run(dir: &Path, name: &str, scene: &str, extra: &[&str]) -> PathBuf {
     let path = dir.join(format!("{name}.toml"));

@@ -9,11 +9,8 @@ use mpi_common::*;
 #[test]
 fn a_balanced_grid_and_rebalancing_on_ranks_give_the_one_process_result() {
     let dir = scratch("balance_ranks");
-    let scene = include_str!("balance.rs");
-    let start = "pub const FALL: &str = r#\"";
-    let fall = &scene[scene.find(start).expect("FALL") + start.len()..];
-    let fall = &fall[..fall.find("\"#;").expect("end of FALL")];
-    let fall = fall
+    // balance.rs's falling lattice on 2 × 2 subdomains, balanced
+    let fall = include_str!("scenes/fall.toml")
         .replace("nx = 1\nny = 2\n", "nx = 2\nny = 2\n")
         .replace("rebalance = 1.15", "rebalance = 1.15\ngrid = \"balanced\"");
     let path = write(&dir, "fall.toml", &fall);
