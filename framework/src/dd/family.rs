@@ -196,7 +196,7 @@ impl<D: Dim> Family for Rigid<D> {
     fn sweep(c: &mut Self::Contacts, vel: &mut [Self::V], inv: &[Self::InvMass], order: &[u32], omega: f64, sums: Option<&mut Sums>) {
         nlgs::sweep(c, vel, inv, order, omega, None);
         if let Some(s) = sums {
-            nlgs::check_pass(c, vel, inv, order, omega, s);
+            nlgs::check_pass(c, vel, inv, order, s);
         }
     }
     fn mu(c: &Self::Contacts, a: usize) -> f64 {

@@ -300,7 +300,7 @@ pub fn solve<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMas
             }
         }
         if let Some(sums) = sums {
-            check_pass(c, vel, inv, order, s.relaxation, sums);
+            check_pass(c, vel, inv, order, sums);
         }
     });
     report.residual = residual(c, vel);
@@ -312,7 +312,7 @@ pub fn solve<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMas
         if at_best < report.residual {
             report.residual = at_best;
             let mut sums = Sums::default();
-            check_pass(c, vel, inv, order, s.relaxation, &mut sums);
+            check_pass(c, vel, inv, order, &mut sums);
             report.norms = Norms::from_sums(&sums, s.tolerance);
         } else {
             set_impulses(c, vel, inv, &x);

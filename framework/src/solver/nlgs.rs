@@ -94,9 +94,11 @@ pub fn sweep<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMas
 }
 
 /// LMGC90's check pass: the check sums of every contact's local solution with the
-/// others as they are, nothing updated.
-pub fn check_pass<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMass], order: &[u32], omega: f64, sums: &mut Sums) {
-    pass(c, vel, inv, order, omega, Some(sums), false)
+/// others as they are, nothing updated. The solution is not relaxed (as in
+/// LMGC90's `solve_nlgs(i_check)`): with ω < 1 the sums measure the distance to
+/// the local solutions, not the relaxed step towards them.
+pub fn check_pass<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMass], order: &[u32], sums: &mut Sums) {
+    pass(c, vel, inv, order, 1.0, Some(sums), false)
 }
 
 #[inline(never)]
@@ -227,7 +229,7 @@ pub fn solve<D: Dim>(c: &mut Contacts<D>, vel: &mut [D::Twist], inv: &[D::InvMas
         n += 1;
         sweep(c, vel, inv, order, s.relaxation, None);
         if let Some(sums) = sums {
-            check_pass(c, vel, inv, order, s.relaxation, sums);
+            check_pass(c, vel, inv, order, sums);
         }
     });
     report.residual = residual(c, vel);
@@ -318,7 +320,7 @@ mod tests {
         sweep(&mut c, &mut vel, &inv, &[], 1.0, None);
         let (r, v) = (c.r.clone(), vel.clone());
         let mut sums = Sums::default();
-        check_pass(&mut c, &mut vel, &inv, &[], 1.0, &mut sums);
+        check_pass(&mut c, &mut vel, &inv, &[], &mut sums);
         assert_eq!((&c.r, &vel), (&r, &v), "a check pass changes no impulse and no velocity");
         // the sums of each contact's local solution against the state before the
         // pass (a Jacobi pass)
@@ -332,6 +334,31 @@ mod tests {
             expected.add(&c.r[a], &rn, wr.sub(&wr_old).as_ref(), &wr_old, &wr);
         }
         assert_eq!(format!("{sums:?}"), format!("{expected:?}"));
+    }
+
+    /// With ω = ½ a sweep goes half way to the local solutions; the check pass
+    /// measures the distance to them, not the relaxed step (LMGC90's i_check), so
+    /// a relaxed NLGS does not stop early.
+    #[test]
+    fn the_check_pass_is_not_relaxed() {
+        let run = |omega: f64| {
+            let (mut c, mut vel, inv) = column(4);
+            sweep(&mut c, &mut vel, &inv, &[], omega, None);
+            let mut sums = Sums::default();
+            check_pass(&mut c, &mut vel, &inv, &[], &mut sums);
+            (c, vel, sums)
+        };
+        let (c, vel, sums) = run(0.5);
+        let mut expected = Sums::default();
+        for a in 0..c.len() {
+            let wr_old = D2::w_mul(&c.block[a], &c.r[a]);
+            let u0 = c.local_velocity(a, &vel).sub(&wr_old);
+            let rn = D2::solve(&c.block[a], &u0, 0.0, 0.5, &c.r[a]);
+            let wr = D2::w_mul(&c.block[a], &rn);
+            expected.add(&c.r[a], &rn, wr.sub(&wr_old).as_ref(), &wr_old, &wr);
+        }
+        assert_eq!(format!("{sums:?}"), format!("{expected:?}"));
+        assert!(sums.sum_dvdv > 0.0);
     }
 
     #[test]
