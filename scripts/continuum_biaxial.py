@@ -2,7 +2,7 @@
 """The biaxial test with continuum outer parts against its all-discrete reference
 (docs/CONTINUUM.md): sin φ(ε1) and times.
 
-Usage: continuum_biaxial.py OUT_DIR [--young E ...] [--hardening PHI0 KAPPA_H [PHI]] [--example]
+Usage: continuum_biaxial.py OUT_DIR [--young E ...] [--hardening PHI0 KAPPA_H [PHI]] [--grain-share S] [--example]
 
 For seeds 7 and 11: runs examples/scenes/biaxial.toml (2000 disks, 0.3 s of
 isotropic compaction at 10 kPa, then the top wall at 0.05 m/s), and its
@@ -21,7 +21,9 @@ docs/continuum_biaxial.png (matplotlib: scripts/biaxial_study.sh installs it in
 .venv-docs). `--young`: the regions' E (Pa; default 4e5 6e5 8e5: E at 1 %, 60 σ3,
 E50 of scripts/identify_continuum.py on the two seeds). `--hardening PHI0 KAPPA_H [PHI]`: the regions' friction angle grows from
 PHI0 to PHI (default 15.1°) with the plastic shear strain (half-way at
-KAPPA_H). `--example`: writes
+KAPPA_H). `--grain-share S`: the bands' `grain_share` (a band grain keeps at
+least the share S of its mass; the continuum's weight is at most 1 − S in the
+band). `--example`: writes
 examples/scenes/biaxial_continuum.toml (seed 7, E = 6e5) and stops.
 Needs target/release/nscdd built with the `fem` feature and NSCDD_PYTHON_ENV.
 """
@@ -40,6 +42,8 @@ Y1, Y2, BW, CELL = 0.2, 0.3, 0.05, 0.025
 PHI = 15.1
 # friction hardening (--hardening PHI0 KAPPA_H [PHI]): None, or (φ0, κ_h)
 HARD = None
+# the bands' grain_share (--grain-share S)
+SHARE = 0.0
 
 
 def run(scene, out):
@@ -64,8 +68,12 @@ initial_stress = [{-S3!r}, {-S3!r}, 0.0]
 load = {{ left = [{S3!r}, 0.0], right = [{-S3!r}, 0.0] }}
 drive = {drive}
 mesh = {{ rectangle = {{ origin = [0.0, {y0!r}], size = [{width!r}, {y1 - y0!r}], cells = [{nx}, {ny}] }} }}
-band = {{ normal = [0.0, 1.0], continuum = {band_c!r}, discrete = {band_d!r} }}
+band = {{ normal = [0.0, 1.0], continuum = {band_c!r}, discrete = {band_d!r}{share()} }}
 """
+
+
+def share():
+    return f", grain_share = {SHARE!r}" if SHARE > 0 else ""
 
 
 def plastic():
@@ -75,11 +83,12 @@ def plastic():
 
 def right_walls(width):
     """The grains' right side: a wall per segment, each pushed by its share of σ3
-    (the core at σ3, the bands' 1 cm segments at (1 − α(y_mid)) σ3)."""
+    (the core at σ3, the bands' 1 cm segments at (1 − α(y_mid)) σ3, α at most
+    1 − `grain_share`)."""
     segs = [(Y1, Y2, 1.0)]
     n = round(BW / 0.01)
     for k in range(n):
-        a = (k + 0.5) / n  # α at the segment's middle, from the core outwards
+        a = min((k + 0.5) / n, 1.0 - SHARE)  # α at the segment's middle, from the core outwards
         segs.append((Y1 - (k + 1) * BW / n, Y1 - k * BW / n, 1.0 - a))
         segs.append((Y2 + k * BW / n, Y2 + (k + 1) * BW / n, 1.0 - a))
     out = ""
@@ -213,6 +222,9 @@ def main():
         HARD = (args[0], args[1])
         if len(args) > 2:
             PHI = args[2]
+    if "--grain-share" in sys.argv:
+        global SHARE
+        SHARE = float(sys.argv[sys.argv.index("--grain-share") + 1])
     os.makedirs(out, exist_ok=True)
     base = open(os.path.join(ROOT, "examples", "scenes", "biaxial.toml")).read()
     curves, times = {}, {}

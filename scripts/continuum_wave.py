@@ -32,7 +32,8 @@ def main():
     for data, style, label in ((shared, "-", "shared"), (unshared, ":", "not shared")):
         for coupling, a in (("node", ax[0]), ("grain", ax[1])):
             for cell in ("1", "2", "4"):
-                pts = [r for r in data if r["coupling"] == coupling and r["cell_d"] == cell and r["q"] == "1"]
+                pts = [r for r in data if r["coupling"] == coupling and r["cell_d"] == cell and r["q"] == "1"
+                       and float(r.get("share") or 0) == 0]
                 pts.sort(key=lambda r: float(r["band_d"]))
                 a.plot(
                     [float(r["band_d"]) for r in pts],

@@ -85,6 +85,45 @@ fn the_band_ties_its_grains_and_shares_their_mass() {
     }
 }
 
+/// `band.grain_share = 0.25`: a band grain keeps at least a quarter of its mass
+/// (w_p = max(y/0.2, 0.25)), the continuum's weight is at most 0.75 inside the
+/// band (its cells' weights too: the partition of unity holds), 1 beyond it; a
+/// uniform translation still passes with no force; a share outside [0, 1) is
+/// refused naming the key.
+#[test]
+fn a_grain_share_keeps_a_least_share_of_the_band_grains_mass() {
+    let v0 = [0.3, -0.1];
+    let text = lattice_scene(&|_, _| v0, 1e6, &format!("velocity = [{}, {}]", v0[0], v0[1]))
+        .replace("discrete = 0.2 }", "discrete = 0.2, grain_share = 0.25 }");
+    let mut r = Run::new(&text);
+    let c = r.cont();
+    let m = 2600.0 * std::f64::consts::PI * 0.02 * 0.02;
+    assert_eq!(c.band.len(), 4 * 19);
+    for &(g, w) in &c.band {
+        let y = r.s.world.bodies.pos[g as usize][1];
+        let wp = (y / 0.2).max(0.25);
+        assert!((w - wp).abs() < 1e-12, "y {y}: share {w}");
+        assert!((r.s.world.bodies.mass[g as usize] - wp * m).abs() < 1e-12 * m);
+        assert!((c.bands[0].alpha(&[0.5, y]) + wp - 1.0).abs() < 1e-12);
+    }
+    assert_eq!(c.bands[0].alpha(&[0.5, -0.1]), 1.0);
+    assert_eq!(c.bands[0].alpha(&[0.5, 0.01]), 0.75);
+    for _ in 0..20 {
+        assert!(r.step().solve.converged);
+    }
+    let c = r.cont();
+    let lam = c.ties.r.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    assert!(lam < 1e-9 * m * 0.3, "largest tie impulse {lam:e}");
+    for share in ["1.0", "-0.1"] {
+        let bad = text.replace("grain_share = 0.25", &format!("grain_share = {share}"));
+        let e = nscdd::scene::Scene::<nscdd::dim::D2>::load_str(&bad, "bad.toml", &common::registry())
+            .err()
+            .expect("refused");
+        assert_eq!(e.key, "continuum[0].band", "{e}");
+        assert!(e.to_string().contains("grain_share"), "{e}");
+    }
+}
+
 #[test]
 fn a_uniform_translation_passes_the_band_with_no_force() {
     let v0 = [0.3, -0.1];

@@ -33,20 +33,31 @@ impl FamilyKind<D3> for ContinuumKind {
 }
 
 /// The overlap band: along the unit `normal`, the continuum's weight α is 1 at
-/// s = n·x = `continuum`, 0 at s = `discrete`, linear between, clamped to [0, 1].
+/// s = n·x = `continuum`, 0 at s = `discrete`, linear between, clamped to [0, 1],
+/// and inside the band at most 1 − `grain_share` (docs/CONTINUUM.md, weights).
 #[derive(Deserialize, Debug, Clone, Copy)]
 #[serde(deny_unknown_fields)]
 pub struct Band {
     pub normal: [f64; 3],
     pub continuum: f64,
     pub discrete: f64,
+    /// The least share of its mass (and of its contacts' stiffness) a band grain
+    /// keeps; 0 (the default): the linear weight across the whole band.
+    #[serde(default)]
+    pub grain_share: f64,
 }
 
 impl Band {
     /// α(x), the continuum's weight.
     pub fn alpha(&self, x: &[f64]) -> f64 {
         let s: f64 = x.iter().zip(&self.normal).map(|(a, b)| a * b).sum();
-        ((self.discrete - s) / (self.discrete - self.continuum)).clamp(0.0, 1.0)
+        let a = ((self.discrete - s) / (self.discrete - self.continuum)).clamp(0.0, 1.0);
+        // beyond the band the continuum alone; inside, the grains keep their share
+        if a >= 1.0 {
+            1.0
+        } else {
+            a.min(1.0 - self.grain_share)
+        }
     }
 }
 
@@ -69,6 +80,9 @@ fn band_of(i: usize, e: &toml::Table, dim: usize) -> Result<Band, EntryError> {
         return Err(at("band", "`normal` must be a finite nonzero vector".into()));
     }
     b.normal = b.normal.map(|x| x / len);
+    if !(0.0..1.0).contains(&b.grain_share) {
+        return Err(at("band", format!("`grain_share` must lie in [0, 1), got {}", b.grain_share)));
+    }
     if !(b.continuum.is_finite() && b.discrete.is_finite() && b.continuum != b.discrete) {
         return Err(at(
             "band",
