@@ -27,6 +27,17 @@ pub trait Cluster {
     /// Rank r receives `all[displ_r .. displ_r + counts[r]]` of rank 0's `all` into
     /// `mine` (displ_r = counts[0] + … + counts[r − 1]).
     fn scatter(&mut self, all: &[f64], counts: &[usize], mine: &mut Vec<f64>);
+    /// One value from every rank to every rank (MPI_Alltoall): rank s's `to[r]`
+    /// arrives in rank r's `from[s]` (`to`: one value per rank). This default goes
+    /// through [`Cluster::all_gather`] (every rank receives every row).
+    fn all_to_all(&mut self, to: &[u64], from: &mut Vec<u64>) {
+        let (n, me) = (self.size() as usize, self.rank() as usize);
+        let mine: Vec<f64> = to.iter().map(|&x| x as f64).collect();
+        let mut all = Vec::new();
+        self.all_gather(&mine, &vec![n; n], &mut all);
+        from.clear();
+        from.extend((0..n).map(|s| all[s * n + me] as u64));
+    }
     /// The smallest and largest of `x` over the ranks.
     fn min_max(&mut self, x: u64) -> (u64, u64);
     /// Stops every rank at once with exit code `code` (MPI_Abort): for a failure on

@@ -113,6 +113,13 @@ impl Cluster for MpiCluster {
         });
         clock.stop(&mut self.wait);
     }
+    fn all_to_all(&mut self, to: &[u64], from: &mut Vec<u64>) {
+        let clock = WaitClock::start();
+        from.clear();
+        from.resize(to.len(), 0);
+        self.comm.all_to_all_into(to, &mut from[..]);
+        clock.stop(&mut self.wait);
+    }
     fn all_gather(&mut self, mine: &[f64], counts: &[usize], all: &mut Vec<f64>) {
         let clock = WaitClock::start();
         let (c, d) = counts_displs(counts);

@@ -31,11 +31,13 @@
 //!
 //! Between repartitions, for rigid bodies, each rank holds only its subdomains'
 //! contacts ([`super::local`]): it detects and builds those alone, the other ranks'
-//! subdomains are shells (their bodies), and the end of the step no longer carries
-//! the impulses; a repartition merges every rank's bounds and counts and detects
-//! again; each rank steps only the bodies near its cells ([`super::owned`]). What is
-//! not distributed yet (docs/SCALING.md): the bodies' arrays (every rank allocates
-//! the whole sample) and the copies' velocities and F_Γ, still sent to every rank.
+//! subdomains are shells (their bodies), and the end of the step carries only the
+//! copy velocities a rank asked for, point to point ([`super::rank_share`]); a
+//! repartition merges every rank's bounds and counts and detects again; each rank
+//! steps only the bodies near its cells ([`super::owned`]). What is not distributed
+//! yet (docs/SCALING.md): the bodies' arrays (every rank allocates the whole
+//! sample), the shells' body lists (all-gathered each step) and, before a
+//! repartition, every subdomain's results.
 
 use super::cluster::Cluster;
 use super::family::Family;
