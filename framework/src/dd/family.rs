@@ -38,8 +38,11 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     /// between processes.
     fn r(c: &Self::Contacts, a: usize) -> &[f64];
     fn r_mut(c: &mut Self::Contacts, a: usize) -> &mut [f64];
-    /// W_αα (and its precomputed data) from the copies' M̂_E⁻¹.
-    fn copy_delassus(c: &mut Self::Contacts, inv: &[Self::InvMass]);
+    /// W_αα (and its precomputed data) from the copies' M̂_E⁻¹, for the contacts
+    /// touching a copy marked in `split` (M̂_E⁻¹ = m M̂⁻¹ with m ≥ 2); the others
+    /// keep the world's block, which their copies' M̂_E⁻¹ = M̂⁻¹ would give again
+    /// bit for bit.
+    fn copy_delassus(c: &mut Self::Contacts, inv: &[Self::InvMass], split: &[bool]);
     /// V += M̂⁻¹ H r for every contact with r ≠ 0, in storage order.
     fn warm_start(c: &Self::Contacts, vel: &mut [Self::V], inv: &[Self::InvMass]);
     /// One NLGS sweep (a check pass when `sums` is given).
@@ -185,8 +188,8 @@ impl<D: Dim> Family for Rigid<D> {
     fn r_mut(c: &mut Self::Contacts, a: usize) -> &mut [f64] {
         c.r[a].as_mut()
     }
-    fn copy_delassus(c: &mut Self::Contacts, inv: &[Self::InvMass]) {
-        c.refresh_delassus(inv);
+    fn copy_delassus(c: &mut Self::Contacts, inv: &[Self::InvMass], split: &[bool]) {
+        c.refresh_delassus_of(inv, |[i, j]| split[i as usize] || split[j as usize]);
     }
     fn warm_start(c: &Self::Contacts, vel: &mut [Self::V], inv: &[Self::InvMass]) {
         c.apply_all(vel, inv);

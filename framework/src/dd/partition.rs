@@ -219,7 +219,8 @@ pub fn decompose_owned<D: Family>(
                 .iter()
                 .map(|&g| D::scale_inv(D::inv_mass(w, g as usize), mult[g as usize] as f64))
                 .collect();
-            sub.copy_delassus();
+            let split: Vec<bool> = sub.body_global.iter().map(|&g| mult[g as usize] >= 2).collect();
+            sub.copy_delassus(&split);
             let Subdomain { parts, inv_mass, .. } = sub;
             for (f, p) in parts.0.iter_mut() {
                 let m: Vec<u32> = p.entities().iter().map(|&e| ent_copies[*f as usize].mult[e as usize]).collect();

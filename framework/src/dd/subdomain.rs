@@ -176,9 +176,10 @@ impl<D: Family> Subdomain<D> {
         self.contact_global.push(a as u32);
     }
 
-    /// W_αα and its precomputed inverses from the copies' M̂_E⁻¹.
-    pub(crate) fn copy_delassus(&mut self) {
-        D::copy_delassus(&mut self.contacts, &self.inv_mass);
+    /// W_αα and its precomputed inverses from the copies' M̂_E⁻¹ (`split[l]`: copy
+    /// l's M̂_E⁻¹ is the body's scaled by its multiplicity m ≥ 2).
+    pub(crate) fn copy_delassus(&mut self, split: &[bool]) {
+        D::copy_delassus(&mut self.contacts, &self.inv_mass, split);
     }
 
     /// V_E = V_free + M̂_E⁻¹ (F_Γ + H_E r) with the warm-start impulses, applied in

@@ -151,8 +151,16 @@ impl<D: Dim> Contacts<D> {
     /// W_αα (and the local solver's precomputed data) of every contact from the
     /// bodies' M̂⁻¹ (an NSCDD subdomain's copies).
     pub fn refresh_delassus(&mut self, inv: &[D::InvMass]) {
+        self.refresh_delassus_of(inv, |_| true)
+    }
+
+    /// [`Contacts::refresh_delassus`] of the contacts whose bodies `which` selects.
+    pub fn refresh_delassus_of(&mut self, inv: &[D::InvMass], which: impl Fn([u32; 2]) -> bool) {
         for a in 0..self.len() {
             let [i, j] = self.bodies[a];
+            if !which([i, j]) {
+                continue;
+            }
             let w = D::delassus(&self.frame[a], &inv[i as usize], &inv[j as usize]);
             let w = if self.compliant {
                 D::with_compliance(w, self.compliance[a])
