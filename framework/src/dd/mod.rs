@@ -56,6 +56,7 @@ pub mod mpi;
 mod owned;
 mod owner;
 pub mod partition;
+mod rank_ask;
 mod rank_balance;
 mod rank_fresh;
 mod rank_link;

@@ -6,8 +6,9 @@
 //! own subdomains' F_Γ up to date (`rank_share`: the other ranks' are not sent), so
 //! the mean over copies held by several ranks needs the others' kept values: each
 //! rank asks, for the fresh bodies with a copy in its subdomains, the kept F_Γ of
-//! their copies in other ranks' subdomains, and each subdomain's rank answers (two
-//! all-gathers as long as the fresh bodies at rank boundaries). Then every rank
+//! their copies in other ranks' subdomains, and each subdomain's rank answers (point
+//! to point, [`RankState::ask_ranks`]: as long as the fresh bodies at rank
+//! boundaries). Then every rank
 //! starts its copies where one process does, bit for bit.
 
 use super::family::Family;
@@ -21,7 +22,8 @@ impl RankState {
     pub(super) fn fresh_f_gamma<D: Family>(&mut self, d: &mut Decomposition<D>, store: &FGammaStore<D::V>, v_free: &[D::V]) {
         let iface = &d.iface;
         let mut bodies = Vec::new();
-        let mut ask = Vec::new();
+        // (subdomain, body) of the other ranks' copies asked
+        let mut asks = Vec::new();
         for ib in 0..iface.n_rigid {
             let ks = iface.copies(ib);
             if !iface.fresh[ib] || !ks.clone().any(|k| self.is_own(iface.sub[k])) {
@@ -32,31 +34,21 @@ impl RankState {
             for k in ks {
                 let s = iface.sub[k];
                 if !self.is_own(s) && store.get(g, s).is_some() {
-                    ask.extend([f64::from(g), f64::from(s)]);
+                    asks.push((s, g));
                 }
             }
         }
-        let (_, asked) = self.all_gather_any(&ask);
-        let mut mine: Vec<(u32, u32)> = asked
-            .chunks_exact(2)
-            .map(|x| (x[0] as u32, x[1] as u32))
-            .filter(|&(_, s)| self.is_own(s))
-            .collect();
-        mine.sort_unstable();
-        mine.dedup();
-        let mut answer = Vec::new();
-        for &(g, s) in &mine {
-            answer.extend([f64::from(g), f64::from(s)]);
-            answer.extend_from_slice(store.get(g, s).unwrap_or_default().as_ref());
-        }
-        let (_, got) = self.all_gather_any(&answer);
         let ndof = super::subdomain::dofs::<D>();
-        let mut kept: Vec<((u32, u32), D::V)> = got
-            .chunks_exact(2 + ndof)
-            .map(|x| {
+        let got = self.ask_ranks(&asks, ndof, |s, g, out| {
+            out.extend_from_slice(store.get(g, s).unwrap_or_default().as_ref())
+        });
+        let mut kept: Vec<((u32, u32), D::V)> = asks
+            .iter()
+            .zip(got.chunks_exact(ndof))
+            .map(|(&(s, g), x)| {
                 let mut v = D::V::default();
-                v.as_mut().copy_from_slice(&x[2..]);
-                ((x[0] as u32, x[1] as u32), v)
+                v.as_mut().copy_from_slice(x);
+                ((g, s), v)
             })
             .collect();
         kept.sort_unstable_by_key(|e| e.0);

@@ -148,13 +148,9 @@ impl<D: Dim> Contacts<D> {
         }
     }
 
-    /// W_αα (and the local solver's precomputed data) of every contact from the
-    /// bodies' M̂⁻¹ (an NSCDD subdomain's copies).
-    pub fn refresh_delassus(&mut self, inv: &[D::InvMass]) {
-        self.refresh_delassus_of(inv, |_| true)
-    }
-
-    /// [`Contacts::refresh_delassus`] of the contacts whose bodies `which` selects.
+    /// W_αα (and the local solver's precomputed data) from the bodies' M̂⁻¹ (an
+    /// NSCDD subdomain's copies) of the contacts whose pair of bodies `which`
+    /// selects; the others keep their block.
     pub fn refresh_delassus_of(&mut self, inv: &[D::InvMass], which: impl Fn([u32; 2]) -> bool) {
         for a in 0..self.len() {
             let [i, j] = self.bodies[a];

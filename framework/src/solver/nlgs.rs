@@ -341,14 +341,10 @@ mod tests {
     /// a relaxed NLGS does not stop early.
     #[test]
     fn the_check_pass_is_not_relaxed() {
-        let run = |omega: f64| {
-            let (mut c, mut vel, inv) = column(4);
-            sweep(&mut c, &mut vel, &inv, &[], omega, None);
-            let mut sums = Sums::default();
-            check_pass(&mut c, &mut vel, &inv, &[], &mut sums);
-            (c, vel, sums)
-        };
-        let (c, vel, sums) = run(0.5);
+        let (mut c, mut vel, inv) = column(4);
+        sweep(&mut c, &mut vel, &inv, &[], 0.5, None);
+        let mut sums = Sums::default();
+        check_pass(&mut c, &mut vel, &inv, &[], &mut sums);
         let mut expected = Sums::default();
         for a in 0..c.len() {
             let wr_old = D2::w_mul(&c.block[a], &c.r[a]);
