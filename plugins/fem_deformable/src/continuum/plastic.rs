@@ -71,7 +71,7 @@ impl Hardening {
     /// (η, ξ) at κ.
     fn cone(&self, kappa: f64) -> (f64, f64) {
         let s = self.sin0 + (self.sin_peak - self.sin0) * kappa / (kappa + self.kappa_h);
-        dp(s.clamp(0.0, 1.0 - 1e-12).asin().to_degrees())
+        dp_of_sin(s.clamp(0.0, 1.0 - 1e-12))
     }
 }
 
@@ -80,6 +80,14 @@ fn dp(deg: f64) -> (f64, f64) {
     let t = deg.to_radians().tan();
     let den = (9.0 + 12.0 * t * t).sqrt();
     (3.0 * t / den, 3.0 / den)
+}
+
+/// [`dp`] from s = sin φ, without trigonometry (the return at every yielding cell
+/// and step calls it): with tan² φ = s²/(1 − s²), η = 3s/√(9 + 3s²) and
+/// ξ = 3√(1 − s²)/√(9 + 3s²).
+fn dp_of_sin(s: f64) -> (f64, f64) {
+    let den = (9.0 + 3.0 * s * s).sqrt();
+    (3.0 * s / den, 3.0 * (1.0 - s * s).sqrt() / den)
 }
 
 impl Plastic {
@@ -349,6 +357,15 @@ mod tests {
             yielding: 0,
             hardening: None,
             kappa: vec![],
+        }
+    }
+
+    #[test]
+    fn the_cone_from_sin_phi_is_the_cone_from_phi() {
+        for k in 0..=90 {
+            let deg = k as f64 * 0.99;
+            let (a, b) = (dp(deg), dp_of_sin(deg.to_radians().sin()));
+            assert!((a.0 - b.0).abs() < 1e-14 && (a.1 - b.1).abs() < 1e-14, "{deg}°: {a:?} {b:?}");
         }
     }
 
