@@ -34,7 +34,7 @@ pub struct Continuum<D: Dim, const N: usize> {
     /// unity), ascending grain.
     pub band: Vec<(u32, f64)>,
     /// Each region's band, and the region of each band grain (grain, region).
-    pub bands: Vec<super::scene::Band>,
+    pub bands: Vec<super::band::Band>,
     pub band_region: Vec<(u32, u32)>,
     /// Each region's tie nodes (fixed), G among them and their velocities.
     pub sets: Vec<NodeSet<N>>,

@@ -24,6 +24,7 @@
 //! w_p = 1 − α(x_p) of its mass (its rotation stays free, with its whole inertia).
 //! The ties are the family's contacts in the NSCDD stage ([`family`]).
 
+pub mod band;
 pub mod family;
 pub mod plastic;
 pub mod scene;
