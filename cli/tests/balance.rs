@@ -7,7 +7,7 @@
 mod common;
 
 use common::*;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// A wide bed of disks with a tall column at its left end: the contact points'
 /// box is tall, their mass at the bottom. 1 × 2 subdomains (cut along y).
@@ -62,23 +62,6 @@ spacing = 0.02
 /// `mpi_balance.rs`).
 const FALL: &str = include_str!("scenes/fall.toml");
 
-fn run(dir: &Path, name: &str, scene: &str, extra: &[&str]) -> PathBuf {
-    let path = dir.join(format!("{name}.toml"));
-    std::fs::write(&path, scene).unwrap();
-    let out = dir.join(name);
-    let mut a: Vec<&std::ffi::OsStr> = vec![
-        "run".as_ref(),
-        path.as_os_str(),
-        "--out".as_ref(),
-        out.as_os_str(),
-        "--quiet".as_ref(),
-    ];
-    a.extend(extra.iter().map(std::ffi::OsStr::new));
-    let o = nscdd(&a);
-    assert_eq!(o.status.code(), Some(0), "{name}: {}", text(&o.stderr));
-    out
-}
-
 /// (step, repartitioned, imbalance) of each history row.
 fn balance(out: &Path) -> Vec<(u64, bool, f64)> {
     let h = std::fs::read_to_string(out.join("history.csv")).unwrap();
@@ -113,8 +96,8 @@ fn untimed(out: &Path) -> Vec<String> {
 #[test]
 fn a_balanced_grid_splits_the_contacts_evenly() {
     let dir = scratch("balanced_grid");
-    let uniform = balance(&run(&dir, "uniform", BED, &[]));
-    let bal = run(
+    let uniform = balance(&run_scene(&dir, "uniform", BED, &[]));
+    let bal = run_scene(
         &dir,
         "balanced",
         &BED.replace("repartition_every = 5", "repartition_every = 5\ngrid = \"balanced\""),
@@ -132,7 +115,7 @@ fn a_balanced_grid_splits_the_contacts_evenly() {
     let fin = std::fs::read_to_string(bal.join("final.json")).unwrap();
     assert!(fin.contains("\"cuts\""), "the balanced cuts are saved with the grid");
     // two threads: the same bits
-    let two = run(
+    let two = run_scene(
         &dir,
         "balanced2",
         &BED.replace("repartition_every = 5", "repartition_every = 5\ngrid = \"balanced\""),
@@ -149,7 +132,7 @@ fn a_balanced_grid_splits_the_contacts_evenly() {
 #[test]
 fn a_growing_imbalance_re_partitions_and_restarts_bitwise() {
     let dir = scratch("rebalance");
-    let whole = run(&dir, "whole", FALL, &[]);
+    let whole = run_scene(&dir, "whole", FALL, &[]);
     let b = balance(&whole);
     let periodic = |s: u64| s <= 10 || (s - 1) % 40 == 0;
     let extra: Vec<u64> = b.iter().filter(|x| x.1 && !periodic(x.0)).map(|x| x.0).collect();
@@ -164,10 +147,10 @@ fn a_growing_imbalance_re_partitions_and_restarts_bitwise() {
         assert!(b[(s - 3) as usize].2 > 1.15 * last, "step {s}: {b:?}");
     }
     // without `rebalance`: only the periodic ones
-    let plain = balance(&run(&dir, "plain", &FALL.replace("rebalance = 1.15\n", ""), &[]));
+    let plain = balance(&run_scene(&dir, "plain", &FALL.replace("rebalance = 1.15\n", ""), &[]));
     assert!(plain.iter().all(|x| !x.1 || periodic(x.0)));
     // threads, and a restart between a trigger and its repartition's reference
-    let two = run(&dir, "two", FALL, &["--threads", "2"]);
+    let two = run_scene(&dir, "two", FALL, &["--threads", "2"]);
     let fin = std::fs::read_to_string(whole.join("final.json")).unwrap();
     assert!(
         std::fs::read_to_string(two.join("final.json")).unwrap() == fin,
@@ -175,9 +158,9 @@ fn a_growing_imbalance_re_partitions_and_restarts_bitwise() {
     );
     // stopped after the step that decided a repartition, before it
     let stop = extra[0] - 1;
-    let first = run(&dir, "first", &FALL.replace("steps = 200", &format!("steps = {stop}")), &[]);
+    let first = run_scene(&dir, "first", &FALL.replace("steps = 200", &format!("steps = {stop}")), &[]);
     let state = first.join("final.json");
-    let cont = run(&dir, "cont", FALL, &["--restart", state.to_str().unwrap()]);
+    let cont = run_scene(&dir, "cont", FALL, &["--restart", state.to_str().unwrap()]);
     assert!(
         std::fs::read_to_string(cont.join("final.json")).unwrap() == fin,
         "the restart at step {stop} ends elsewhere"

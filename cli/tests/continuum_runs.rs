@@ -18,22 +18,6 @@ fn footing(steps: u32, output: &str, extra: &str) -> String {
     format!("{s}\n{extra}\n")
 }
 
-fn run(dir: &std::path::Path, scene: &str, name: &str, flags: &[&str]) -> std::path::PathBuf {
-    let path = dir.join(format!("{name}.toml"));
-    std::fs::write(&path, scene).unwrap();
-    let out = dir.join(name);
-    let o = std::process::Command::new(common::BIN)
-        .arg("run")
-        .arg(&path)
-        .args(["--quiet", "--out"])
-        .arg(&out)
-        .args(flags)
-        .output()
-        .unwrap();
-    assert_eq!(o.status.code(), Some(0), "{name}: {}", String::from_utf8_lossy(&o.stderr));
-    out
-}
-
 fn fin(d: &std::path::Path) -> String {
     std::fs::read_to_string(d.join("final.json")).unwrap()
 }
@@ -42,22 +26,22 @@ fn fin(d: &std::path::Path) -> String {
 fn continuum_scenes_restart_bitwise_and_thread_independently() {
     let dir = common::scratch("continuum_restart");
     let dec = "[decomposition]\nby_model = true\nnx = 2";
-    let a = run(&dir, &footing(30, "checkpoint_every = 15\n", dec), "whole", &[]);
-    let b = run(&dir, &footing(15, "", dec), "first", &[]);
+    let a = common::run_scene(&dir, "whole", &footing(30, "checkpoint_every = 15\n", dec), &[]);
+    let b = common::run_scene(&dir, "first", &footing(15, "", dec), &[]);
     let from = b.join("final.json");
-    let c = run(&dir, &footing(30, "", dec), "second", &["--restart", from.to_str().unwrap()]);
+    let c = common::run_scene(&dir, "second", &footing(30, "", dec), &["--restart", from.to_str().unwrap()]);
     assert!(fin(&a) == fin(&c), "the restarted run ends elsewhere");
     let ck = std::fs::read_to_string(a.join("checkpoint.json")).unwrap();
     assert!(ck.contains("\"continuum\"") && ck.contains("\"plastic_strain\""));
-    let t = run(&dir, &footing(30, "", dec), "threads", &["--threads", "2"]);
+    let t = common::run_scene(&dir, "threads", &footing(30, "", dec), &["--threads", "2"]);
     assert!(fin(&a) == fin(&t), "2 threads differ from 1");
     // one domain (no decomposition) restarts bitwise too
-    let a = run(&dir, &footing(20, "", ""), "whole1", &[]);
-    let b = run(&dir, &footing(10, "", ""), "first1", &[]);
-    let c = run(
+    let a = common::run_scene(&dir, "whole1", &footing(20, "", ""), &[]);
+    let b = common::run_scene(&dir, "first1", &footing(10, "", ""), &[]);
+    let c = common::run_scene(
         &dir,
-        &footing(20, "", ""),
         "second1",
+        &footing(20, "", ""),
         &["--restart", b.join("final.json").to_str().unwrap()],
     );
     assert!(fin(&a) == fin(&c), "the restarted one-domain run ends elsewhere");

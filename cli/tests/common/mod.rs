@@ -1,9 +1,10 @@
-//! Helpers of the `nscdd` binary's bad-input tests: a valid base scene, a scratch
-//! directory, running the binary, and the check that a malformed scene gives exit 2
-//! and one message naming the file, the line and the key.
+//! Helpers of the `nscdd` binary's tests: a valid base scene, a scratch directory,
+//! running the binary (on a scene text: [`run_scene`]), and the check that a
+//! malformed scene gives exit 2 and one message naming the file, the line and the
+//! key.
 #![allow(dead_code)]
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 pub const BIN: &str = env!("CARGO_BIN_EXE_nscdd");
@@ -46,6 +47,24 @@ pub fn scratch(name: &str) -> PathBuf {
 
 pub fn nscdd(args: &[&std::ffi::OsStr]) -> Output {
     Command::new(BIN).args(args).output().expect("the nscdd binary runs")
+}
+
+/// Writes `scene` as `dir/name.toml`, runs it (`--quiet`, outputs in `dir/name`,
+/// then `flags`), asserts exit 0 and returns the output directory.
+pub fn run_scene(dir: &Path, name: &str, scene: &str, flags: &[&str]) -> PathBuf {
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, scene).unwrap();
+    let out = dir.join(name);
+    let o = Command::new(BIN)
+        .arg("run")
+        .arg(&path)
+        .args(["--quiet", "--out"])
+        .arg(&out)
+        .args(flags)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{name}: {}", text(&o.stderr));
+    out
 }
 
 pub fn text(b: &[u8]) -> String {
