@@ -42,16 +42,9 @@ impl RankState {
         let got = self.ask_ranks(&asks, ndof, |s, g, out| {
             out.extend_from_slice(store.get(g, s).unwrap_or_default().as_ref())
         });
-        let mut kept: Vec<((u32, u32), D::V)> = asks
-            .iter()
-            .zip(got.chunks_exact(ndof))
-            .map(|(&(s, g), x)| {
-                let mut v = D::V::default();
-                v.as_mut().copy_from_slice(x);
-                ((g, s), v)
-            })
-            .collect();
-        kept.sort_unstable_by_key(|e| e.0);
+        // the answers in the order asked: the loop below meets the same copies in
+        // the same order
+        let mut answers = got.chunks_exact(ndof);
         let iface = &d.iface;
         let mut touched = Vec::new();
         for ib in bodies {
@@ -60,12 +53,15 @@ impl RankState {
                 .copies(ib)
                 .map(|k| {
                     let s = iface.sub[k];
-                    let v = if self.is_own(s) {
-                        store.get(g, s)
-                    } else {
-                        kept.binary_search_by_key(&(g, s), |e| e.0).ok().map(|p| kept[p].1)
-                    };
-                    v.unwrap_or_default()
+                    let kept = store.get(g, s);
+                    if self.is_own(s) || kept.is_none() {
+                        return kept.unwrap_or_default();
+                    }
+                    let mut v = D::V::default();
+                    if let Some(x) = answers.next() {
+                        v.as_mut().copy_from_slice(x);
+                    }
+                    v
                 })
                 .collect();
             zero_mean(&mut f);
