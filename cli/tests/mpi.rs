@@ -190,6 +190,9 @@ fn two_and_four_ranks_give_the_one_process_result_3d() {
             r["rank"]
         );
         assert!(r["bodies_sent"].as_u64().expect("sent") > 0, "{r}");
+        // the other ranks' subdomains held as shells limited to the bodies near it
+        // between repartitions
+        assert!(r["limited_shell_steps"].as_u64().expect("limited") > 0, "{r}");
         // the rank's CPU, split into communication and compute
         let cpu = |k: &str| r[k].as_f64().unwrap_or_else(|| panic!("{k}: {r}"));
         assert!(cpu("compute_cpu_seconds") > 0.0 && cpu("wait_cpu_seconds") >= 0.0, "{r}");

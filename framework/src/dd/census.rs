@@ -5,13 +5,13 @@
 //! loaded contacts of the grains that are not rattlers).
 //!
 //! A contact belongs to one subdomain; a body's loaded contacts are the sum of its
-//! counts in the subdomains holding it, exchanged for the bodies held by several
-//! (one all-gather); each body is then counted by its first subdomain, and the
-//! per-subdomain integers are added (a second all-gather on ranks).
+//! counts in the subdomains holding it, asked of the other copies' ranks for the
+//! bodies held by several (point to point); each body is then counted by its first
+//! subdomain, and the per-subdomain integers are added (an all-gather on ranks).
 
 use super::family::Family;
 use super::partition::Decomposition;
-use super::rank_reduce::{per_subdomain, per_subdomain_v};
+use super::rank_reduce::per_subdomain;
 use super::ranks::RankState;
 
 /// The counts of a step (see the module docs).
@@ -97,25 +97,12 @@ fn loaded<D: Family>(w: &D::World, d: &Decomposition<D>, s: usize) -> (Vec<u32>,
 }
 
 /// The loaded contacts of the bodies held by several subdomains, summed over them
-/// (their counts exchanged; 0 for the other bodies).
-fn shared_totals<D: Family>(
-    d: &Decomposition<D>,
-    w: &D::World,
-    ranks: Option<&mut RankState>,
-    counts: &[Option<(Vec<u32>, u64)>],
-) -> Vec<u32> {
-    let ns = d.subs.len();
-    let multi = d.shared_locals();
+/// (their other ranks' counts asked of their ranks, [`super::shells::copy_counts`];
+/// 0 for the other bodies).
+fn shared_totals<D: Family>(d: &Decomposition<D>, w: &D::World, ranks: Option<&mut RankState>, counts: &[Option<Vec<u32>>]) -> Vec<u32> {
     let mut total = vec![0u32; D::n_bodies(w)];
-    let fill = |s: usize, v: &mut Vec<f64>| {
-        let (c, _) = counts[s].as_ref().expect("an own subdomain");
-        v.extend(multi[s].iter().map(|&l| c[l as usize] as f64));
-    };
-    let (at, all) = per_subdomain_v(ranks, ns, |s| multi[s].len(), fill);
-    for (s, ls) in multi.iter().enumerate() {
-        for (k, &l) in ls.iter().enumerate() {
-            total[d.subs[s].body_global[l as usize] as usize] += all[at[s] + k] as u32;
-        }
+    for (g, _, n) in super::shells::copy_counts(d, ranks, counts) {
+        total[g as usize] += n;
     }
     total
 }
@@ -146,7 +133,15 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
         out.add_sums(&per, 1, k, bulk.is_some());
         return out;
     }
-    let counts: Vec<Option<(Vec<u32>, u64)>> = (0..ns).map(|s| own(s).then(|| loaded(w, d, s))).collect();
+    let (counts, ngg_of): (Vec<Option<Vec<u32>>>, Vec<u64>) = (0..ns)
+        .map(|s| match own(s) {
+            true => {
+                let (c, n) = loaded(w, d, s);
+                (Some(c), n)
+            }
+            false => (None, 0),
+        })
+        .unzip();
     let total = shared_totals(d, w, ranks.as_deref_mut(), &counts);
     // per subdomain: contacts, loaded grain–grain contacts, non-rattler grains and
     // their loaded contacts, each body counted by its first subdomain
@@ -159,7 +154,7 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
     let inner = |g: usize| bulk.is_some_and(|(lo, hi)| (0..3).all(|k| D::position(w, g)[k] > lo[k] && D::position(w, g)[k] < hi[k]));
     let aggregate = |s: usize, v: &mut Vec<f64>| {
         let sub = &d.subs[s];
-        let (c, ngg) = counts[s].as_ref().expect("an own subdomain");
+        let (c, ngg) = (counts[s].as_ref().expect("an own subdomain"), ngg_of[s]);
         let mut a = [0u64; 6]; // n_m, sum_m, then the bulk counts
         for (l, &g) in sub.body_global.iter().enumerate() {
             let g = g as usize;
@@ -181,7 +176,7 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
                 }
             }
         }
-        v.extend([D::len(&sub.contacts) as f64, *ngg as f64]);
+        v.extend([D::len(&sub.contacts) as f64, ngg as f64]);
         v.extend(a.map(|x| x as f64));
         add_cell(s, v);
     };

@@ -10,9 +10,9 @@
 //! detection:         the own cells (edge cells unbounded) and the own kept pairs
 //! after detection:   a raw contact stays when its owner — its kept subdomain, else
 //!                    the cell of its point — is an own subdomain
-//! partition:         the other ranks' subdomains as shells: their bodies, from one
-//!                    exchange of the own subdomains' body lists (the interface and
-//!                    multiplicities are then those of one process)
+//! partition:         the other ranks' subdomains as shells: their bodies near this
+//!                    rank ([`super::shells`]; the interface and multiplicities of
+//!                    those bodies are then those of one process)
 //! ```
 //!
 //! A repartition step detects in the old regions (the exchange above), merges every
@@ -38,16 +38,17 @@ pub(super) struct Local {
     pub held: bool,
     /// Whether the step in progress runs local.
     pub now: bool,
-    boxes: Vec<[[f64; 3]; 2]>,
+    /// The bodies' boxes at the start of the step (those this rank steps up to date).
+    pub boxes: Vec<[[f64; 3]; 2]>,
     /// With contacts held per rank: each body's subdomain for the outputs
-    /// ([`body_subdomains`]).
+    /// ([`super::shells::body_subdomains`]).
     pub body_sub: Vec<i32>,
     /// The step in progress needs no `body_sub` (no output frame after it).
     pub skip_view: bool,
     /// A distributed repartition's grid and number of contacts, for the partition.
     pub new_grid: Option<(Grid, usize)>,
     /// The bodies this rank steps ([`super::owned`]).
-    owned: super::owned::Owned,
+    pub owned: super::owned::Owned,
     /// On a repartition step: this rank's contacts of the last step (their
     /// [`Family::prev_record`]s), for the ranks whose new cells they may meet.
     own_prev: Option<Vec<f64>>,
@@ -153,8 +154,13 @@ pub(super) fn region<D: Family>(rs: &RankState, grid: &Grid, kept: &[(ContactKey
 impl<D: Family> super::NscddOf<D> {
     /// Whether this step re-partitions over a new grid.
     pub(super) fn repartitions(&self) -> bool {
+        self.repartitions_at(self.steps)
+    }
+
+    /// Whether the partition after `steps` steps re-partitions.
+    pub(super) fn repartitions_at(&self, steps: u64) -> bool {
         let k = self.repartition_every.max(1) as u64;
-        self.grid.is_none() || self.grid_empty || self.steps.is_multiple_of(k) || self.balance.due == Some(self.steps)
+        self.grid.is_none() || self.grid_empty || steps.is_multiple_of(k) || self.balance.due == Some(steps)
     }
 
     /// Before detection: on ranks, with `eligible` (rigid bodies only), the exchange
@@ -334,64 +340,4 @@ impl<D: Family> super::NscddOf<D> {
         let all = rs.gather_any_on_root(mine);
         (rs.cluster.rank() == 0).then_some(all)
     }
-}
-
-impl RankState {
-    /// The other ranks' subdomains' bodies, in their order (two all-gathers): the
-    /// shells of [`super::partition::decompose_owned`].
-    pub(super) fn fill_shells<D: Family>(&mut self, subs: &mut [super::Subdomain<D>]) {
-        let ns = subs.len();
-        let lens = self.per_subdomain(ns, 1, |s, out| out.push(subs[s].body_global.len() as f64));
-        let (at, all) = self.per_subdomain_v(
-            ns,
-            |s| lens[s] as usize,
-            |s, out| out.extend(subs[s].body_global.iter().map(|&g| f64::from(g))),
-        );
-        for (s, sub) in subs.iter_mut().enumerate() {
-            if !self.is_own(s as u32) {
-                sub.body_global = all[at[s]..at[s] + lens[s] as usize].iter().map(|&g| g as u32).collect();
-            }
-        }
-    }
-}
-
-/// The subdomain owning most of each body's contacts (ties: the smaller id; −1
-/// without contacts), as `NscddOf::view` counts them over the whole contact list:
-/// a body held by one subdomain is its; the counts of the bodies held by several
-/// come from their subdomains' ranks (collective).
-pub(super) fn body_subdomains<D: Family>(rs: &mut RankState, d: &super::partition::Decomposition<D>, nb: usize) -> Vec<i32> {
-    let ns = d.subs.len();
-    let multi = d.shared_locals();
-    let count = |s: usize, out: &mut Vec<f64>| {
-        let sub = &d.subs[s];
-        let mut n = vec![0u32; sub.body_global.len()];
-        for a in 0..D::len(&sub.contacts) {
-            for l in D::bodies(&sub.contacts, a) {
-                n[l as usize] += 1;
-            }
-        }
-        out.extend(multi[s].iter().map(|&l| f64::from(n[l as usize])));
-    };
-    let (at, all) = rs.per_subdomain_v(ns, |s| multi[s].len(), count);
-    let mut out = vec![-1i32; nb];
-    let mut best = vec![0u32; nb];
-    for (s, sub) in d.subs.iter().enumerate() {
-        let mut k = 0;
-        for (l, &g) in sub.body_global.iter().enumerate() {
-            let g = g as usize;
-            let n = if d.mult[g] >= 2 {
-                k += 1;
-                all[at[s] + k - 1] as u32
-            } else {
-                1
-            };
-            debug_assert!(d.mult[g] < 2 || multi[s][k - 1] == l as u32);
-            // ascending subdomain ids: a strictly larger count wins
-            if n > best[g] {
-                best[g] = n;
-                out[g] = s as i32;
-            }
-        }
-    }
-    out
 }

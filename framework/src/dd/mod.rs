@@ -67,6 +67,7 @@ pub mod ranks;
 mod reactions;
 mod report;
 pub mod schemes;
+mod shells;
 mod state;
 pub use state::NscddState;
 pub mod subdomain;
@@ -304,7 +305,31 @@ impl<D: Family> NscddOf<D> {
             fams,
             owner: &self.fam_owner,
         };
-        let mut shells = |subs: &mut [Subdomain<D>]| self.ranks.as_mut().expect("ranks").fill_shells(subs);
+        // shells limited to the bodies near this rank between repartitions, while it
+        // steps some bodies only, with the decentralized scheme ([`shells`])
+        let limited = self.local.now && !repart && !self.repartitions_at(self.steps + 1) && self.settings.scheme == Scheme::Decentralized;
+        let local = &self.local;
+        let alert = D::alert(w);
+        let mut shells = |subs: &mut [Subdomain<D>]| {
+            let rs = self.ranks.as_mut().expect("ranks");
+            match (limited, D::active(w), local.owned.cells.as_ref()) {
+                (true, Some(active), Some(cells)) => {
+                    let everywhere = local.owned.everywhere();
+                    let boxes = &local.boxes;
+                    rs.fill_shells_near(
+                        subs,
+                        &shells::Near {
+                            cells,
+                            boxes,
+                            everywhere,
+                            active,
+                            alert,
+                        },
+                    );
+                }
+                _ => rs.fill_shells(subs),
+            }
+        };
         let shells = self.local.now.then_some(&mut shells as &mut dyn FnMut(&mut [Subdomain<D>]));
         self.last = partition::decompose_owned::<D>(w, &self.v_free, grid, owner, ns, &self.store, build.as_deref(), &fo, shells);
         // contacts held per rank: the other ranks' F_Γ are not kept up to date here
@@ -360,10 +385,14 @@ impl<D: Family> NscddOf<D> {
         rep.interface_bodies = d.iface.len();
         rep.links = d.iface.links();
         rep.max_multiplicity = d.mult.iter().copied().max().unwrap_or(0);
+        let mut fresh = d.iface.fresh.iter().any(|&f| f);
         let mut total = D::len(D::contacts(w)) + self.fam_points.len();
         if let (true, Some(rs)) = (self.local.now, self.ranks.as_mut()) {
-            // contacts held per rank: whether any rank has one
-            total = rs.all_gather_any(&[total as f64]).1.iter().map(|&x| x as usize).sum();
+            // contacts held per rank: whether any rank has one; the interface's
+            // counts and freshness over the ranks ([`shells`])
+            let t = shells::interface_totals(rs, d, total);
+            (total, fresh) = (t.contacts, t.fresh);
+            (rep.interface_bodies, rep.links, rep.max_multiplicity) = (t.bodies, t.links, t.max_multiplicity);
         }
         if total == 0 {
             rep.solve.converged = true;
@@ -410,7 +439,7 @@ impl<D: Family> NscddOf<D> {
                 set.scheme,
                 (per, sv.relaxation, max_stages, k),
                 hybrid,
-                (mixer, requests),
+                (mixer, requests, fresh),
                 |s, g| converged(s, g, rep),
             );
             rep.exchange = stats;
@@ -439,7 +468,7 @@ impl<D: Family> NscddOf<D> {
         rep.solve.residual = attach::write_back_families(d, w, fams, self.ranks.as_mut());
         self.local.body_sub.clear();
         if let (true, false, Some(rs)) = (self.local.now, self.local.skip_view, self.ranks.as_mut()) {
-            self.local.body_sub = local::body_subdomains(rs, d, D::n_bodies(w));
+            self.local.body_sub = shells::body_subdomains(rs, d, D::n_bodies(w));
         }
     }
 }

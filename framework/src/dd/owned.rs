@@ -93,6 +93,11 @@ impl Owned {
         self.own_bodies::<D>(w, rs, grid);
     }
 
+    /// The bodies stepped by every rank, by id (set by [`Owned::start`]).
+    pub(super) fn everywhere(&self) -> &[bool] {
+        &self.everywhere
+    }
+
     /// The active bodies whose centre lies in one of this rank's cells.
     fn own_bodies<D: Family>(&mut self, w: &D::World, rs: &RankState, grid: &Grid) {
         let me = rs.cluster.rank();

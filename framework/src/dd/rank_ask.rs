@@ -11,13 +11,37 @@
 //! ```
 //!
 //! The messages are as long as what is asked (the rank boundaries), and go only to
-//! the ranks concerned. Used by the end of a step ([`super::rank_share`]) and the
-//! fresh bodies' F_Γ ([`super::rank_fresh`]).
+//! the ranks concerned. Used by the end of a step ([`super::rank_share`]), the
+//! fresh bodies' F_Γ ([`super::rank_fresh`]) and the counts of shared bodies
+//! ([`super::shells`]); [`RankState::send_ranks`], its first round alone, sends the
+//! shells' bodies.
 
 use super::ranks::RankState;
 use std::time::Instant;
 
 impl RankState {
+    /// Values to some ranks, point to point (`out[r]`: the values for rank r, empty
+    /// for itself and the ranks sent nothing): one all-to-all of the lengths, then
+    /// one exchange with the ranks sent to or receiving from this one (a symmetric
+    /// relation). Returns those ranks (ascending) and what each sent this one.
+    /// Collective.
+    pub(super) fn send_ranks(&mut self, mut out: Vec<Vec<f64>>) -> (Vec<u32>, Vec<Vec<f64>>) {
+        let (me, np) = (self.cluster.rank(), self.cluster.size() as usize);
+        debug_assert_eq!(out.len(), np, "one list a rank");
+        let to: Vec<u64> = out.iter().map(|v| v.len() as u64).collect();
+        let mut from = Vec::new();
+        self.cluster.all_to_all(&to, &mut from);
+        self.sent_p2p(np - 1, np - 1);
+        let peers: Vec<u32> = (0..np as u32)
+            .filter(|&r| r != me && (to[r as usize] > 0 || from[r as usize] > 0))
+            .collect();
+        let sent: Vec<Vec<f64>> = peers.iter().map(|&r| std::mem::take(&mut out[r as usize])).collect();
+        let mut inbox = vec![Vec::new(); peers.len()];
+        self.cluster.exchange(&peers, &sent, &mut inbox);
+        self.sent_p2p(sent.iter().filter(|o| !o.is_empty()).count(), sent.iter().map(Vec::len).sum());
+        (peers, inbox)
+    }
+
     /// The values of the pairs `asks` = (subdomain, key), `n` per pair, from the
     /// subdomains' ranks, in the order of `asks` (every subdomain another rank's);
     /// `answer(s, key, out)` appends this rank's values of a pair asked of it.
@@ -32,25 +56,11 @@ impl RankState {
             debug_assert_ne!(r, me, "a pair of another rank's subdomain");
             of[r as usize].push(i);
         }
-        let to: Vec<u64> = of.iter().map(|v| v.len() as u64).collect();
-        let mut from = Vec::new();
-        self.cluster.all_to_all(&to, &mut from);
-        self.sent_p2p(np - 1, np - 1);
-        let peers: Vec<u32> = (0..np as u32)
-            .filter(|&r| r != me && (to[r as usize] > 0 || from[r as usize] > 0))
-            .collect();
-        let out: Vec<Vec<f64>> = peers
+        let out: Vec<Vec<f64>> = of
             .iter()
-            .map(|&r| {
-                of[r as usize]
-                    .iter()
-                    .flat_map(|&i| [f64::from(asks[i].0), f64::from(asks[i].1)])
-                    .collect()
-            })
+            .map(|v| v.iter().flat_map(|&i| [f64::from(asks[i].0), f64::from(asks[i].1)]).collect())
             .collect();
-        let mut inbox = vec![Vec::new(); peers.len()];
-        self.cluster.exchange(&peers, &out, &mut inbox);
-        self.sent_p2p(out.iter().filter(|o| !o.is_empty()).count(), out.iter().map(Vec::len).sum());
+        let (peers, mut inbox) = self.send_ranks(out);
         let out: Vec<Vec<f64>> = inbox
             .iter()
             .map(|q| {

@@ -5,10 +5,11 @@
 //! ([`super::partition::zero_mean`]). Between repartitions a rank keeps only its
 //! own subdomains' F_Γ up to date (`rank_share`: the other ranks' are not sent), so
 //! the mean over copies held by several ranks needs the others' kept values: each
-//! rank asks, for the fresh bodies with a copy in its subdomains, the kept F_Γ of
-//! their copies in other ranks' subdomains, and each subdomain's rank answers (point
-//! to point, [`RankState::ask_ranks`]: as long as the fresh bodies at rank
-//! boundaries). Then every rank
+//! rank asks, for the fresh bodies with a copy in its subdomains, whether their
+//! copies in other ranks' subdomains kept an F_Γ and its value, and each
+//! subdomain's rank answers from its own store (point to point,
+//! [`RankState::ask_ranks`]: as long as the fresh bodies at rank boundaries; the
+//! asking rank's store may not know those copies, [`super::shells`]). Then every rank
 //! starts its copies where one process does, bit for bit.
 
 use super::family::Family;
@@ -22,7 +23,9 @@ impl RankState {
     pub(super) fn fresh_f_gamma<D: Family>(&mut self, d: &mut Decomposition<D>, store: &FGammaStore<D::V>, v_free: &[D::V]) {
         let iface = &d.iface;
         let mut bodies = Vec::new();
-        // (subdomain, body) of the other ranks' copies asked
+        // (subdomain, body) of the other ranks' copies asked: each one's kept F_Γ,
+        // zero if it has none (this rank's store may not know: with limited shells
+        // it holds the others' copies of the bodies near it only)
         let mut asks = Vec::new();
         for ib in 0..iface.n_rigid {
             let ks = iface.copies(ib);
@@ -31,12 +34,7 @@ impl RankState {
             }
             bodies.push(ib);
             let g = iface.body[ib];
-            for k in ks {
-                let s = iface.sub[k];
-                if !self.is_own(s) && store.get(g, s).is_some() {
-                    asks.push((s, g));
-                }
-            }
+            asks.extend(ks.map(|k| iface.sub[k]).filter(|&s| !self.is_own(s)).map(|s| (s, g)));
         }
         let ndof = super::subdomain::dofs::<D>();
         let got = self.ask_ranks(&asks, ndof, |s, g, out| {
@@ -53,9 +51,8 @@ impl RankState {
                 .copies(ib)
                 .map(|k| {
                     let s = iface.sub[k];
-                    let kept = store.get(g, s);
-                    if self.is_own(s) || kept.is_none() {
-                        return kept.unwrap_or_default();
+                    if self.is_own(s) {
+                        return store.get(g, s).unwrap_or_default();
                     }
                     let mut v = D::V::default();
                     if let Some(x) = answers.next() {

@@ -91,24 +91,3 @@ pub(super) fn per_subdomain(ranks: Option<&mut RankState>, ns: usize, k: usize, 
         }
     }
 }
-
-/// [`RankState::per_subdomain_v`] on ranks; in one process every subdomain's values
-/// from `own` and where they start.
-pub(super) fn per_subdomain_v(
-    ranks: Option<&mut RankState>,
-    ns: usize,
-    len: impl Fn(usize) -> usize,
-    mut own: impl FnMut(usize, &mut Vec<f64>),
-) -> (Vec<usize>, Vec<f64>) {
-    match ranks {
-        Some(r) => r.per_subdomain_v(ns, len, own),
-        None => {
-            let (mut at, mut v) = (Vec::with_capacity(ns), Vec::new());
-            for s in 0..ns {
-                at.push(v.len());
-                own(s, &mut v);
-            }
-            (at, v)
-        }
-    }
-}

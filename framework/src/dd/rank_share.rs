@@ -27,13 +27,15 @@ impl RankState {
     pub(super) fn share_requested<D: Family>(&mut self, d: &mut Decomposition<D>, active: Option<&[u32]>) {
         let ndof = super::subdomain::dofs::<D>();
         let me = self.cluster.rank();
-        // (subdomain, local body) of the copies asked, in subdomain then body order
-        let mut asks = Vec::new();
+        // (subdomain, local body) of the copies asked, in subdomain then body order:
+        // their ids on the subdomain's rank, and here (a limited shell's own)
+        let (mut asks, mut here) = (Vec::new(), Vec::new());
         for s in d.subs.iter_mut().filter(|s| self.rank_of[s.id as usize] != me) {
             s.vel.resize(s.body_global.len(), D::V::default());
             for (l, g) in s.body_global.iter().enumerate() {
                 if active.is_none_or(|a| a.binary_search(g).is_ok()) {
-                    asks.push((s.id, l as u32));
+                    asks.push((s.id, s.remote_id(l as u32)));
+                    here.push((s.id, l as u32));
                 }
             }
         }
@@ -43,7 +45,7 @@ impl RankState {
         });
         let mut answered = self.answered.take().unwrap_or_default();
         answered.clear();
-        for (&(s, l), v) in asks.iter().zip(got.chunks_exact(ndof)) {
+        for (&(s, l), v) in here.iter().zip(got.chunks_exact(ndof)) {
             d.subs[s as usize].vel[l as usize].as_mut().copy_from_slice(v);
             answered.push((s, l));
         }

@@ -9,9 +9,12 @@ use super::ranks::RankState;
 /// seconds since the run started, those spent in communication (`wait_cpu_seconds`,
 /// the main thread's) and the rest (`compute_cpu_seconds`): a rank's compute
 /// measured apart from its waits even when ranks share cores; its peak resident
-/// memory (`peak_rss_mib`, at the end of the run: `final.json` written).
+/// memory (`peak_rss_mib`, at the end of the run: `final.json` written); the other
+/// ranks' subdomains' bodies it held, summed over the steps (`shell_bodies`), and
+/// the steps whose shells were limited to the bodies near it
+/// (`limited_shell_steps`, [`super::shells`]).
 pub fn totals_json(st: &mut RankState) -> String {
-    const H: usize = 17;
+    const H: usize = 19;
     let p = st.cluster.size() as usize;
     let t = &st.totals;
     let (wait_wall, wait_cpu) = st.cluster.waited();
@@ -34,6 +37,8 @@ pub fn totals_json(st: &mut RankState) -> String {
         t.bodies_stepped as f64,
         t.bodies_sent as f64,
         super::cluster::peak_rss_mib(),
+        t.shell_bodies as f64,
+        t.limited_shells as f64,
         t.peers.len() as f64,
     ];
     mine.extend(t.peers.iter().map(|&x| x as f64));
@@ -65,6 +70,8 @@ pub fn totals_json(st: &mut RankState) -> String {
                 "bodies_stepped": x[13] as u64,
                 "bodies_sent": x[14] as u64,
                 "peak_rss_mib": x[15],
+                "shell_bodies": x[16] as u64,
+                "limited_shell_steps": x[17] as u64,
                 "peers": peers,
                 "last_subdomains": subs,
             })

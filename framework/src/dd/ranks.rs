@@ -31,13 +31,14 @@
 //!
 //! Between repartitions, for rigid bodies, each rank holds only its subdomains'
 //! contacts ([`super::local`]): it detects and builds those alone, the other ranks'
-//! subdomains are shells (their bodies), and the end of the step carries only the
-//! copy velocities a rank asked for, point to point ([`super::rank_share`]); a
-//! repartition merges every rank's bounds and counts and detects again; each rank
-//! steps only the bodies near its cells ([`super::owned`]). What is not distributed
-//! yet (docs/SCALING.md): the bodies' arrays (every rank allocates the whole
-//! sample), the shells' body lists (all-gathered each step) and, before a
-//! repartition, every subdomain's results.
+//! subdomains are shells (the bodies near it, [`super::shells`]), and the end of
+//! the step carries only the copy velocities a rank asked for, point to point
+//! ([`super::rank_share`]); a repartition merges every rank's bounds and counts
+//! and detects again; each rank steps only the bodies near its cells
+//! ([`super::owned`]). What is not distributed yet (docs/SCALING.md): the bodies'
+//! arrays (every rank allocates the whole sample), the shells' body lists on the
+//! steps around a repartition (all-gathered) and, before a repartition, every
+//! subdomain's results.
 
 use super::cluster::Cluster;
 use super::family::Family;
@@ -79,6 +80,10 @@ pub struct RankTotals {
     /// all before a full step, to rank 0 for the outputs).
     pub bodies_stepped: u64,
     pub bodies_sent: u64,
+    /// Bodies of the other ranks' subdomains (shells) this rank held, summed over
+    /// the steps, and the steps whose shells were limited ([`super::shells`]).
+    pub shell_bodies: u64,
+    pub limited_shells: u64,
 }
 
 /// The multi-process state of an NSCDD solver.
@@ -441,8 +446,10 @@ impl RankState {
 /// `max_stages` stages of `per` sweeps (relaxation `omega`) and one gluing, a check
 /// every `k` stages and at the last, `converged(sums, residual share)` deciding on
 /// every rank from the same merged numbers; then every subdomain's results on every
-/// rank. The subdomains' ranks are those of [`RankState::assign`] at the partition.
-/// Returns the stages run and this step's exchange counts.
+/// rank. The subdomains' ranks are those of [`RankState::assign`] at the partition;
+/// `fresh`: whether any interface body is fresh (the same on every rank: the ranks
+/// glue those together first). Returns the stages run and this step's exchange
+/// counts.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn iterate<D: Family>(
     st: &mut RankState,
@@ -450,7 +457,7 @@ pub(super) fn iterate<D: Family>(
     scheme: Scheme,
     (per, omega, max_stages, k): (u32, f64, u32, u32),
     (threads, workers): (usize, &mut super::team::Workers),
-    (mut mixer, requests): (Option<&mut super::anderson::StageMixer>, Option<Option<&[u32]>>),
+    (mut mixer, requests, fresh): (Option<&mut super::anderson::StageMixer>, Option<Option<&[u32]>>, bool),
     mut converged: impl FnMut(&Sums, &GluePartial) -> bool,
 ) -> (u32, TransportStats) {
     let t0 = Instant::now();
@@ -468,7 +475,7 @@ pub(super) fn iterate<D: Family>(
     let iface = &d.iface;
     let mine_id = |id: u32| rank_of[id as usize] == me;
     let (stages, _) = super::team::with_team(&mut d.subs, (threads, &mine), iface, workers, |team| {
-        if iface.fresh.iter().any(|&f| f) {
+        if fresh {
             team.with_all(|subs| st.glue(subs, iface, scheme, true, &mut own));
         }
         if let Some(m) = mixer.as_deref_mut() {

@@ -39,6 +39,10 @@ pub struct Subdomain<D: Family> {
     pub order: Vec<u32>,
     /// Global id of each local body copy.
     pub body_global: Vec<u32>,
+    /// Another rank's subdomain limited to the bodies this rank needs
+    /// ([`super::shells`]): each body's local id on the subdomain's rank. Empty when
+    /// the ids are those of the subdomain's rank ([`Subdomain::remote_id`]).
+    pub shell_local: Vec<u32>,
     /// Copy velocities V_E.
     pub vel: Vec<D::V>,
     /// Copy M̂_E⁻¹ = m M̂⁻¹.
@@ -69,6 +73,14 @@ pub struct Subdomain<D: Family> {
     pub chain: Vec<(u32, u32)>,
     /// Check-pass sums of the last check sweep.
     pub sums: Sums,
+}
+
+impl<D: Family> Subdomain<D> {
+    /// The local id, on the subdomain's rank, of this process's copy `l` (the same
+    /// id unless the subdomain is a limited shell).
+    pub fn remote_id(&self, l: u32) -> u32 {
+        self.shell_local.get(l as usize).copied().unwrap_or(l)
+    }
 }
 
 /// A subdomain of 2D rigid bodies.

@@ -1,0 +1,266 @@
+//! The other ranks' subdomains as shells (contacts held per rank, [`super::local`]):
+//! their bodies only, so that a rank's multiplicities, chains and F_Γ are those of
+//! one process; and the counts over shared bodies that the outputs read.
+//!
+//! ```text
+//! whole shells    every subdomain's body list to every rank (two all-gathers): on
+//!                 the steps around a repartition, with the centralized scheme, or
+//!                 while a rank steps every body
+//! limited shells  between repartitions: subdomain t's rank sends body b of t to
+//!                 rank R (point to point, RankState::send_ranks) when
+//!                   b is stepped by every rank (fixed, driven, named, unbounded), or
+//!                   b's box grown by the alert distance meets R's cells, or
+//!                   R announced b (one small all-gather): a body R steps or holds
+//!                   that the box test misses (a kept contact drifted off R's cells)
+//! ```
+//!
+//! Every rank holding b tests the same box (b's state is bitwise the same wherever
+//! it is stepped), so R receives either every copy of b or none: every body R steps
+//! or holds in its subdomains comes with all its copies, and R's interface is the
+//! one-process interface restricted to those bodies. What reads more than that is
+//! reduced over the ranks: the history's interface counts and whether any body is
+//! fresh ([`interface_totals`]), the census' loaded contacts of shared bodies and
+//! the bodies' subdomains of the VTK frames ([`copy_counts`], asked of the copies'
+//! ranks), a fresh body's kept F_Γ ([`super::rank_fresh`]). A shell's local ids
+//! are this rank's; [`super::Subdomain::remote_id`] gives its rank's.
+
+use super::cells::CellIndex;
+use super::family::Family;
+use super::partition::Decomposition;
+use super::ranks::RankState;
+use super::subdomain::Subdomain;
+use crate::detect::Region;
+
+/// What decides which bodies of its subdomains a rank sends to another (module docs).
+pub(super) struct Near<'a> {
+    /// Every rank's cells.
+    pub cells: &'a CellIndex,
+    /// The bodies' boxes at the start of the step (those a rank steps up to date).
+    pub boxes: &'a [[[f64; 3]; 2]],
+    /// Bodies stepped by every rank, by id.
+    pub everywhere: &'a [bool],
+    /// The bodies this rank steps (ascending).
+    pub active: &'a [u32],
+    pub alert: f64,
+}
+
+impl Near<'_> {
+    /// Calls `f` with the ranks whose cells body g's grown box meets.
+    fn ranks_of<D: Family>(&self, g: u32, f: impl FnMut(u32)) {
+        let b = &self.boxes[g as usize];
+        let (lo, hi) = Region::grown_box(D::SPACE, &b[0], &b[1], self.alert);
+        self.cells.ranks_meeting(D::SPACE, &lo, &hi, f);
+    }
+}
+
+impl RankState {
+    /// The other ranks' subdomains' bodies, in their order (two all-gathers): whole
+    /// shells ([`super::partition::decompose_owned`]).
+    pub(super) fn fill_shells<D: Family>(&mut self, subs: &mut [Subdomain<D>]) {
+        let ns = subs.len();
+        let lens = self.per_subdomain(ns, 1, |s, out| out.push(subs[s].body_global.len() as f64));
+        let (at, all) = self.per_subdomain_v(
+            ns,
+            |s| lens[s] as usize,
+            |s, out| out.extend(subs[s].body_global.iter().map(|&g| f64::from(g))),
+        );
+        for (s, sub) in subs.iter_mut().enumerate() {
+            if !self.is_own(s as u32) {
+                sub.body_global = all[at[s]..at[s] + lens[s] as usize].iter().map(|&g| g as u32).collect();
+                self.totals.shell_bodies += lens[s] as u64;
+            }
+        }
+    }
+
+    /// The other ranks' subdomains limited to the bodies this rank may need, from
+    /// their ranks point to point (module docs). Collective.
+    pub(super) fn fill_shells_near<D: Family>(&mut self, subs: &mut [Subdomain<D>], near: &Near) {
+        let (me, np) = (self.cluster.rank(), self.cluster.size() as usize);
+        // this rank's bodies the box test misses, announced to every rank
+        let mut extra: Vec<u32> = Vec::new();
+        let mut missed = |g: u32| {
+            let mut meets = false;
+            near.ranks_of::<D>(g, |q| meets |= q == me);
+            if !meets && !near.everywhere[g as usize] {
+                extra.push(g);
+            }
+        };
+        near.active.iter().for_each(|&g| missed(g));
+        for s in subs.iter().filter(|s| self.is_own(s.id)) {
+            s.body_global.iter().for_each(|&g| missed(g));
+        }
+        extra.sort_unstable();
+        extra.dedup();
+        let mine: Vec<f64> = extra.iter().map(|&g| f64::from(g)).collect();
+        let (counts, all) = self.all_gather_any(&mine);
+        // (body, rank) of every rank's announced bodies, by body
+        let mut asked: Vec<(u32, u32)> = Vec::with_capacity(all.len());
+        let mut start = 0;
+        for (q, &n) in counts.iter().enumerate() {
+            asked.extend(all[start..start + n].iter().map(|&g| (g as u32, q as u32)));
+            start += n;
+        }
+        asked.sort_unstable();
+        // each own subdomain's bodies (subdomain, local id, body) to the ranks that may need them
+        let mut out: Vec<Vec<f64>> = vec![Vec::new(); np];
+        let mut to: Vec<u32> = Vec::new();
+        for s in subs.iter().filter(|s| self.is_own(s.id)) {
+            for (l, &g) in s.body_global.iter().enumerate() {
+                to.clear();
+                if near.everywhere[g as usize] {
+                    to.extend(0..np as u32);
+                } else {
+                    near.ranks_of::<D>(g, |q| to.push(q));
+                    let a = asked.partition_point(|e| e.0 < g);
+                    to.extend(asked[a..].iter().take_while(|e| e.0 == g).map(|e| e.1));
+                }
+                to.sort_unstable();
+                to.dedup();
+                for &q in to.iter().filter(|&&q| q != me) {
+                    out[q as usize].extend([f64::from(s.id), l as f64, f64::from(g)]);
+                }
+            }
+        }
+        let (_, got) = self.send_ranks(out);
+        for sub in subs.iter_mut().filter(|s| !self.is_own(s.id)) {
+            sub.body_global.clear();
+            sub.shell_local.clear();
+        }
+        // a rank's subdomains in ascending id, each in its local order
+        for x in got.iter().flat_map(|m| m.chunks_exact(3)) {
+            let sub = &mut subs[x[0] as usize];
+            sub.body_global.push(x[2] as u32);
+            sub.shell_local.push(x[1] as u32);
+        }
+        self.totals.shell_bodies += got.iter().map(|m| m.len() as u64 / 3).sum::<u64>();
+        self.totals.limited_shells += 1;
+    }
+}
+
+/// A step's totals over the ranks (contacts held per rank).
+pub(super) struct Totals {
+    pub contacts: usize,
+    /// The interface bodies and links, the largest multiplicity, and whether some
+    /// interface body is fresh: those of one process.
+    pub bodies: usize,
+    pub links: usize,
+    pub max_multiplicity: u32,
+    pub fresh: bool,
+}
+
+/// The step's totals from every rank's share (one all-gather; `contacts`: this
+/// rank's): each rank counts the interface bodies and links whose first copy is in
+/// its subdomains, the largest multiplicity of its subdomains' bodies, and whether
+/// one of its copies is fresh (it knows every copy of those bodies). Collective.
+pub(super) fn interface_totals<D: Family>(rs: &mut RankState, d: &Decomposition<D>, contacts: usize) -> Totals {
+    let ifc = &d.iface;
+    let own = |s: u32| rs.is_own(s);
+    let (mut bodies, mut links, mut fresh) = (0usize, 0usize, false);
+    for ib in 0..ifc.len() {
+        let ks = ifc.copies(ib);
+        if own(ifc.sub[ks.start]) {
+            bodies += 1;
+            links += ks.len() - 1;
+        }
+        fresh |= ifc.fresh[ib] && ks.clone().any(|k| own(ifc.sub[k]));
+    }
+    let m = d.subs.iter().filter(|s| own(s.id));
+    let max = m.flat_map(|s| s.body_global.iter().map(|&g| d.mult[g as usize])).max().unwrap_or(0);
+    let mine = [
+        contacts as f64,
+        bodies as f64,
+        links as f64,
+        f64::from(max),
+        f64::from(u8::from(fresh)),
+    ];
+    let (_, all) = rs.all_gather_any(&mine);
+    let x = all.chunks_exact(mine.len());
+    Totals {
+        contacts: x.clone().map(|x| x[0] as usize).sum(),
+        bodies: x.clone().map(|x| x[1] as usize).sum(),
+        links: x.clone().map(|x| x[2] as usize).sum(),
+        max_multiplicity: x.clone().map(|x| x[3] as u32).max().unwrap_or(0),
+        fresh: x.clone().any(|x| x[4] > 0.0),
+    }
+}
+
+/// Every copy (body, subdomain, count) of the bodies held by several subdomains and
+/// by one of this rank's, sorted, where `counts[s]` (given for this rank's
+/// subdomains, by local body) are the subdomains' per-copy counts; the other ranks'
+/// asked of their ranks (collective; in one process every subdomain is its own).
+pub(super) fn copy_counts<D: Family>(
+    d: &Decomposition<D>,
+    ranks: Option<&mut RankState>,
+    counts: &[Option<Vec<u32>>],
+) -> Vec<(u32, u32, u32)> {
+    let nb = d.mult.len();
+    let own = |s: usize| counts[s].is_some();
+    let mut held = vec![false; nb];
+    let mut out = Vec::new();
+    for (s, sub) in d.subs.iter().enumerate().filter(|(s, _)| own(*s)) {
+        let c = counts[s].as_deref().unwrap_or_default();
+        for (l, &g) in sub.body_global.iter().enumerate() {
+            if d.mult[g as usize] >= 2 {
+                held[g as usize] = true;
+                out.push((g, s as u32, c[l]));
+            }
+        }
+    }
+    if let Some(rs) = ranks {
+        // the other ranks' copies of those bodies: (subdomain, their local id)
+        let (mut asks, mut bodies) = (Vec::new(), Vec::new());
+        for (s, sub) in d.subs.iter().enumerate().filter(|(s, _)| !own(*s)) {
+            for (l, &g) in sub.body_global.iter().enumerate() {
+                if held[g as usize] {
+                    asks.push((s as u32, sub.remote_id(l as u32)));
+                    bodies.push(g);
+                }
+            }
+        }
+        let got = rs.ask_ranks(&asks, 1, |s, l, v| {
+            v.push(counts[s as usize].as_ref().map_or(0.0, |c| f64::from(c[l as usize])));
+        });
+        out.extend(asks.iter().zip(&bodies).zip(&got).map(|((a, &g), &n)| (g, a.0, n as u32)));
+    }
+    out.sort_unstable();
+    out
+}
+
+/// The subdomain owning most of each body's contacts (ties: the smaller id; −1
+/// without contacts), as `NscddOf::view` counts them over the whole contact list,
+/// for the bodies this rank holds (another subdomain of the others it knows): a
+/// body held by one subdomain is its; the counts of the bodies held by several
+/// come from their subdomains' ranks (collective).
+pub(super) fn body_subdomains<D: Family>(rs: &mut RankState, d: &Decomposition<D>, nb: usize) -> Vec<i32> {
+    let counts: Vec<Option<Vec<u32>>> = d
+        .subs
+        .iter()
+        .map(|sub| {
+            rs.is_own(sub.id).then(|| {
+                let mut n = vec![0u32; sub.body_global.len()];
+                for a in 0..D::len(&sub.contacts) {
+                    for l in D::bodies(&sub.contacts, a) {
+                        n[l as usize] += 1;
+                    }
+                }
+                n
+            })
+        })
+        .collect();
+    let copies = copy_counts(d, Some(rs), &counts);
+    let mut out = vec![-1i32; nb];
+    for sub in d.subs.iter().rev() {
+        for &g in &sub.body_global {
+            out[g as usize] = sub.id as i32;
+        }
+    }
+    let mut best = vec![0u32; nb];
+    // ascending subdomain ids: a strictly larger count wins
+    for (g, s, n) in copies {
+        if n > best[g as usize] {
+            best[g as usize] = n;
+            out[g as usize] = s as i32;
+        }
+    }
+    out
+}
