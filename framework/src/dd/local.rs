@@ -47,6 +47,9 @@ pub(super) struct Local {
     pub skip_view: bool,
     /// A distributed repartition's grid and number of contacts, for the partition.
     pub new_grid: Option<(Grid, usize)>,
+    /// The step in progress holds the other ranks' subdomains as limited shells
+    /// ([`super::shells`]; its end then comes by requests, even before a repartition).
+    pub limited: bool,
     /// The bodies this rank steps ([`super::owned`]).
     pub owned: super::owned::Owned,
     /// On a repartition step: this rank's contacts of the last step (their
@@ -253,7 +256,8 @@ impl<D: Family> super::NscddOf<D> {
             loads[grid.cell_of(D::point(c, a)) as usize] += 1.0;
         }
         let sum: Vec<usize> = rs.all_sum(&loads).into_iter().map(|x| x as usize).collect();
-        rs.rank_of = super::rank_balance::balanced_ranks(&sum, rs.cluster.size());
+        let new = super::rank_balance::balanced_ranks(&sum, rs.cluster.size());
+        rs.old_rank_of = std::mem::replace(&mut rs.rank_of, new);
         if D::active(w).is_some() {
             let Local { owned, boxes, .. } = &mut self.local;
             owned.repartition::<D>(w, (rs, &grid), boxes, &mut self.v_free);

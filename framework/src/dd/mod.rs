@@ -292,7 +292,9 @@ impl<D: Family> NscddOf<D> {
             o.extend(self.fam_points[r].iter().map(|&p| base + grid.cell_of(p)));
         }
         let nb = D::n_bodies(w);
-        let before = (repart && self.steps > 0).then(|| partition::body_sets(&self.last, nb));
+        // limited shells ([`shells`]): on a repartition step, the kept F_Γ routed
+        let start = self.start_shells(w, repart);
+        let before = (repart && self.steps > 0 && start.is_none()).then(|| partition::body_sets(&self.last, nb));
         if repart {
             self.grid = Some(grid.clone());
             let total = self.local.new_grid.take().map_or(nc, |(_, t)| t);
@@ -305,29 +307,12 @@ impl<D: Family> NscddOf<D> {
             fams,
             owner: &self.fam_owner,
         };
-        // shells limited to the bodies near this rank between repartitions, while it
-        // steps some bodies only, with the decentralized scheme ([`shells`])
-        let limited = self.local.now && !repart && !self.repartitions_at(self.steps + 1) && self.settings.scheme == Scheme::Decentralized;
         let local = &self.local;
-        let alert = D::alert(w);
         let mut shells = |subs: &mut [Subdomain<D>]| {
             let rs = self.ranks.as_mut().expect("ranks");
-            match (limited, D::active(w), local.owned.cells.as_ref()) {
-                (true, Some(active), Some(cells)) => {
-                    let everywhere = local.owned.everywhere();
-                    let boxes = &local.boxes;
-                    rs.fill_shells_near(
-                        subs,
-                        &shells::Near {
-                            cells,
-                            boxes,
-                            everywhere,
-                            active,
-                            alert,
-                        },
-                    );
-                }
-                _ => rs.fill_shells(subs),
+            match start.as_ref().and_then(|(asked, _)| shells::near_of::<D>(local, w, asked)) {
+                Some(near) => rs.fill_shells_near(subs, &near),
+                None => rs.fill_shells(subs),
             }
         };
         let shells = self.local.now.then_some(&mut shells as &mut dyn FnMut(&mut [Subdomain<D>]));
@@ -337,6 +322,9 @@ impl<D: Family> NscddOf<D> {
             rs.fresh_f_gamma(&mut self.last, &self.store, &self.v_free);
         }
         rep.repartitioned = repart;
+        if let (Some((_, Some(before))), Some(rs)) = (&start, self.ranks.as_mut()) {
+            rep.migrations = shells::migrations(rs, &self.last, before);
+        }
         if let Some(before) = before {
             let after = partition::body_sets(&self.last, nb);
             rep.migrations = before
@@ -432,7 +420,9 @@ impl<D: Family> NscddOf<D> {
             // bodies stepped per rank, the subdomains kept on their ranks next step:
             // only the copies of the bodies this rank steps come back (`rank_share`)
             // (the same choice on every rank: the all-gathers that follow are collective)
-            let requests = (self.local.now && !next_repartitions).then(|| D::active(w));
+            // (with limited shells before a repartition too: the next step routes
+            // the kept F_Γ, [`shells`])
+            let requests = (self.local.now && (self.local.limited || !next_repartitions)).then(|| D::active(w));
             let (stages, stats) = ranks::iterate(
                 rs,
                 d,

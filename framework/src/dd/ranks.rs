@@ -91,6 +91,8 @@ pub struct RankState {
     pub cluster: Box<dyn Cluster>,
     /// Rank of each subdomain (the last repartition's).
     pub rank_of: Vec<u32>,
+    /// On a distributed repartition's step, the ranks of the last step's subdomains.
+    pub(super) old_rank_of: Vec<u32>,
     link: RankLink,
     glue: GlueBuffers,
     chain: ChainBuffers,
@@ -120,6 +122,7 @@ impl RankState {
         RankState {
             cluster,
             rank_of: Vec::new(),
+            old_rank_of: Vec::new(),
             link: RankLink::default(),
             glue: GlueBuffers::default(),
             chain: ChainBuffers::default(),

@@ -26,7 +26,7 @@
 
 use super::cells::CellIndex;
 use super::family::Family;
-use super::partition::Decomposition;
+use super::partition::{Decomposition, FGammaStore};
 use super::ranks::RankState;
 use super::subdomain::Subdomain;
 use crate::detect::Region;
@@ -42,6 +42,8 @@ pub(super) struct Near<'a> {
     /// The bodies this rank steps (ascending).
     pub active: &'a [u32],
     pub alert: f64,
+    /// (body, rank) of the bodies each rank announced ([`RankState::announce`]).
+    pub asked: &'a [(u32, u32)],
 }
 
 impl Near<'_> {
@@ -50,6 +52,19 @@ impl Near<'_> {
         let b = &self.boxes[g as usize];
         let (lo, hi) = Region::grown_box(D::SPACE, &b[0], &b[1], self.alert);
         self.cells.ranks_meeting(D::SPACE, &lo, &hi, f);
+    }
+
+    /// The ranks (`np` of them) that may need body g, into `to` (ascending, once each).
+    fn targets<D: Family>(&self, g: u32, np: usize, to: &mut Vec<u32>) {
+        to.clear();
+        if self.everywhere[g as usize] {
+            return to.extend(0..np as u32);
+        }
+        self.ranks_of::<D>(g, |q| to.push(q));
+        let a = self.asked.partition_point(|e| e.0 < g);
+        to.extend(self.asked[a..].iter().take_while(|e| e.0 == g).map(|e| e.1));
+        to.sort_unstable();
+        to.dedup();
     }
 }
 
@@ -72,28 +87,21 @@ impl RankState {
         }
     }
 
-    /// The other ranks' subdomains limited to the bodies this rank may need, from
-    /// their ranks point to point (module docs). Collective.
-    pub(super) fn fill_shells_near<D: Family>(&mut self, subs: &mut [Subdomain<D>], near: &Near) {
-        let (me, np) = (self.cluster.rank(), self.cluster.size() as usize);
-        // this rank's bodies the box test misses, announced to every rank
-        let mut extra: Vec<u32> = Vec::new();
-        let mut missed = |g: u32| {
+    /// The bodies this rank steps (`near.active`) or holds (`held`: its contacts'
+    /// bodies) that the box test misses, announced to every rank (one all-gather):
+    /// (body, rank) of every rank's, sorted ([`Near::asked`]). Collective.
+    pub(super) fn announce<D: Family>(&mut self, near: &Near, held: impl Iterator<Item = u32>) -> Vec<(u32, u32)> {
+        let me = self.cluster.rank();
+        let missed = |g: &u32| {
             let mut meets = false;
-            near.ranks_of::<D>(g, |q| meets |= q == me);
-            if !meets && !near.everywhere[g as usize] {
-                extra.push(g);
-            }
+            near.ranks_of::<D>(*g, |q| meets |= q == me);
+            !meets && !near.everywhere[*g as usize]
         };
-        near.active.iter().for_each(|&g| missed(g));
-        for s in subs.iter().filter(|s| self.is_own(s.id)) {
-            s.body_global.iter().for_each(|&g| missed(g));
-        }
+        let mut extra: Vec<u32> = near.active.iter().copied().chain(held).filter(missed).collect();
         extra.sort_unstable();
         extra.dedup();
         let mine: Vec<f64> = extra.iter().map(|&g| f64::from(g)).collect();
         let (counts, all) = self.all_gather_any(&mine);
-        // (body, rank) of every rank's announced bodies, by body
         let mut asked: Vec<(u32, u32)> = Vec::with_capacity(all.len());
         let mut start = 0;
         for (q, &n) in counts.iter().enumerate() {
@@ -101,21 +109,19 @@ impl RankState {
             start += n;
         }
         asked.sort_unstable();
+        asked
+    }
+
+    /// The other ranks' subdomains limited to the bodies this rank may need, from
+    /// their ranks point to point (module docs). Collective.
+    pub(super) fn fill_shells_near<D: Family>(&mut self, subs: &mut [Subdomain<D>], near: &Near) {
+        let (me, np) = (self.cluster.rank(), self.cluster.size() as usize);
         // each own subdomain's bodies (subdomain, local id, body) to the ranks that may need them
         let mut out: Vec<Vec<f64>> = vec![Vec::new(); np];
         let mut to: Vec<u32> = Vec::new();
         for s in subs.iter().filter(|s| self.is_own(s.id)) {
             for (l, &g) in s.body_global.iter().enumerate() {
-                to.clear();
-                if near.everywhere[g as usize] {
-                    to.extend(0..np as u32);
-                } else {
-                    near.ranks_of::<D>(g, |q| to.push(q));
-                    let a = asked.partition_point(|e| e.0 < g);
-                    to.extend(asked[a..].iter().take_while(|e| e.0 == g).map(|e| e.1));
-                }
-                to.sort_unstable();
-                to.dedup();
+                near.targets::<D>(g, np, &mut to);
                 for &q in to.iter().filter(|&&q| q != me) {
                     out[q as usize].extend([f64::from(s.id), l as f64, f64::from(g)]);
                 }
@@ -135,6 +141,113 @@ impl RankState {
         self.totals.shell_bodies += got.iter().map(|m| m.len() as u64 / 3).sum::<u64>();
         self.totals.limited_shells += 1;
     }
+
+    /// On a repartition step with limited shells (the new cells and ranks set,
+    /// before the partition): each copy of the last step's own subdomains
+    /// (`last`, its ranks `old_rank_of`) goes, with its kept F_Γ, to the ranks that
+    /// may need its body now. Returns the store of the bodies near this rank (every
+    /// copy's kept F_Γ: those of one process) and their last subdomains, (body,
+    /// subdomain) sorted: the migrations' "before". Collective.
+    pub(super) fn route_repartition<D: Family>(
+        &mut self,
+        last: &Decomposition<D>,
+        store: &FGammaStore<D::V>,
+        near: &Near,
+    ) -> (FGammaStore<D::V>, Vec<(u32, u32)>) {
+        let (me, np) = (self.cluster.rank(), self.cluster.size() as usize);
+        let ndof = super::subdomain::dofs::<D>();
+        let per = 3 + ndof;
+        let mut out: Vec<Vec<f64>> = vec![Vec::new(); np];
+        let mut to: Vec<u32> = Vec::new();
+        let old_own = |t: u32| self.old_rank_of.get(t as usize) == Some(&me);
+        for sub in last.subs.iter().filter(|s| old_own(s.id)) {
+            for &g in &sub.body_global {
+                near.targets::<D>(g, np, &mut to);
+                let kept = store.get(g, sub.id);
+                for &q in &to {
+                    let o = &mut out[q as usize];
+                    o.extend([f64::from(sub.id), f64::from(g), f64::from(u8::from(kept.is_some()))]);
+                    o.extend_from_slice(kept.unwrap_or_default().as_ref());
+                }
+            }
+        }
+        let mine = std::mem::take(&mut out[me as usize]);
+        let (_, got) = self.send_ranks(out);
+        let (mut entries, mut before) = (Vec::new(), Vec::new());
+        for x in got.iter().chain([&mine]).flat_map(|m| m.chunks_exact(per)) {
+            let (t, g) = (x[0] as u32, x[1] as u32);
+            before.push((g, t));
+            if x[2] > 0.0 {
+                let mut v = D::V::default();
+                v.as_mut().copy_from_slice(&x[3..]);
+                entries.push((g, t, v));
+            }
+        }
+        before.sort_unstable();
+        (FGammaStore::from_entries(entries), before)
+    }
+}
+
+/// The bodies whose subdomains changed at a repartition with limited shells, over
+/// every rank (one all-gather): each rank counts the bodies whose first new
+/// subdomain is its own (it knows all their copies, now and, from `before`, at the
+/// last step) and that were held before. Collective.
+pub(super) fn migrations<D: Family>(rs: &mut RankState, d: &Decomposition<D>, before: &[(u32, u32)]) -> usize {
+    let mut after: Vec<(u32, u32)> = d.subs.iter().flat_map(|s| s.body_global.iter().map(move |&g| (g, s.id))).collect();
+    after.sort_unstable();
+    let mut n = 0usize;
+    let mut i = 0;
+    while i < after.len() {
+        let g = after[i].0;
+        let k = after[i..].iter().take_while(|e| e.0 == g).count();
+        if rs.is_own(after[i].1) {
+            let a = before.partition_point(|e| e.0 < g);
+            let b = before[a..].iter().take_while(|e| e.0 == g).count();
+            n += usize::from(b > 0 && before[a..a + b] != after[i..i + k]);
+        }
+        i += k;
+    }
+    let (_, all) = rs.all_gather_any(&[n as f64]);
+    all.iter().map(|&x| x as usize).sum()
+}
+
+impl<D: Family> super::NscddOf<D> {
+    /// Before the partition, with contacts held per rank: whether this step's shells
+    /// are limited (the decentralized scheme, while this rank steps some bodies
+    /// only: `self.local.limited`); if so the bodies every rank announced and, on a
+    /// repartition step, the store routed from the last step's ranks (module docs;
+    /// it replaces this rank's) and the migrations' "before". Collective.
+    pub(super) fn start_shells(&mut self, w: &D::World, repart: bool) -> Option<(Vec<(u32, u32)>, Option<Vec<(u32, u32)>>)> {
+        let decentralized = self.settings.scheme == super::Scheme::Decentralized;
+        self.local.limited = self.local.now && decentralized && near_of::<D>(&self.local, w, &[]).is_some();
+        if !self.local.limited {
+            return None;
+        }
+        let rs = self.ranks.as_mut()?;
+        let near = near_of::<D>(&self.local, w, &[])?;
+        let c = D::contacts(w);
+        let asked = rs.announce::<D>(&near, (0..D::len(c)).flat_map(|a| D::bodies(c, a)));
+        let near = Near { asked: &asked, ..near };
+        let before = repart.then(|| {
+            let (store, before) = rs.route_repartition(&self.last, &self.store, &near);
+            self.store = store;
+            before
+        });
+        Some((asked, before))
+    }
+}
+
+/// The rule of a step's limited shells ([`Near`]; None while this rank steps every
+/// body).
+pub(super) fn near_of<'a, D: Family>(local: &'a super::local::Local, w: &'a D::World, asked: &'a [(u32, u32)]) -> Option<Near<'a>> {
+    Some(Near {
+        cells: local.owned.cells.as_ref()?,
+        boxes: &local.boxes,
+        everywhere: local.owned.everywhere(),
+        active: D::active(w)?,
+        alert: D::alert(w),
+        asked,
+    })
 }
 
 /// A step's totals over the ranks (contacts held per rank).
