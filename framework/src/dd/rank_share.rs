@@ -11,8 +11,10 @@
 //! reads the own subdomains and the copies received only
 //! (`attach::write_back_held`). The
 //! other ranks' F_Γ are left as they were: a rank glues and warm-starts only its own
-//! subdomains' copies, and before a repartition (when subdomains change ranks) the
-//! whole results are shared instead ([`RankState::share_results`]). Every copy a
+//! subdomains' copies; before a repartition (when subdomains change ranks) the
+//! repartition step routes the kept F_Γ ([`super::shells`]), or, with whole
+//! shells, the whole results are shared instead ([`RankState::share_results`]).
+//! Every copy a
 //! rank writes back is the one its subdomain's rank computed, so the results stay
 //! bitwise those of one process.
 

@@ -36,9 +36,9 @@
 //! ([`super::rank_share`]); a repartition merges every rank's bounds and counts
 //! and detects again; each rank steps only the bodies near its cells
 //! ([`super::owned`]). What is not distributed yet (docs/SCALING.md): the bodies'
-//! arrays (every rank allocates the whole sample), the shells' body lists on the
-//! steps around a repartition (all-gathered) and, before a repartition, every
-//! subdomain's results.
+//! arrays (every rank allocates the whole sample); with the centralized scheme or
+//! while a rank steps every body, the shells' body lists (all-gathered) and, before
+//! a repartition, every subdomain's results.
 
 use super::cluster::Cluster;
 use super::family::Family;

@@ -3,15 +3,17 @@
 //! one process; and the counts over shared bodies that the outputs read.
 //!
 //! ```text
-//! whole shells    every subdomain's body list to every rank (two all-gathers): on
-//!                 the steps around a repartition, with the centralized scheme, or
-//!                 while a rank steps every body
-//! limited shells  between repartitions: subdomain t's rank sends body b of t to
-//!                 rank R (point to point, RankState::send_ranks) when
+//! limited shells  subdomain t's rank sends body b of t to rank R (point to point,
+//!                 RankState::send_ranks) when
 //!                   b is stepped by every rank (fixed, driven, named, unbounded), or
 //!                   b's box grown by the alert distance meets R's cells, or
 //!                   R announced b (one small all-gather): a body R steps or holds
 //!                   that the box test misses (a kept contact drifted off R's cells)
+//! a repartition   the same rule, over the new cells, carries each copy of the last
+//!                 step's subdomains with its kept F_Γ from its old rank: the store
+//!                 of the bodies near R, and their last subdomains (the migrations)
+//! whole shells    every subdomain's body list to every rank (two all-gathers), with
+//!                 the centralized scheme or while a rank steps every body
 //! ```
 //!
 //! Every rank holding b tests the same box (b's state is bitwise the same wherever
@@ -19,10 +21,14 @@
 //! or holds in its subdomains comes with all its copies, and R's interface is the
 //! one-process interface restricted to those bodies. What reads more than that is
 //! reduced over the ranks: the history's interface counts and whether any body is
-//! fresh ([`interface_totals`]), the census' loaded contacts of shared bodies and
+//! fresh ([`interface_totals`]), the migrations ([`migrations`]: counted by the rank
+//! of a body's first subdomain), the census' loaded contacts of shared bodies and
 //! the bodies' subdomains of the VTK frames ([`copy_counts`], asked of the copies'
 //! ranks), a fresh body's kept F_Γ ([`super::rank_fresh`]). A shell's local ids
-//! are this rank's; [`super::Subdomain::remote_id`] gives its rank's.
+//! are this rank's; [`super::Subdomain::remote_id`] gives its rank's. With limited
+//! shells the step before a repartition ends by requests as any other
+//! ([`super::rank_share`]): the repartition step routes the kept F_Γ instead of
+//! every subdomain's results going to every rank.
 
 use super::cells::CellIndex;
 use super::family::Family;
