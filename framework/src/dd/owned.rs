@@ -12,7 +12,7 @@
 //! ```
 //!
 //! A rank steps its active bodies exactly as one process does: their V⁺ is the
-//! subdomains' (every subdomain's copy velocities reach every rank) or their free
+//! subdomains' (a rank receives every copy of the bodies it steps) or their free
 //! velocity, so an active body's state is bitwise the same on every rank holding it.
 //! At the end of a step, the owner of a body at the start of the step sends its new
 //! state to the ranks whose halo it has just entered (one all-gather); every rank

@@ -124,21 +124,6 @@ pub struct Decomposition<D: Family> {
     pub iface: Interface,
 }
 
-impl<D: Family> Decomposition<D> {
-    /// Per subdomain, the local ids of its bodies that other subdomains hold too
-    /// (multiplicity ≥ 2, immovable bodies included), ascending.
-    pub fn shared_locals(&self) -> Vec<Vec<u32>> {
-        self.subs
-            .iter()
-            .map(|s| {
-                (0..s.body_global.len() as u32)
-                    .filter(|&l| self.mult[s.body_global[l as usize] as usize] >= 2)
-                    .collect()
-            })
-            .collect()
-    }
-}
-
 impl<D: Family> Default for Decomposition<D> {
     fn default() -> Self {
         Decomposition {
@@ -151,7 +136,8 @@ impl<D: Family> Default for Decomposition<D> {
     }
 }
 
-/// Fills the other ranks' subdomains with their bodies (contacts held per rank).
+/// Fills the other ranks' subdomains with their bodies, or those near this rank
+/// (contacts held per rank, [`super::shells`]).
 pub type Shells<'a, D> = &'a mut dyn FnMut(&mut [Subdomain<D>]);
 
 /// The subdomains of each body (ascending), `out[b]`, from a decomposition.

@@ -1,4 +1,5 @@
-//! The starting F_Γ of a body whose copies changed, on ranks between repartitions.
+//! The starting F_Γ of a body whose copies changed, on ranks with contacts held per
+//! rank (on a repartition step from the store routed there, [`super::shells`]).
 //!
 //! A body whose set of copies changed since the last step is *fresh*: its copies
 //! start from their kept F_Γ (zero for a new copy) with the mean removed

@@ -389,8 +389,8 @@ impl RankState {
     }
 
     /// Every subdomain's impulses, copy velocities and F_Γ from its rank to all; with
-    /// `requests` (contacts held per rank, no repartition next), only the copy
-    /// velocities of the bodies this rank steps (`Some(None)`: all of them;
+    /// `requests` (contacts held per rank, no repartition next or limited shells,
+    /// [`super::shells`]), only the copy velocities of the bodies this rank steps (`Some(None)`: all of them;
     /// [`RankState::share_requested`]).
     fn share_results<D: Family>(&mut self, d: &mut Decomposition<D>, requests: Option<Option<&[u32]>>) {
         if let (Some(active), true) = (requests, self.local) {
@@ -449,7 +449,7 @@ impl RankState {
 /// `max_stages` stages of `per` sweeps (relaxation `omega`) and one gluing, a check
 /// every `k` stages and at the last, `converged(sums, residual share)` deciding on
 /// every rank from the same merged numbers; then every subdomain's results on every
-/// rank. The subdomains' ranks are those of [`RankState::assign`] at the partition;
+/// rank, or with `requests` the copies this rank asked for. The subdomains' ranks are those of [`RankState::assign`] at the partition;
 /// `fresh`: whether any interface body is fresh (the same on every rank: the ranks
 /// glue those together first). Returns the stages run and this step's exchange
 /// counts.
@@ -488,6 +488,10 @@ pub(super) fn iterate<D: Family>(
             team.sweep(per, omega, check);
             team.with_all(|subs| {
                 own.clear();
+                // (a rank-local test: with limited shells a rank's interface holds
+                // the bodies near it only; the decentralized scheme then talks to
+                // the peers sharing those alone, and limited shells are never used
+                // with the centralized one, whose gather is collective)
                 if !iface.is_empty() {
                     st.glue(subs, iface, scheme, false, &mut own);
                 }

@@ -165,7 +165,8 @@ impl RankState {
         let per = 3 + ndof;
         let mut out: Vec<Vec<f64>> = vec![Vec::new(); np];
         let mut to: Vec<u32> = Vec::new();
-        let old_own = |t: u32| self.old_rank_of.get(t as usize) == Some(&me);
+        let old_rank_of = std::mem::take(&mut self.old_rank_of);
+        let old_own = |t: u32| old_rank_of.get(t as usize) == Some(&me);
         for sub in last.subs.iter().filter(|s| old_own(s.id)) {
             for &g in &sub.body_global {
                 near.targets::<D>(g, np, &mut to);
@@ -225,12 +226,16 @@ impl<D: Family> super::NscddOf<D> {
     /// it replaces this rank's) and the migrations' "before". Collective.
     pub(super) fn start_shells(&mut self, w: &D::World, repart: bool) -> Option<(Vec<(u32, u32)>, Option<Vec<(u32, u32)>>)> {
         let decentralized = self.settings.scheme == super::Scheme::Decentralized;
-        self.local.limited = self.local.now && decentralized && near_of::<D>(&self.local, w, &[]).is_some();
-        if !self.local.limited {
+        let limited = self.local.now && decentralized && near_of::<D>(&self.local, w, &[]).is_some();
+        // a step after limited shells is limited too (the same scheme and mode, and
+        // every rank steps some bodies only): its repartition routes the kept F_Γ
+        // that the step before did not share
+        debug_assert!(!self.local.limited || limited, "limited shells lost between two steps");
+        self.local.limited = limited;
+        if !limited {
             return None;
         }
-        let rs = self.ranks.as_mut()?;
-        let near = near_of::<D>(&self.local, w, &[])?;
+        let (rs, near) = (self.ranks.as_mut()?, near_of::<D>(&self.local, w, &[])?);
         let c = D::contacts(w);
         let asked = rs.announce::<D>(&near, (0..D::len(c)).flat_map(|a| D::bodies(c, a)));
         let near = Near { asked: &asked, ..near };
@@ -346,8 +351,10 @@ pub(super) fn copy_counts<D: Family>(
 }
 
 /// The subdomain owning most of each body's contacts (ties: the smaller id; −1
-/// without contacts), as `NscddOf::view` counts them over the whole contact list,
-/// for the bodies this rank holds (another subdomain of the others it knows): a
+/// without contacts), as `NscddOf::view` counts them over the whole contact list:
+/// exact for the bodies of this rank's subdomains and the bodies it owns (another
+/// holder's id for the other bodies it knows, −1 for the rest; the VTK pieces read
+/// no others, `Piece::has_body`): a
 /// body held by one subdomain is its; the counts of the bodies held by several
 /// come from their subdomains' ranks (collective).
 pub(super) fn body_subdomains<D: Family>(rs: &mut RankState, d: &Decomposition<D>, nb: usize) -> Vec<i32> {
