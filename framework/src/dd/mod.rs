@@ -291,10 +291,13 @@ impl<D: Family> NscddOf<D> {
             o.clear();
             o.extend(self.fam_points[r].iter().map(|&p| base + grid.cell_of(p)));
         }
-        let nb = D::n_bodies(w);
         // limited shells ([`shells`]): on a repartition step, the kept F_Γ routed
-        let start = self.start_shells(w, repart);
-        let before = (repart && self.steps > 0 && start.is_none()).then(|| partition::body_sets(&self.last, nb));
+        let mut start = self.start_shells(w, repart);
+        // the last step's copies, for the migrations (routed with limited shells)
+        let before = (repart && self.steps > 0).then(|| match start.as_mut().and_then(|s| s.1.take()) {
+            Some(routed) => (routed, true),
+            None => (partition::copies(&self.last), false),
+        });
         if repart {
             self.grid = Some(grid.clone());
             let total = self.local.new_grid.take().map_or(nc, |(_, t)| t);
@@ -322,16 +325,9 @@ impl<D: Family> NscddOf<D> {
             rs.fresh_f_gamma(&mut self.last, &self.store, &self.v_free);
         }
         rep.repartitioned = repart;
-        if let (Some((_, Some(before))), Some(rs)) = (&start, self.ranks.as_mut()) {
-            rep.migrations = shells::migrations(rs, &self.last, before);
-        }
-        if let Some(before) = before {
-            let after = partition::body_sets(&self.last, nb);
-            rep.migrations = before
-                .iter()
-                .zip(&after)
-                .filter(|(x, y)| !x.is_empty() && !y.is_empty() && x != y)
-                .count();
+        if let Some((before, routed)) = before {
+            let ranks = self.ranks.as_mut().filter(|_| routed);
+            rep.migrations = shells::migrations(ranks, &self.last, &before);
         }
         self.kept.clear();
         self.kept.extend((0..nc).map(|a| D::key(c, a)).zip(self.last.owner.iter().copied()));

@@ -140,16 +140,11 @@ impl<D: Family> Default for Decomposition<D> {
 /// (contacts held per rank, [`super::shells`]).
 pub type Shells<'a, D> = &'a mut dyn FnMut(&mut [Subdomain<D>]);
 
-/// The subdomains of each body (ascending), `out[b]`, from a decomposition.
-pub fn body_sets<D: Family>(d: &Decomposition<D>, nb: usize) -> Vec<Vec<u32>> {
-    let mut out = vec![Vec::new(); nb];
-    for s in &d.subs {
-        for &g in &s.body_global {
-            if let Some(v) = out.get_mut(g as usize) {
-                v.push(s.id);
-            }
-        }
-    }
+/// Every body copy of a decomposition as (body, subdomain), sorted: each body's
+/// subdomains, ascending.
+pub fn copies<D: Family>(d: &Decomposition<D>) -> Vec<(u32, u32)> {
+    let mut out: Vec<(u32, u32)> = d.subs.iter().flat_map(|s| s.body_global.iter().map(move |&g| (g, s.id))).collect();
+    out.sort_unstable();
     out
 }
 

@@ -67,8 +67,7 @@ impl Near<'_> {
             return to.extend(0..np as u32);
         }
         self.ranks_of::<D>(g, |q| to.push(q));
-        let a = self.asked.partition_point(|e| e.0 < g);
-        to.extend(self.asked[a..].iter().take_while(|e| e.0 == g).map(|e| e.1));
+        to.extend(of_body(self.asked, g).iter().map(|e| e.1));
         to.sort_unstable();
         to.dedup();
     }
@@ -195,27 +194,36 @@ impl RankState {
     }
 }
 
-/// The bodies whose subdomains changed at a repartition with limited shells, over
-/// every rank (one all-gather): each rank counts the bodies whose first new
-/// subdomain is its own (it knows all their copies, now and, from `before`, at the
-/// last step) and that were held before. Collective.
-pub(super) fn migrations<D: Family>(rs: &mut RankState, d: &Decomposition<D>, before: &[(u32, u32)]) -> usize {
-    let mut after: Vec<(u32, u32)> = d.subs.iter().flat_map(|s| s.body_global.iter().map(move |&g| (g, s.id))).collect();
-    after.sort_unstable();
+/// The bodies whose subdomains changed at a repartition: held by some subdomain
+/// both in `before` (the last step's copies, [`super::partition::copies`]) and now,
+/// by other subdomains. With `ranks` (limited shells, `before` routed: one
+/// all-gather) each rank counts the bodies whose first subdomain is its own (it
+/// knows all their copies, old and new) and the counts are added. Collective with
+/// `ranks`.
+pub(super) fn migrations<D: Family>(mut ranks: Option<&mut RankState>, d: &Decomposition<D>, before: &[(u32, u32)]) -> usize {
+    let after = super::partition::copies(d);
     let mut n = 0usize;
     let mut i = 0;
     while i < after.len() {
-        let g = after[i].0;
-        let k = after[i..].iter().take_while(|e| e.0 == g).count();
-        if rs.is_own(after[i].1) {
-            let a = before.partition_point(|e| e.0 < g);
-            let b = before[a..].iter().take_while(|e| e.0 == g).count();
-            n += usize::from(b > 0 && before[a..a + b] != after[i..i + k]);
+        let (g, first) = after[i];
+        let now = of_body(&after[i..], g);
+        let was = of_body(before, g);
+        if ranks.as_ref().is_none_or(|rs| rs.is_own(first)) {
+            n += usize::from(!was.is_empty() && was != now);
         }
-        i += k;
+        i += now.len();
     }
-    let (_, all) = rs.all_gather_any(&[n as f64]);
-    all.iter().map(|&x| x as usize).sum()
+    match ranks.as_mut() {
+        Some(rs) => rs.all_sum(&[n as f64])[0] as usize,
+        None => n,
+    }
+}
+
+/// The pairs of body `g` in `pairs`, sorted by body.
+fn of_body(pairs: &[(u32, u32)], g: u32) -> &[(u32, u32)] {
+    let a = pairs.partition_point(|e| e.0 < g);
+    let n = pairs[a..].iter().take_while(|e| e.0 == g).count();
+    &pairs[a..a + n]
 }
 
 impl<D: Family> super::NscddOf<D> {
