@@ -120,19 +120,11 @@ impl RankState {
     /// The other ranks' subdomains limited to the bodies this rank may need, from
     /// their ranks point to point (module docs). Collective.
     pub(super) fn fill_shells_near<D: Family>(&mut self, subs: &mut [Subdomain<D>], near: &Near) {
-        let (me, np) = (self.cluster.rank(), self.cluster.size() as usize);
         // each own subdomain's bodies (subdomain, local id, body) to the ranks that may need them
-        let mut out: Vec<Vec<f64>> = vec![Vec::new(); np];
-        let mut to: Vec<u32> = Vec::new();
-        for s in subs.iter().filter(|s| self.is_own(s.id)) {
-            for (l, &g) in s.body_global.iter().enumerate() {
-                near.targets::<D>(g, np, &mut to);
-                for &q in to.iter().filter(|&&q| q != me) {
-                    out[q as usize].extend([f64::from(s.id), l as f64, f64::from(g)]);
-                }
-            }
-        }
-        let (_, got) = self.send_ranks(out);
+        let own: Vec<&Subdomain<D>> = subs.iter().filter(|s| self.is_own(s.id)).collect();
+        let (got, _) = self.route(own.into_iter(), near, false, |s, l, g, o| {
+            o.extend([f64::from(s.id), l as f64, f64::from(g)]);
+        });
         for sub in subs.iter_mut().filter(|s| !self.is_own(s.id)) {
             sub.body_global.clear();
             sub.shell_local.clear();
@@ -147,6 +139,33 @@ impl RankState {
         self.totals.limited_shells += 1;
     }
 
+    /// Each copy of `subs` (this rank's subdomains) to the ranks that may need its
+    /// body ([`Near::targets`]), as `pack(subdomain, local id, body, out)` appends
+    /// it, point to point; returns what the other ranks sent this one and, with
+    /// `to_me`, this rank's own part. Collective.
+    fn route<'s, D: Family>(
+        &mut self,
+        subs: impl Iterator<Item = &'s Subdomain<D>>,
+        near: &Near,
+        to_me: bool,
+        mut pack: impl FnMut(&Subdomain<D>, usize, u32, &mut Vec<f64>),
+    ) -> (Vec<Vec<f64>>, Vec<f64>) {
+        let (me, np) = (self.cluster.rank(), self.cluster.size() as usize);
+        let mut out: Vec<Vec<f64>> = vec![Vec::new(); np];
+        let mut to: Vec<u32> = Vec::new();
+        for s in subs {
+            for (l, &g) in s.body_global.iter().enumerate() {
+                near.targets::<D>(g, np, &mut to);
+                for &q in to.iter().filter(|&&q| to_me || q != me) {
+                    pack(s, l, g, &mut out[q as usize]);
+                }
+            }
+        }
+        let mine = std::mem::take(&mut out[me as usize]);
+        let (_, got) = self.send_ranks(out);
+        (got, mine)
+    }
+
     /// On a repartition step with limited shells (the new cells and ranks set,
     /// before the partition): each copy of the last step's own subdomains
     /// (`last`, its ranks `old_rank_of`) goes, with its kept F_Γ, to the ranks that
@@ -159,26 +178,16 @@ impl RankState {
         store: &FGammaStore<D::V>,
         near: &Near,
     ) -> (FGammaStore<D::V>, Vec<(u32, u32)>) {
-        let (me, np) = (self.cluster.rank(), self.cluster.size() as usize);
-        let ndof = super::subdomain::dofs::<D>();
-        let per = 3 + ndof;
-        let mut out: Vec<Vec<f64>> = vec![Vec::new(); np];
-        let mut to: Vec<u32> = Vec::new();
+        let me = self.cluster.rank();
         let old_rank_of = std::mem::take(&mut self.old_rank_of);
-        let old_own = |t: u32| old_rank_of.get(t as usize) == Some(&me);
-        for sub in last.subs.iter().filter(|s| old_own(s.id)) {
-            for &g in &sub.body_global {
-                near.targets::<D>(g, np, &mut to);
-                let kept = store.get(g, sub.id);
-                for &q in &to {
-                    let o = &mut out[q as usize];
-                    o.extend([f64::from(sub.id), f64::from(g), f64::from(u8::from(kept.is_some()))]);
-                    o.extend_from_slice(kept.unwrap_or_default().as_ref());
-                }
-            }
-        }
-        let mine = std::mem::take(&mut out[me as usize]);
-        let (_, got) = self.send_ranks(out);
+        let old_own = last.subs.iter().filter(|s| old_rank_of.get(s.id as usize) == Some(&me));
+        let (got, mine) = self.route(old_own, near, true, |s, _, g, o| {
+            let kept = store.get(g, s.id);
+            o.extend([f64::from(s.id), f64::from(g), f64::from(u8::from(kept.is_some()))]);
+            o.extend_from_slice(kept.unwrap_or_default().as_ref());
+        });
+        // (subdomain, body, whether it kept an F_Γ, F_Γ)
+        let per = 3 + super::subdomain::dofs::<D>();
         let (mut entries, mut before) = (Vec::new(), Vec::new());
         for x in got.iter().chain([&mine]).flat_map(|m| m.chunks_exact(per)) {
             let (t, g) = (x[0] as u32, x[1] as u32);
