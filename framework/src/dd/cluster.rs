@@ -2,10 +2,11 @@
 //!
 //! [`Cluster`] is the handful of operations [`super::ranks`] needs: a point-to-point
 //! round with a few peers, gathers and a scatter of `f64` buffers, an all-to-all of
-//! one count per pair of ranks (who will send to whom), an agreement and an abort. The MPI implementation is [`super::mpi::MpiCluster`] (cargo feature
-//! `mpi`); nothing else in the framework names MPI. [`Solo`] is the one-process
-//! cluster (every operation a copy), which runs the multi-process code path in one
-//! process for tests.
+//! one count per pair of ranks (who will send to whom), an agreement and an abort.
+//! The MPI implementation is [`super::mpi::MpiCluster`] (cargo feature `mpi`);
+//! nothing else in the framework names MPI. [`Solo`] is the one-process cluster
+//! (every operation a copy), which runs the multi-process code path in one process
+//! for tests.
 //!
 //! Every operation but [`Cluster::exchange`] is collective: every rank calls it, in
 //! the same order, with the same `counts`.

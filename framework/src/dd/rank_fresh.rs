@@ -6,12 +6,12 @@
 //! ([`super::partition::zero_mean`]). Between repartitions a rank keeps only its
 //! own subdomains' F_Γ up to date (`rank_share`: the other ranks' are not sent), so
 //! the mean over copies held by several ranks needs the others' kept values: each
-//! rank asks, for the fresh bodies with a copy in its subdomains, whether their
-//! copies in other ranks' subdomains kept an F_Γ and its value, and each
+//! rank asks, for the fresh bodies with a copy in its subdomains, the kept F_Γ of
+//! their copies in other ranks' subdomains (zero where a copy kept none), and each
 //! subdomain's rank answers from its own store (point to point,
 //! [`RankState::ask_ranks`]: as long as the fresh bodies at rank boundaries; the
-//! asking rank's store may not know those copies, [`super::shells`]). Then every rank
-//! starts its copies where one process does, bit for bit.
+//! asking rank's store may not know those copies, [`super::shells`]). Then every
+//! rank starts its copies where one process does, bit for bit.
 
 use super::family::Family;
 use super::partition::{zero_mean, Decomposition, FGammaStore};

@@ -9,14 +9,12 @@
 //! halos), and go to the neighbouring ranks only (two all-gathers before
 //! 2026-11-25 sent every rank every other rank's boundary); the write-back then
 //! reads the own subdomains and the copies received only
-//! (`attach::write_back_held`). The
-//! other ranks' F_Γ are left as they were: a rank glues and warm-starts only its own
-//! subdomains' copies; before a repartition (when subdomains change ranks) the
-//! repartition step routes the kept F_Γ ([`super::shells`]), or, with whole
-//! shells, the whole results are shared instead ([`RankState::share_results`]).
-//! Every copy a
-//! rank writes back is the one its subdomain's rank computed, so the results stay
-//! bitwise those of one process.
+//! (`attach::write_back_held`). The other ranks' F_Γ are left as they were: a rank
+//! glues and warm-starts only its own subdomains' copies; before a repartition
+//! (when subdomains change ranks) the repartition step routes the kept F_Γ
+//! ([`super::shells`]), or, with whole shells, the whole results are shared instead
+//! ([`RankState::share_results`]). Every copy a rank writes back is the one its
+//! subdomain's rank computed, so the results stay bitwise those of one process.
 
 use super::family::Family;
 use super::partition::Decomposition;

@@ -75,14 +75,6 @@ pub struct Subdomain<D: Family> {
     pub sums: Sums,
 }
 
-impl<D: Family> Subdomain<D> {
-    /// The local id, on the subdomain's rank, of this process's copy `l` (the same
-    /// id unless the subdomain is a limited shell).
-    pub fn remote_id(&self, l: u32) -> u32 {
-        self.shell_local.get(l as usize).copied().unwrap_or(l)
-    }
-}
-
 /// A subdomain of 2D rigid bodies.
 pub type Subdomain2 = Subdomain<Rigid2>;
 /// A subdomain of 3D rigid bodies.
@@ -186,6 +178,12 @@ impl<D: Family> Subdomain<D> {
     pub(crate) fn push_contact(&mut self, c: &D::Contacts, a: usize, li: u32, lj: u32) {
         D::push_contact(&mut self.contacts, c, a, li, lj);
         self.contact_global.push(a as u32);
+    }
+
+    /// The local id, on the subdomain's rank, of this process's copy `l` (the same
+    /// id unless the subdomain is a limited shell).
+    pub fn remote_id(&self, l: u32) -> u32 {
+        self.shell_local.get(l as usize).copied().unwrap_or(l)
     }
 
     /// W_αα and its precomputed inverses from the copies' M̂_E⁻¹ (`split[l]`: copy
