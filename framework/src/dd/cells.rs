@@ -115,10 +115,10 @@ impl CellIndex {
         }
     }
 
-    /// Whether `[lo, hi]` meets a cell of a rank other than `me`.
-    pub fn meets_other(&self, n: usize, lo: &[f64], hi: &[f64], me: u32) -> bool {
+    /// Whether `[lo, hi]` meets a cell of rank `r`.
+    pub fn meets_rank(&self, n: usize, lo: &[f64], hi: &[f64], r: u32) -> bool {
         let mut any = false;
-        self.ranks_meeting(n, lo, hi, |q| any |= q != me);
+        self.ranks_meeting(n, lo, hi, |q| any |= q == r);
         any
     }
 }

@@ -5,8 +5,8 @@
 //! ```text
 //! before detection:  the last step's contacts another rank may meet again (their
 //!                    pair's boxes, grown by the alert distance, reach its cells)
-//!                    go to every rank (one all-gather): their warm starts, and their
-//!                    kept subdomains (a contact kept by another rank is its)
+//!                    go to those ranks, point to point: their warm starts, and
+//!                    their kept subdomains (a contact kept by another rank is its)
 //! detection:         the own cells (edge cells unbounded) and the own kept pairs
 //! after detection:   a raw contact stays when its owner — its kept subdomain, else
 //!                    the cell of its point — is an own subdomain
@@ -17,8 +17,8 @@
 //!
 //! A repartition step detects in the old regions (the exchange above), merges every
 //! rank's bounds and counts into the new grid and ranks, sends the last step's
-//! contacts the other ranks' new cells may meet (their warm starts, one more
-//! all-gather of those only) and detects again in the new regions
+//! contacts the other ranks' new cells may meet to those ranks (their warm starts,
+//! point to point) and detects again in the new regions
 //! ([`super::NscddOf::repartition_local`]); only the first step, and the first
 //! after a restart, run on the whole sample. Every decision above is the one a
 //! single process takes with all the contacts, so results stay bitwise those of one
@@ -63,72 +63,104 @@ fn pair_meets(n: usize, a: &[[f64; 3]; 2], b: &[[f64; 3]; 2], alert: f64, region
 }
 
 impl Local {
-    /// Before a step's detection: the last step's contacts other ranks may meet
-    /// gathered from every rank into the warm start; returns the other ranks' kept
-    /// subdomains of theirs (key, owner). (`cells`: every rank's cells)
+    /// Before a step's detection (collective): the last step's contacts each other
+    /// rank may meet sent to it, and those this rank may meet received into the
+    /// warm start; returns the other ranks' kept subdomains of theirs (key, owner),
+    /// ranks ascending. (`cells`: every rank's cells)
     pub(super) fn exchange<D: Family>(
         &self,
         rs: &mut RankState,
         w: &mut D::World,
         (owner, cells, alert): (&[u32], &CellIndex, f64),
     ) -> Vec<(ContactKey, u32)> {
-        let me = rs.cluster.rank();
         let c = D::contacts(w);
-        let mut mine = Vec::new();
+        let mut to = ToRanks::new(rs, D::SPACE);
+        let mut rec = Vec::with_capacity(D::PREV_RECORD + 1);
         for (a, &o) in owner.iter().enumerate().take(D::len(c)) {
             let [i, j] = D::bodies(c, a);
-            let (bi, bj) = (&self.boxes[i as usize], &self.boxes[j as usize]);
-            // the region's pair test ([`Region::meets_pair`]) over the other ranks' cells
-            let (lo, hi) = Region::pair_box(D::SPACE, (&bi[0], &bi[1]), (&bj[0], &bj[1]), alert);
-            if cells.meets_other(D::SPACE, &lo, &hi, me) {
-                D::prev_record(c, a, &mut mine);
-                mine.push(f64::from(o));
-            }
+            rec.clear();
+            D::prev_record(c, a, &mut rec);
+            rec.push(f64::from(o));
+            to.send(cells, self.pair_box::<D>([i, j], alert), &rec);
         }
-        let (counts, got) = rs.all_gather_any(&mine);
+        let got = to.finish(rs);
         let per = D::PREV_RECORD + 1;
-        let mut start = 0;
         let (mut prev, mut kept) = (Vec::new(), Vec::new());
-        for (q, &n) in counts.iter().enumerate() {
-            if q as u32 != me {
-                for x in got[start..start + n].chunks_exact(per) {
-                    prev.extend_from_slice(&x[..D::PREV_RECORD]);
-                    let key = ContactKey {
-                        i: x[0] as u32,
-                        j: x[1] as u32,
-                        feature: x[2] as u32,
-                    };
-                    kept.push((key, x[D::PREV_RECORD] as u32));
-                }
-            }
-            start += n;
+        for x in got.iter().flat_map(|m| m.chunks_exact(per)) {
+            prev.extend_from_slice(&x[..D::PREV_RECORD]);
+            let key = ContactKey {
+                i: x[0] as u32,
+                j: x[1] as u32,
+                feature: x[2] as u32,
+            };
+            kept.push((key, x[D::PREV_RECORD] as u32));
         }
         D::set_extra_prev(w, &prev);
         kept
+    }
+
+    /// The box of the pair (i, j) grown by `alert`: the region's pair test
+    /// ([`Region::meets_pair`]).
+    fn pair_box<D: Family>(&self, [i, j]: [u32; 2], alert: f64) -> ([f64; 3], [f64; 3]) {
+        let (bi, bj) = (&self.boxes[i as usize], &self.boxes[j as usize]);
+        Region::pair_box(D::SPACE, (&bi[0], &bi[1]), (&bj[0], &bj[1]), alert)
+    }
+}
+
+/// Records each sent to the other ranks whose cells meet a box, point to point
+/// ([`RankState::send_ranks`]): a rank's detection pairs only bodies whose grown
+/// boxes meet its cells, so no other rank needs them.
+struct ToRanks {
+    /// The dimension of space.
+    n: usize,
+    me: u32,
+    out: Vec<Vec<f64>>,
+    to: Vec<u32>,
+}
+
+impl ToRanks {
+    fn new(rs: &RankState, n: usize) -> Self {
+        let np = rs.cluster.size() as usize;
+        ToRanks {
+            n,
+            me: rs.cluster.rank(),
+            out: vec![Vec::new(); np],
+            to: Vec::new(),
+        }
+    }
+
+    /// `rec` to every rank but this one whose `cells` meet `[lo, hi]`, once each.
+    fn send(&mut self, cells: &CellIndex, (lo, hi): ([f64; 3], [f64; 3]), rec: &[f64]) {
+        let (me, to) = (self.me, &mut self.to);
+        to.clear();
+        cells.ranks_meeting(self.n, &lo, &hi, |q| {
+            if q != me && !to.contains(&q) {
+                to.push(q);
+            }
+        });
+        for &q in to.iter() {
+            self.out[q as usize].extend_from_slice(rec);
+        }
+    }
+
+    /// Sends (collective); what each other rank sent this one, ranks ascending.
+    fn finish(self, rs: &mut RankState) -> Vec<Vec<f64>> {
+        rs.send_ranks(self.out).1
     }
 }
 
 impl Local {
     /// On a repartition step (collective): this rank's last-step contacts `own`
     /// ([`Family::prev_record`]s) whose pair's grown boxes meet another rank's new
-    /// `cells` go to every rank; returns the other ranks' that this one receives
+    /// `cells` go to that rank; returns the other ranks' that this one receives
     /// (the warm starts its new cells may need; those of its old cells came before
     /// detection).
     fn prev_for_new_cells<D: Family>(&self, rs: &mut RankState, cells: &CellIndex, own: &[f64], alert: f64) -> Vec<f64> {
-        let me = rs.cluster.rank();
-        let mut mine = Vec::new();
+        let mut to = ToRanks::new(rs, D::SPACE);
         for x in own.chunks_exact(D::PREV_RECORD) {
-            let (bi, bj) = (&self.boxes[x[0] as usize], &self.boxes[x[1] as usize]);
-            let (lo, hi) = Region::pair_box(D::SPACE, (&bi[0], &bi[1]), (&bj[0], &bj[1]), alert);
-            if cells.meets_other(D::SPACE, &lo, &hi, me) {
-                mine.extend_from_slice(x);
-            }
+            to.send(cells, self.pair_box::<D>([x[0] as u32, x[1] as u32], alert), x);
         }
-        let (counts, got) = rs.all_gather_any(&mine);
-        let start: usize = counts[..me as usize].iter().sum();
-        let mut other = got;
-        other.drain(start..start + counts[me as usize]);
-        other
+        to.finish(rs).concat()
     }
 }
 

@@ -26,6 +26,7 @@ impl RankState {
     /// relation). Returns those ranks (ascending) and what each sent this one.
     /// Collective.
     pub(super) fn send_ranks(&mut self, mut out: Vec<Vec<f64>>) -> (Vec<u32>, Vec<Vec<f64>>) {
+        let t0 = Instant::now();
         let (me, np) = (self.cluster.rank(), self.cluster.size() as usize);
         debug_assert_eq!(out.len(), np, "one list a rank");
         let to: Vec<u64> = out.iter().map(|v| v.len() as u64).collect();
@@ -39,6 +40,7 @@ impl RankState {
         let mut inbox = vec![Vec::new(); peers.len()];
         self.cluster.exchange(&peers, &sent, &mut inbox);
         self.sent_p2p(sent.iter().filter(|o| !o.is_empty()).count(), sent.iter().map(Vec::len).sum());
+        self.totals.reduce_seconds += t0.elapsed().as_secs_f64();
         (peers, inbox)
     }
 
@@ -47,7 +49,6 @@ impl RankState {
     /// `answer(s, key, out)` appends this rank's values of a pair asked of it.
     /// Collective.
     pub(super) fn ask_ranks(&mut self, asks: &[(u32, u32)], n: usize, answer: impl Fn(u32, u32, &mut Vec<f64>)) -> Vec<f64> {
-        let t0 = Instant::now();
         let (me, np) = (self.cluster.rank(), self.cluster.size() as usize);
         // the pairs asked of each rank, in the order of `asks`
         let mut of: Vec<Vec<usize>> = vec![Vec::new(); np];
@@ -61,6 +62,8 @@ impl RankState {
             .map(|v| v.iter().flat_map(|&i| [f64::from(asks[i].0), f64::from(asks[i].1)]).collect())
             .collect();
         let (peers, mut inbox) = self.send_ranks(out);
+        // (the requests' time counted by `send_ranks`)
+        let t0 = Instant::now();
         let out: Vec<Vec<f64>> = inbox
             .iter()
             .map(|q| {

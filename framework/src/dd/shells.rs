@@ -53,6 +53,13 @@ pub(super) struct Near<'a> {
 }
 
 impl Near<'_> {
+    /// Whether body g's grown box meets rank r's cells.
+    fn meets<D: Family>(&self, g: u32, r: u32) -> bool {
+        let b = &self.boxes[g as usize];
+        let (lo, hi) = Region::grown_box(D::SPACE, &b[0], &b[1], self.alert);
+        self.cells.meets_rank(D::SPACE, &lo, &hi, r)
+    }
+
     /// Calls `f` with the ranks whose cells body g's grown box meets.
     fn ranks_of<D: Family>(&self, g: u32, f: impl FnMut(u32)) {
         let b = &self.boxes[g as usize];
@@ -97,14 +104,11 @@ impl RankState {
     /// (body, rank) of every rank's, sorted ([`Near::asked`]). Collective.
     pub(super) fn announce<D: Family>(&mut self, near: &Near, held: impl Iterator<Item = u32>) -> Vec<(u32, u32)> {
         let me = self.cluster.rank();
-        let missed = |g: &u32| {
-            let mut meets = false;
-            near.ranks_of::<D>(*g, |q| meets |= q == me);
-            !meets && !near.everywhere[*g as usize]
-        };
-        let mut extra: Vec<u32> = near.active.iter().copied().chain(held).filter(missed).collect();
+        // each body tested once (a contact's bodies come with each of its contacts)
+        let mut extra: Vec<u32> = near.active.iter().copied().chain(held).collect();
         extra.sort_unstable();
         extra.dedup();
+        extra.retain(|&g| !near.everywhere[g as usize] && !near.meets::<D>(g, me));
         let mine: Vec<f64> = extra.iter().map(|&g| f64::from(g)).collect();
         let (counts, all) = self.all_gather_any(&mine);
         let mut asked: Vec<(u32, u32)> = Vec::with_capacity(all.len());
