@@ -2,9 +2,9 @@
 """The biaxial test with continuum outer parts against its all-discrete reference
 (docs/CONTINUUM.md): sin φ(ε1) and times.
 
-Usage: continuum_biaxial.py OUT_DIR [--young E ...] [--hardening PHI0 KAPPA_H [PHI]] [--grain-share S] [--example]
+Usage: continuum_biaxial.py OUT_DIR [--young E ...] [--hardening PHI0 KAPPA_H [PHI]] [--grain-share S] [--seeds 7,11,...] [--example]
 
-For seeds 7 and 11: runs examples/scenes/biaxial.toml (2000 disks, 0.3 s of
+For each seed (`--seeds`, default 7 and 11): runs examples/scenes/biaxial.toml (2000 disks, 0.3 s of
 isotropic compaction at 10 kPa, then the top wall at 0.05 m/s), and its
 compaction alone (0.3 s); builds from the compacted grains the hybrid sample
 (`hybrid_scene`): a discrete core 0.2 < y < 0.3 with 5 cm bands on either side
@@ -16,15 +16,20 @@ scripts/identify_continuum.py), at the isotropic 10 kPa from the start:
 σ3, the bands' 1 cm segments at (1 − α) σ3: the grains' share), the top side driven down at
 0.05 m/s on a frictionless platen (`drive = { top = ["free", -0.05] }`), the
 bottom side on a frictionless base. Prints sin φ at ε1 = 0.5 … 9.5 % (means over
-±0.25 %), each run's time and sweeps, and the RMS distances; plots
+±0.25 %), each run's time and sweeps, and the RMS distances: between the
+discrete seeds (with more than two, each discrete seed's distance to the mean of
+the others: the scatter a hybrid's distance to the mean of all is measured
+against) and of each hybrid to the discrete mean; plots
 docs/continuum_biaxial.png (matplotlib: scripts/biaxial_study.sh installs it in
 .venv-docs). `--young`: the regions' E (Pa; default 4e5 6e5 8e5: E at 1 %, 60 σ3,
 E50 of scripts/identify_continuum.py on the two seeds). `--hardening PHI0 KAPPA_H [PHI]`: the regions' friction angle grows from
 PHI0 to PHI (default 15.1°) with the plastic shear strain (half-way at
 KAPPA_H). `--grain-share S`: the bands' `grain_share` (a band grain keeps at
 least the share S of its mass; the continuum's weight is at most 1 − S in the
-band). `--example`: writes
-examples/scenes/biaxial_continuum.toml (seed 7, E = 6e5) and stops.
+band). `--seeds`: the deposit seeds (comma-separated; some seeds' deposits do
+not fit 2000 disks in the box: the run stops naming the seed's scene).
+`--example`: writes examples/scenes/biaxial_continuum.toml (the first seed,
+the first `--young`) and stops.
 Needs target/release/nscdd built with the `fem` feature and NSCDD_PYTHON_ENV.
 """
 import csv
@@ -210,6 +215,11 @@ def rms(a, b):
     return (sum(d) / len(d)) ** 0.5
 
 
+def mean_curve(cs):
+    """The mean of curves `cs`, at the ε1 of EPS."""
+    return [(e, sum(at(c, e) for c in cs) / len(cs)) for e in EPS]
+
+
 def main():
     if len(sys.argv) < 2:
         sys.exit(__doc__)
@@ -225,10 +235,11 @@ def main():
     if "--grain-share" in sys.argv:
         global SHARE
         SHARE = float(sys.argv[sys.argv.index("--grain-share") + 1])
+    seeds = [int(x) for x in sys.argv[sys.argv.index("--seeds") + 1].split(",")] if "--seeds" in sys.argv else [7, 11]
     os.makedirs(out, exist_ok=True)
     base = open(os.path.join(ROOT, "examples", "scenes", "biaxial.toml")).read()
     curves, times = {}, {}
-    for seed in (7, 11):
+    for seed in seeds:
         text = base.replace("seed = 7", f"seed = {seed}")
         comp = os.path.join(out, f"compact_{seed}.toml")
         open(comp, "w").write(text.replace("duration = 1.3", "duration = 0.3"))
@@ -236,7 +247,7 @@ def main():
         final = os.path.join(out, f"compact_{seed}", "final.json")
         if "--example" in sys.argv:
             header = open(os.path.join(ROOT, "scripts", "continuum_biaxial_header.txt")).read()
-            s, *_ = hybrid_scene(final, 6e5, header=header)
+            s, *_ = hybrid_scene(final, youngs[0], header=header)
             path = os.path.join(ROOT, "examples", "scenes", "biaxial_continuum.toml")
             open(path, "w").write(s)
             print(path)
@@ -263,9 +274,15 @@ def main():
         print(f"{e:.3f}  " + " ".join(f"{at(curves[n], e):20.3f}" for n in names))
     for n in names:
         print(f"{n}: {times[n][0]:.1f} s wall, {times[n][1]} sweeps, loading {times[n][2]:.1f} s")
-    d7, d11 = curves["discrete 7"], curves["discrete 11"]
-    mean = [(e, 0.5 * (at(d7, e) + at(d11, e))) for e in EPS]
-    print(f"RMS discrete 7 − discrete 11: {rms(d7, d11):.4f}")
+    disc = [curves[f"discrete {k}"] for k in seeds]
+    mean = mean_curve(disc)
+    print(f"RMS discrete {seeds[0]} − discrete {seeds[1]}: {rms(disc[0], disc[1]):.4f}")
+    if len(seeds) > 2:
+        # each seed against the mean of the others: what one more sample deviates by
+        for k, c in zip(seeds, disc):
+            print(f"RMS discrete {k} − mean of the other discrete seeds: {rms(c, mean_curve([d for d in disc if d is not c])):.4f}")
+        for k, c in zip(seeds, disc):
+            print(f"RMS discrete {k} − discrete mean: {rms(c, mean):.4f}")
     for n in names:
         if n.startswith("hybrid"):
             print(f"RMS {n} − discrete mean: {rms(curves[n], mean):.4f}")
@@ -282,9 +299,21 @@ def plot(curves):
         print("matplotlib missing: no plot")
         return
     fig, ax = plt.subplots(figsize=(7, 4.5))
-    for n, c in curves.items():
-        xs = [e for e in EPS]
-        ax.plot([100 * e for e in xs], [at(c, e) for e in xs], "-" if n.startswith("discrete") else "--", marker="o" if n.startswith("discrete") else ".", label=n)
+    x = [100 * e for e in EPS]
+    disc = [c for n, c in curves.items() if n.startswith("discrete")]
+    hyb = [(n, c) for n, c in curves.items() if n.startswith("hybrid")]
+    if len(disc) > 2:
+        # many seeds: the discrete seeds' range and mean, each hybrid thin
+        lo = [min(at(c, e) for c in disc) for e in EPS]
+        hi = [max(at(c, e) for c in disc) for e in EPS]
+        ax.fill_between(x, lo, hi, color="C0", alpha=0.2, label=f"discrete, {len(disc)} seeds: range")
+        ax.plot(x, [m for _, m in mean_curve(disc)], "-o", color="C0", label="discrete: mean")
+        for i, (n, c) in enumerate(hyb):
+            ax.plot(x, [at(c, e) for e in EPS], "--", color="C1", lw=0.8, label="hybrid, each seed" if i == 0 else None)
+        ax.plot(x, [m for _, m in mean_curve([c for _, c in hyb])], "--.", color="C3", label="hybrid: mean")
+    else:
+        for n, c in curves.items():
+            ax.plot(x, [at(c, e) for e in EPS], "-" if n.startswith("discrete") else "--", marker="o" if n.startswith("discrete") else ".", label=n)
     ax.set_xlabel("ε1 (%)")
     ax.set_ylabel("sin φ (means over ±0.25 %)")
     ax.set_title("biaxial: all discrete (2000 disks) vs continuum outer parts (~800 disks)")
