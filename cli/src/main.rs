@@ -48,6 +48,10 @@ struct SolveFcArgs {
     /// Check the stopping test every k sweeps.
     #[arg(long, default_value_t = 1)]
     check_every: u32,
+    /// ω of the NLGS sweeps (`nlgs`, and `anderson`'s map), in (0, 2): below 1
+    /// under-relaxed, above 1 over-relaxed and projected on the Coulomb cones.
+    #[arg(long, default_value_t = 1.0)]
+    relaxation: f64,
     /// Also write the problem as read (FCLIB global problems: condensed) in the
     /// JSON exchange format (`.gz`: compressed).
     #[arg(long, value_name = "FILE")]
@@ -412,6 +416,12 @@ fn solve_fc(a: &SolveFcArgs) -> ExitCode {
     if !(tol > 0.0) || max_sweeps == 0 || check_every == 0 || a.repeat == 0 {
         return input_error("--tol must be > 0, --max-sweeps, --check-every and --repeat ≥ 1");
     }
+    if !(a.relaxation > 0.0 && a.relaxation < 2.0) {
+        return input_error(format!("--relaxation: ω must lie in (0, 2), got {}", a.relaxation));
+    }
+    if method == nscdd::solver::Method::Newton && a.relaxation != 1.0 {
+        return input_error("--relaxation: `newton` takes no relaxation (use nlgs or anderson)");
+    }
     let p = match nscdd::fc::read_any(&a.problem) {
         Ok(p) => p,
         Err(e) => return input_error(e),
@@ -428,6 +438,7 @@ fn solve_fc(a: &SolveFcArgs) -> ExitCode {
         check_every,
         norm,
         method,
+        relaxation: a.relaxation,
     };
     let mut sol = p.solve(&opts);
     for _ in 1..a.repeat {

@@ -297,6 +297,7 @@ fn solver_settings_a_method_cannot_use() {
             "solver.relaxation",
             "relaxation",
         ),
+        ("relaxation_too_large", "relaxation = 2.0", "solver.relaxation", "relaxation"),
         (
             "method_scrambled",
             "method = \"anderson\"\nordering = \"scrambled\"",
@@ -309,8 +310,9 @@ fn solver_settings_a_method_cannot_use() {
     }
 }
 
-/// `solve-fc --method`: every method solves a two-contact problem; an unknown
-/// method or `--repeat 0` is an input error (exit 2).
+/// `solve-fc --method`: every method solves a two-contact problem, NLGS and
+/// Anderson over-relaxed too; an unknown method, `--repeat 0`, a relaxation out of
+/// (0, 2) or one given to Newton is an input error (exit 2).
 #[test]
 fn solve_fc_methods() {
     let dir = scratch("solve_fc_methods");
@@ -318,7 +320,13 @@ fn solve_fc_methods() {
     let json = r#"{"dim": 2, "nc": 2, "W": {"n": 4, "rows": [0, 1, 2, 3, 0, 2], "cols": [0, 1, 2, 3, 2, 0],
         "vals": [2.0, 2.0, 2.0, 2.0, 1.0, 1.0]}, "q": [-1.0, 0.0, -1.0, 0.0], "mu": [0.5, 0.5]}"#;
     std::fs::write(&p, json).unwrap();
-    for m in ["nlgs", "anderson", "newton"] {
+    for (m, omega) in [
+        ("nlgs", "1"),
+        ("anderson", "1"),
+        ("newton", "1"),
+        ("nlgs", "1.3"),
+        ("anderson", "1.3"),
+    ] {
         let o = nscdd(&[
             "solve-fc".as_ref(),
             p.as_os_str(),
@@ -326,6 +334,8 @@ fn solve_fc_methods() {
             m.as_ref(),
             "--repeat".as_ref(),
             "3".as_ref(),
+            "--relaxation".as_ref(),
+            omega.as_ref(),
         ]);
         let out = text(&o.stdout);
         assert!(
@@ -334,8 +344,15 @@ fn solve_fc_methods() {
             text(&o.stderr)
         );
     }
-    for bad in [["--method", "cg"], ["--repeat", "0"]] {
-        let o = nscdd(&["solve-fc".as_ref(), p.as_os_str(), bad[0].as_ref(), bad[1].as_ref()]);
+    for bad in [
+        vec!["--method", "cg"],
+        vec!["--repeat", "0"],
+        vec!["--relaxation", "2"],
+        vec!["--relaxation", "1.2", "--method", "newton"],
+    ] {
+        let mut args: Vec<&std::ffi::OsStr> = vec!["solve-fc".as_ref(), p.as_os_str()];
+        args.extend(bad.iter().map(|a: &&str| -> &std::ffi::OsStr { a.as_ref() }));
+        let o = nscdd(&args);
         assert_eq!(o.status.code(), Some(2), "{bad:?}: {}", text(&o.stderr));
         assert!(text(&o.stderr).contains(bad[0]), "{bad:?}: {}", text(&o.stderr));
     }

@@ -14,14 +14,15 @@ from ._nscdd import RunError, SceneError, Simulation, __version__, _solve_fc_coo
 __all__ = ["Simulation", "SceneError", "RunError", "solve_fc", "__version__"]
 
 
-def solve_fc(W, q, mu, *, method="nlgs", tol=1e-8, max_sweeps=100_000, norm="natural", check_every=1, r0=None):
+def solve_fc(W, q, mu, *, method="nlgs", tol=1e-8, max_sweeps=100_000, norm="natural", check_every=1, r0=None, relaxation=1.0):
     """Solves the frictional contact problem u = W r + q, Coulomb's law per contact.
 
     W: a dense (n, n) array or a scipy.sparse matrix (n = dim × contacts, each
     contact's unknowns normal first); q: (n,); mu: (contacts,) friction
     coefficients. method: "nlgs", "anderson" or "newton"; norm: "natural" (the
     natural-map residual ‖F(r)‖/‖q‖ < tol) or one of LMGC90's "Quad", "Maxm",
-    "QM/16"; r0: a warm start. Returns a dict: r, u, sweeps (iterations),
+    "QM/16"; r0: a warm start; relaxation: ω of the NLGS sweeps (NLGS and
+    Anderson's map) in (0, 2), over-relaxed and projected above 1. Returns a dict: r, u, sweeps (iterations),
     converged, residual, seconds, norms.
     """
     import numpy as np
@@ -46,5 +47,6 @@ def solve_fc(W, q, mu, *, method="nlgs", tol=1e-8, max_sweeps=100_000, norm="nat
         max_sweeps=max_sweeps,
         norm=norm,
         check_every=check_every,
+        relaxation=relaxation,
         r0=None if r0 is None else np.ascontiguousarray(r0, dtype=float).ravel(),
     )

@@ -18,5 +18,6 @@ def solve_fc(
     norm: str = "natural",
     check_every: int = 1,
     r0: Optional[npt.ArrayLike] = None,
+    relaxation: float = 1.0,
 ) -> dict[str, Any]:
     """Solves u = W r + q under Coulomb's law (W dense or scipy.sparse); returns r, u, sweeps, converged, residual, seconds, norms."""

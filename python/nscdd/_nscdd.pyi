@@ -115,5 +115,6 @@ def _solve_fc_coo(
     max_sweeps: int = 100000,
     norm: str = "natural",
     check_every: int = 1,
+    relaxation: float = 1.0,
     r0: Optional[npt.NDArray[np.float64]] = None,
 ) -> dict[str, Any]: ...

@@ -11,7 +11,7 @@ use pyo3::types::PyDict;
 /// sparse matrix (given as its COO rows, cols, vals: see the package wrapper).
 /// Returns a dict: r, u, sweeps, converged, residual (natural map), norms.
 #[pyfunction]
-#[pyo3(signature = (rows, cols, vals, q, mu, *, method="nlgs", tol=1e-8, max_sweeps=100_000, norm="natural", check_every=1, r0=None))]
+#[pyo3(signature = (rows, cols, vals, q, mu, *, method="nlgs", tol=1e-8, max_sweeps=100_000, norm="natural", check_every=1, relaxation=1.0, r0=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn _solve_fc_coo<'py>(
     py: Python<'py>,
@@ -25,6 +25,7 @@ pub fn _solve_fc_coo<'py>(
     max_sweeps: u32,
     norm: &str,
     check_every: u32,
+    relaxation: f64,
     r0: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     use nscdd::fc::{CooMatrix, FcNorm, FcOptions, FcProblem};
@@ -64,12 +65,18 @@ pub fn _solve_fc_coo<'py>(
     if !(tol > 0.0) || max_sweeps == 0 || check_every == 0 {
         return Err(PyValueError::new_err("tol > 0, max_sweeps ≥ 1 and check_every ≥ 1"));
     }
+    if !(relaxation > 0.0 && relaxation < 2.0) || (method == nscdd::solver::Method::Newton && relaxation != 1.0) {
+        return Err(PyValueError::new_err(format!(
+            "relaxation: ω must lie in (0, 2) (and be 1 with newton), got {relaxation}"
+        )));
+    }
     let opts = FcOptions {
         tol,
         max_sweeps,
         check_every,
         norm,
         method,
+        relaxation,
     };
     let r0 = r0.map(|r| r.as_slice().map(|s| s.to_vec())).transpose()?;
     if r0.as_ref().is_some_and(|r| r.len() != p.q.len()) {

@@ -259,10 +259,10 @@ def random_problem(nc=40, dim=2, seed=3):
     return W, q, np.full(nc, 0.3)
 
 
-@pytest.mark.parametrize("method", ["nlgs", "anderson", "newton"])
-def test_solve_fc_reaches_its_tolerance(method):
+@pytest.mark.parametrize("method,relaxation", [("nlgs", 1.0), ("anderson", 1.0), ("newton", 1.0), ("nlgs", 1.2), ("anderson", 1.3)])
+def test_solve_fc_reaches_its_tolerance(method, relaxation):
     W, q, mu = random_problem()
-    s = nscdd.solve_fc(W, q, mu, method=method, tol=1e-8)
+    s = nscdd.solve_fc(W, q, mu, method=method, tol=1e-8, relaxation=relaxation)
     assert s["converged"] and s["residual"] < 1e-8
     r, u = s["r"].reshape(-1, 2), s["u"].reshape(-1, 2)
     assert np.allclose(u.ravel(), W @ s["r"] + q, atol=1e-9)
@@ -283,6 +283,10 @@ def test_solve_fc_takes_sparse_matrices_and_a_warm_start():
         nscdd.solve_fc(W, q, mu, method="pgs")
     with pytest.raises(ValueError, match="contacts"):
         nscdd.solve_fc(W, q[:-1], mu)
+    with pytest.raises(ValueError, match="relaxation"):
+        nscdd.solve_fc(W, q, mu, relaxation=2.0)
+    with pytest.raises(ValueError, match="relaxation"):
+        nscdd.solve_fc(W, q, mu, method="newton", relaxation=1.2)
 
 
 def test_the_stubs_name_every_method():

@@ -4,6 +4,8 @@
 //! - each reaches a natural-map residual of 1e-8 on a generated 2D problem (the
 //!   last step of a 300-disk deposit) and on the FCLIB files (3D), the residual it
 //!   reports being the one recomputed from its r with the problem's own W and q;
+//!   so do over-relaxed NLGS (ω = 1.2) and Anderson over over-relaxed sweeps
+//!   (ω = 1.3), and the deposit steps with them, one domain and 2 × 2 subdomains;
 //! - warm start: from a solution each stops at once, and from a loose solution in
 //!   fewer iterations than from r = 0;
 //! - a budget too small is reported as not converged, never silently;
@@ -85,15 +87,24 @@ fn opts(method: Method, tol: f64) -> FcOptions {
     }
 }
 
-/// Solves `p` to 1e-8 with every method and checks the reported residual against
-/// the one recomputed from r. Returns each method's iterations.
+/// Solves `p` to 1e-8 with every method (and relaxation, [`RELAXED`]) and checks
+/// the reported residual against the one recomputed from r. Returns each one's
+/// iterations.
 fn reach_1e8(label: &str, p: &FcProblem) -> Vec<u32> {
-    METHODS
+    RELAXED
         .iter()
-        .map(|&m| {
-            let s = p.solve(&opts(m, 1e-8));
-            println!("{label} {}: {} iterations, residual {:.2e}", m.name(), s.sweeps, s.residual);
-            assert!(s.converged && s.residual < 1e-8, "{label} {}: {s:?}", m.name());
+        .map(|&(m, omega)| {
+            let s = p.solve(&FcOptions {
+                relaxation: omega,
+                ..opts(m, 1e-8)
+            });
+            println!(
+                "{label} {} ω = {omega}: {} iterations, residual {:.2e}",
+                m.name(),
+                s.sweeps,
+                s.residual
+            );
+            assert!(s.converged && s.residual < 1e-8, "{label} {} ω = {omega}: {s:?}", m.name());
             let again = p.natural_residual(&s.r);
             assert!(again < 1e-8, "{label} {}: recomputed residual {again:.3e}", m.name());
             assert!(
@@ -203,11 +214,23 @@ fn refused(extra_solver: &str, key: &str) {
     assert!(e.contains(key), "`{extra_solver}`: {e}");
 }
 
+/// The methods with a relaxation: each method unrelaxed, over-relaxed NLGS and
+/// Anderson over over-relaxed sweeps.
+const RELAXED: [(Method, f64); 5] = [
+    (Method::Nlgs, 1.0),
+    (Method::Anderson, 1.0),
+    (Method::Newton, 1.0),
+    (Method::Nlgs, 1.2),
+    (Method::Anderson, 1.3),
+];
+
 #[test]
 fn settings_a_method_cannot_use_are_refused() {
     refused("method = \"cholesky\"", "method");
     refused("method = \"newton\"\nordering = \"shuffled\"", "solver.ordering");
     refused("method = \"newton\"\nrelaxation = 0.8", "solver.relaxation");
+    refused("relaxation = 2.0", "solver.relaxation");
+    refused("relaxation = 0.0", "solver.relaxation");
     refused("method = \"anderson\"\nordering = \"scrambled\"", "solver.ordering");
     // Newton has no place between NSCDD's gluing stages
     let text = deposit("method = \"newton\"").replace("[[materials]]", "[decomposition]\nnx = 2\nny = 1\n\n[[materials]]");
@@ -293,5 +316,46 @@ fn every_method_steps_the_deposit() {
     }
     for t in &tops[1..] {
         assert!((t - tops[0]).abs() < 1e-3, "pile tops {tops:?}");
+    }
+}
+
+/// Over-relaxed sweeps step the deposit: every step converges, in one domain and
+/// on 2 × 2 NSCDD subdomains, for NLGS at ω = 1.2 and Anderson at ω = 1.3, and
+/// the pile settles as with plain NLGS.
+#[test]
+fn over_relaxed_sweeps_step_the_deposit() {
+    let top = |s: &nscdd::scene::Scene| s.world.bodies.pos.iter().map(|p| p[1]).fold(f64::MIN, f64::max);
+    let mut plain = load(&deposit("")).unwrap();
+    for _ in 0..100 {
+        plain.world.step().unwrap();
+    }
+    for extra in ["relaxation = 1.2", "method = \"anderson\"\nrelaxation = 1.3"] {
+        let mut s = load(&deposit(extra)).unwrap();
+        for k in 0..100 {
+            let rep = s.world.step().unwrap();
+            assert!(rep.solve.converged, "`{extra}` step {k}: {rep:?}");
+        }
+        assert!(
+            (top(&s) - top(&plain)).abs() < 1e-3,
+            "`{extra}`: top {} vs {}",
+            top(&s),
+            top(&plain)
+        );
+        let mut s = load(&deposit(extra)).unwrap();
+        let mut n = Nscdd::new(DdSettings {
+            nx: 2,
+            ny: 2,
+            ..Default::default()
+        });
+        for k in 0..100 {
+            let rep = n.step(&mut s.world).unwrap();
+            assert!(rep.solve.converged, "`{extra}` on 2 × 2, step {k}: {rep:?}");
+        }
+        assert!(
+            (top(&s) - top(&plain)).abs() < 1e-3,
+            "`{extra}` on 2 × 2: top {} vs {}",
+            top(&s),
+            top(&plain)
+        );
     }
 }

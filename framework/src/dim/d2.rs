@@ -210,6 +210,10 @@ impl Dim for D2 {
     fn solve_joint(b: &Block2, u0: &[f64; 2], u_target: f64, mu: f64, j: &Joint, prev: &[f64; 2]) -> [f64; 2] {
         coulomb::solve_joint(b.w, &b.pre, *u0, u_target, mu, j, *prev)
     }
+    fn project_joint(z: &[f64], mu: f64, j: &Joint) -> [f64; 3] {
+        let p = coulomb::project_joint([z[0], z[1]], mu, j);
+        [p[0], p[1], 0.0]
+    }
     fn joint_holds(b: &Block2, r: &[f64; 2], u0: &[f64; 2], u_target: f64, mu: f64, j: &Joint, tol: f64) -> bool {
         coulomb::joint_holds(b.w, &b.pre, *r, *u0, u_target, mu, j, tol)
     }

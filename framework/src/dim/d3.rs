@@ -358,6 +358,9 @@ impl Dim for D3 {
     fn solve_joint(b: &Block3, u0: &[f64; 3], u_target: f64, mu: f64, j: &Joint, prev: &[f64; 3]) -> [f64; 3] {
         joint::solve(&b.w, &b.pre, *u0, u_target, mu, j, *prev)
     }
+    fn project_joint(z: &[f64], mu: f64, j: &Joint) -> [f64; 3] {
+        joint::project([z[0], z[1], z[2]], mu, j)
+    }
     fn joint_holds(b: &Block3, r: &[f64; 3], u0: &[f64; 3], u_target: f64, mu: f64, j: &Joint, tol: f64) -> bool {
         joint::holds(&b.w, &b.pre, *r, *u0, u_target, mu, j, tol)
     }

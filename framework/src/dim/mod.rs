@@ -217,6 +217,9 @@ pub trait Dim: sealed::Sealed + Copy + Default + Debug + PartialEq + Send + Sync
     fn solve(b: &Self::Block, u0: &Self::Local, u_target: f64, mu: f64, prev: &Self::Local) -> Self::Local;
     /// The one-contact solution of a bonded mortar joint ([`joint`]).
     fn solve_joint(b: &Self::Block, u0: &Self::Local, u_target: f64, mu: f64, j: &Joint, prev: &Self::Local) -> Self::Local;
+    /// The projection of `z` on a bonded joint's admissible set K_c ([`joint`];
+    /// components past the dimension 0).
+    fn project_joint(z: &[f64], mu: f64, j: &Joint) -> [f64; 3];
     /// Whether a bonded joint holds on the converged impulse ([`joint::holds`]).
     #[allow(clippy::too_many_arguments)]
     fn joint_holds(b: &Self::Block, r: &Self::Local, u0: &Self::Local, u_target: f64, mu: f64, j: &Joint, tol: f64) -> bool;

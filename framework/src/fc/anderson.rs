@@ -35,7 +35,7 @@ pub(crate) fn solve<const D: usize>(l: &Local<D>, r: &mut Vec<[f64; D]>, opts: &
     let (mut best, mut best_f) = (r.clone(), f64::INFINITY);
     let (iterations, converged) = crate::solver::check_loop(opts.max_sweeps, opts.check_every, |check| {
         g.copy_from_slice(r);
-        l.b.sweep(&l.q, &l.mu, &mut g);
+        l.b.sweep(&l.q, &l.mu, &mut g, opts.relaxation);
         let mixing = mixer.step(r.as_flattened(), g.as_flattened(), &mut InOrder);
         if mixer.f_norm() < best_f {
             best_f = mixer.f_norm();

@@ -86,6 +86,8 @@ pub struct FcOptions {
     pub check_every: u32,
     pub norm: FcNorm,
     pub method: Method,
+    /// ω of the NLGS sweeps (NLGS, and Anderson's map): [`crate::solver::relax`].
+    pub relaxation: f64,
 }
 
 impl FcOptions {
@@ -98,6 +100,7 @@ impl FcOptions {
             check_every: 1,
             norm: FcNorm::Natural,
             method: Method::Nlgs,
+            relaxation: 1.0,
         }
     }
 }

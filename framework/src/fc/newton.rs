@@ -262,7 +262,7 @@ pub(crate) fn solve<const D: usize>(l: &Local<D>, r: &mut Vec<[f64; D]>, opts: &
         if accepted.is_none() || strikes >= STRIKES {
             r.copy_from_slice(&best.1);
             for _ in 0..block {
-                l.b.sweep(&l.q, &l.mu, r);
+                l.b.sweep(&l.q, &l.mu, r, 1.0);
             }
             block = (2 * block).min(FALLBACK_MAX);
             l.b.velocity(&l.q, r, &mut w.u);

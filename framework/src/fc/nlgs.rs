@@ -159,12 +159,16 @@ impl<const D: usize> Blocks<D> {
         out
     }
 
-    /// One NLGS sweep in storage order.
+    /// One NLGS sweep in storage order, relaxed by ω ([`crate::solver::relax`]).
     #[inline(never)]
-    pub fn sweep(&self, q: &[[f64; D]], mu: &[f64], r: &mut [[f64; D]]) {
+    pub fn sweep(&self, q: &[[f64; D]], mu: &[f64], r: &mut [[f64; D]], omega: f64) {
         for a in 0..q.len() {
             let u0 = self.off_sum(a, q[a], r);
-            r[a] = self.local(a, u0, mu[a], r[a]);
+            let mut rn = self.local(a, u0, mu[a], r[a]);
+            if omega != 1.0 {
+                crate::solver::relax(&r[a], &mut rn, omega, |z| crate::norms::project_cone(z, mu[a]));
+            }
+            r[a] = rn;
         }
     }
 }

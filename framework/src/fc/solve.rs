@@ -82,7 +82,7 @@ pub fn solve<const D: usize>(p: &FcProblem, r0: Option<&[f64]>, opts: &FcOptions
     } else {
         match opts.method {
             Method::Nlgs => crate::solver::check_loop(opts.max_sweeps, opts.check_every, |check| {
-                l.b.sweep(&l.q, &l.mu, &mut r);
+                l.b.sweep(&l.q, &l.mu, &mut r, opts.relaxation);
                 check && l.stop(&r, &mut u, opts)
             }),
             Method::Anderson => anderson::solve(&l, &mut r, opts),

@@ -302,6 +302,7 @@ pub fn solve_world<D: crate::dim::Dim>(w: &mut crate::world::World<D>) -> crate:
         check_every: s.check_every,
         norm: super::FcNorm::Lmgc(s.norm),
         method: s.method,
+        relaxation: s.relaxation,
     };
     let c = &mut w.contacts;
     let r0: Vec<f64> = c.r.iter().flat_map(|r| r.as_ref().iter().copied()).collect();

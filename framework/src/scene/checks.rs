@@ -300,8 +300,8 @@ pub(crate) fn validate_solver(cx: &Ctx, s: &crate::solver::SolverSettings) -> Re
     if s.check_every == 0 {
         return Err(cx.err(&p("check_every"), "must be ≥ 1"));
     }
-    if !(s.relaxation > 0.0 && s.relaxation <= 1.0) {
-        return Err(cx.err(&p("relaxation"), format!("ω must lie in (0, 1], got {}", s.relaxation)));
+    if !(s.relaxation > 0.0 && s.relaxation < 2.0) {
+        return Err(cx.err(&p("relaxation"), format!("ω must lie in (0, 2), got {}", s.relaxation)));
     }
     // Newton sweeps nothing (its fallback sweeps the assembled W in storage order,
     // unrelaxed); Anderson mixes the world's sweeps in their order and relaxation,

@@ -66,12 +66,31 @@ pub struct SolverSettings {
     pub max_sweeps: u32,
     /// A check pass every `check_every` sweeps.
     pub check_every: u32,
-    /// Relaxation ω in (0, 1].
+    /// Relaxation ω in (0, 2) ([`relax`]): under-relaxed below 1, over-relaxed
+    /// (projected) above.
     pub relaxation: f64,
     pub ordering: Ordering,
     pub seed: u64,
     /// `nlgs` (default), `anderson` or `newton`.
     pub method: Method,
+}
+
+/// A contact's relaxed update, r_loc ← r + ω (r_loc − r), from its impulse `r` and
+/// its local solution `r_loc` (overwritten). With ω ∈ (0, 1] the result stays in
+/// the contact's convex admissible set (a mean of two of its points); with ω ∈
+/// (1, 2) it is projected on it (`project`: the Coulomb cone, or a joint's set),
+/// the projected over-relaxation of NLGS. Both keep NLGS's fixed points: at
+/// r = r_loc the update gives r. `project` is called only when ω > 1.
+#[inline(always)]
+pub fn relax(r: &[f64], r_loc: &mut [f64], omega: f64, project: impl FnOnce(&[f64]) -> [f64; 3]) {
+    for (x, &y) in r_loc.iter_mut().zip(r) {
+        *x = omega * *x + (1.0 - omega) * y;
+    }
+    if omega > 1.0 {
+        let p = project(r_loc);
+        let n = r_loc.len();
+        r_loc.copy_from_slice(&p[..n]);
+    }
 }
 
 impl Default for SolverSettings {
@@ -150,4 +169,38 @@ pub struct SolveReport {
     pub norms: Norms,
     /// Natural-map residual ‖F(r)‖/‖q‖ after the solve.
     pub residual: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::relax;
+    use crate::norms::project_cone;
+
+    /// Under-relaxation is the plain mean; over-relaxation lands in the cone, on
+    /// the projection of the extrapolated point; r_loc = r stays r (to rounding) for
+    /// any ω.
+    #[test]
+    fn relax_means_below_one_and_projects_above() {
+        let mu = 0.5;
+        let (r, loc) = ([1.0, 0.4, 0.0], [2.0, -0.9, 0.3]);
+        let mut x = loc;
+        relax(&r, &mut x, 0.5, |_| unreachable!("no projection below 1"));
+        assert_eq!(x, [1.5, -0.25, 0.15]);
+        let mut x = loc;
+        relax(&r, &mut x, 1.5, |z| project_cone(z, mu));
+        // extrapolated (2.5, −1.55, 0.45): outside the cone, projected on its surface
+        let t = (x[1] * x[1] + x[2] * x[2]).sqrt();
+        assert!((t - mu * x[0]).abs() < 1e-12 && x[0] > 0.0, "{x:?}");
+        let e: [f64; 3] = std::array::from_fn(|k| 1.5 * loc[k] + (1.0 - 1.5) * r[k]);
+        assert_eq!(x, project_cone(&e, mu));
+        for omega in [0.3, 1.0, 1.2, 1.9] {
+            let mut x = r;
+            relax(&r, &mut x, omega, |z| project_cone(z, mu));
+            assert!((0..3).all(|k| (x[k] - r[k]).abs() <= 1e-15), "ω = {omega}: {x:?}");
+        }
+        // 2D: the third component is not touched
+        let mut x = [0.5, 0.1];
+        relax(&[0.2, 0.0], &mut x, 1.8, |z| project_cone(z, mu));
+        assert!(x[1].abs() <= mu * x[0] + 1e-15, "{x:?}");
+    }
 }

@@ -44,7 +44,7 @@ use super::{Ordering, SolveReport, SolverSettings};
 use crate::dim::joint::Joint;
 use crate::dim::{Dim, Vector};
 use crate::model::{Contacts, Target};
-use crate::norms::{natural_map_sq, Sums};
+use crate::norms::{natural_map_sq, project_cone, Sums};
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 
@@ -194,7 +194,14 @@ fn visit<D: Dim, const CHECK: bool, const UPDATE: bool, const RELAX: bool, const
         D::solve(blk, &u0, t.u_target, t.mu, &r)
     };
     if RELAX {
-        rn = D::Local::from_fn(|k| omega * rn[k] + (1.0 - omega) * r[k]);
+        let joint = COLD && h.joint[a].bonded();
+        super::relax(r.as_ref(), rn.as_mut(), omega, |z| {
+            if joint {
+                D::project_joint(z, t.mu, &h.joint[a])
+            } else {
+                project_cone(z, t.mu)
+            }
+        });
     }
     let dr = rn.sub(&r);
     if CHECK {

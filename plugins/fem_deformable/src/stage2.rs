@@ -17,9 +17,9 @@ use nscdd::dim::d2::Block2;
 use nscdd::engine::{ContactStage, Diverged};
 use nscdd::law::{Law, LawInput, LawOutput, LawStep};
 use nscdd::model::Target;
-use nscdd::norms::{natural_map_sq, Sums};
-use nscdd::solver::nlgs;
+use nscdd::norms::{natural_map_sq, project_cone, Sums};
 use nscdd::solver::SolveReport;
+use nscdd::solver::{nlgs, relax};
 use nscdd::world::World2;
 use std::time::Instant;
 
@@ -403,7 +403,7 @@ pub fn sweep(c: &mut FeContacts2, sets: &mut [NodeSet], vel: &mut [[f64; 3]], in
         let t = c.target[a];
         let mut rn = coulomb::solve_pre(w, &pre, u0, t.u_target, t.mu);
         if omega != 1.0 {
-            rn = [omega * rn[0] + (1.0 - omega) * r[0], omega * rn[1] + (1.0 - omega) * r[1]];
+            relax(&r, &mut rn, omega, |z| project_cone(z, t.mu));
         }
         let dr = [rn[0] - r[0], rn[1] - r[1]];
         if let Some(s) = sums.as_deref_mut() {

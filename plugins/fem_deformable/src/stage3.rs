@@ -15,9 +15,9 @@ use nscdd::dim::coulomb3 as coulomb;
 use nscdd::dim::d3::{tangents, Block3};
 use nscdd::engine::{ContactStage, Diverged};
 use nscdd::model::Target;
-use nscdd::norms::{natural_map_sq, Sums};
-use nscdd::solver::nlgs;
+use nscdd::norms::{natural_map_sq, project_cone, Sums};
 use nscdd::solver::SolveReport;
+use nscdd::solver::{nlgs, relax};
 use nscdd::world::World3;
 use std::time::Instant;
 
@@ -327,9 +327,7 @@ pub fn sweep(c: &mut FeContacts3, sets: &mut [NodeSet3], vel: &mut [[f64; 6]], i
         let t = c.target[a];
         let mut rn = coulomb::solve_pre_warm(&blk.w, &blk.pre, u0, t.u_target, t.mu, r);
         if omega != 1.0 {
-            for k in 0..3 {
-                rn[k] = omega * rn[k] + (1.0 - omega) * r[k];
-            }
+            relax(&r, &mut rn, omega, |z| project_cone(z, t.mu));
         }
         let dr = [rn[0] - r[0], rn[1] - r[1], rn[2] - r[2]];
         if let Some(s) = sums.as_deref_mut() {

@@ -1,7 +1,9 @@
 //! Bonded mortar joints (law `mohr_coulomb`): a joint holds a load 2 % below its
 //! strength and fails 2 % above it, in tension (a hanging block: σ_t A against m g)
 //! and in shear (a flat block on a tilted base: c A + μ N against the downhill pull);
-//! bonds are made at the first step only and survive a restart.
+//! bonds are made at the first step only and survive a restart. The first two
+//! also with over-relaxed sweeps (`relaxation = 1.2`: the relaxed impulse is
+//! projected on the joint's admissible set).
 use nscdd::output::final_json;
 use nscdd::scene::restart::restart_str;
 use nscdd::scene::Scene3;
@@ -34,6 +36,10 @@ fn block(name: &str, lo: [f64; 3], hi: [f64; 3], fixed: bool) -> String {
 }
 
 fn scene(gravity: [f64; 3], law: &str, bodies: &str) -> String {
+    scene_relaxed(gravity, law, bodies, 1.0)
+}
+
+fn scene_relaxed(gravity: [f64; 3], law: &str, bodies: &str, omega: f64) -> String {
     format!(
         r#"dimension = 3
 gravity = [{}, {}, {}]
@@ -44,6 +50,7 @@ steps = 200
 [solver]
 tolerance = 1e-6
 max_sweeps = 20000
+relaxation = {omega:?}
 [detection]
 alert = 0.002
 [[materials]]
@@ -69,18 +76,24 @@ fn bonds(w: &World3) -> usize {
 }
 
 /// A 0.4 m cube hanging under a fixed block by a joint of area 0.16 m², tensile
-/// strength `ratio` × m g / A.
-fn hanging(ratio: f64) -> World3 {
+/// strength `ratio` × m g / A; sweeps relaxed by `omega`.
+fn hanging(ratio: f64, omega: f64) -> World3 {
     let (a, m) = (0.16, RHO * 0.064);
     let sigma = ratio * m * G / a;
     let law = format!("law = \"mohr_coulomb\"\nfriction = 0.6\ncohesion = 1e5\ntensile_strength = {sigma}");
     let bodies = block("ceiling", [-0.3, -0.3, 1.0], [0.3, 0.3, 1.2], true) + &block("block", [-0.2, -0.2, 0.6], [0.2, 0.2, 1.0], false);
-    world(&scene([0.0, 0.0, -G], &law, &bodies))
+    world(&scene_relaxed([0.0, 0.0, -G], &law, &bodies, omega))
 }
 
 #[test]
 fn a_joint_holds_in_tension_below_its_strength_and_fails_above() {
-    let mut w = hanging(1.02);
+    for omega in [1.0, 1.2] {
+        tension(omega);
+    }
+}
+
+fn tension(omega: f64) {
+    let mut w = hanging(1.02, omega);
     assert_eq!(bonds(&w), 0);
     run(&mut w, 200);
     assert_eq!(bonds(&w), 4, "the four corners of the joint stay bonded");
@@ -91,7 +104,7 @@ fn a_joint_holds_in_tension_below_its_strength_and_fails_above() {
     let weight = RHO * 0.064 * G;
     assert!((f.abs() - weight).abs() < 1e-6 * weight, "carried {f} N of {weight} N");
 
-    let mut w = hanging(0.98);
+    let mut w = hanging(0.98, omega);
     run(&mut w, 200);
     assert_eq!(bonds(&w), 0);
     // broken at the first step, it falls freely: ½ g t² (t = 0.2 s), less the
@@ -103,25 +116,31 @@ fn a_joint_holds_in_tension_below_its_strength_and_fails_above() {
 
 /// A 1 × 1 × 0.1 m slab bonded on a fixed base, gravity tilted by α = 40° (μ = 0.5
 /// < tan α): it holds iff c A + μ m g cos α ≥ m g sin α; cohesion `ratio` × the
-/// critical value.
-fn sheared(ratio: f64) -> World3 {
+/// critical value; sweeps relaxed by `omega`.
+fn sheared(ratio: f64, omega: f64) -> World3 {
     let alpha = 40f64.to_radians();
     let (mu, m, a) = (0.5, RHO * 0.1, 1.0);
     let c = ratio * m * G * (alpha.sin() - mu * alpha.cos()) / a;
     let law = format!("law = \"mohr_coulomb\"\nfriction = {mu}\ncohesion = {c}");
     let bodies = block("base", [-1.0, -1.0, -0.2], [1.0, 1.0, 0.0], true) + &block("slab", [-0.5, -0.5, 0.0], [0.5, 0.5, 0.1], false);
-    world(&scene([G * alpha.sin(), 0.0, -G * alpha.cos()], &law, &bodies))
+    world(&scene_relaxed([G * alpha.sin(), 0.0, -G * alpha.cos()], &law, &bodies, omega))
 }
 
 #[test]
 fn a_joint_holds_in_shear_below_its_strength_and_slides_above() {
-    let mut w = sheared(1.02);
+    for omega in [1.0, 1.2] {
+        shear(omega);
+    }
+}
+
+fn shear(omega: f64) {
+    let mut w = sheared(1.02, omega);
     run(&mut w, 200);
     assert_eq!(bonds(&w), 4);
     let dx = w.bodies.pos[1][0];
     assert!(dx.abs() < 1e-9, "held slab moved {dx:e} m");
 
-    let mut w = sheared(0.98);
+    let mut w = sheared(0.98, omega);
     run(&mut w, 200);
     assert_eq!(bonds(&w), 0);
     // then Coulomb sliding: x = ½ g (sin α − μ cos α) t², less the first step
