@@ -114,13 +114,6 @@ impl CellIndex {
             }
         }
     }
-
-    /// Whether `[lo, hi]` meets a cell of rank `r`.
-    pub fn meets_rank(&self, n: usize, lo: &[f64], hi: &[f64], r: u32) -> bool {
-        let mut any = false;
-        self.ranks_meeting(n, lo, hi, |q| any |= q == r);
-        any
-    }
 }
 
 #[cfg(test)]

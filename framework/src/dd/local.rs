@@ -77,11 +77,12 @@ impl Local {
         let mut to = ToRanks::new(rs, D::SPACE);
         let mut rec = Vec::with_capacity(D::PREV_RECORD + 1);
         for (a, &o) in owner.iter().enumerate().take(D::len(c)) {
-            let [i, j] = D::bodies(c, a);
-            rec.clear();
-            D::prev_record(c, a, &mut rec);
-            rec.push(f64::from(o));
-            to.send(cells, self.pair_box::<D>([i, j], alert), &rec);
+            if to.aim(cells, self.pair_box::<D>(D::bodies(c, a), alert)) {
+                rec.clear();
+                D::prev_record(c, a, &mut rec);
+                rec.push(f64::from(o));
+                to.push(&rec);
+            }
         }
         let got = to.finish(rs);
         let per = D::PREV_RECORD + 1;
@@ -129,8 +130,9 @@ impl ToRanks {
         }
     }
 
-    /// `rec` to every rank but this one whose `cells` meet `[lo, hi]`, once each.
-    fn send(&mut self, cells: &CellIndex, (lo, hi): ([f64; 3], [f64; 3]), rec: &[f64]) {
+    /// Aims at the ranks but this one whose `cells` meet `[lo, hi]` (once each);
+    /// whether there is any.
+    fn aim(&mut self, cells: &CellIndex, (lo, hi): ([f64; 3], [f64; 3])) -> bool {
         let (me, to) = (self.me, &mut self.to);
         to.clear();
         cells.ranks_meeting(self.n, &lo, &hi, |q| {
@@ -138,7 +140,12 @@ impl ToRanks {
                 to.push(q);
             }
         });
-        for &q in to.iter() {
+        !to.is_empty()
+    }
+
+    /// `rec` to the ranks aimed at last.
+    fn push(&mut self, rec: &[f64]) {
+        for &q in &self.to {
             self.out[q as usize].extend_from_slice(rec);
         }
     }
@@ -158,7 +165,9 @@ impl Local {
     fn prev_for_new_cells<D: Family>(&self, rs: &mut RankState, cells: &CellIndex, own: &[f64], alert: f64) -> Vec<f64> {
         let mut to = ToRanks::new(rs, D::SPACE);
         for x in own.chunks_exact(D::PREV_RECORD) {
-            to.send(cells, self.pair_box::<D>([x[0] as u32, x[1] as u32], alert), x);
+            if to.aim(cells, self.pair_box::<D>([x[0] as u32, x[1] as u32], alert)) {
+                to.push(x);
+            }
         }
         to.finish(rs).concat()
     }

@@ -55,9 +55,9 @@ pub(super) struct Near<'a> {
 impl Near<'_> {
     /// Whether body g's grown box meets rank r's cells.
     fn meets<D: Family>(&self, g: u32, r: u32) -> bool {
-        let b = &self.boxes[g as usize];
-        let (lo, hi) = Region::grown_box(D::SPACE, &b[0], &b[1], self.alert);
-        self.cells.meets_rank(D::SPACE, &lo, &hi, r)
+        let mut any = false;
+        self.ranks_of::<D>(g, |q| any |= q == r);
+        any
     }
 
     /// Calls `f` with the ranks whose cells body g's grown box meets.
