@@ -16,7 +16,7 @@
 //! - Anderson over NSCDD's stages converges in fewer stages than NLGS, bitwise the
 //!   same for any thread count.
 //!
-//! The physics tests run with each method where it applies
+//! The physics tests run with each method, and over-relaxed, where it applies
 //! (`physics::incline::every_method_gives_the_incline_answers`,
 //! `physics::stacks::column_contact_forces_are_k_m_g`).
 

@@ -174,18 +174,21 @@ fn disk_slips_below_mu_eq_tan_alpha_over_3() {
     assert_rel("friction impulse r_t = −μ r_n (N s)", r[1], -mu * r[0], EXACT);
 }
 
-/// Anderson and Newton (`[solver] method`) give the incline's answers too: the
-/// block sticking below tan α = μ and sliding above it, the free disk rolling above
-/// μ = tan α / 3 and slipping below it (one contact: every method solves its
-/// problem exactly, hence the same tolerance).
+/// Anderson and Newton (`[solver] method`), and over-relaxed NLGS and Anderson
+/// (`relaxation` 1.2 and 1.3), give the incline's answers too: the block sticking
+/// below tan α = μ and sliding above it, the free disk rolling above μ = tan α / 3
+/// and slipping below it (one contact: every method solves its problem exactly,
+/// hence the same tolerance).
 #[test]
 fn every_method_gives_the_incline_answers() {
     let m = disk_mass(RHO, R);
-    for method in ["anderson", "newton"] {
+    for (method, omega) in [("anderson", 1.0), ("newton", 1.0), ("nlgs", 1.2), ("anderson", 1.3)] {
         let with = |alpha: f64, mu: f64, block: bool| {
             let text = incline_text(alpha, mu, block, true);
-            scene(&text.replace("tolerance = 1e-8", &format!("tolerance = 1e-8\nmethod = \"{method}\"")))
+            let solver = format!("tolerance = 1e-8\nmethod = \"{method}\"\nrelaxation = {omega:?}");
+            scene(&text.replace("tolerance = 1e-8", &solver))
         };
+        let method = format!("{method} ω = {omega}");
         let mu: f64 = 0.5;
         let alpha = (0.95 * mu).atan();
         let mut s = with(alpha, mu, true);

@@ -55,11 +55,14 @@ fn disk(x: f64, y: f64) -> String {
 fn column_contact_forces_are_k_m_g() {
     const N: usize = 10;
     let m = disk_mass(RHO, R);
-    // NLGS in three orders, Anderson and Newton (storage order)
-    for ordering in ["stored", "reversed", "shuffled", "anderson", "newton"] {
+    // NLGS in three orders, Anderson and Newton (storage order), NLGS over-relaxed
+    for ordering in ["stored", "reversed", "shuffled", "anderson", "newton", "over-relaxed"] {
         let mut text = header(1e-6, ordering, 0.3);
         if ordering == "anderson" || ordering == "newton" {
             text = text.replace(&format!("ordering = \"{ordering}\""), &format!("method = \"{ordering}\""));
+        }
+        if ordering == "over-relaxed" {
+            text = text.replace("ordering = \"over-relaxed\"", "relaxation = 1.2");
         }
         for k in 0..N {
             text += &disk(0.0, R + 2.0 * R * k as f64);
