@@ -331,6 +331,7 @@ fn generated(label: &str, toml: &str, steps: usize, at_rest: bool) -> (usize, u3
             check_every: 10,
             norm: FcNorm::Lmgc(Criterion::QuadMax16),
             method: nscdd::solver::Method::Nlgs,
+            relaxation: 1.0,
         },
     )
     .unwrap();
@@ -444,6 +445,7 @@ fn two_stacked_blocks() {
             check_every: 3,
             norm: FcNorm::Lmgc(Criterion::Quad),
             method: nscdd::solver::Method::Nlgs,
+            relaxation: 1.0,
         },
     )
     .unwrap();
@@ -458,6 +460,7 @@ fn two_stacked_blocks() {
             check_every: 1,
             norm: FcNorm::Natural,
             method: nscdd::solver::Method::Nlgs,
+            relaxation: 1.0,
         },
     )
     .unwrap();
@@ -535,6 +538,7 @@ fn fclib_files_reach_the_requested_residual() {
             check_every: 10,
             norm: FcNorm::Natural,
             method: nscdd::solver::Method::Nlgs,
+            relaxation: 1.0,
         };
         let s = p.solve(&opts);
         println!(

@@ -73,13 +73,21 @@ pub fn fc_json(data: &[u8]) {
 }
 
 pub(crate) fn solve_problem(p: &FcProblem) {
-    for method in [Method::Nlgs, Method::Anderson, Method::Newton] {
+    // each method, and the over-relaxed sweeps (projected on the cones)
+    for (method, relaxation) in [
+        (Method::Nlgs, 1.0),
+        (Method::Anderson, 1.0),
+        (Method::Newton, 1.0),
+        (Method::Nlgs, 1.5),
+        (Method::Anderson, 1.5),
+    ] {
         let _ = p.solve(&FcOptions {
             tol: 1e-8,
             max_sweeps: 50,
             check_every: 1,
             norm: FcNorm::Natural,
             method,
+            relaxation,
         });
     }
 }
