@@ -330,32 +330,25 @@ fn over_relaxed_sweeps_step_the_deposit() {
         plain.world.step().unwrap();
     }
     for extra in ["relaxation = 1.2", "method = \"anderson\"\nrelaxation = 1.3"] {
-        let mut s = load(&deposit(extra)).unwrap();
-        for k in 0..100 {
-            let rep = s.world.step().unwrap();
-            assert!(rep.solve.converged, "`{extra}` step {k}: {rep:?}");
+        // one domain, then 2 × 2 subdomains
+        for dd in [false, true] {
+            let label = format!("`{extra}`{}", if dd { " on 2 × 2" } else { "" });
+            let mut s = load(&deposit(extra)).unwrap();
+            let mut n = dd.then(|| {
+                Nscdd::new(DdSettings {
+                    nx: 2,
+                    ny: 2,
+                    ..Default::default()
+                })
+            });
+            for k in 0..100 {
+                let solve = match n.as_mut() {
+                    Some(n) => n.step(&mut s.world).unwrap().solve,
+                    None => s.world.step().unwrap().solve,
+                };
+                assert!(solve.converged, "{label} step {k}: {solve:?}");
+            }
+            assert!((top(&s) - top(&plain)).abs() < 1e-3, "{label}: top {} vs {}", top(&s), top(&plain));
         }
-        assert!(
-            (top(&s) - top(&plain)).abs() < 1e-3,
-            "`{extra}`: top {} vs {}",
-            top(&s),
-            top(&plain)
-        );
-        let mut s = load(&deposit(extra)).unwrap();
-        let mut n = Nscdd::new(DdSettings {
-            nx: 2,
-            ny: 2,
-            ..Default::default()
-        });
-        for k in 0..100 {
-            let rep = n.step(&mut s.world).unwrap();
-            assert!(rep.solve.converged, "`{extra}` on 2 × 2, step {k}: {rep:?}");
-        }
-        assert!(
-            (top(&s) - top(&plain)).abs() < 1e-3,
-            "`{extra}` on 2 × 2: top {} vs {}",
-            top(&s),
-            top(&plain)
-        );
     }
 }

@@ -134,12 +134,12 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
         return out;
     }
     let (counts, ngg_of): (Vec<Option<Vec<u32>>>, Vec<u64>) = (0..ns)
-        .map(|s| match own(s) {
-            true => {
-                let (c, n) = loaded(w, d, s);
-                (Some(c), n)
+        .map(|s| {
+            if !own(s) {
+                return (None, 0);
             }
-            false => (None, 0),
+            let (c, n) = loaded(w, d, s);
+            (Some(c), n)
         })
         .unzip();
     let total = shared_totals(d, w, ranks.as_deref_mut(), &counts);

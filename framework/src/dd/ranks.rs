@@ -390,8 +390,8 @@ impl RankState {
 
     /// Every subdomain's impulses, copy velocities and F_Γ from its rank to all; with
     /// `requests` (contacts held per rank, no repartition next or limited shells,
-    /// [`super::shells`]), only the copy velocities of the bodies this rank steps (`Some(None)`: all of them;
-    /// [`RankState::share_requested`]).
+    /// [`super::shells`]), only the copy velocities of the bodies this rank steps
+    /// (`Some(None)`: all of them; [`RankState::share_requested`]).
     fn share_results<D: Family>(&mut self, d: &mut Decomposition<D>, requests: Option<Option<&[u32]>>) {
         if let (Some(active), true) = (requests, self.local) {
             return self.share_requested(d, active);
@@ -449,10 +449,10 @@ impl RankState {
 /// `max_stages` stages of `per` sweeps (relaxation `omega`) and one gluing, a check
 /// every `k` stages and at the last, `converged(sums, residual share)` deciding on
 /// every rank from the same merged numbers; then every subdomain's results on every
-/// rank, or with `requests` the copies this rank asked for. The subdomains' ranks are those of [`RankState::assign`] at the partition;
-/// `fresh`: whether any interface body is fresh (the same on every rank: the ranks
-/// glue those together first). Returns the stages run and this step's exchange
-/// counts.
+/// rank, or with `requests` the copies this rank asked for. The subdomains' ranks
+/// are those of [`RankState::assign`] at the partition; `fresh`: whether any
+/// interface body is fresh (the same on every rank: the ranks glue those together
+/// first). Returns the stages run and this step's exchange counts.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn iterate<D: Family>(
     st: &mut RankState,
