@@ -49,6 +49,8 @@ PHI = 15.1
 HARD = None
 # the bands' grain_share (--grain-share S)
 SHARE = 0.0
+# the regions' dilatancy angle ψ (°; scripts/continuum_biaxial_fit.py varies it)
+PSI = 4.0
 
 
 def run(scene, out):
@@ -83,7 +85,7 @@ def share():
 
 def plastic():
     h = "" if HARD is None else f", initial_friction = {HARD[0]!r}, hardening_strain = {HARD[1]!r}"
-    return f"{{ friction = {PHI!r}, dilatancy = 4.0{h} }}"
+    return f"{{ friction = {PHI!r}, dilatancy = {PSI!r}{h} }}"
 
 
 def right_walls(width):

@@ -47,8 +47,7 @@ def main():
     for arg in sys.argv[3:]:
         v = [float(x) for x in arg.split(",")]
         cb.HARD, cb.PHI = (v[0], v[1]), v[2]
-        psi = v[4] if len(v) > 4 else 4.0
-        cb.plastic = lambda: f"{{ friction = {cb.PHI!r}, dilatancy = {psi!r}, initial_friction = {cb.HARD[0]!r}, hardening_strain = {cb.HARD[1]!r} }}"
+        cb.PSI = v[4] if len(v) > 4 else 4.0
         tag = arg.replace(",", "_")
         with ThreadPoolExecutor(2) as ex:
             curves = list(ex.map(lambda k: hybrid(run_dir, tag, k, v[3]), seeds))
