@@ -304,8 +304,8 @@ pub(crate) fn build_from_raw<D: Dim>(w: &mut World<D>) {
         let u_begin = D::local_velocity(&frame, &s.v_begin[i], &s.v_begin[j]);
         let u_free = D::local_velocity(&frame, &b.vel[i], &b.vel[j]);
         let key = ContactKey {
-            i: rc.i,
-            j: rc.j,
+            i: w.ids.global(rc.i),
+            j: w.ids.global(rc.j),
             feature: rc.feature,
         };
         // the same key at the same place, else the nearest point of the pair; a
@@ -416,7 +416,11 @@ fn integrate<D: Dim>(w: &mut World<D>) -> Result<(), usize> {
 /// error, the reactions (when `reactions`), the step and time counted.
 fn finish_positions<D: Dim>(w: &mut World<D>, reactions: bool, moved: Result<(), usize>) -> Result<(), Diverged> {
     if let Err(k) = moved {
-        return Err(Diverged::non_finite(w.step + 1, k, w.body_label(k), &w.bodies));
+        let e = Diverged::non_finite(w.step + 1, k, w.body_label(k), &w.bodies);
+        return Err(Diverged {
+            body: w.ids.global(k as u32),
+            ..e
+        });
     }
     let h = w.time.h;
     if reactions {

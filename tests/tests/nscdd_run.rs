@@ -15,61 +15,7 @@ fn load(text: &str) -> Scene {
 // ---------------------------------------------------------------- outputs
 
 /// 48 disks of a triangular lattice on a floor between two walls, NSCDD 2 × 2.
-const PILE: &str = r#"
-[time]
-step = 1e-3
-steps = 20
-[solver]
-tolerance = 1e-5
-norm = "QM/16"
-max_sweeps = 5000
-check_every = 5
-[output]
-every = 10
-[decomposition]
-nx = 2
-ny = 2
-scheme = "centralized"
-threads = 2
-repartition_every = 3
-[[materials]]
-name = "m"
-density = 1000.0
-[[laws]]
-materials = ["m", "m"]
-friction = 0.3
-[[bodies]]
-name = "floor"
-shape = "wall"
-material = "m"
-position = [0.08, -0.005]
-length = 0.4
-thickness = 0.01
-fixed = true
-[[bodies]]
-shape = "wall"
-material = "m"
-position = [-0.005, 0.1]
-rotation = 1.5707963267948966
-length = 0.3
-thickness = 0.01
-fixed = true
-[[bodies]]
-shape = "wall"
-material = "m"
-position = [0.175, 0.1]
-rotation = 1.5707963267948966
-length = 0.3
-thickness = 0.01
-fixed = true
-[[generate]]
-kind = "triangular_lattice"
-material = "m"
-nx = 8
-ny = 6
-radius = 0.01
-origin = [0.01, 0.01]
-"#;
+const PILE: &str = include_str!("scenes/pile48.toml");
 
 /// The named float arrays of a VTK file's points or cells, and its point and cell counts.
 fn arrays(path: &std::path::Path, cells: bool) -> (Vec<(String, Vec<f64>)>, usize) {

@@ -187,7 +187,7 @@ pub(super) fn write_back_held<D: Family>(
 ) {
     let one = |w: &mut D::World, s: &super::Subdomain<D>, l: usize, g: usize| {
         if d.mult[g] == 1 || !D::movable(w, g) {
-            D::vel_mut(w)[g] = s.vel[l];
+            D::set_vel(w, g, s.vel[l]);
         }
     };
     for s in d.subs.iter().filter(|s| held.is_none_or(|(own, _)| own(s.id))) {
@@ -204,7 +204,6 @@ pub(super) fn write_back_held<D: Family>(
         one(w, s, l as usize, s.body_global[l as usize] as usize);
     }
     let ifc = &d.iface;
-    let vel = D::vel_mut(w);
     let mut vc = Vec::new();
     for ib in 0..ifc.n_rigid {
         let r = ifc.copies(ib);
@@ -220,6 +219,6 @@ pub(super) fn write_back_held<D: Family>(
         for x in v.as_mut() {
             *x /= m;
         }
-        vel[ifc.body[ib] as usize] = v;
+        D::set_vel(w, ifc.body[ib] as usize, v);
     }
 }

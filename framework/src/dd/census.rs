@@ -58,7 +58,7 @@ impl BodySums<'_> {
         own: &dyn Fn(usize) -> bool,
     ) -> Vec<[f64; SUMS]> {
         let mut out = vec![[0.0; SUMS]; self.grid.len()];
-        crate::step::each_body(D::n_bodies(w), D::active(w), |g| {
+        crate::step::each_body(D::n_bodies(w), D::stepped(w), |g| {
             let p = D::position(w, g);
             let c = self.grid.cell_of(p) as usize;
             if !own(c) {

@@ -60,7 +60,13 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     /// freedom and its interface impulse grows by M̂_E dv.
     fn glue(v: &mut Self::V, f_gamma: &mut Self::V, inv: &Self::InvMass, dv: &Self::V);
 
+    /// Bodies in the scene: NSCDD's body ids g are the scene's global ids
+    /// (`crate::model::ids`), 0..n_bodies, of which a world may hold a part.
     fn n_bodies(w: &Self::World) -> usize;
+    /// The global id of the world's slot `k`, and the slot of global id `g` if
+    /// the world holds it.
+    fn global(w: &Self::World, k: usize) -> usize;
+    fn slot(w: &Self::World, g: usize) -> Option<usize>;
     fn movable(w: &Self::World, g: usize) -> bool;
     fn inv_mass(w: &Self::World, g: usize) -> Self::InvMass;
     /// ρ² = I/m of body g (0 when undefined): the weight of rotations in the gluing
@@ -68,8 +74,12 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     fn rho2(w: &Self::World, g: usize) -> f64;
     fn contacts(w: &Self::World) -> &Self::Contacts;
     fn contacts_mut(w: &mut Self::World) -> &mut Self::Contacts;
-    fn vel(w: &Self::World) -> &[Self::V];
-    fn vel_mut(w: &mut Self::World) -> &mut [Self::V];
+    /// The held bodies' velocities into `out`, by global id (`n_bodies` long; the
+    /// others' left at zero).
+    fn velocities(w: &Self::World, out: &mut Vec<Self::V>);
+    fn set_vel(w: &mut Self::World, g: usize, v: Self::V);
+    /// The global ids of contact `a` of the world's contacts.
+    fn contact_bodies(w: &Self::World, a: usize) -> [u32; 2];
     /// The step's visiting order of the contacts (empty: storage order).
     fn order(w: &Self::World) -> &[u32];
     /// Steps completed (the step being computed, during a step).
@@ -82,9 +92,9 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     fn residual_parts_in(w: &Self::World, which: &[u32]) -> (f64, f64);
     /// Adds the contacts' Σ ±H r to `out` (indexed by the contacts' body ids).
     fn add_reactions(c: &Self::Contacts, out: &mut [Self::V]);
-    /// The world's per-body reactions, and the bodies whose reactions are observed
-    /// (ascending: outputs and drives read them).
-    fn reactions_mut(w: &mut Self::World) -> &mut Vec<Self::V>;
+    /// Sets the world's per-body reactions from `r` (by global id), and the bodies
+    /// whose reactions are observed (ascending: outputs and drives read them).
+    fn set_reactions(w: &mut Self::World, r: Vec<Self::V>);
     fn observed(w: &Self::World) -> Vec<u32>;
     /// Whether body g is a grain (a free disk or sphere: the coordination numbers'
     /// population), and whether the world's outputs need the coordination numbers.
@@ -107,11 +117,18 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     fn retain_raw(w: &mut Self::World, keep: &mut dyn FnMut(ContactKey, [f64; 3]) -> bool);
     fn body_boxes(w: &Self::World, out: &mut Vec<[[f64; 3]; 2]>);
     /// Bodies owned per rank ([`super::owned`]): the bodies this process steps
-    /// (ascending; `None`: all), whether a body is stepped by every process (fixed,
+    /// (ascending; `None`: every body it holds), whether a body is stepped by every process (fixed,
     /// driven or unbounded), and a body's moving state (position, orientation,
     /// velocity) as `BODY_RECORD` numbers, and back.
     fn set_active(w: &mut Self::World, active: Option<Vec<u32>>);
     fn active(w: &Self::World) -> Option<&[u32]>;
+    /// The bodies the world holds (ascending global ids; `None`: 0..n_bodies).
+    fn held(w: &Self::World) -> Option<&[u32]>;
+    /// The bodies this process steps: the active ones, else the held ones
+    /// (ascending; `None`: 0..n_bodies).
+    fn stepped(w: &Self::World) -> Option<&[u32]> {
+        Self::active(w).or(Self::held(w))
+    }
     fn everywhere(w: &Self::World, g: usize) -> bool;
     const BODY_RECORD: usize;
     fn body_record(w: &Self::World, g: usize, out: &mut Vec<f64>);
@@ -218,16 +235,22 @@ impl<D: Dim> Family for Rigid<D> {
         D::glue(v, f, im, dv);
     }
     fn n_bodies(w: &Self::World) -> usize {
-        w.bodies.len()
+        w.ids.n_global(w.bodies.len())
+    }
+    fn global(w: &Self::World, k: usize) -> usize {
+        w.ids.global(k as u32) as usize
+    }
+    fn slot(w: &Self::World, g: usize) -> Option<usize> {
+        w.ids.slot(g as u32).map(|k| k as usize)
     }
     fn movable(w: &Self::World, g: usize) -> bool {
-        w.bodies.movable(g)
+        w.bodies.movable(slot(w, g))
     }
     fn inv_mass(w: &Self::World, g: usize) -> Self::InvMass {
-        w.bodies.inv_mass[g]
+        w.bodies.inv_mass[slot(w, g)]
     }
     fn rho2(w: &Self::World, g: usize) -> f64 {
-        w.bodies.rho2(g)
+        w.bodies.rho2(slot(w, g))
     }
     fn contacts(w: &Self::World) -> &Self::Contacts {
         &w.contacts
@@ -235,11 +258,24 @@ impl<D: Dim> Family for Rigid<D> {
     fn contacts_mut(w: &mut Self::World) -> &mut Self::Contacts {
         &mut w.contacts
     }
-    fn vel(w: &Self::World) -> &[Self::V] {
-        &w.bodies.vel
+    fn velocities(w: &Self::World, out: &mut Vec<Self::V>) {
+        out.clear();
+        match w.ids.held() {
+            None => out.extend_from_slice(&w.bodies.vel),
+            Some(held) => {
+                out.resize(Self::n_bodies(w), Self::V::default());
+                for (&g, v) in held.iter().zip(&w.bodies.vel) {
+                    out[g as usize] = *v;
+                }
+            }
+        }
     }
-    fn vel_mut(w: &mut Self::World) -> &mut [Self::V] {
-        &mut w.bodies.vel
+    fn set_vel(w: &mut Self::World, g: usize, v: Self::V) {
+        let k = slot(w, g);
+        w.bodies.vel[k] = v;
+    }
+    fn contact_bodies(w: &Self::World, a: usize) -> [u32; 2] {
+        w.contacts.bodies[a].map(|k| w.ids.global(k))
     }
     fn order(w: &Self::World) -> &[u32] {
         &w.scratch.order
@@ -262,14 +298,17 @@ impl<D: Dim> Family for Rigid<D> {
     fn add_reactions(c: &Self::Contacts, out: &mut [Self::V]) {
         crate::step::add_reactions(c, out);
     }
-    fn reactions_mut(w: &mut Self::World) -> &mut Vec<Self::V> {
-        &mut w.reaction
+    fn set_reactions(w: &mut Self::World, r: Vec<Self::V>) {
+        w.reaction = match w.ids.held() {
+            None => r,
+            Some(held) => held.iter().map(|&g| r[g as usize]).collect(),
+        };
     }
     fn observed(w: &Self::World) -> Vec<u32> {
-        w.observed()
+        w.observed().into_iter().map(|k| w.ids.global(k)).collect()
     }
     fn is_grain(w: &Self::World, g: usize) -> bool {
-        w.is_grain(g)
+        w.ids.slot(g as u32).is_some_and(|k| w.is_grain(k as usize))
     }
     fn wants_coordination(w: &Self::World) -> bool {
         w.box_walls.is_some()
@@ -279,16 +318,16 @@ impl<D: Dim> Family for Rigid<D> {
         w3.bulk_box(4.0 * w3.max_grain_size())
     }
     fn body_energies(w: &Self::World, g: usize) -> Option<(f64, f64)> {
-        w.body_energies(g)
+        w.body_energies(slot(w, g))
     }
     fn grain_in_box(w: &Self::World, g: usize, lo: [f64; 3], hi: [f64; 3]) -> f64 {
         (w as &dyn std::any::Any)
             .downcast_ref::<crate::world::World3>()
-            .map_or(0.0, |w3| w3.grain_in_box(g, lo, hi))
+            .map_or(0.0, |w3| w3.grain_in_box(slot(w, g), lo, hi))
     }
     fn position(w: &Self::World, g: usize) -> [f64; 3] {
         let mut p = [0.0; 3];
-        p[..D::N].copy_from_slice(w.bodies.pos[g].as_ref());
+        p[..D::N].copy_from_slice(w.bodies.pos[slot(w, g)].as_ref());
         p
     }
     fn set_region(w: &mut Self::World, region: Option<crate::detect::Region>) {
@@ -298,47 +337,66 @@ impl<D: Dim> Family for Rigid<D> {
         w.alert
     }
     fn retain_raw(w: &mut Self::World, keep: &mut dyn FnMut(ContactKey, [f64; 3]) -> bool) {
+        let ids = &w.ids;
         w.scratch.raw.retain(|rc| {
             let mut p = [0.0; 3];
             p[..D::N].copy_from_slice(rc.point.as_ref());
             keep(
                 ContactKey {
-                    i: rc.i,
-                    j: rc.j,
+                    i: ids.global(rc.i),
+                    j: ids.global(rc.j),
                     feature: rc.feature,
                 },
                 p,
             )
         });
     }
-    /// (only the active bodies' boxes are recomputed)
+    /// (only the active bodies' boxes are recomputed; by global id)
     fn body_boxes(w: &Self::World, out: &mut Vec<[[f64; 3]; 2]>) {
         let b = &w.bodies;
-        out.resize(b.len(), [[0.0; 3]; 2]);
+        out.resize(Self::n_bodies(w), [[0.0; 3]; 2]);
         crate::step::each_body(b.len(), w.scratch.active.as_deref(), |k| {
             let s = b.shape[k];
             let a = w.shapes[s.kind as usize].aabb(s.index, b.pos[k], b.rot[k]);
-            out[k][0][..D::N].copy_from_slice(a.min.as_ref());
-            out[k][1][..D::N].copy_from_slice(a.max.as_ref());
+            let o = &mut out[w.ids.global(k as u32) as usize];
+            o[0][..D::N].copy_from_slice(a.min.as_ref());
+            o[1][..D::N].copy_from_slice(a.max.as_ref());
         });
     }
     fn set_active(w: &mut Self::World, active: Option<Vec<u32>>) {
-        w.scratch.active = active;
+        let s = &mut w.scratch;
+        if w.ids.is_identity() {
+            s.active = active;
+        } else {
+            let ids = &w.ids;
+            let slots = active.as_ref().map(|a| a.iter().map(|&g| ids.slot(g).expect(HELD)).collect());
+            (s.active, s.active_global) = (slots, active);
+        }
     }
     fn active(w: &Self::World) -> Option<&[u32]> {
-        w.scratch.active.as_deref()
+        match w.ids.is_identity() {
+            true => w.scratch.active.as_deref(),
+            false => w.scratch.active_global.as_deref(),
+        }
+    }
+    fn held(w: &Self::World) -> Option<&[u32]> {
+        w.ids.held()
     }
     fn everywhere(w: &Self::World, g: usize) -> bool {
-        !w.bodies.movable(g) || w.drives.iter().any(|d| d.body as usize == g) || !w.aabb(g).is_bounded()
+        let Some(k) = w.ids.slot(g as u32).map(|k| k as usize) else {
+            return false;
+        };
+        !w.bodies.movable(k) || w.drives.iter().any(|d| d.body as usize == k) || !w.aabb(k).is_bounded()
     }
     const BODY_RECORD: usize = D::N + D::DOF + if D::N == 2 { 1 } else { 4 };
     fn body_record(w: &Self::World, g: usize, out: &mut Vec<f64>) {
-        let b = &w.bodies;
+        let (b, g) = (&w.bodies, slot(w, g));
         out.extend_from_slice(b.pos[g].as_ref());
         out.extend_from_slice(b.rot[g].coords());
         out.extend_from_slice(b.vel[g].as_ref());
     }
     fn set_body_record(w: &mut Self::World, g: usize, x: &[f64]) {
+        let g = slot(w, g);
         let b = &mut w.bodies;
         let (p, rest) = x.split_at(D::N);
         b.pos[g].as_mut().copy_from_slice(p);
@@ -348,7 +406,7 @@ impl<D: Dim> Family for Rigid<D> {
     }
     const STEP_RECORD: usize = Self::BODY_RECORD + D::DOF;
     fn step_record(w: &Self::World, g: usize, v_free: &Self::V, out: &mut Vec<f64>) {
-        let b = &w.bodies;
+        let (b, g) = (&w.bodies, slot(w, g));
         out.extend_from_slice(b.pos[g].as_ref());
         out.extend_from_slice(b.rot[g].coords());
         out.extend_from_slice(w.scratch.v_begin[g].as_ref());
@@ -356,6 +414,7 @@ impl<D: Dim> Family for Rigid<D> {
     }
     fn set_step_record(w: &mut Self::World, g: usize, x: &[f64]) -> Self::V {
         Self::set_body_record(w, g, &x[..Self::BODY_RECORD]);
+        let g = slot(w, g);
         let (n, dof) = (Self::BODY_RECORD, D::DOF);
         w.scratch.v_begin[g] = w.bodies.vel[g];
         w.bodies.vel[g].as_mut().copy_from_slice(&x[n..n + dof]);
@@ -379,7 +438,14 @@ impl<D: Dim> Family for Rigid<D> {
         keep: &mut dyn FnMut(ContactKey, [f64; 3]) -> bool,
         (v_free, more_prev): (&[Self::V], &[f64]),
     ) {
-        w.bodies.vel.copy_from_slice(v_free);
+        match w.ids.held() {
+            None => w.bodies.vel.copy_from_slice(v_free),
+            Some(held) => {
+                for (v, &g) in w.bodies.vel.iter_mut().zip(held) {
+                    *v = v_free[g as usize];
+                }
+            }
+        }
         let s = &mut w.scratch;
         if !more_prev.is_empty() {
             s.prev_keys.extend(prev_contacts::<D>(more_prev));
@@ -405,6 +471,15 @@ impl<D: Dim> Family for Rigid<D> {
     fn step_with(w: &mut Self::World, stage: &mut super::Stage<'_, '_, Self>) -> Result<StepReport, Diverged> {
         w.step_with(stage)
     }
+}
+
+/// What NSCDD asks of a world body it holds.
+const HELD: &str = "NSCDD asks only for the bodies the world holds";
+
+/// The slot of body `g` (a global id) in `w`.
+#[inline]
+fn slot<D: Dim>(w: &World<D>, g: usize) -> usize {
+    w.ids.slot(g as u32).expect(HELD) as usize
 }
 
 /// The warm starts of [`Family::prev_record`]s.

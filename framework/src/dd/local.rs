@@ -77,7 +77,7 @@ impl Local {
         let mut to = ToRanks::new(rs, D::SPACE);
         let mut rec = Vec::with_capacity(D::PREV_RECORD + 1);
         for (a, &o) in owner.iter().enumerate().take(D::len(c)) {
-            if to.aim(cells, self.pair_box::<D>(D::bodies(c, a), alert)) {
+            if to.aim(cells, self.pair_box::<D>(D::contact_bodies(w, a), alert)) {
                 rec.clear();
                 D::prev_record(c, a, &mut rec);
                 rec.push(f64::from(o));
@@ -329,7 +329,7 @@ impl<D: Family> super::NscddOf<D> {
     /// ([`super::owned`]); every rank returns the same divergence.
     pub(super) fn after_integrate(&mut self, w: &mut D::World, moved: Result<(), usize>) -> Result<(), usize> {
         if let Some(rs) = self.ranks.as_mut() {
-            rs.totals.bodies_stepped += D::active(w).map_or(D::n_bodies(w), |a| a.len()) as u64;
+            rs.totals.bodies_stepped += D::stepped(w).map_or(D::n_bodies(w), |a| a.len()) as u64;
         }
         if !self.local.now {
             return moved;

@@ -483,8 +483,7 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
         self.dd.after_detection(w);
     }
     fn after_free_velocity(&mut self, w: &D::World) {
-        self.dd.v_free.clear();
-        self.dd.v_free.extend_from_slice(D::vel(w));
+        D::velocities(w, &mut self.dd.v_free);
         for f in self.fams.iter_mut() {
             f.after_free_velocity(w);
         }
@@ -505,8 +504,12 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
         self.dd.pending = rep;
         s
     }
+    /// (the world's slots; NSCDD's global ids inside)
     fn after_integrate(&mut self, w: &mut D::World, moved: Result<(), usize>) -> Result<(), usize> {
-        self.dd.after_integrate(w, moved)
+        let moved = moved.map_err(|k| D::global(w, k));
+        self.dd
+            .after_integrate(w, moved)
+            .map_err(|g| D::slot(w, g).expect("the diverging body is held"))
     }
     /// The counts outputs read ([`census`]), on the moved bodies (collective).
     fn after_update(&mut self, w: &mut D::World) {

@@ -103,7 +103,7 @@ impl Owned {
         let me = rs.cluster.rank();
         self.mine.clear();
         let owner = |g: usize| rs.rank_of.get(grid.cell_of(D::position(w, g)) as usize) == Some(&me);
-        crate::step::each_body(D::n_bodies(w), D::active(w), |g| {
+        crate::step::each_body(D::n_bodies(w), D::stepped(w), |g| {
             if owner(g) {
                 self.mine.push(g as u32);
             }
@@ -207,7 +207,7 @@ impl Owned {
         keep.resize(nb, false);
         let c = D::contacts(w);
         for a in 0..D::len(c) {
-            for g in D::bodies(c, a) {
+            for g in D::contact_bodies(w, a) {
                 keep[g as usize] = true;
             }
         }
@@ -220,7 +220,7 @@ impl Owned {
         });
         D::set_active(w, candidates);
         D::body_boxes(w, boxes);
-        crate::step::each_body(nb, D::active(w), |g| {
+        crate::step::each_body(nb, D::stepped(w), |g| {
             let (lo, hi) = grown(D::SPACE, &boxes[g], alert);
             keep[g] |= self.everywhere[g] || mine.meets(D::SPACE, &lo, &hi);
         });

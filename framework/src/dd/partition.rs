@@ -176,9 +176,8 @@ pub fn decompose_owned<D: Family>(
     shells: Option<Shells<'_, D>>,
 ) -> Decomposition<D> {
     let built = |s: u32| build.is_none_or(|b| b[s as usize]);
-    let c = D::contacts(w);
     let nb = D::n_bodies(w);
-    let (mut subs, mut mult, mut copy_of) = split_contacts::<D>(c, &owner, ns, nb);
+    let (mut subs, mut mult, mut copy_of) = split_contacts::<D>(w, &owner, ns, nb);
     if let Some(fill) = shells {
         // contacts held per rank: the other ranks' subdomains get their bodies only
         fill(&mut subs);
@@ -334,13 +333,14 @@ fn entity_interface<D: Family>(iface: &mut Interface, subs: &mut [Subdomain<D>],
 /// bodies made on first sight; returns the subdomains, each body's number of
 /// copies and the copies as (body, subdomain, local id).
 #[allow(clippy::type_complexity)]
-fn split_contacts<D: Family>(c: &D::Contacts, owner: &[u32], ns: usize, nb: usize) -> (Vec<Subdomain<D>>, Vec<u32>, Vec<(u32, u32, u32)>) {
+fn split_contacts<D: Family>(w: &D::World, owner: &[u32], ns: usize, nb: usize) -> (Vec<Subdomain<D>>, Vec<u32>, Vec<(u32, u32, u32)>) {
     let mut subs: Vec<Subdomain<D>> = (0..ns)
         .map(|s| Subdomain {
             id: s as u32,
             ..Default::default()
         })
         .collect();
+    let c = D::contacts(w);
     // contacts in storage order, copies on first sight
     let (mut stamp, mut local) = (vec![u32::MAX; nb], vec![0u32; nb]);
     let mut mult = vec![0u32; nb];
@@ -366,7 +366,7 @@ fn split_contacts<D: Family>(c: &D::Contacts, owner: &[u32], ns: usize, nb: usiz
                 }
                 local[gi]
             };
-            let [bi, bj] = D::bodies(c, a);
+            let [bi, bj] = D::contact_bodies(w, a);
             let (li, lj) = (id(bi), id(bj));
             sub.push_contact(c, a, li, lj);
         }

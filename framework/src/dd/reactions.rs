@@ -15,7 +15,7 @@ use super::family::Family;
 use super::partition::Decomposition;
 use super::ranks::RankState;
 
-/// Sets `D::reactions_mut(w)` from the subdomains of `d` (see the module docs).
+/// Sets the world's reactions ([`Family::set_reactions`]) from the subdomains of `d` (see the module docs).
 pub(super) fn set<D: Family>(d: &Decomposition<D>, w: &mut D::World, ranks: Option<&mut RankState>, observed: &[u32]) {
     let nb = D::n_bodies(w);
     let own = |s: u32| ranks.as_ref().is_none_or(|r| r.is_own(s));
@@ -33,9 +33,7 @@ pub(super) fn set<D: Family>(d: &Decomposition<D>, w: &mut D::World, ranks: Opti
         })
         .collect();
     let remote = ranks.map(|r| r.share_reactions(d, &shares, observed));
-    let out = D::reactions_mut(w);
-    out.clear();
-    out.resize(nb, D::V::default());
+    let mut out = vec![D::V::default(); nb];
     for (s, sub) in d.subs.iter().enumerate() {
         match &remote {
             Some(rem) if !rem.is_own(s) => {
@@ -51,6 +49,7 @@ pub(super) fn set<D: Family>(d: &Decomposition<D>, w: &mut D::World, ranks: Opti
             }
         }
     }
+    D::set_reactions(w, out);
 }
 
 fn add<V: AsMut<[f64]>>(x: &mut V, y: &[f64]) {

@@ -150,7 +150,7 @@ impl<D: super::Family> super::NscddOf<D> {
         }
         let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(2 * d.owner.len());
         for (a, &s) in d.owner.iter().enumerate() {
-            for g in D::bodies(c, a) {
+            for g in D::contact_bodies(w, a) {
                 pairs.push((g, s));
             }
         }

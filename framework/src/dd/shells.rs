@@ -258,7 +258,7 @@ impl<D: Family> super::NscddOf<D> {
         }
         let (rs, near) = (self.ranks.as_mut()?, near_of::<D>(&self.local, w, &[])?);
         let c = D::contacts(w);
-        let asked = rs.announce::<D>(&near, (0..D::len(c)).flat_map(|a| D::bodies(c, a)));
+        let asked = rs.announce::<D>(&near, (0..D::len(c)).flat_map(|a| D::contact_bodies(w, a)));
         let near = Near { asked: &asked, ..near };
         let before = repart.then(|| {
             let (store, before) = rs.route_repartition(&self.last, &self.store, &near);

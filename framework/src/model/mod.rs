@@ -1,12 +1,15 @@
 //! What a simulation holds, for any dimension: the bodies
-//! ([`bodies`]) and the contact set ([`contacts`]).
+//! ([`bodies`]), their slots and global ids ([`ids`]) and the contact set
+//! ([`contacts`]).
 //! Imports only [`crate::dim`]: never the solver, NSCDD or io.
 
 pub mod bodies;
 pub mod contacts;
+pub mod ids;
 
 pub use bodies::{all_free, Bodies, ShapeRef};
 pub use contacts::{ContactKey, Contacts, Target};
+pub use ids::BodyIds;
 
 use crate::dim::{D2, D3};
 

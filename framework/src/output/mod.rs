@@ -100,7 +100,7 @@ impl<D: Dim> Serialize for BodiesOut<'_, D> {
         s.collect_seq((0..b.len()).map(|k| {
             let sh = b.shape[k];
             BodyOut::<D> {
-                id: k as u32,
+                id: w.ids.global(k as u32),
                 name: w.names[k].as_deref(),
                 kind: w.kind_name(k),
                 material: &w.materials[b.material[k] as usize].name,
@@ -137,7 +137,9 @@ pub const fn contact_record_len(n: usize) -> usize {
 pub fn contact_records<D: Dim>(w: &World<D>, which: impl Iterator<Item = usize>, out: &mut Vec<f64>) {
     let c = &w.contacts;
     for a in which {
-        out.extend([f64::from(c.bodies[a][0]), f64::from(c.bodies[a][1]), f64::from(c.key[a].feature)]);
+        // (global ids: the key's)
+        let k = c.key[a];
+        out.extend([f64::from(k.i), f64::from(k.j), f64::from(k.feature)]);
         out.extend_from_slice(c.point[a].as_ref());
         out.extend_from_slice(D::normal(&c.frame[a]).as_ref());
         out.extend_from_slice(c.r[a].as_ref());

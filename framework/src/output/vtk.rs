@@ -172,7 +172,10 @@ impl VtkWriter {
         let (sel_b, sel_c): (Vec<usize>, Vec<usize>) = match (dd, piece) {
             (Some(d), Some(p)) => (
                 (0..nb)
-                    .filter(|&k| p.has_body(k, d.body_subdomain.get(k).copied().unwrap_or(-1)))
+                    .filter(|&k| {
+                        let g = w.ids.global(k as u32) as usize;
+                        p.has_body(g, d.body_subdomain.get(g).copied().unwrap_or(-1))
+                    })
                     .collect(),
                 (0..nc)
                     .filter(|&a| d.contact_subdomain.get(a).map_or(p.rank == 0, |&s| p.has_contact(s)))
@@ -270,12 +273,12 @@ fn bodies<D: Dim>(w: &World<D>, dd: Option<&DdView>, sel: &[usize], bodies: &Pat
                 wpts.extend(xyz(v.as_ref()));
             }
             woff.push(wconn.len() as u64);
-            wid.push(k as f64);
+            wid.push(f64::from(w.ids.global(k as u32)));
         }
     }
     let rdof = D::DOF - D::N;
     let mut point = vec![
-        Attribute::scalars("id", 1).with_data(sel.iter().map(|&k| k as f64).collect::<Vec<_>>()),
+        Attribute::scalars("id", 1).with_data(sel.iter().map(|&k| f64::from(w.ids.global(k as u32))).collect::<Vec<_>>()),
         Attribute::scalars("radius", 1).with_data(radius),
         Attribute::vectors("velocity").with_data(vel),
         per_dim("angular_velocity", rdof, omega),
@@ -283,8 +286,13 @@ fn bodies<D: Dim>(w: &World<D>, dd: Option<&DdView>, sel: &[usize], bodies: &Pat
         Attribute::scalars("material", 1).with_data(sel.iter().map(|&k| b.material[k] as f64).collect::<Vec<_>>()),
     ];
     if let Some(d) = dd {
-        let sub: Vec<f64> = sel.iter().map(|&k| d.body_subdomain.get(k).copied().unwrap_or(-1) as f64).collect();
-        let mult: Vec<f64> = sel.iter().map(|&k| d.multiplicity.get(k).copied().unwrap_or(0) as f64).collect();
+        // (the view is by global id)
+        let g = |k: usize| w.ids.global(k as u32) as usize;
+        let sub: Vec<f64> = sel
+            .iter()
+            .map(|&k| d.body_subdomain.get(g(k)).copied().unwrap_or(-1) as f64)
+            .collect();
+        let mult: Vec<f64> = sel.iter().map(|&k| d.multiplicity.get(g(k)).copied().unwrap_or(0) as f64).collect();
         point.push(Attribute::scalars("subdomain", 1).with_data(sub));
         point.push(Attribute::scalars("multiplicity", 1).with_data(mult));
     }

@@ -80,6 +80,7 @@ pub(crate) fn load_parsed<D: SceneDim>(cx: &Ctx, sf: SceneFile<BodySpec<D>>, reg
     };
     let world = World {
         bodies: b.bodies,
+        ids: Default::default(),
         names: b.names,
         shapes: b.shapes,
         materials: b.materials,

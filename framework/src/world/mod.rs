@@ -7,7 +7,7 @@ use crate::detect::{Detector, DetectorTable};
 use crate::dim::{Dim, Vector, D2, D3};
 use crate::drive::BodyDrive;
 use crate::law::{Law, LawBatches};
-use crate::model::{Bodies, ContactKey, Contacts};
+use crate::model::{Bodies, BodyIds, ContactKey, Contacts};
 use crate::shape::{Aabb, RawContact, ShapeStore};
 use crate::solver::SolverSettings;
 use std::sync::Arc;
@@ -49,7 +49,11 @@ impl BoxWalls {
 
 /// The scene in memory.
 pub struct World<D: Dim> {
+    /// The bodies, by slot.
     pub bodies: Bodies<D>,
+    /// Slot ↔ global id (the identity in one process; [`crate::model::ids`]).
+    /// Contact keys and everything leaving the world use global ids.
+    pub ids: BodyIds,
     /// Optional user names of bodies (for outputs), by body id.
     pub names: Vec<Option<String>>,
     /// One store per shape kind used by the scene; `bodies.shape[b].kind` indexes it.
@@ -117,6 +121,8 @@ pub(crate) struct Scratch<D: Dim> {
     /// The bodies this process steps (ascending ids; `None`: all): on MPI ranks, its
     /// own and its halo (`dd::owned`); the others' state is left as it was.
     pub active: Option<Vec<u32>>,
+    /// `active` in global ids, for a world holding part of the scene.
+    pub active_global: Option<Vec<u32>>,
 }
 
 impl<D: Dim> Default for Scratch<D> {
@@ -134,6 +140,7 @@ impl<D: Dim> Default for Scratch<D> {
             region: None,
             extra_prev: vec![],
             active: None,
+            active_global: None,
         }
     }
 }
@@ -159,11 +166,12 @@ impl<D: Dim> World<D> {
     pub fn kind_name(&self, b: usize) -> &'static str {
         self.shapes[self.bodies.shape[b].kind as usize].kind()
     }
-    /// A human name for body b: its user name, or its id.
+    /// A human name for body b (a slot): its user name, or its global id.
     pub fn body_label(&self, b: usize) -> String {
+        let g = self.ids.global(b as u32);
         match &self.names[b] {
-            Some(n) => format!("body {b} (`{n}`, {})", self.kind_name(b)),
-            None => format!("body {b} ({})", self.kind_name(b)),
+            Some(n) => format!("body {g} (`{n}`, {})", self.kind_name(b)),
+            None => format!("body {g} ({})", self.kind_name(b)),
         }
     }
     /// Bounding box of body b at its pose.
