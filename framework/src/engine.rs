@@ -416,11 +416,8 @@ fn integrate<D: Dim>(w: &mut World<D>) -> Result<(), usize> {
 /// error, the reactions (when `reactions`), the step and time counted.
 fn finish_positions<D: Dim>(w: &mut World<D>, reactions: bool, moved: Result<(), usize>) -> Result<(), Diverged> {
     if let Err(k) = moved {
-        let e = Diverged::non_finite(w.step + 1, k, w.body_label(k), &w.bodies);
-        return Err(Diverged {
-            body: w.ids.global(k as u32),
-            ..e
-        });
+        let g = w.ids.global(k as u32);
+        return Err(Diverged::non_finite(w.step + 1, (k, g), w.body_label(k), &w.bodies));
     }
     let h = w.time.h;
     if reactions {

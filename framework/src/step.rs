@@ -13,11 +13,12 @@ use crate::model::{all_free, Bodies, Contacts};
 pub use crate::error::Diverged;
 
 impl Diverged {
-    /// Body k (labelled `label`) has a non-finite state after step `step`.
-    pub fn non_finite<D: Dim>(step: u64, k: usize, label: String, b: &Bodies<D>) -> Diverged {
+    /// Body k (a slot of `b`; global id `global`, labelled `label`) has a
+    /// non-finite state after step `step`.
+    pub fn non_finite<D: Dim>(step: u64, (k, global): (usize, u32), label: String, b: &Bodies<D>) -> Diverged {
         Diverged {
             step,
-            body: k as u32,
+            body: global,
             message: format!(
                 "{label} has a non-finite or diverging state (position {:?}, velocity {:?})",
                 b.pos[k], b.vel[k]

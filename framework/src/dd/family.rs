@@ -117,9 +117,9 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     fn retain_raw(w: &mut Self::World, keep: &mut dyn FnMut(ContactKey, [f64; 3]) -> bool);
     fn body_boxes(w: &Self::World, out: &mut Vec<[[f64; 3]; 2]>);
     /// Bodies owned per rank ([`super::owned`]): the bodies this process steps
-    /// (ascending; `None`: every body it holds), whether a body is stepped by every process (fixed,
-    /// driven or unbounded), and a body's moving state (position, orientation,
-    /// velocity) as `BODY_RECORD` numbers, and back.
+    /// (ascending; `None`: every body it holds), whether a body is stepped by
+    /// every process (fixed, driven or unbounded), and a body's moving state
+    /// (position, orientation, velocity) as `BODY_RECORD` numbers, and back.
     fn set_active(w: &mut Self::World, active: Option<Vec<u32>>);
     fn active(w: &Self::World) -> Option<&[u32]>;
     /// The bodies the world holds (ascending global ids; `None`: 0..n_bodies).

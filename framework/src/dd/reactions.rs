@@ -15,7 +15,8 @@ use super::family::Family;
 use super::partition::Decomposition;
 use super::ranks::RankState;
 
-/// Sets the world's reactions ([`Family::set_reactions`]) from the subdomains of `d` (see the module docs).
+/// Sets the world's reactions ([`Family::set_reactions`]) from the subdomains of
+/// `d` (see the module docs).
 pub(super) fn set<D: Family>(d: &Decomposition<D>, w: &mut D::World, ranks: Option<&mut RankState>, observed: &[u32]) {
     let nb = D::n_bodies(w);
     let own = |s: u32| ranks.as_ref().is_none_or(|r| r.is_own(s));
