@@ -236,7 +236,10 @@ pub fn solve_pre(w: &Sym3, pre: &Pre3, u0: [f64; 3], u_target: f64, mu: f64) -> 
 /// coupled block is searched first from `prev`'s slip direction (in NLGS the
 /// iterates change little from sweep to sweep, so the secant steps start next to
 /// the root). The result is the same solution up to round-off.
-#[inline]
+///
+/// Always inlined: called, it returns its 24 bytes through memory, and the sweep's
+/// reading them back failed store forwarding in some builds (+9 %, PERFORMANCE.md).
+#[inline(always)]
 pub fn solve_pre_warm(w: &Sym3, pre: &Pre3, u0: [f64; 3], u_target: f64, mu: f64, prev: [f64; 3]) -> [f64; 3] {
     let s0 = u0[0] - u_target;
     // 1. no contact
