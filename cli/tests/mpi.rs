@@ -190,6 +190,9 @@ fn two_and_four_ranks_give_the_one_process_result_3d() {
             r["rank"]
         );
         assert!(r["bodies_sent"].as_u64().expect("sent") > 0, "{r}");
+        // and its world held only those (compact arrays): fewer than all
+        let held = r["bodies_held"].as_u64().expect("held");
+        assert!(held >= stepped && held < steps * nb, "rank {}: {held} bodies held", r["rank"]);
         // the other ranks' subdomains held as shells limited to the bodies near it
         // between repartitions
         assert!(r["limited_shell_steps"].as_u64().expect("limited") > 0, "{r}");

@@ -134,3 +134,73 @@ fn gapped_ids_step_as_the_plain_world_in_3d() {
         assert!(reps.iter().map(|r| r.interface_bodies).sum::<usize>() > 0, "interface bodies");
     }
 }
+
+/// Compact arrays: drops the grains `leave` picks (none of them in a contact) with
+/// their records, checks the world holds the others only, admits them back, and
+/// checks the world is `plain`'s bit for bit, then after `steps` more steps each.
+fn leave_and_come_back<D: Dim>(mut plain: Scene<D>, mut w: Scene<D>, leave: impl Fn(usize) -> bool, steps: usize)
+where
+    D::Twist: AsRef<[f64]>,
+    D::Point: AsRef<[f64]>,
+    D::Local: AsRef<[f64]>,
+{
+    let wd = &mut w.world;
+    let n = wd.bodies.len();
+    let in_contact: Vec<bool> = (0..n).map(|k| wd.contacts.bodies.iter().any(|p| p.contains(&(k as u32)))).collect();
+    let gone: Vec<usize> = (0..n).filter(|&k| wd.is_grain(k) && !in_contact[k] && leave(k)).collect();
+    assert!(!gone.is_empty(), "the test drops bodies");
+    let mut rec = vec![Vec::new(); gone.len()];
+    for (r, &k) in rec.iter_mut().zip(&gone) {
+        wd.body_record(k, r);
+    }
+    let keep: Vec<u32> = (0..n as u32).filter(|k| !gone.contains(&(*k as usize))).collect();
+    wd.hold(&keep);
+    assert_eq!(wd.bodies.len(), keep.len());
+    assert_eq!(wd.ids.held(), Some(&keep[..]));
+    // the whole scene's sums kept
+    assert_eq!(wd.grain_sums().0, plain.world.grain_sums().0);
+    let entering: Vec<(u32, &[f64])> = gone.iter().zip(&rec).map(|(&k, r)| (k as u32, &r[..])).collect();
+    wd.admit(&entering);
+    assert_eq!(wd.bodies.len(), n);
+    for round in 0..2 {
+        let (a, b) = (&plain.world, &w.world);
+        assert_eq!(bits(&a.bodies.pos), bits(&b.bodies.pos), "positions, round {round}");
+        assert_eq!(bits(&a.bodies.vel), bits(&b.bodies.vel), "velocities, round {round}");
+        assert_eq!(a.bodies.mass, b.bodies.mass);
+        assert_eq!(format!("{:?}", a.bodies.inv_mass), format!("{:?}", b.bodies.inv_mass));
+        assert_eq!(format!("{:?}", a.bodies.rot), format!("{:?}", b.bodies.rot));
+        assert_eq!(
+            (&a.bodies.shape, &a.bodies.material, &a.bodies.free),
+            (&b.bodies.shape, &b.bodies.material, &b.bodies.free)
+        );
+        assert_eq!((&a.names, &a.fixed), (&b.names, &b.fixed));
+        assert_eq!(bits(&a.contacts.r), bits(&b.contacts.r), "impulses, round {round}");
+        assert_eq!(a.contacts.bodies, b.contacts.bodies);
+        assert_eq!(
+            nscdd::output::final_json(a),
+            nscdd::output::final_json(b),
+            "final.json, round {round}"
+        );
+        for _ in 0..steps {
+            plain.world.step().unwrap();
+            w.world.step().unwrap();
+        }
+    }
+}
+
+#[test]
+fn a_body_dropped_and_admitted_back_steps_as_before() {
+    // before the first step, every other grain
+    leave_and_come_back(pile(), pile(), |k| k % 2 == 1, 30);
+    // in 3D mid-run, the grains without contacts (walls driven, named: kept)
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/scenes/triaxial3d.toml")).expect("the example");
+    let reg = nscdd_spheres::registry();
+    let load = || {
+        let mut s = nscdd::scene::Scene3::load_str(&text, "triaxial3d.toml", &reg).unwrap_or_else(|e| panic!("{e}"));
+        for _ in 0..5 {
+            s.world.step().unwrap();
+        }
+        s
+    };
+    leave_and_come_back(load(), load(), |_| true, 10);
+}

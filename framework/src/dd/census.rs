@@ -201,7 +201,7 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
         });
         out.bulk = Some([b[0], b[1], b[2] + idle, b[3] + idle]);
     }
-    let ng = (0..D::n_bodies(w)).filter(|&g| D::is_grain(w, g)).count();
+    let ng = D::n_grains(w);
     out.z = if ng > 0 { 2.0 * ngg as f64 / ng as f64 } else { 0.0 };
     out.z_m = if n_m > 0 { sum_m as f64 / n_m as f64 } else { 0.0 };
     out

@@ -6,7 +6,7 @@
 //! contact set, the copies' M̂_E⁻¹ and the operations of DESIGN.md §3: one NLGS sweep,
 //! M̂_E⁻¹ applied to an impulse, M̂_E applied to a velocity increment (the gluing).
 
-use crate::dim::{Coords, Dim, Vector, D2, D3};
+use crate::dim::{Dim, Vector, D2, D3};
 use crate::engine::{Diverged, StepReport};
 use crate::model::{ContactKey, Contacts};
 use crate::norms::Sums;
@@ -119,7 +119,8 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     /// Bodies owned per rank ([`super::owned`]): the bodies this process steps
     /// (ascending; `None`: every body it holds), whether a body is stepped by
     /// every process (fixed, driven or unbounded), and a body's moving state
-    /// (position, orientation, velocity) as `BODY_RECORD` numbers, and back.
+    /// (position, orientation, velocity, then its static data: a body a process
+    /// lacks enters with it) as `BODY_RECORD` numbers, and back.
     fn set_active(w: &mut Self::World, active: Option<Vec<u32>>);
     fn active(w: &Self::World) -> Option<&[u32]>;
     /// The bodies the world holds (ascending global ids; `None`: 0..n_bodies).
@@ -133,6 +134,13 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     const BODY_RECORD: usize;
     fn body_record(w: &Self::World, g: usize, out: &mut Vec<f64>);
     fn set_body_record(w: &mut Self::World, g: usize, x: &[f64]);
+    /// Compact arrays ([`crate::world::held`]): the world admits the bodies of
+    /// `entering` (global id, [`Family::body_record`]: it carries their static
+    /// data) it does not hold, and keeps only the bodies `keep` (ascending global
+    /// ids; every body of its contacts among them). The grains of the whole scene.
+    fn admit(w: &mut Self::World, entering: &[(u32, &[f64])]);
+    fn hold(w: &mut Self::World, keep: &[u32]);
+    fn n_grains(w: &Self::World) -> usize;
     /// During a step (a distributed repartition): a body's position, orientation,
     /// V⁻ and V_free (`STEP_RECORD` numbers), and back (M̂⁻¹ refreshed as the free
     /// velocity stage does; returns V_free).
@@ -243,14 +251,15 @@ impl<D: Dim> Family for Rigid<D> {
     fn slot(w: &Self::World, g: usize) -> Option<usize> {
         w.ids.slot(g as u32).map(|k| k as usize)
     }
+    /// (static: known of a body the world does not hold)
     fn movable(w: &Self::World, g: usize) -> bool {
-        w.bodies.movable(slot(w, g))
+        w.movable_rho2(g as u32).0
     }
     fn inv_mass(w: &Self::World, g: usize) -> Self::InvMass {
         w.bodies.inv_mass[slot(w, g)]
     }
     fn rho2(w: &Self::World, g: usize) -> f64 {
-        w.bodies.rho2(slot(w, g))
+        w.movable_rho2(g as u32).1
     }
     fn contacts(w: &Self::World) -> &Self::Contacts {
         &w.contacts
@@ -270,9 +279,11 @@ impl<D: Dim> Family for Rigid<D> {
             }
         }
     }
+    /// (a body the world does not hold is not stepped here: nothing to write)
     fn set_vel(w: &mut Self::World, g: usize, v: Self::V) {
-        let k = slot(w, g);
-        w.bodies.vel[k] = v;
+        if let Some(k) = w.ids.slot(g as u32) {
+            w.bodies.vel[k as usize] = v;
+        }
     }
     fn contact_bodies(w: &Self::World, a: usize) -> [u32; 2] {
         w.contacts.bodies[a].map(|k| w.ids.global(k))
@@ -330,8 +341,9 @@ impl<D: Dim> Family for Rigid<D> {
         p[..D::N].copy_from_slice(w.bodies.pos[slot(w, g)].as_ref());
         p
     }
+    /// (the region's pairs, in global ids, go to the detector in slots)
     fn set_region(w: &mut Self::World, region: Option<crate::detect::Region>) {
-        w.scratch.region = region;
+        w.scratch.region = region.map(|r| in_slots(&w.ids, r));
     }
     fn alert(w: &Self::World) -> f64 {
         w.alert
@@ -388,28 +400,28 @@ impl<D: Dim> Family for Rigid<D> {
         };
         !w.bodies.movable(k) || w.drives.iter().any(|d| d.body as usize == k) || !w.aabb(k).is_bounded()
     }
-    const BODY_RECORD: usize = D::N + D::DOF + if D::N == 2 { 1 } else { 4 };
+    const BODY_RECORD: usize = World::<D>::BODY_RECORD;
     fn body_record(w: &Self::World, g: usize, out: &mut Vec<f64>) {
-        let (b, g) = (&w.bodies, slot(w, g));
-        out.extend_from_slice(b.pos[g].as_ref());
-        out.extend_from_slice(b.rot[g].coords());
-        out.extend_from_slice(b.vel[g].as_ref());
+        w.body_record(slot(w, g), out);
     }
     fn set_body_record(w: &mut Self::World, g: usize, x: &[f64]) {
-        let g = slot(w, g);
-        let b = &mut w.bodies;
-        let (p, rest) = x.split_at(D::N);
-        b.pos[g].as_mut().copy_from_slice(p);
-        let nr = b.rot[g].coords().len();
-        b.rot[g].coords_mut().copy_from_slice(&rest[..nr]);
-        b.vel[g].as_mut().copy_from_slice(&rest[nr..nr + D::DOF]);
+        w.set_moving(slot(w, g), x);
+    }
+    fn admit(w: &mut Self::World, entering: &[(u32, &[f64])]) {
+        w.admit(entering);
+    }
+    fn hold(w: &mut Self::World, keep: &[u32]) {
+        w.hold(keep);
+    }
+    fn n_grains(w: &Self::World) -> usize {
+        w.grain_sums().0
     }
     const STEP_RECORD: usize = Self::BODY_RECORD + D::DOF;
+    /// (the body's record with V⁻ for its velocity, then V_free)
     fn step_record(w: &Self::World, g: usize, v_free: &Self::V, out: &mut Vec<f64>) {
-        let (b, g) = (&w.bodies, slot(w, g));
-        out.extend_from_slice(b.pos[g].as_ref());
-        out.extend_from_slice(b.rot[g].coords());
-        out.extend_from_slice(w.scratch.v_begin[g].as_ref());
+        let (k, at) = (slot(w, g), out.len() + World::<D>::MOVING_RECORD - D::DOF);
+        w.body_record(k, out);
+        out[at..at + D::DOF].copy_from_slice(w.scratch.v_begin[k].as_ref());
         out.extend_from_slice(v_free.as_ref());
     }
     fn set_step_record(w: &mut Self::World, g: usize, x: &[f64]) -> Self::V {
@@ -458,7 +470,7 @@ impl<D: Dim> Family for Rigid<D> {
             &w.shapes,
             &w.detectors,
             w.alert,
-            Some(&region),
+            Some(&in_slots(&w.ids, region)),
             &mut s.raw,
         );
         Self::retain_raw(w, keep);
@@ -480,6 +492,15 @@ const HELD: &str = "NSCDD asks only for the bodies the world holds";
 #[inline]
 fn slot<D: Dim>(w: &World<D>, g: usize) -> usize {
     w.ids.slot(g as u32).expect(HELD) as usize
+}
+
+/// `r` with its pairs of global ids as pairs of slots (the detector's ids; a pair
+/// with a body the world does not hold cannot be detected and is left out).
+fn in_slots(ids: &crate::model::BodyIds, mut r: crate::detect::Region) -> crate::detect::Region {
+    if !ids.is_identity() {
+        r.pairs = r.pairs.iter().filter_map(|&[i, j]| Some([ids.slot(i)?, ids.slot(j)?])).collect();
+    }
+    r
 }
 
 /// The warm starts of [`Family::prev_record`]s.

@@ -330,6 +330,7 @@ impl<D: Family> super::NscddOf<D> {
     pub(super) fn after_integrate(&mut self, w: &mut D::World, moved: Result<(), usize>) -> Result<(), usize> {
         if let Some(rs) = self.ranks.as_mut() {
             rs.totals.bodies_stepped += D::stepped(w).map_or(D::n_bodies(w), |a| a.len()) as u64;
+            rs.totals.bodies_held += D::held(w).map_or(D::n_bodies(w), |a| a.len()) as u64;
         }
         if !self.local.now {
             return moved;

@@ -141,6 +141,12 @@ impl Owned {
         rs.totals.bodies_sent += (mine.len() / per) as u64;
         let (_, all) = rs.all_gather_any(&mine);
         let mut active = D::active(w).map(<[u32]>::to_vec).unwrap_or_default();
+        let entering: Vec<(u32, &[f64])> = all
+            .chunks_exact(per)
+            .filter(|x| x[0] as u32 == me)
+            .map(|x| (x[1] as u32, &x[2..2 + D::BODY_RECORD]))
+            .collect();
+        D::admit(w, &entering);
         for x in all.chunks_exact(per).filter(|x| x[0] as u32 == me) {
             let g = x[1] as usize;
             v_free[g] = D::set_step_record(w, g, &x[2..]);
@@ -226,6 +232,9 @@ impl Owned {
         });
         let active: Vec<u32> = (0..nb as u32).filter(|&g| keep[g as usize]).collect();
         D::set_active(w, Some(active));
+        // the world holds only them (they come back with their records)
+        let active = D::active(w).map(<[u32]>::to_vec).unwrap_or_default();
+        D::hold(w, &active);
         self.keep = keep;
     }
 }
@@ -260,6 +269,10 @@ pub(super) fn exchange<D: Family>(
         rs.gather_any_on_root(&mine)
     };
     let (mut first, mut got) = (None::<usize>, Vec::new());
+    // a body this process lacks enters with its record
+    let decode = |x: f64| if x < 0.0 { (-1.0 - x) as u32 } else { x as u32 };
+    let entering: Vec<(u32, &[f64])> = all.chunks_exact(per).map(|x| (decode(x[0]), &x[1..])).collect();
+    D::admit(w, &entering);
     for x in all.chunks_exact(per) {
         let g = if x[0] < 0.0 {
             let k = (-1.0 - x[0]) as usize;

@@ -12,9 +12,10 @@ use super::ranks::RankState;
 /// memory (`peak_rss_mib`, at the end of the run: `final.json` written); the other
 /// ranks' subdomains' bodies it held, summed over the steps (`shell_bodies`), and
 /// the steps whose shells were limited to the bodies near it
-/// (`limited_shell_steps`, [`super::shells`]).
+/// (`limited_shell_steps`, [`super::shells`]); the bodies its world held, summed
+/// over the steps (`bodies_held`, [`crate::world::held`]).
 pub fn totals_json(st: &mut RankState) -> String {
-    const H: usize = 19;
+    const H: usize = 20;
     let p = st.cluster.size() as usize;
     let t = &st.totals;
     let (wait_wall, wait_cpu) = st.cluster.waited();
@@ -39,6 +40,7 @@ pub fn totals_json(st: &mut RankState) -> String {
         super::cluster::peak_rss_mib(),
         t.shell_bodies as f64,
         t.limited_shells as f64,
+        t.bodies_held as f64,
         t.peers.len() as f64,
     ];
     mine.extend(t.peers.iter().map(|&x| x as f64));
@@ -72,6 +74,7 @@ pub fn totals_json(st: &mut RankState) -> String {
                 "peak_rss_mib": x[15],
                 "shell_bodies": x[16] as u64,
                 "limited_shell_steps": x[17] as u64,
+                "bodies_held": x[18] as u64,
                 "peers": peers,
                 "last_subdomains": subs,
             })

@@ -117,6 +117,13 @@ impl Dim for D2 {
         let inv = |k: u8, x: f64| if free & (1 << k) != 0 { 1.0 / x } else { 0.0 };
         [inv(0, mass), inv(1, mass), inv(2, *inertia)]
     }
+    const INV_MASS_LEN: usize = 3;
+    fn inv_mass_coords(im: &[f64; 3], out: &mut Vec<f64>) {
+        out.extend_from_slice(im);
+    }
+    fn inv_mass_from(x: &[f64]) -> [f64; 3] {
+        [x[0], x[1], x[2]]
+    }
     fn isotropic(_inertia: &f64) -> bool {
         true
     }

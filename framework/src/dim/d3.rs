@@ -247,6 +247,17 @@ impl Dim for D3 {
     fn inv_mass(mass: f64, inertia: &[f64; 3], rot: &[f64; 4], free: u8) -> InvMass3 {
         inv_mass(mass, inertia, rot, free)
     }
+    const INV_MASS_LEN: usize = 9;
+    fn inv_mass_coords(im: &InvMass3, out: &mut Vec<f64>) {
+        out.extend_from_slice(&im.m);
+        out.extend_from_slice(&im.i);
+    }
+    fn inv_mass_from(x: &[f64]) -> InvMass3 {
+        InvMass3 {
+            m: [x[0], x[1], x[2]],
+            i: [x[3], x[4], x[5], x[6], x[7], x[8]],
+        }
+    }
     fn isotropic(i: &[f64; 3]) -> bool {
         i[0] == i[1] && i[1] == i[2]
     }

@@ -170,6 +170,12 @@ pub trait Dim: sealed::Sealed + Copy + Default + Debug + PartialEq + Send + Sync
     /// M̂⁻¹ of a body of mass m and inertia I at orientation `rot`, restricted to the
     /// free degrees of freedom (bit k of `free`: dof k moves under impulses).
     fn inv_mass(mass: f64, inertia: &Self::Inertia, rot: &Self::Rot, free: u8) -> Self::InvMass;
+    /// Numbers of M̂⁻¹ as [`Dim::inv_mass_coords`] writes them (3 in 2D, 9 in 3D).
+    const INV_MASS_LEN: usize;
+    /// M̂⁻¹'s numbers appended to `out`, and back (bit for bit: a body sent between
+    /// processes keeps the M̂⁻¹ it has, not one recomputed at its orientation).
+    fn inv_mass_coords(im: &Self::InvMass, out: &mut Vec<f64>);
+    fn inv_mass_from(x: &[f64]) -> Self::InvMass;
     /// Whether M̂⁻¹ does not depend on the orientation (2D; isotropic 3D bodies).
     fn isotropic(inertia: &Self::Inertia) -> bool;
     /// ρ² = I/m (3D: tr(I)/3m), 0 when undefined: the weight of rotations in the

@@ -70,7 +70,12 @@ impl<W: Write, D: Dim> History<W, D> {
         let tracked: Vec<(u32, String)> = w
             .observed()
             .into_iter()
-            .map(|b| (b, w.names[b as usize].clone().unwrap_or_else(|| format!("body{b}"))))
+            .map(|b| {
+                (
+                    w.ids.global(b),
+                    w.names[b as usize].clone().unwrap_or_else(|| format!("body{}", w.ids.global(b))),
+                )
+            })
             .collect();
         let has_box = w.box_walls.is_some();
         let mut head = String::from(SOLVER_COLUMNS);
@@ -125,10 +130,11 @@ impl<W: Write, D: Dim> History<W, D> {
         if let Some(c) = census {
             r.contacts = c.contacts;
         }
-        let mut s = solver_fields(w.step, w.t, w.bodies.len(), &r, ek, ep);
+        let mut s = solver_fields(w.step, w.t, w.ids.n_global(w.bodies.len()), &r, ek, ep);
         let h = w.time.h;
-        for (b, _) in &self.tracked {
-            let b = *b as usize;
+        for (g, _) in &self.tracked {
+            // (a tracked body is held by every process: its slot may change)
+            let b = w.ids.slot(*g).expect("a tracked body is held") as usize;
             let (p, f) = (w.bodies.pos[b], w.reaction[b]);
             let rot = D::rot_to_vec(&w.bodies.rot[b]);
             for x in p.as_ref().iter().chain(rot.coords()) {

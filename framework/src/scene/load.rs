@@ -99,6 +99,7 @@ pub(crate) fn load_parsed<D: SceneDim>(cx: &Ctx, sf: SceneFile<BodySpec<D>>, reg
         contacts: Default::default(),
         reaction: vec![D::Twist::zero(); n],
         contact_shares: vec![],
+        whole: None,
         scratch: Default::default(),
     };
     Ok(Scene {

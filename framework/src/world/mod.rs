@@ -2,6 +2,7 @@
 //! and the contact set. Built by [`crate::scene`], advanced by [`crate::engine`].
 
 pub mod bulk;
+pub mod held;
 
 use crate::detect::{Detector, DetectorTable};
 use crate::dim::{Dim, Vector, D2, D3};
@@ -86,6 +87,9 @@ pub struct World<D: Dim> {
     /// point) and a compliant contact's stiffness and damping are multiplied by
     /// the product, i.e. its compliance c divided by it. Empty: w = 1.
     pub contact_shares: Vec<ContactShare<D>>,
+    /// The whole scene's static sums, kept before the world first drops a body
+    /// ([`held`]); `None`: computed from the bodies.
+    pub whole: Option<held::WholeScene>,
     pub(crate) scratch: Scratch<D>,
 }
 
@@ -195,10 +199,7 @@ impl<D: Dim> World<D> {
     /// Σ grain areas (3D: volumes) / box area (volume).
     pub fn solid_fraction(&self) -> Option<f64> {
         let e = self.box_extent()?;
-        let v: f64 = (0..self.bodies.len())
-            .filter(|&b| self.is_grain(b))
-            .map(|b| self.bodies.volume[b])
-            .sum();
+        let v = self.grain_sums().1;
         Some(v / (0..D::N).map(|k| e.max[k] - e.min[k]).product::<f64>())
     }
     /// Mean stresses on the box walls (σ_xx, σ_yy[, σ_zz]), compression positive,
@@ -250,13 +251,7 @@ impl<D: Dim> World<D> {
     }
     /// The largest grain size (radius of a disk or sphere).
     pub fn max_grain_size(&self) -> f64 {
-        (0..self.bodies.len())
-            .filter(|&b| self.is_grain(b))
-            .map(|b| {
-                let s = self.bodies.shape[b];
-                self.shapes[s.kind as usize].size(s.index)
-            })
-            .fold(0.0, f64::max)
+        self.grain_sums().2
     }
     /// Kinetic energy and gravity potential of the bodies impulses can move.
     pub fn energies(&self) -> (f64, f64) {
