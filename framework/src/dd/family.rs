@@ -139,6 +139,9 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     /// data) it does not hold, and keeps only the bodies `keep` (ascending global
     /// ids; every body of its contacts among them). The grains of the whole scene.
     fn admit(w: &mut Self::World, entering: &[(u32, &[f64])]);
+    /// What rank 0 writes of a body another rank holds (`OUTPUT_RECORD` numbers).
+    const OUTPUT_RECORD: usize;
+    fn output_record(w: &Self::World, g: usize, out: &mut Vec<f64>);
     fn hold(w: &mut Self::World, keep: &[u32]);
     fn n_grains(w: &Self::World) -> usize;
     /// During a step (a distributed repartition): a body's position, orientation,
@@ -409,6 +412,10 @@ impl<D: Dim> Family for Rigid<D> {
     }
     fn admit(w: &mut Self::World, entering: &[(u32, &[f64])]) {
         w.admit(entering);
+    }
+    const OUTPUT_RECORD: usize = World::<D>::OUTPUT_RECORD;
+    fn output_record(w: &Self::World, g: usize, out: &mut Vec<f64>) {
+        w.output_record(slot(w, g), out);
     }
     fn hold(w: &mut Self::World, keep: &[u32]) {
         w.hold(keep);

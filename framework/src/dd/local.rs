@@ -363,13 +363,24 @@ impl<D: Family> super::NscddOf<D> {
         Some(mine)
     }
 
-    /// With bodies held per rank, every body's state from its owner to rank 0
-    /// (collective; before rank 0 writes the state).
-    pub fn gather_bodies(&mut self, w: &mut D::World) {
-        let Some(mine) = self.owned_bodies(w) else { return };
-        let Some(rs) = self.ranks.as_mut() else { return };
-        let send: Vec<u32> = (0..mine.len() as u32).filter(|&g| mine[g as usize]).collect();
-        super::owned::exchange::<D>(w, rs, &send, None, false);
+    /// With bodies held per rank, every body's record from its owner to rank 0
+    /// (collective; before rank 0 writes the state): `[g, record…]` chunks on rank 0
+    /// ([`Family::output_record`]), `None` elsewhere or when every rank holds every
+    /// body.
+    pub fn gather_bodies(&mut self, w: &D::World) -> Option<Vec<f64>> {
+        let mine = self.owned_bodies(w)?;
+        let rs = self.ranks.as_mut()?;
+        let mut out = Vec::new();
+        for g in (0..mine.len()).filter(|&g| mine[g]) {
+            out.push(g as f64);
+            D::output_record(w, g, &mut out);
+        }
+        let root = rs.cluster.rank() == 0;
+        if !root {
+            rs.totals.bodies_sent += (out.len() / (1 + D::OUTPUT_RECORD)) as u64;
+        }
+        let all = rs.gather_any_on_root(&out);
+        root.then_some(all)
     }
 
     /// Whether the world holds this rank's contacts only (the last step ran with

@@ -25,8 +25,8 @@
 //! The outputs never read a body its rank does not hold: the sums over bodies are
 //! added per cell by the cells' ranks ([`super::census::BodySums`]), the named and
 //! driven bodies are stepped by every rank, a body without contacts is written in
-//! the VTK frames by its owner, and rank 0 gathers every body before it writes
-//! `final.json` or a checkpoint ([`super::NscddOf::gather_bodies`]).
+//! the VTK frames by its owner, and rank 0 gathers every body's record before it
+//! writes `final.json` or a checkpoint ([`super::NscddOf::gather_bodies`]).
 
 use super::cells::CellIndex;
 use super::family::Family;
@@ -188,7 +188,7 @@ impl Owned {
                 full_next || !to.is_empty()
             };
             let send: Vec<u32> = self.mine.iter().copied().filter(|&g| entering(g)).collect();
-            exchange::<D>(w, rs, &send, moved.err(), true)
+            exchange::<D>(w, rs, &send, moved.err())
         };
         if diverged.is_some() || full_next {
             D::set_active(w, None);
@@ -240,15 +240,14 @@ impl Owned {
 }
 
 /// The states of the bodies `send` (and, with `diverged`, of the body found
-/// diverging, marked by its id as −1 − id) from every rank to every rank
-/// (`to_all`) or to rank 0, written into the receivers' worlds. Returns the first
-/// body any rank found diverging and the bodies received. Collective.
+/// diverging, marked by its id as −1 − id) from every rank to every rank, written
+/// into the receivers' worlds (a body one lacks enters it). Returns the first body
+/// any rank found diverging and the bodies received. Collective.
 pub(super) fn exchange<D: Family>(
     w: &mut D::World,
     rs: &mut RankState,
     send: &[u32],
     diverged: Option<usize>,
-    to_all: bool,
 ) -> (Option<usize>, Vec<u32>) {
     let per = 1 + D::BODY_RECORD;
     let mut mine = Vec::with_capacity((send.len() + 1) * per);
@@ -260,14 +259,8 @@ pub(super) fn exchange<D: Family>(
         mine.push(f64::from(g));
         D::body_record(w, g as usize, &mut mine);
     }
-    if to_all || rs.cluster.rank() != 0 {
-        rs.totals.bodies_sent += send.len() as u64;
-    }
-    let all = if to_all {
-        rs.all_gather_any(&mine).1
-    } else {
-        rs.gather_any_on_root(&mine)
-    };
+    rs.totals.bodies_sent += send.len() as u64;
+    let all = rs.all_gather_any(&mine).1;
     let (mut first, mut got) = (None::<usize>, Vec::new());
     // a body this process lacks enters with its record
     let decode = |x: f64| if x < 0.0 { (-1.0 - x) as u32 } else { x as u32 };

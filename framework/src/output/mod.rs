@@ -91,28 +91,72 @@ struct FinalOut<'a, D: Dim, N: Serialize> {
     nscdd: Option<&'a N>,
 }
 
-/// The bodies of `final.json`, each made as it is written (no list of them held).
-struct BodiesOut<'a, D: Dim>(&'a World<D>);
+/// The bodies of `final.json`, each made as it is written (no list of them held):
+/// the world's, and those of `records` it does not hold (other processes' bodies,
+/// `[g, output record…]` chunks, [`World::output_record`]).
+struct BodiesOut<'a, D: Dim>(&'a World<D>, &'a [f64]);
 
 impl<D: Dim> Serialize for BodiesOut<'_, D> {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         let (w, b) = (self.0, &self.0.bodies);
-        s.collect_seq((0..b.len()).map(|k| {
+        let held = (0..b.len()).map(|k| {
             let sh = b.shape[k];
-            BodyOut::<D> {
-                id: w.ids.global(k as u32),
-                name: w.names[k].as_deref(),
-                kind: w.kind_name(k),
-                material: &w.materials[b.material[k] as usize].name,
-                position: b.pos[k],
-                rotation: D::rot_to_vec(&b.rot[k]),
-                quaternion: (D::N == 3).then_some(b.rot[k]),
-                velocity: b.vel[k],
-                fixed: w.fixed[k],
+            let g = w.ids.global(k as u32);
+            (
+                g,
+                BodyOut::<D> {
+                    id: g,
+                    name: w.names[k].as_deref(),
+                    kind: w.kind_name(k),
+                    material: &w.materials[b.material[k] as usize].name,
+                    position: b.pos[k],
+                    rotation: D::rot_to_vec(&b.rot[k]),
+                    quaternion: (D::N == 3).then_some(b.rot[k]),
+                    velocity: b.vel[k],
+                    fixed: w.fixed[k],
+                    shape: w.shapes[sh.kind as usize].describe(sh.index),
+                },
+            )
+        });
+        // the others, by id (a body not held is neither named nor fixed: those every
+        // process holds)
+        let mut others: Vec<(u32, &[f64])> = self
+            .1
+            .chunks_exact(1 + World::<D>::OUTPUT_RECORD)
+            .map(|x| (x[0] as u32, &x[1..]))
+            .filter(|(g, _)| w.ids.slot(*g).is_none())
+            .collect();
+        others.sort_unstable_by_key(|x| x.0);
+        others.dedup_by_key(|x| x.0);
+        let others = others.into_iter().map(|(g, x)| {
+            let ((pos, rot, vel), sh, material) = crate::world::held::read_output::<D>(x);
+            let body = BodyOut::<D> {
+                id: g,
+                name: None,
+                kind: w.shapes[sh.kind as usize].kind(),
+                material: &w.materials[material as usize].name,
+                position: pos,
+                rotation: D::rot_to_vec(&rot),
+                quaternion: (D::N == 3).then_some(rot),
+                velocity: vel,
+                fixed: false,
                 shape: w.shapes[sh.kind as usize].describe(sh.index),
-            }
-        }))
+            };
+            (g, body)
+        });
+        s.collect_seq(merge_by_id(held, others))
     }
+}
+
+/// Two sequences ascending in id merged into one.
+fn merge_by_id<T>(a: impl Iterator<Item = (u32, T)>, b: impl Iterator<Item = (u32, T)>) -> impl Iterator<Item = T> {
+    let (mut a, mut b) = (a.peekable(), b.peekable());
+    std::iter::from_fn(move || match (a.peek(), b.peek()) {
+        (Some(x), Some(y)) if y.0 < x.0 => b.next(),
+        (Some(_), _) => a.next(),
+        (None, _) => b.next(),
+    })
+    .map(|(_, t)| t)
 }
 
 /// The state as `final.json`: the dimension, step, time, `box_h0` (the box height
@@ -158,18 +202,20 @@ pub fn final_json_of<D: Dim, N: Serialize>(
     records: Option<&[f64]>,
 ) -> String {
     let mut out = Vec::new();
-    write_final_json(&mut out, w, families, nscdd, records).expect("writing to memory");
+    write_final_json(&mut out, w, families, nscdd, (records, None)).expect("writing to memory");
     String::from_utf8(out).expect("serde_json writes UTF-8")
 }
 
 /// Writes [`final_json_of`] to `out` as it is made: no copy of the state (a 55 000-
-/// sphere state is ≈ 140 MB of text) is held in memory, only the contacts' records.
+/// sphere state is ≈ 140 MB of text) is held in memory, only the contacts' records;
+/// `bodies`: other processes' bodies' records (`[g, output record…]`,
+/// [`World::output_record`]) written beside the world's.
 pub fn write_final_json<D: Dim, N: Serialize>(
     out: impl std::io::Write,
     w: &World<D>,
     families: Option<&serde_json::Map<String, serde_json::Value>>,
     nscdd: Option<&N>,
-    records: Option<&[f64]>,
+    (records, bodies): (Option<&[f64]>, Option<&[f64]>),
 ) -> std::io::Result<()> {
     let mut own = Vec::new();
     let records = records.unwrap_or_else(|| {
@@ -204,7 +250,7 @@ pub fn write_final_json<D: Dim, N: Serialize>(
         step: w.step,
         time: w.t,
         box_h0: w.box_h0,
-        bodies: BodiesOut(w),
+        bodies: BodiesOut(w, bodies.unwrap_or_default()),
         contacts,
         families,
         nscdd,

@@ -203,10 +203,8 @@ pub(crate) fn save_state<D: Dim>(
     dd: &mut Option<NscddOf<Rigid<D>>>,
 ) -> Result<(), RunError> {
     let root = dd.as_mut().and_then(|n| n.ranks_mut()).is_none_or(|r| r.cluster.rank() == 0);
-    // bodies held per rank: every body from its owner to rank 0
-    if let Some(n) = dd.as_mut() {
-        n.gather_bodies(w);
-    }
+    // bodies held per rank: every body's record from its owner to rank 0
+    let bodies = dd.as_mut().and_then(|n| n.gather_bodies(w));
     // contacts held per rank: every rank's gathered on rank 0
     let records = match dd.as_mut().filter(|n| n.holds_own_contacts()) {
         Some(n) => {
@@ -222,7 +220,7 @@ pub(crate) fn save_state<D: Dim>(
     }
     let states = (!families.is_empty()).then(|| crate::family::states(families));
     save_state_with(dir, name, |f| {
-        crate::output::write_final_json(f, w, states.as_ref(), dd.as_ref(), records.as_deref())
+        crate::output::write_final_json(f, w, states.as_ref(), dd.as_ref(), (records.as_deref(), bodies.as_deref()))
     })
 }
 

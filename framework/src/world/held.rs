@@ -81,6 +81,18 @@ impl<D: Dim> World<D> {
         ]);
     }
 
+    /// What `final.json` needs of a body another process holds: its moving state,
+    /// then its shape kind and index and its material.
+    pub const OUTPUT_RECORD: usize = Self::MOVING_RECORD + 3;
+    pub fn output_record(&self, k: usize, out: &mut Vec<f64>) {
+        let b = &self.bodies;
+        out.extend_from_slice(b.pos[k].as_ref());
+        out.extend_from_slice(b.rot[k].coords());
+        out.extend_from_slice(b.vel[k].as_ref());
+        let s = b.shape[k];
+        out.extend([f64::from(s.kind), f64::from(s.index), f64::from(b.material[k])]);
+    }
+
     /// Sets body `k`'s moving state from the start of a record.
     pub fn set_moving(&mut self, k: usize, x: &[f64]) {
         let b = &mut self.bodies;
@@ -235,32 +247,83 @@ impl<D: Dim> World<D> {
     }
 }
 
-/// The entering bodies' records as columns.
-fn decode<D: Dim>(entering: &[(u32, &[f64])]) -> Bodies<D> {
-    let mut b = Bodies::<D>::default();
-    let (nr, ni) = (if D::N == 2 { 1 } else { 4 }, if D::N == 2 { 1 } else { 3 });
-    for (_, x) in entering {
-        let (mut pos, mut rot, mut vel, mut inertia) = (D::Point::zero(), D::rot_identity(), D::Twist::zero(), D::Inertia::default());
-        pos.as_mut().copy_from_slice(&x[..D::N]);
-        rot.coords_mut().copy_from_slice(&x[D::N..D::N + nr]);
-        vel.as_mut().copy_from_slice(&x[D::N + nr..World::<D>::MOVING_RECORD]);
+/// A body's record ([`World::body_record`]) read back.
+pub struct Record<D: Dim> {
+    pub pos: D::Point,
+    pub rot: D::Rot,
+    pub vel: D::Twist,
+    pub mass: f64,
+    pub inertia: D::Inertia,
+    pub inv_mass: D::InvMass,
+    pub free: u8,
+    pub volume: f64,
+    pub shape: ShapeRef,
+    pub material: u16,
+}
+
+/// A body's moving state (position, orientation, velocity) at the start of a record.
+pub fn read_moving<D: Dim>(x: &[f64]) -> (D::Point, D::Rot, D::Twist) {
+    let nr = if D::N == 2 { 1 } else { 4 };
+    let (mut pos, mut rot, mut vel) = (D::Point::zero(), D::rot_identity(), D::Twist::zero());
+    pos.as_mut().copy_from_slice(&x[..D::N]);
+    rot.coords_mut().copy_from_slice(&x[D::N..D::N + nr]);
+    vel.as_mut().copy_from_slice(&x[D::N + nr..World::<D>::MOVING_RECORD]);
+    (pos, rot, vel)
+}
+
+/// A body's [`World::output_record`] read back: its moving state, shape and material.
+pub fn read_output<D: Dim>(x: &[f64]) -> ((D::Point, D::Rot, D::Twist), ShapeRef, u16) {
+    let r = &x[World::<D>::MOVING_RECORD..];
+    let shape = ShapeRef {
+        kind: r[0] as u16,
+        index: r[1] as u32,
+    };
+    (read_moving::<D>(x), shape, r[2] as u16)
+}
+
+impl<D: Dim> Record<D> {
+    /// The record `x` ([`World::BODY_RECORD`] numbers).
+    pub fn read(x: &[f64]) -> Self {
+        let ni = if D::N == 2 { 1 } else { 3 };
+        let (pos, rot, vel) = read_moving::<D>(x);
+        let mut inertia = D::Inertia::default();
         // the static data: mass, inertia, M̂⁻¹, then the rest
         let s = &x[World::<D>::MOVING_RECORD..];
         inertia.coords_mut().copy_from_slice(&s[1..1 + ni]);
-        let x = &s[1 + ni + D::INV_MASS_LEN..];
-        b.pos.push(pos);
-        b.rot.push(rot);
-        b.vel.push(vel);
-        b.mass.push(s[0]);
-        b.inertia.push(inertia);
-        b.inv_mass.push(D::inv_mass_from(&s[1 + ni..]));
-        b.free.push(x[0] as u8);
-        b.volume.push(x[1]);
-        b.shape.push(ShapeRef {
-            kind: x[2] as u16,
-            index: x[3] as u32,
-        });
-        b.material.push(x[4] as u16);
+        let r = &s[1 + ni + D::INV_MASS_LEN..];
+        Record {
+            pos,
+            rot,
+            vel,
+            mass: s[0],
+            inertia,
+            inv_mass: D::inv_mass_from(&s[1 + ni..]),
+            free: r[0] as u8,
+            volume: r[1],
+            shape: ShapeRef {
+                kind: r[2] as u16,
+                index: r[3] as u32,
+            },
+            material: r[4] as u16,
+        }
+    }
+}
+
+/// The entering bodies' records as columns.
+fn decode<D: Dim>(entering: &[(u32, &[f64])]) -> Bodies<D> {
+    let mut b = Bodies::<D>::default();
+    for (_, x) in entering {
+        let r = Record::<D>::read(x);
+        b.pos.push(r.pos);
+        b.rot.push(r.rot);
+        b.vel.push(r.vel);
+        b.mass.push(r.mass);
+        b.inertia.push(r.inertia);
+        b.inv_mass.push(r.inv_mass);
+        b.free.push(r.free);
+        b.volume.push(r.volume);
+        b.shape.push(r.shape);
+        b.material.push(r.material);
     }
     b
 }
