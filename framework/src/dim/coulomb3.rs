@@ -237,8 +237,9 @@ pub fn solve_pre(w: &Sym3, pre: &Pre3, u0: [f64; 3], u_target: f64, mu: f64) -> 
 /// iterates change little from sweep to sweep, so the secant steps start next to
 /// the root). The result is the same solution up to round-off.
 ///
-/// Always inlined: called, it returns its 24 bytes through memory, and the sweep's
-/// reading them back failed store forwarding in some builds (+9 %, PERFORMANCE.md).
+/// Its closed forms (no contact, a sphere's isotropic block) always inlined: called,
+/// it returns its 24 bytes through memory, and the sweep's reading them back failed
+/// store forwarding in some builds (+9 %, PERFORMANCE.md); the rest is called.
 #[inline(always)]
 pub fn solve_pre_warm(w: &Sym3, pre: &Pre3, u0: [f64; 3], u_target: f64, mu: f64, prev: [f64; 3]) -> [f64; 3] {
     let s0 = u0[0] - u_target;
@@ -261,6 +262,12 @@ pub fn solve_pre_warm(w: &Sym3, pre: &Pre3, u0: [f64; 3], u_target: f64, mu: f64
         let k = mu * rn / ut;
         return [rn, -k * u0[1], -k * u0[2]];
     }
+    solve_general(w, pre, u0, (s0, u_target), mu, prev)
+}
+
+/// [`solve_pre_warm`] past its closed forms (called: the sweep's hot path stays small).
+#[inline(never)]
+fn solve_general(w: &Sym3, pre: &Pre3, u0: [f64; 3], (s0, u_target): (f64, f64), mu: f64, prev: [f64; 3]) -> [f64; 3] {
     if mu == 0.0 && pre.inv_nn > 0.0 {
         return [-s0 * pre.inv_nn, 0.0, 0.0];
     }
