@@ -118,9 +118,10 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     fn body_boxes(w: &Self::World, out: &mut Vec<[[f64; 3]; 2]>);
     /// Bodies owned per rank ([`super::owned`]): the bodies this process steps
     /// (ascending; `None`: every body it holds), whether a body is stepped by
-    /// every process (fixed, driven or unbounded), and a body's moving state
-    /// (position, orientation, velocity, then its static data: a body a process
-    /// lacks enters with it) as `BODY_RECORD` numbers, and back.
+    /// every process (fixed, driven or unbounded), and a body's record as
+    /// `BODY_RECORD` numbers: its moving state (position, orientation, velocity),
+    /// then its static data (a body a process lacks enters with it); setting a
+    /// record sets the moving state of a body the world holds.
     fn set_active(w: &mut Self::World, active: Option<Vec<u32>>);
     fn active(w: &Self::World) -> Option<&[u32]>;
     /// The bodies the world holds (ascending global ids; `None`: 0..n_bodies).
@@ -136,17 +137,19 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     fn set_body_record(w: &mut Self::World, g: usize, x: &[f64]);
     /// Compact arrays ([`crate::world::held`]): the world admits the bodies of
     /// `entering` (global id, [`Family::body_record`]: it carries their static
-    /// data) it does not hold, and keeps only the bodies `keep` (ascending global
-    /// ids; every body of its contacts among them). The grains of the whole scene.
+    /// data) it does not hold.
     fn admit(w: &mut Self::World, entering: &[(u32, &[f64])]);
+    /// The world keeps only the bodies `keep` (ascending global ids; every body of
+    /// its contacts, drives and box walls among them).
+    fn hold(w: &mut Self::World, keep: &[u32]);
+    /// The whole scene's grains (held or not).
+    fn n_grains(w: &Self::World) -> usize;
     /// What rank 0 writes of a body another rank holds (`OUTPUT_RECORD` numbers).
     const OUTPUT_RECORD: usize;
     fn output_record(w: &Self::World, g: usize, out: &mut Vec<f64>);
-    fn hold(w: &mut Self::World, keep: &[u32]);
-    fn n_grains(w: &Self::World) -> usize;
-    /// During a step (a distributed repartition): a body's position, orientation,
-    /// V⁻ and V_free (`STEP_RECORD` numbers), and back (M̂⁻¹ refreshed as the free
-    /// velocity stage does; returns V_free).
+    /// During a step (a distributed repartition): a body's record with V⁻ for its
+    /// velocity, then V_free (`STEP_RECORD` numbers), and back (M̂⁻¹ refreshed as
+    /// the free velocity stage does; returns V_free).
     const STEP_RECORD: usize;
     fn step_record(w: &Self::World, g: usize, v_free: &Self::V, out: &mut Vec<f64>);
     fn set_step_record(w: &mut Self::World, g: usize, x: &[f64]) -> Self::V;

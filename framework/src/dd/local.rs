@@ -349,9 +349,10 @@ impl<D: Family> super::NscddOf<D> {
         self.local.held = self.local.now;
     }
 
-    /// With bodies held per rank (some not up to date here): which bodies this rank
-    /// holds and owns (the cell of their centre is its), the writer of a body's
-    /// outputs; `None` when every rank holds every body.
+    /// With bodies stepped per rank: which bodies this rank holds and owns (the
+    /// cell of their centre is its), the writer of a body's outputs; `None` when
+    /// the step had no active set (every rank stepped every body it holds: a full
+    /// step, or one that diverged).
     pub(super) fn owned_bodies(&self, w: &D::World) -> Option<Vec<bool>> {
         let active = D::active(w)?;
         let (rs, grid) = (self.ranks.as_ref()?, self.grid.as_ref()?);

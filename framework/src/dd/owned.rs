@@ -1,7 +1,8 @@
 //! Bodies stepped per rank (docs/SCALING.md, "Bodies owned per rank", step 1): with
 //! contacts held per rank ([`super::local`]), a rank also steps only the bodies it
-//! needs — free velocity, detection boxes and position update — and leaves the
-//! others' state as it was (the arrays keep every body).
+//! needs — free velocity, detection boxes and position update — and its world holds
+//! only them (compact arrays, [`crate::world::held`]): a body leaves when the rank
+//! no longer steps it and enters, with its record, when it comes back.
 //!
 //! ```text
 //! owner(b)   the rank of the grid cell holding b's centre (edge cells unbounded)
@@ -231,9 +232,8 @@ impl Owned {
             keep[g] |= self.everywhere[g] || mine.meets(D::SPACE, &lo, &hi);
         });
         let active: Vec<u32> = (0..nb as u32).filter(|&g| keep[g as usize]).collect();
-        D::set_active(w, Some(active));
+        D::set_active(w, Some(active.clone()));
         // the world holds only them (they come back with their records)
-        let active = D::active(w).map(<[u32]>::to_vec).unwrap_or_default();
         D::hold(w, &active);
         self.keep = keep;
     }
@@ -262,19 +262,18 @@ pub(super) fn exchange<D: Family>(
     rs.totals.bodies_sent += send.len() as u64;
     let all = rs.all_gather_any(&mine).1;
     let (mut first, mut got) = (None::<usize>, Vec::new());
+    // (the body's id; a diverging one's as −1 − id)
+    let id = |x: f64| if x < 0.0 { (-1.0 - x) as u32 } else { x as u32 };
     // a body this process lacks enters with its record
-    let decode = |x: f64| if x < 0.0 { (-1.0 - x) as u32 } else { x as u32 };
-    let entering: Vec<(u32, &[f64])> = all.chunks_exact(per).map(|x| (decode(x[0]), &x[1..])).collect();
+    let entering: Vec<(u32, &[f64])> = all.chunks_exact(per).map(|x| (id(x[0]), &x[1..])).collect();
     D::admit(w, &entering);
     for x in all.chunks_exact(per) {
-        let g = if x[0] < 0.0 {
-            let k = (-1.0 - x[0]) as usize;
-            first = Some(first.map_or(k, |f| f.min(k)));
-            k
+        let g = id(x[0]) as usize;
+        if x[0] < 0.0 {
+            first = Some(first.map_or(g, |f| f.min(g)));
         } else {
-            got.push(x[0] as u32);
-            x[0] as usize
-        };
+            got.push(g as u32);
+        }
         D::set_body_record(w, g, &x[1..]);
     }
     (first, got)

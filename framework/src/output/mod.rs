@@ -128,6 +128,17 @@ impl<D: Dim> Serialize for BodiesOut<'_, D> {
             .collect();
         others.sort_unstable_by_key(|x| x.0);
         others.dedup_by_key(|x| x.0);
+        // with records (rank 0 of several), every body once: a body neither held nor
+        // sent would be lost from the file
+        let n = w.ids.n_global(b.len());
+        if !self.1.is_empty() && b.len() + others.len() != n {
+            use serde::ser::Error as _;
+            return Err(S::Error::custom(format!(
+                "internal error: {} bodies held and {} received of {n}",
+                b.len(),
+                others.len()
+            )));
+        }
         let others = others.into_iter().map(|(g, x)| {
             let ((pos, rot, vel), sh, material) = crate::world::held::read_output::<D>(x);
             let body = BodyOut::<D> {

@@ -6,8 +6,9 @@
 //! every order taken from body ids is the scene's. A change of the held set
 //! renumbers the slots and remaps every table holding a slot: the bodies' columns,
 //! the names, `fixed`, the reactions, the step's V⁻, the contacts' bodies (the
-//! world's, the step's next set and the raw ones), the drives, the box walls and
-//! the active list. A body enters with its whole record ([`World::body_record`]):
+//! world's, the step's next set and the raw ones), the detection region's pairs,
+//! the drives, the box walls and the active list (a drop, between steps, clears
+//! the step's detection and build buffers instead). A body enters with its whole record ([`World::body_record`]):
 //! its moving state and its static data (mass, inertia, M̂⁻¹ as it is, free degrees
 //! of freedom, volume, shape, material); the shape stores stay whole.
 //!
@@ -118,8 +119,13 @@ impl<D: Dim> World<D> {
             w.max_grain_size = w.max_grain_size.max(self.shapes[s.kind as usize].size(s.index));
         }
         if per_body {
-            w.movable = (0..self.bodies.len()).map(|k| self.bodies.movable(k)).collect();
-            w.rho2 = (0..self.bodies.len()).map(|k| self.bodies.rho2(k)).collect();
+            // by global id (a world already partial leaves the others unknown: still)
+            let n = self.ids.n_global(self.bodies.len());
+            (w.movable, w.rho2) = (vec![false; n], vec![0.0; n]);
+            for k in 0..self.bodies.len() {
+                let g = self.ids.global(k as u32) as usize;
+                (w.movable[g], w.rho2[g]) = (self.bodies.movable(k), self.bodies.rho2(k));
+            }
         }
         w
     }
@@ -221,7 +227,7 @@ impl<D: Dim> World<D> {
         }
         let map = |k: &mut u32| {
             *k = new_of_old[*k as usize];
-            debug_assert!(*k != u32::MAX, "a dropped body still referenced");
+            assert!(*k != u32::MAX, "a contact, drive or box wall of a body the world drops");
         };
         self.contacts.bodies.iter_mut().for_each(|p| p.iter_mut().for_each(map));
         if new_of_old.contains(&u32::MAX) {
@@ -232,6 +238,13 @@ impl<D: Dim> World<D> {
             s.raw.iter_mut().for_each(|rc| {
                 map(&mut rc.i);
                 map(&mut rc.j);
+            });
+        }
+        if let Some(r) = s.region.as_mut() {
+            // a pair of the detection region with a body dropped cannot be detected
+            r.pairs.retain_mut(|p| {
+                *p = p.map(|k| new_of_old[k as usize]);
+                !p.contains(&u32::MAX)
             });
         }
         self.drives.iter_mut().for_each(|d| map(&mut d.body));

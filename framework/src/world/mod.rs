@@ -122,8 +122,9 @@ pub(crate) struct Scratch<D: Dim> {
     /// Last step's contacts held by other processes that this one may meet again
     /// (their warm starts), beside the world's own.
     pub extra_prev: Vec<PrevContact<D>>,
-    /// The bodies this process steps (ascending ids; `None`: all): on MPI ranks, its
-    /// own and its halo (`dd::owned`); the others' state is left as it was.
+    /// The bodies this process steps (slots, ascending; `None`: all it holds): on
+    /// MPI ranks, its own and its halo (`dd::owned`), which between steps are the
+    /// bodies its world holds ([`held`]).
     pub active: Option<Vec<u32>>,
     /// `active` in global ids, for a world holding part of the scene.
     pub active_global: Option<Vec<u32>>,
