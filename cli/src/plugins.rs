@@ -78,11 +78,12 @@ pub fn install_panic_hook() {
 
 /// A caught panic: its message, and exit 1 (the outputs written so far are kept).
 pub fn report(payload: Box<dyn std::any::Any + Send>) -> ExitCode {
-    let text = PANIC
-        .lock()
-        .ok()
-        .and_then(|p| p.clone())
-        .unwrap_or_else(|| format!("internal error: {}", nscdd::plugin::panic_text(&*payload)));
+    let text = panic_message().unwrap_or_else(|| format!("internal error: {}", nscdd::plugin::panic_text(&*payload)));
     eprintln!("error: {text}; the run stopped, the outputs written so far are kept");
     ExitCode::from(1)
+}
+
+/// The message of the first panic the hook saw (`None` before any).
+pub fn panic_message() -> Option<String> {
+    PANIC.lock().ok().and_then(|p| p.clone())
 }

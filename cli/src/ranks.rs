@@ -5,9 +5,10 @@
 //! Failures: a rank that cannot load the scene (or its flags) stops every rank at the
 //! agreement that follows loading (exit code 2, the failing rank's message on
 //! stderr); ranks that read different scenes stop there too. A rank that fails
-//! while the others step (an unwritable output on rank 0) prints its message and
-//! aborts every rank (`MPI_Abort`): never a hang. A divergence happens on every rank
-//! at once (each holds the whole world): rank 0 reports it, every rank exits 1.
+//! while the others step (an unwritable output on rank 0, a panic in a plugin)
+//! prints its message and aborts every rank (`MPI_Abort`): never a hang. A
+//! divergence stops every rank at the same step (the diverging body's state goes to
+//! every rank with the step's exchange): rank 0 reports it, every rank exits 1.
 
 use nscdd::dd::Cluster;
 use std::hash::{Hash, Hasher};
@@ -124,6 +125,27 @@ impl Ranks {
         }
         eprintln!("error: {msg}");
         ExitCode::from(code as u8)
+    }
+}
+
+/// A panic unwinding through a multi-rank run (a plugin's, or a bug) on one rank:
+/// the others may wait for it in a collective, and `MPI_Finalize` (the session's
+/// drop, next) would wait for them. The rank prints the message with its rank and
+/// stops every rank instead: never a hang.
+#[cfg(feature = "mpi")]
+impl Drop for Ranks {
+    fn drop(&mut self) {
+        if !std::thread::panicking() {
+            return;
+        }
+        if let Some(s) = self.session.as_ref().filter(|s| s.size() > 1) {
+            let text = crate::plugins::panic_message().unwrap_or_else(|| "internal error".into());
+            eprintln!(
+                "rank {}: error: {text}; the run stopped, the outputs written so far are kept",
+                s.rank()
+            );
+            s.abort(1)
+        }
     }
 }
 

@@ -61,3 +61,37 @@ fn a_diverging_body_stops_every_rank_and_keeps_the_outputs() {
     assert_eq!(hist.lines().count(), 1 + 5, "{hist}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A panic on one rank while the others step (a plugin's detector, here): that rank
+/// prints the message and stops every rank, instead of waiting in `MPI_Finalize`
+/// for ranks that wait for it in a collective.
+#[test]
+fn a_panic_on_one_rank_stops_every_rank() {
+    let Some(lib) = nscdd::plugin::built_library("nscdd_plugin_panics") else {
+        panic!("libnscdd_plugin_panics is not built: run the tests of the whole workspace (cargo test --workspace --release …)")
+    };
+    let dir = scratch("panic_one_rank");
+    // a fragile bead falling on the floor at x = 0, breaking near it, and four
+    // resting at x = 0.5 … 2 (their contacts spread the grid of 2 × 1 subdomains):
+    // only the rank of the left cell detects the falling bead
+    let mut scene_text = String::from(
+        "[time]\nstep = 1e-3\nsteps = 300\n[[materials]]\nname = \"m\"\ndensity = 1000.0\n[[laws]]\n\
+         materials = [\"m\", \"m\"]\nfriction = 0.3\n[[bodies]]\nshape = \"halfplane\"\nmaterial = \"m\"\n\
+         position = [0.0, 0.0]\nfixed = true\n[[bodies]]\nshape = \"fragile\"\npanic_below = 0.02\n\
+         material = \"m\"\nradius = 0.05\nposition = [0.0, 0.1]\n",
+    );
+    for x in [0.5, 1.0, 1.5, 2.0] {
+        scene_text += &format!("[[bodies]]\nshape = \"fragile\"\nmaterial = \"m\"\nradius = 0.05\nposition = [{x}, 0.05]\n");
+    }
+    let scene = write(&dir, "fragile.toml", &every(&scene_text, 10));
+    let lib = lib.display().to_string();
+    let o = mpirun(&[(2, args(&scene, &dir.join("two"), &["--subdomains", "2x1", "--plugin", &lib]))]);
+    let err = text(&o.stderr);
+    assert!(!o.status.success(), "{err}");
+    // the message, with the rank that panicked
+    assert!(
+        err.contains("plugin nscdd_plugin_panics") && err.contains("the fragile bead broke") && err.contains("rank "),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
