@@ -19,8 +19,10 @@
 //! rank's bounds and counts into the new grid and ranks, sends the last step's
 //! contacts the other ranks' new cells may meet to those ranks (their warm starts,
 //! point to point) and detects again in the new regions
-//! ([`super::NscddOf::repartition_local`]); only the first step, and the first
-//! after a restart, run on the whole sample. Every decision above is the one a
+//! ([`super::NscddOf::repartition_local`]). The first step of a fresh run is such
+//! a repartition, its old regions a provisional grid over the bodies' centres
+//! ([`super::NscddOf::start_held`]); only the first step after a restart runs on
+//! the whole sample. Every decision above is the one a
 //! single process takes with all the contacts, so results stay bitwise those of one
 //! process.
 
@@ -196,6 +198,34 @@ pub(super) fn region<D: Family>(rs: &RankState, grid: &Grid, kept: &[(ContactKey
 }
 
 impl<D: Family> super::NscddOf<D> {
+    /// Before the first step of a fresh run on ranks (rigid bodies, contacts held
+    /// per rank): a provisional grid over the movable bodies' centres, its cells'
+    /// ranks balanced by their bodies (the same on every rank: every rank holds the
+    /// whole scene), and each world reduced to its rank's part ([`super::owned`]).
+    /// The first step re-partitions over its contacts as every repartition with
+    /// contacts held per rank does ([`Self::repartition_local`]): the same grid and
+    /// ranks as one process, which never needs every body and contact on a rank.
+    pub(super) fn start_held(&mut self, w: &mut D::World, eligible: bool) {
+        let Some(rs) = self.ranks.as_mut() else { return };
+        if !(eligible && self.local_contacts) || self.grid.is_some() || self.steps != 0 || D::active(w).is_some() {
+            return;
+        }
+        let s = &self.settings;
+        let movable: Vec<usize> = (0..D::n_bodies(w)).filter(|&g| D::movable(w, g)).collect();
+        let (lo, hi) = Grid::bounds(movable.iter().map(|&g| D::position(w, g)));
+        if movable.is_empty() || (0..3).any(|k| !(lo[k].is_finite() && hi[k].is_finite())) {
+            return;
+        }
+        let grid = Grid::from_bounds(lo, hi, s.nx, s.ny, s.nz);
+        let mut loads = vec![0usize; grid.len()];
+        for &g in &movable {
+            loads[grid.cell_of(D::position(w, g)) as usize] += 1;
+        }
+        rs.rank_of = super::rank_balance::balanced_ranks(&loads, rs.cluster.size());
+        self.local.owned.start_held::<D>(w, rs, &grid);
+        self.grid = Some(grid);
+    }
+
     /// Whether this step re-partitions over a new grid.
     pub(super) fn repartitions(&self) -> bool {
         self.repartitions_at(self.steps)

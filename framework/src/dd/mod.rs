@@ -346,6 +346,7 @@ impl<D: Family> NscddOf<D> {
     /// parts and receives the others' packed results, [`LocalPart::pack`]).
     pub fn step_families(&mut self, w: &mut D::World, fams: &mut [&mut dyn Attached<D>]) -> Result<DdStepReport, Diverged> {
         self.pending = DdStepReport::default();
+        self.start_held(w, fams.is_empty() && !self.by_model);
         let base = D::step_with(w, &mut Stage { dd: self, fams });
         self.after_step();
         let base = base?;

@@ -21,7 +21,9 @@
 //! halo at the start of each step. A distributed repartition
 //! ([`super::NscddOf::repartition_local`]) sends, in the step, the bodies of each
 //! rank's new halo it lacks (their state at the start of the step, V⁻ and V_free);
-//! only the first step, and the first after a restart, run with every body.
+//! the first step of a fresh run starts from a provisional grid over the bodies'
+//! centres ([`Owned::start_held`]); only the first step after a restart runs with
+//! every body.
 //!
 //! The outputs never read a body its rank does not hold: the sums over bodies are
 //! added per cell by the cells' ranks ([`super::census::BodySums`]), the named and
@@ -92,6 +94,20 @@ impl Owned {
             }
         }
         self.own_bodies::<D>(w, rs, grid);
+    }
+
+    /// Before the first step of a run (every body held, a provisional `grid` and
+    /// `rs.rank_of` over the bodies' centres): the world keeps only this rank's
+    /// halo and the bodies every rank steps, so that the first step too runs with
+    /// bodies and contacts per rank (and re-partitions over its contacts).
+    pub(super) fn start_held<D: Family>(&mut self, w: &mut D::World, rs: &RankState, grid: &Grid) {
+        self.start::<D>(w, rs, grid);
+        let mine = Region {
+            boxes: super::cells::cells_of(grid, &rs.rank_of, rs.cluster.rank()),
+            pairs: Vec::new(),
+        };
+        let mut boxes = Vec::new();
+        self.next_active::<D>(w, &mine, &[], &mut boxes);
     }
 
     /// The bodies stepped by every rank, by id (set by [`Owned::start`]).
