@@ -19,8 +19,8 @@ fn a_diverging_body_stepped_by_one_rank_stops_every_rank() {
         )
     };
     // gravity along x adds 1e98 m/s a step: the fast grain passes 1e100 at step 3
-    // (the first step with bodies stepped per rank: the first runs on the whole
-    // sample, the second with all its bodies), the slow one would at step 100
+    // (every step steps bodies per rank, the first from a provisional grid over
+    // the bodies), the slow one would at step 100
     let scene_text = format!(
         "gravity = [1e101, 0.0]\n[time]\nstep = 1e-3\nsteps = 20\n[[materials]]\nname = \"grain\"\ndensity = 1e3\n\
          [[laws]]\nmaterials = [\"grain\", \"grain\"]\nfriction = 0.0\n[[bodies]]\nshape = \"halfplane\"\nmaterial = \"grain\"\n\
@@ -88,9 +88,10 @@ fn a_panic_on_one_rank_stops_every_rank() {
     let o = mpirun(&[(2, args(&scene, &dir.join("two"), &["--subdomains", "2x1", "--plugin", &lib]))]);
     let err = text(&o.stderr);
     assert!(!o.status.success(), "{err}");
-    // the message, with the rank that panicked
+    // the message once, from the rank that panicked, with its rank
     assert!(
-        err.contains("plugin nscdd_plugin_panics") && err.contains("the fragile bead broke") && err.contains("rank "),
+        (err.contains("rank 0: error: plugin nscdd_plugin_panics") || err.contains("rank 1: error: plugin nscdd_plugin_panics"))
+            && err.matches("the fragile bead broke").count() == 1,
         "{err}"
     );
     let _ = std::fs::remove_dir_all(&dir);

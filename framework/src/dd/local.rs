@@ -207,7 +207,9 @@ impl<D: Family> super::NscddOf<D> {
     /// ranks as one process, which never needs every body and contact on a rank.
     pub(super) fn start_held(&mut self, w: &mut D::World, eligible: bool) {
         let Some(rs) = self.ranks.as_mut() else { return };
-        if !(eligible && self.local_contacts) || self.grid.is_some() || self.steps != 0 || D::active(w).is_some() {
+        // (a fresh run: a restart, whatever its state, runs its first step whole)
+        let fresh = self.grid.is_none() && self.steps == 0 && D::step(w) == 0;
+        if !(eligible && self.local_contacts && fresh) || D::active(w).is_some() {
             return;
         }
         let s = &self.settings;
