@@ -158,13 +158,10 @@ impl Owned {
         rs.totals.bodies_sent += (mine.len() / per) as u64;
         let (_, all) = rs.all_gather_any(&mine);
         let mut active = D::active(w).map(<[u32]>::to_vec).unwrap_or_default();
-        let entering: Vec<(u32, &[f64])> = all
-            .chunks_exact(per)
-            .filter(|x| x[0] as u32 == me)
-            .map(|x| (x[1] as u32, &x[2..2 + D::BODY_RECORD]))
-            .collect();
+        let to_me: Vec<&[f64]> = all.chunks_exact(per).filter(|x| x[0] as u32 == me).collect();
+        let entering: Vec<(u32, &[f64])> = to_me.iter().map(|x| (x[1] as u32, &x[2..2 + D::BODY_RECORD])).collect();
         D::admit(w, &entering);
-        for x in all.chunks_exact(per).filter(|x| x[0] as u32 == me) {
+        for x in to_me {
             let g = x[1] as usize;
             v_free[g] = D::set_step_record(w, g, &x[2..]);
             active.push(g as u32);

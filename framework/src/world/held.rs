@@ -56,19 +56,42 @@ fn column<T: Clone>(old: &[T], entering: &[T], src: &[Src]) -> Vec<T> {
         .collect()
 }
 
+/// Coordinates of an orientation (the angle in 2D, the quaternion in 3D) and of an
+/// inertia (I in 2D, the principal moments in 3D) in a record.
+const fn rot_len<D: Dim>() -> usize {
+    if D::N == 2 {
+        1
+    } else {
+        4
+    }
+}
+const fn inertia_len<D: Dim>() -> usize {
+    if D::N == 2 {
+        1
+    } else {
+        3
+    }
+}
+
 impl<D: Dim> World<D> {
     /// Numbers of a body's record: its moving state (position, orientation
     /// coordinates, velocity), then its static data ([`World::body_record`]).
-    pub const MOVING_RECORD: usize = D::N + if D::N == 2 { 1 } else { 4 } + D::DOF;
-    pub const BODY_RECORD: usize = Self::MOVING_RECORD + 6 + if D::N == 2 { 1 } else { 3 } + D::INV_MASS_LEN;
+    pub const MOVING_RECORD: usize = D::N + rot_len::<D>() + D::DOF;
+    pub const BODY_RECORD: usize = Self::MOVING_RECORD + 6 + inertia_len::<D>() + D::INV_MASS_LEN;
 
-    /// Body `k`'s (a slot) record: position, orientation, velocity, then mass,
-    /// inertia, M̂⁻¹, free degrees of freedom, volume, shape kind and index, material.
-    pub fn body_record(&self, k: usize, out: &mut Vec<f64>) {
+    /// Body `k`'s moving state: position, orientation, velocity.
+    fn moving_record(&self, k: usize, out: &mut Vec<f64>) {
         let b = &self.bodies;
         out.extend_from_slice(b.pos[k].as_ref());
         out.extend_from_slice(b.rot[k].coords());
         out.extend_from_slice(b.vel[k].as_ref());
+    }
+
+    /// Body `k`'s (a slot) record: position, orientation, velocity, then mass,
+    /// inertia, M̂⁻¹, free degrees of freedom, volume, shape kind and index, material.
+    pub fn body_record(&self, k: usize, out: &mut Vec<f64>) {
+        self.moving_record(k, out);
+        let b = &self.bodies;
         out.push(b.mass[k]);
         out.extend_from_slice(b.inertia[k].coords());
         D::inv_mass_coords(&b.inv_mass[k], out);
@@ -86,22 +109,15 @@ impl<D: Dim> World<D> {
     /// then its shape kind and index and its material.
     pub const OUTPUT_RECORD: usize = Self::MOVING_RECORD + 3;
     pub fn output_record(&self, k: usize, out: &mut Vec<f64>) {
-        let b = &self.bodies;
-        out.extend_from_slice(b.pos[k].as_ref());
-        out.extend_from_slice(b.rot[k].coords());
-        out.extend_from_slice(b.vel[k].as_ref());
-        let s = b.shape[k];
+        self.moving_record(k, out);
+        let (b, s) = (&self.bodies, self.bodies.shape[k]);
         out.extend([f64::from(s.kind), f64::from(s.index), f64::from(b.material[k])]);
     }
 
     /// Sets body `k`'s moving state from the start of a record.
     pub fn set_moving(&mut self, k: usize, x: &[f64]) {
         let b = &mut self.bodies;
-        let (p, rest) = x.split_at(D::N);
-        b.pos[k].as_mut().copy_from_slice(p);
-        let nr = b.rot[k].coords().len();
-        b.rot[k].coords_mut().copy_from_slice(&rest[..nr]);
-        b.vel[k].as_mut().copy_from_slice(&rest[nr..nr + D::DOF]);
+        (b.pos[k], b.rot[k], b.vel[k]) = read_moving::<D>(x);
     }
 
     /// The values [`WholeScene`] holds, over the bodies held now (`per_body`: its
@@ -276,7 +292,7 @@ pub struct Record<D: Dim> {
 
 /// A body's moving state (position, orientation, velocity) at the start of a record.
 pub fn read_moving<D: Dim>(x: &[f64]) -> (D::Point, D::Rot, D::Twist) {
-    let nr = if D::N == 2 { 1 } else { 4 };
+    let nr = rot_len::<D>();
     let (mut pos, mut rot, mut vel) = (D::Point::zero(), D::rot_identity(), D::Twist::zero());
     pos.as_mut().copy_from_slice(&x[..D::N]);
     rot.coords_mut().copy_from_slice(&x[D::N..D::N + nr]);
@@ -297,7 +313,7 @@ pub fn read_output<D: Dim>(x: &[f64]) -> ((D::Point, D::Rot, D::Twist), ShapeRef
 impl<D: Dim> Record<D> {
     /// The record `x` ([`World::BODY_RECORD`] numbers).
     pub fn read(x: &[f64]) -> Self {
-        let ni = if D::N == 2 { 1 } else { 3 };
+        let ni = inertia_len::<D>();
         let (pos, rot, vel) = read_moving::<D>(x);
         let mut inertia = D::Inertia::default();
         // the static data: mass, inertia, M̂⁻¹, then the rest
