@@ -182,7 +182,14 @@ pub fn inv_mass(m: f64, inertia: &[f64; 3], q: &[f64; 4], f: u8) -> InvMass3 {
             nfree += 1;
         }
     }
-    let iw = world_inertia(q, inertia);
+    // an isotropic body's world inertia is its own at any orientation: taken exactly
+    // (rotated, it would carry the orientation's rounding, and a restart, which
+    // recomputes M̂⁻¹ at the saved orientation, would not continue bitwise)
+    let iw = if inertia[0] == inertia[1] && inertia[1] == inertia[2] {
+        [inertia[0], 0.0, 0.0, inertia[0], 0.0, inertia[0]]
+    } else {
+        world_inertia(q, inertia)
+    };
     // entry (a, c) of the symmetric tensor stored as [xx, xy, xz, yy, yz, zz]
     const IDX: [[usize; 3]; 3] = [[0, 1, 2], [1, 3, 4], [2, 4, 5]];
     let full = |a: usize, c: usize| iw[IDX[a][c]];
@@ -432,5 +439,22 @@ impl Dim for D3 {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// An isotropic body's M̂⁻¹ is the same, bit for bit, at any orientation (a
+    /// restart recomputes it at the saved one; the run kept the first), and an
+    /// anisotropic body's turns with it.
+    #[test]
+    fn an_isotropic_bodys_inverse_mass_does_not_depend_on_its_orientation() {
+        let (h, c, s) = (0.5f64, 0.3f64.cos(), 0.3f64.sin());
+        let turned = [c, s * h.sqrt(), 0.0, s * (1.0 - h).sqrt()];
+        let at = |i: [f64; 3], q: [f64; 4]| super::inv_mass(2.0, &i, &q, 0b111111);
+        let ball = [0.7; 3];
+        assert_eq!(at(ball, [1.0, 0.0, 0.0, 0.0]), at(ball, turned));
+        let brick = [0.7, 0.4, 0.2];
+        assert_ne!(at(brick, [1.0, 0.0, 0.0, 0.0]), at(brick, turned));
     }
 }
