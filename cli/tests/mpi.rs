@@ -8,64 +8,10 @@
 #![cfg(feature = "mpi")]
 
 use std::path::Path;
-use std::process::Output;
 use std::time::{Duration, Instant};
 
 mod mpi_common;
 use mpi_common::*;
-
-fn ok(o: &Output, what: &str) {
-    assert!(
-        o.status.success(),
-        "{what} failed ({:?}):\n{}\n{}",
-        o.status.code(),
-        text(&o.stdout),
-        text(&o.stderr)
-    );
-}
-
-/// A 5 × 5 × 3 lattice of spheres, jostled by a tilted gravity, settling on a floor
-/// plane between box walls.
-const PILE3D: &str = r#"
-dimension = 3
-gravity = [1.0, 0.5, -9.81]
-[time]
-step = 1e-3
-steps = 10
-[solver]
-tolerance = 1e-4
-norm = "QM/16"
-max_sweeps = 3000
-check_every = 5
-[output]
-every = 5
-[[materials]]
-name = "m"
-density = 2500.0
-[[laws]]
-materials = ["m", "m"]
-friction = 0.4
-[[bodies]]
-name = "floor"
-shape = "plane"
-material = "m"
-position = [0.0, 0.0, 0.0]
-fixed = true
-[[bodies]]
-shape = "box"
-material = "m"
-position = [0.101, 0.05, 0.05]
-half_extents = [0.001, 0.1, 0.1]
-fixed = true
-[[generate]]
-kind = "sphere_lattice"
-material = "m"
-nx = 5
-ny = 5
-nz = 3
-radius = 0.01
-origin = [0.01, 0.01, 0.01]
-"#;
 
 /// A running-bond wall of 4 courses × 4 bricks bonded by mortar joints on a fixed
 /// slab, under a tilted gravity.
@@ -278,54 +224,6 @@ fn threads_inside_ranks_give_the_one_process_result() {
         "2 ranks × 2 threads: final.json differs from one process"
     );
     let _ = std::fs::remove_dir_all(&dir);
-}
-
-/// A state written by 2 ranks continues on 4 ranks and in one process, and a state
-/// written by 4 ranks on 2: bitwise the uninterrupted one-process run (F_Γ of
-/// every rank's subdomains is gathered into the state).
-#[test]
-fn a_state_written_by_p_ranks_restarts_on_other_rank_counts() {
-    let dir = scratch("restart_ranks");
-    let whole = write(&dir, "pile.toml", PILE2D);
-    let half = write(&dir, "half.toml", &PILE2D.replace("steps = 15", "steps = 8"));
-    let flags = ["--subdomains", "2x2", "--scheme", "decentralized"];
-    let one = dir.join("one");
-    ok(
-        &nscdd(&args(&whole, &one, &[&flags[..], &["--threads", "2"]].concat())),
-        "the uninterrupted run",
-    );
-    let reference = final_json(&one);
-    restarts_match(&dir, &whole, &half, &reference, &flags, "");
-    // contacts held per rank (re-partitioned every 3 steps: the state is written
-    // between two repartitions)
-    let whole = write(&dir, "held.toml", &every(PILE2D, 3));
-    let half = write(&dir, "held_half.toml", &every(&PILE2D.replace("steps = 15", "steps = 8"), 3));
-    let one = dir.join("held-one");
-    ok(
-        &nscdd(&args(&whole, &one, &[&flags[..], &["--threads", "2"]].concat())),
-        "held, uninterrupted",
-    );
-    restarts_match(&dir, &whole, &half, &final_json(&one), &flags, "held-");
-    let _ = std::fs::remove_dir_all(&dir);
-}
-
-/// `half` on P ranks, then `whole` restarted from its state on P′: the reference's
-/// final.json.
-fn restarts_match(dir: &Path, whole: &Path, half: &Path, reference: &str, flags: &[&str], tag: &str) {
-    for (first, then) in [(2, 4), (2, 1), (4, 2)] {
-        let a = dir.join(format!("{tag}first{first}-{then}"));
-        ok(&mpirun(&[(first, args(half, &a, flags))]), &format!("8 steps on {first} ranks"));
-        assert!(final_json(&a).contains("\"f_gamma\""), "the NSCDD state on {first} ranks");
-        let b = dir.join(format!("{tag}then{first}-{then}"));
-        let state = a.join("final.json");
-        let rest = args(whole, &b, &[flags, &["--restart", state.to_str().unwrap()]].concat());
-        let o = if then == 1 { nscdd(&rest) } else { mpirun(&[(then, rest)]) };
-        ok(&o, &format!("the restart on {then} rank(s)"));
-        assert!(
-            final_json(&b) == reference,
-            "{tag}{first} ranks then {then}: final.json differs from the uninterrupted run"
-        );
-    }
 }
 
 fn per_rank(out: &Path) -> Vec<serde_json::Value> {

@@ -230,3 +230,57 @@ pub fn nscdd(args: &[String]) -> Output {
     c.args(args);
     run_limited(c)
 }
+
+/// A 5 × 5 × 3 lattice of spheres, jostled by a tilted gravity, settling on a floor
+/// plane between box walls.
+pub const PILE3D: &str = r#"
+dimension = 3
+gravity = [1.0, 0.5, -9.81]
+[time]
+step = 1e-3
+steps = 10
+[solver]
+tolerance = 1e-4
+norm = "QM/16"
+max_sweeps = 3000
+check_every = 5
+[output]
+every = 5
+[[materials]]
+name = "m"
+density = 2500.0
+[[laws]]
+materials = ["m", "m"]
+friction = 0.4
+[[bodies]]
+name = "floor"
+shape = "plane"
+material = "m"
+position = [0.0, 0.0, 0.0]
+fixed = true
+[[bodies]]
+shape = "box"
+material = "m"
+position = [0.101, 0.05, 0.05]
+half_extents = [0.001, 0.1, 0.1]
+fixed = true
+[[generate]]
+kind = "sphere_lattice"
+material = "m"
+nx = 5
+ny = 5
+nz = 3
+radius = 0.01
+origin = [0.01, 0.01, 0.01]
+"#;
+
+/// Asserts that a run succeeded, printing its outputs otherwise.
+pub fn ok(o: &Output, what: &str) {
+    assert!(
+        o.status.success(),
+        "{what} failed ({:?}):\n{}\n{}",
+        o.status.code(),
+        text(&o.stdout),
+        text(&o.stderr)
+    );
+}

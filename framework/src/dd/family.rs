@@ -115,6 +115,8 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     fn set_region(w: &mut Self::World, region: Option<crate::detect::Region>);
     fn alert(w: &Self::World) -> f64;
     fn retain_raw(w: &mut Self::World, keep: &mut dyn FnMut(ContactKey, [f64; 3]) -> bool);
+    /// Keeps the world's contacts `a` (the last step's) for which `keep(a)` holds.
+    fn retain_contacts(w: &mut Self::World, keep: &mut dyn FnMut(usize) -> bool);
     fn body_boxes(w: &Self::World, out: &mut Vec<[[f64; 3]; 2]>);
     /// Bodies owned per rank ([`super::owned`]): the bodies this process steps
     /// (ascending; `None`: every body it holds), whether a body is stepped by
@@ -353,6 +355,9 @@ impl<D: Dim> Family for Rigid<D> {
     }
     fn alert(w: &Self::World) -> f64 {
         w.alert
+    }
+    fn retain_contacts(w: &mut Self::World, keep: &mut dyn FnMut(usize) -> bool) {
+        w.contacts.retain(keep);
     }
     fn retain_raw(w: &mut Self::World, keep: &mut dyn FnMut(ContactKey, [f64; 3]) -> bool) {
         let ids = &w.ids;

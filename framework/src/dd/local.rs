@@ -21,8 +21,9 @@
 //! point to point) and detects again in the new regions
 //! ([`super::NscddOf::repartition_local`]). The first step of a fresh run is such
 //! a repartition, its old regions a provisional grid over the bodies' centres
-//! ([`super::NscddOf::start_held`]); only the first step after a restart runs on
-//! the whole sample. Every decision above is the one a
+//! ([`super::NscddOf::start_held`]); the first step after a restart starts from
+//! the saved grid and kept subdomains, each rank keeping the loaded contacts of
+//! its own subdomains. Every decision above is the one a
 //! single process takes with all the contacts, so results stay bitwise those of one
 //! process.
 
@@ -47,6 +48,10 @@ pub(super) struct Local {
     pub body_sub: Vec<i32>,
     /// The step in progress needs no `body_sub` (no output frame after it).
     pub skip_view: bool,
+    /// The F_Γ store is a restart's, whole (every rank loaded it): the first
+    /// repartition after it keeps it instead of routing the last step's
+    /// ([`super::NscddOf::start_held`]).
+    pub whole_store: bool,
     /// A distributed repartition's grid and number of contacts, for the partition.
     pub new_grid: Option<(Grid, usize)>,
     /// The step in progress holds the other ranks' subdomains as limited shells
@@ -198,20 +203,30 @@ pub(super) fn region<D: Family>(rs: &RankState, grid: &Grid, kept: &[(ContactKey
 }
 
 impl<D: Family> super::NscddOf<D> {
-    /// Before the first step of a fresh run on ranks (rigid bodies, contacts held
-    /// per rank): a provisional grid over the movable bodies' centres, its cells'
-    /// ranks balanced by their bodies (the same on every rank: every rank holds the
-    /// whole scene), and each world reduced to its rank's part ([`super::owned`]).
-    /// The first step re-partitions over its contacts as every repartition with
-    /// contacts held per rank does ([`Self::repartition_local`]): the same grid and
-    /// ranks as one process, which never needs every body and contact on a rank.
-    pub(super) fn start_held(&mut self, w: &mut D::World, eligible: bool) {
-        let Some(rs) = self.ranks.as_mut() else { return };
-        // (a fresh run: a restart, whatever its state, runs its first step whole)
-        let fresh = self.grid.is_none() && self.steps == 0 && D::step(w) == 0;
-        if !(eligible && self.local_contacts && fresh) || D::active(w).is_some() {
+    /// Before a step on ranks (rigid bodies, contacts held per rank) while every
+    /// world holds every body: each world reduced to its rank's part
+    /// ([`super::owned`]), on a fresh run's first step ([`Self::start_fresh`]) and,
+    /// with `restart`, on the first step after a restart
+    /// ([`Self::start_restarted`]). Nothing otherwise.
+    pub(super) fn start_held(&mut self, w: &mut D::World, eligible: bool, restart: bool) {
+        if self.ranks.is_none() || !(eligible && self.local_contacts) || D::active(w).is_some() {
             return;
         }
+        if self.grid.is_none() && self.steps == 0 && D::step(w) == 0 {
+            self.start_fresh(w);
+        } else if restart {
+            self.start_restarted(w);
+        }
+    }
+
+    /// A fresh run's first step: a provisional grid over the movable bodies'
+    /// centres, its cells' ranks balanced by their bodies (the same on every rank:
+    /// every rank holds the whole scene). The first step re-partitions over its
+    /// contacts as every repartition with contacts held per rank does
+    /// ([`Self::repartition_local`]): the same grid and ranks as one process, which
+    /// never needs every body and contact on a rank.
+    fn start_fresh(&mut self, w: &mut D::World) {
+        let Some(rs) = self.ranks.as_mut() else { return };
         let s = &self.settings;
         let movable: Vec<usize> = (0..D::n_bodies(w)).filter(|&g| D::movable(w, g)).collect();
         let (lo, hi) = Grid::bounds(movable.iter().map(|&g| D::position(w, g)));
@@ -226,6 +241,39 @@ impl<D: Family> super::NscddOf<D> {
         rs.rank_of = super::rank_balance::balanced_ranks(&loads, rs.cluster.size());
         self.local.owned.start_held::<D>(w, rs, &grid);
         self.grid = Some(grid);
+    }
+
+    /// The first step after a restart (the saved grid, no ranks yet; every rank
+    /// loaded every body and the last step's contacts): the cells' ranks balanced
+    /// by their kept contacts (the same on every rank; results do not depend on
+    /// which rank sweeps a subdomain), then each rank keeps the last step's
+    /// contacts whose kept subdomain is its own, as if it had stepped them, and its
+    /// halo. The loaded F_Γ store stays whole (a superset of what a rank's store
+    /// holds) until the next repartition routes it ([`super::shells`]).
+    fn start_restarted(&mut self, w: &mut D::World) {
+        let (Some(rs), Some(grid)) = (self.ranks.as_mut(), self.grid.as_ref()) else {
+            return;
+        };
+        if rs.rank_of.len() == grid.len() || self.grid_empty || self.local.held {
+            return;
+        }
+        let mut loads = vec![0usize; grid.len()];
+        for &(_, o) in &self.kept {
+            if let Some(l) = loads.get_mut(o as usize) {
+                *l += 1;
+            }
+        }
+        rs.rank_of = super::rank_balance::balanced_ranks(&loads, rs.cluster.size());
+        let me = rs.cluster.rank();
+        let rank_of = &rs.rank_of;
+        let own = |o: u32| rank_of.get(o as usize) == Some(&me);
+        let owner = super::owner::kept_owners::<D>(D::contacts(w), grid, &self.kept);
+        D::retain_contacts(w, &mut |a| own(owner[a]));
+        self.last.owner = owner.into_iter().filter(|&o| own(o)).collect();
+        self.kept.retain(|e| own(e.1));
+        self.local.held = true;
+        self.local.whole_store = true;
+        self.local.owned.start_held::<D>(w, rs, grid);
     }
 
     /// Whether this step re-partitions over a new grid.
@@ -247,8 +295,8 @@ impl<D: Family> super::NscddOf<D> {
             self.local.now = false;
             return;
         };
-        // (after a restart the ranks of the subdomains are not known before the first
-        // partition: that step runs on the whole sample)
+        // (ranks of the subdomains not known: a scene with body families, or a
+        // restart that could not start per rank; that step runs on the whole sample)
         if !(eligible && self.local_contacts) || rs.rank_of.len() != grid.len() {
             self.local.now = false;
             rs.local = false;
@@ -379,6 +427,7 @@ impl<D: Family> super::NscddOf<D> {
     /// After the step: whether the world now holds this rank's contacts only.
     pub(super) fn after_step(&mut self) {
         self.local.held = self.local.now;
+        self.local.whole_store = false;
     }
 
     /// With bodies stepped per rank: which bodies this rank holds and owns (the

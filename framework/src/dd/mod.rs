@@ -247,6 +247,15 @@ impl<D: Family> NscddOf<D> {
         self.local.skip_view = skip;
     }
 
+    /// Before a run's first frame: on ranks, each world reduced to its rank's part
+    /// when the first step will run per rank ([`Self::start_held`], which the first
+    /// step calls otherwise), so that the first frame too is written in pieces by
+    /// the bodies' owners instead of whole by rank 0. `families`: whether body
+    /// families are attached (their scenes step every body on every rank).
+    pub fn start_ranks(&mut self, w: &mut D::World, families: bool) {
+        self.start_held(w, !families && !self.by_model, false);
+    }
+
     /// Re-partitions every `k` steps (see [`Nscdd::repartition_every`]).
     pub fn with_repartition_every(mut self, k: u32) -> Self {
         self.repartition_every = k;
@@ -346,7 +355,7 @@ impl<D: Family> NscddOf<D> {
     /// parts and receives the others' packed results, [`LocalPart::pack`]).
     pub fn step_families(&mut self, w: &mut D::World, fams: &mut [&mut dyn Attached<D>]) -> Result<DdStepReport, Diverged> {
         self.pending = DdStepReport::default();
-        self.start_held(w, fams.is_empty() && !self.by_model);
+        self.start_held(w, fams.is_empty() && !self.by_model, true);
         let base = D::step_with(w, &mut Stage { dd: self, fams });
         self.after_step();
         let base = base?;

@@ -22,8 +22,8 @@
 //! ([`super::NscddOf::repartition_local`]) sends, in the step, the bodies of each
 //! rank's new halo it lacks (their state at the start of the step, V⁻ and V_free);
 //! the first step of a fresh run starts from a provisional grid over the bodies'
-//! centres ([`Owned::start_held`]); only the first step after a restart runs with
-//! every body.
+//! centres ([`Owned::start_held`]), the first step after a restart from the saved
+//! grid (every rank loaded every body, then keeps its part).
 //!
 //! The outputs never read a body its rank does not hold: the sums over bodies are
 //! added per cell by the cells' ranks ([`super::census::BodySums`]), the named and

@@ -260,7 +260,8 @@ impl<D: Family> super::NscddOf<D> {
         let c = D::contacts(w);
         let asked = rs.announce::<D>(&near, (0..D::len(c)).flat_map(|a| D::contact_bodies(w, a)));
         let near = Near { asked: &asked, ..near };
-        let before = repart.then(|| {
+        // (a restart's whole store needs no routing: [`super::local`])
+        let before = (repart && !self.local.whole_store).then(|| {
             let (store, before) = rs.route_repartition(&self.last, &self.store, &near);
             self.store = store;
             before

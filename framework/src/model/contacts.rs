@@ -108,6 +108,16 @@ impl<D: Dim> Contacts<D> {
         }
     }
 
+    /// Keeps the contacts `a` for which `keep(a)` holds, in their order.
+    pub fn retain(&mut self, mut keep: impl FnMut(usize) -> bool) {
+        let mut out = Contacts::default();
+        for a in (0..self.len()).filter(|&a| keep(a)) {
+            let [i, j] = self.bodies[a];
+            out.push_from(self, a, i, j);
+        }
+        *self = out;
+    }
+
     /// Whether some contact is a bonded joint (the sweep then takes the joint path).
     pub fn any_bonded(&self) -> bool {
         self.joint.iter().any(|j| j.bonded())

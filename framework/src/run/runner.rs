@@ -108,6 +108,9 @@ impl<D: Dim> Runner<D> {
             sum: RunSummary::default(),
             start,
         };
+        if let Some(n) = r.dd.as_mut() {
+            n.start_ranks(&mut scene.world, !scene.families.is_empty());
+        }
         r.write_frame(scene).map_err(io(here, "the first output frame"))?;
         Ok(r)
     }

@@ -1,0 +1,116 @@
+//! Restarts on MPI ranks (cargo feature `mpi`, issue 20): a state written by P
+//! ranks continues on P′ ranks, and in one process, bitwise as the uninterrupted
+//! one-process run, in 2D and 3D, written between two repartitions or just before
+//! one; the first step after a restart, like every other, runs with each rank's
+//! part of the bodies and contacts (contacts held per rank).
+#![cfg(feature = "mpi")]
+
+use std::path::Path;
+
+mod mpi_common;
+use mpi_common::*;
+
+/// A state written by 2 ranks continues on 4 ranks and in one process, and a state
+/// written by 4 ranks on 2: bitwise the uninterrupted one-process run (F_Γ of
+/// every rank's subdomains is gathered into the state).
+#[test]
+fn a_state_written_by_p_ranks_restarts_on_other_rank_counts() {
+    let dir = scratch("restart_ranks");
+    let whole = write(&dir, "pile.toml", PILE2D);
+    let half = write(&dir, "half.toml", &PILE2D.replace("steps = 15", "steps = 8"));
+    let flags = ["--subdomains", "2x2", "--scheme", "decentralized"];
+    let one = dir.join("one");
+    ok(
+        &nscdd(&args(&whole, &one, &[&flags[..], &["--threads", "2"]].concat())),
+        "the uninterrupted run",
+    );
+    let reference = final_json(&one);
+    restarts_match(&dir, &whole, &half, &reference, &flags, "");
+    // contacts held per rank (re-partitioned every 3 steps: the state is written
+    // between two repartitions)
+    let whole = write(&dir, "held.toml", &every(PILE2D, 3));
+    let half = write(&dir, "held_half.toml", &every(&PILE2D.replace("steps = 15", "steps = 8"), 3));
+    let one = dir.join("held-one");
+    ok(
+        &nscdd(&args(&whole, &one, &[&flags[..], &["--threads", "2"]].concat())),
+        "held, uninterrupted",
+    );
+    restarts_match(&dir, &whole, &half, &final_json(&one), &flags, "held-");
+    // re-partitioned every 4 steps: the state is written just before a repartition
+    let whole = write(&dir, "rep.toml", &every(PILE2D, 4));
+    let half = write(&dir, "rep_half.toml", &every(&PILE2D.replace("steps = 15", "steps = 8"), 4));
+    let one = dir.join("rep-one");
+    ok(
+        &nscdd(&args(&whole, &one, &[&flags[..], &["--threads", "2"]].concat())),
+        "re-partitioned, uninterrupted",
+    );
+    restarts_match(&dir, &whole, &half, &final_json(&one), &flags, "rep-");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `half` on P ranks, then `whole` restarted from its state on P′: the reference's
+/// final.json; with contacts held per rank (`[decomposition] repartition_every`)
+/// each rank of the restarted run held fewer bodies than all at every step, the
+/// first one included.
+fn restarts_match(dir: &Path, whole: &Path, half: &Path, reference: &str, flags: &[&str], tag: &str) {
+    for (first, then) in [(2, 4), (2, 1), (4, 2)] {
+        let a = dir.join(format!("{tag}first{first}-{then}"));
+        ok(&mpirun(&[(first, args(half, &a, flags))]), &format!("8 steps on {first} ranks"));
+        assert!(final_json(&a).contains("\"f_gamma\""), "the NSCDD state on {first} ranks");
+        let b = dir.join(format!("{tag}then{first}-{then}"));
+        let state = a.join("final.json");
+        let rest = args(whole, &b, &[flags, &["--restart", state.to_str().unwrap()]].concat());
+        let o = if then == 1 { nscdd(&rest) } else { mpirun(&[(then, rest)]) };
+        ok(&o, &format!("the restart on {then} rank(s)"));
+        assert!(
+            final_json(&b) == reference,
+            "{tag}{first} ranks then {then}: final.json differs from the uninterrupted run"
+        );
+        if then > 1 && std::fs::read_to_string(whole).unwrap().contains("repartition_every") {
+            held_less_than_all(&b);
+        }
+    }
+}
+
+/// A 3D pile (spheres rolling under a tilted gravity: rotations, friction) written
+/// by 2 ranks just before a repartition and between two, restarted on 4, 1 and 2
+/// ranks: bitwise the uninterrupted run (an isotropic body's M̂⁻¹, recomputed at the
+/// saved orientation, is its own at any orientation).
+#[test]
+fn a_3d_state_restarts_on_other_rank_counts() {
+    let dir = scratch("restart_ranks3");
+    let flags = ["--subdomains", "2x2x1", "--scheme", "decentralized"];
+    let whole = write(&dir, "pile3d.toml", &every(&PILE3D.replace("steps = 10", "steps = 16"), 5));
+    let one = dir.join("one");
+    ok(
+        &nscdd(&args(&whole, &one, &[&flags[..], &["--threads", "2"]].concat())),
+        "the uninterrupted run",
+    );
+    let reference = final_json(&one);
+    for (at, tag) in [(10, "rep-"), (12, "mid-")] {
+        let half = write(
+            &dir,
+            &format!("half{at}.toml"),
+            &every(&PILE3D.replace("steps = 10", &format!("steps = {at}")), 5),
+        );
+        restarts_match(&dir, &whole, &half, &reference, &flags, tag);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Each rank of the run in `out` held fewer bodies than all at every step.
+fn held_less_than_all(out: &Path) {
+    let fin: serde_json::Value = serde_json::from_str(&final_json(out)).expect("final.json");
+    let nb = fin["bodies"].as_array().expect("bodies").len() as u64;
+    let ranks: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("ranks.json")).expect("ranks.json")).expect("json");
+    for r in ranks["per_rank"].as_array().expect("ranks") {
+        let (steps, held) = (r["steps"].as_u64().expect("steps"), r["bodies_held"].as_u64().expect("held"));
+        assert!(
+            held < steps * nb,
+            "{}: rank {}: {held} bodies held in {steps} steps of {nb}",
+            out.display(),
+            r["rank"]
+        );
+    }
+}
