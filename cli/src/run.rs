@@ -34,7 +34,8 @@ pub fn run<D: Dim>(mut s: Scene<D>, reg: &Registry, scene: &Path, out: &Path, qu
     });
     let digest = flags.map(|()| {
         let w = &s.world;
-        crate::ranks::digest(scene, &nscdd::output::final_json(w), (&s.decomposition, &w.time, &w.solver))
+        let state = |out: &mut dyn std::io::Write| nscdd::output::write_final_json(out, w, None, None::<&()>, (None, None));
+        crate::ranks::digest(scene, state, (&s.decomposition, &w.time, &w.solver))
     });
     if let Err(code) = ranks.agree(digest, out) {
         return code;

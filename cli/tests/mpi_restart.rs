@@ -70,6 +70,15 @@ fn restarts_match(dir: &Path, whole: &Path, half: &Path, reference: &str, flags:
             held_less_than_all(&b);
         }
     }
+    // the restarted runs' frames, the one at the restart included, in pieces that
+    // hold each body and contact once
+    let one = dir.join(format!("{tag}then2-1"));
+    let frames = (0..)
+        .take_while(|f| one.join("vtk").join(format!("bodies_{f:06}.vtp")).exists())
+        .count() as u32;
+    assert!(frames >= 2, "{tag}: {frames} frames");
+    pieces_add_up_in(&one, &dir.join(format!("{tag}then2-4")), frames, 4);
+    pieces_add_up_in(&one, &dir.join(format!("{tag}then4-2")), frames, 2);
 }
 
 /// A 3D pile (spheres rolling under a tilted gravity: rotations, friction) written

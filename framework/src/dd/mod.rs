@@ -249,11 +249,12 @@ impl<D: Family> NscddOf<D> {
 
     /// Before a run's first frame: on ranks, each world reduced to its rank's part
     /// when the first step will run per rank ([`Self::start_held`], which the first
-    /// step calls otherwise), so that the first frame too is written in pieces by
-    /// the bodies' owners instead of whole by rank 0. `families`: whether body
-    /// families are attached (their scenes step every body on every rank).
+    /// step calls otherwise), a fresh run's or a restart's, so that the first frame
+    /// too is written in pieces by the bodies' owners instead of whole by rank 0.
+    /// `families`: whether body families are attached (their scenes step every
+    /// body on every rank).
     pub fn start_ranks(&mut self, w: &mut D::World, families: bool) {
-        self.start_held(w, !families && !self.by_model, false);
+        self.start_held(w, !families && !self.by_model, true);
     }
 
     /// Re-partitions every `k` steps (see [`Nscdd::repartition_every`]).

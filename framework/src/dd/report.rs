@@ -143,6 +143,11 @@ impl<D: super::Family> super::NscddOf<D> {
             return v;
         }
         v.contact_subdomain.clone_from(&d.owner);
+        if self.local.whole_store {
+            // a restart before its first step (contacts per rank, no step's counts
+            // over the ranks yet): each body by its owner, as before any contact
+            return v;
+        }
         if self.local.held && self.local.body_sub.len() == nb {
             // contacts held per rank: the counts over every rank's
             v.body_subdomain.clone_from(&self.local.body_sub);

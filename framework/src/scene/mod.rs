@@ -12,6 +12,7 @@ mod checks;
 mod load;
 pub mod locate;
 pub mod restart;
+mod restart_stream;
 pub mod schema;
 
 use crate::dim::{Dim, D2, D3};

@@ -1,0 +1,252 @@
+//! A saved state read as a stream ([`super::restart`]): one pass over the file, each
+//! body written into the world as it is read and each contact into the world's
+//! contact list, so that neither the file's text nor a list of its bodies is ever
+//! held whole (a 55 000-sphere state is a 60 MB file, and every MPI rank reads it).
+//! A check that fails names its key; its line is looked up in the text only then.
+
+use super::restart::{SavedBody, SavedContact};
+use crate::dim::joint::Joint;
+use crate::dim::{Dim, Vector};
+use crate::model::{ContactKey, Contacts};
+use crate::world::World;
+use serde::de::{DeserializeSeed, IgnoredAny, MapAccess, SeqAccess, Visitor};
+use std::fmt;
+
+/// A check that failed while reading: its key, its message, and the k-th
+/// occurrence of which key holds its line.
+pub(super) struct Failed {
+    pub key: String,
+    pub message: String,
+    pub at: Option<(&'static str, usize)>,
+}
+
+/// What a saved state holds besides the bodies (written into the world as read).
+pub(super) struct Streamed<D: Dim> {
+    pub step: Option<u64>,
+    pub time: Option<f64>,
+    pub box_h0: Option<f64>,
+    /// The number of saved bodies (those past the scene's are skipped).
+    pub bodies: Option<usize>,
+    /// The contacts (their frames set by [`Streamed::frames`]) and their normals.
+    pub contacts: Option<(Contacts<D>, Vec<D::Point>)>,
+    pub nscdd: Option<crate::dd::NscddState>,
+    pub families: Option<serde_json::Map<String, serde_json::Value>>,
+}
+
+impl<D: Dim> Streamed<D> {
+    /// The contacts' frames at the bodies' saved positions.
+    pub fn frames(c: &mut Contacts<D>, normals: &[D::Point], pos: &[D::Point]) {
+        for (a, n) in normals.iter().enumerate() {
+            let [i, j] = c.bodies[a];
+            c.frame[a] = D::frame(&c.point[a], n, &pos[i as usize], &pos[j as usize]);
+        }
+    }
+}
+
+/// Reads a saved state (a JSON object) into `w` and the returned parts; `parts`:
+/// whether to read `nscdd` and `families` (else skipped). A failed check is left
+/// in `failed` (the error returned is then a placeholder), and the dimension read
+/// in `dimension` (an error of a state without it may be a 2D state's).
+pub(super) struct StateSeed<'a, D: Dim> {
+    pub w: &'a mut World<D>,
+    pub parts: bool,
+    pub failed: &'a mut Option<Failed>,
+    pub dimension: &'a mut Option<u64>,
+}
+
+impl<'de, D: Dim> DeserializeSeed<'de> for StateSeed<'_, D> {
+    type Value = Streamed<D>;
+    fn deserialize<De: serde::Deserializer<'de>>(self, de: De) -> Result<Streamed<D>, De::Error> {
+        de.deserialize_map(self)
+    }
+}
+
+impl<'de, D: Dim> Visitor<'de> for StateSeed<'_, D> {
+    type Value = Streamed<D>;
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("a saved state (a JSON object)")
+    }
+    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Streamed<D>, A::Error> {
+        let mut s = Streamed {
+            step: None,
+            time: None,
+            box_h0: None,
+            bodies: None,
+            contacts: None,
+            nscdd: None,
+            families: None,
+        };
+        while let Some(key) = map.next_key::<String>()? {
+            match key.as_str() {
+                "dimension" => {
+                    let d: u64 = map.next_value()?;
+                    if d != D::N as u64 {
+                        let message = format!("the state is {d}D, the scene {}", D::NAME);
+                        return Err(fail(self.failed, "dimension", message, ("dimension", 0)));
+                    }
+                    *self.dimension = Some(d);
+                }
+                "step" => s.step = Some(map.next_value()?),
+                "time" => s.time = Some(map.next_value()?),
+                "box_h0" => s.box_h0 = map.next_value()?,
+                "bodies" => {
+                    let seed = BodiesSeed {
+                        w: &mut *self.w,
+                        failed: &mut *self.failed,
+                    };
+                    s.bodies = Some(map.next_value_seed(seed)?);
+                }
+                "contacts" => {
+                    let nb = self.w.bodies.len();
+                    s.contacts = Some(map.next_value_seed(ContactsSeed::<D> {
+                        nb,
+                        failed: &mut *self.failed,
+                        dim: std::marker::PhantomData,
+                    })?);
+                }
+                "nscdd" if self.parts => s.nscdd = map.next_value()?,
+                "families" if self.parts => s.families = map.next_value()?,
+                _ => {
+                    map.next_value::<IgnoredAny>()?;
+                }
+            }
+        }
+        Ok(s)
+    }
+}
+
+/// Records a failed check and returns the error that stops the reading.
+fn fail<E: serde::de::Error>(failed: &mut Option<Failed>, key: impl Into<String>, message: String, at: (&'static str, usize)) -> E {
+    *failed = Some(Failed {
+        key: key.into(),
+        message,
+        at: Some(at),
+    });
+    E::custom("a failed check")
+}
+
+/// The saved bodies, each checked against the scene's (id in order, kind, finite
+/// state) and written into the world; returns their count.
+struct BodiesSeed<'a, D: Dim> {
+    w: &'a mut World<D>,
+    failed: &'a mut Option<Failed>,
+}
+
+impl<'de, D: Dim> DeserializeSeed<'de> for BodiesSeed<'_, D> {
+    type Value = usize;
+    fn deserialize<De: serde::Deserializer<'de>>(self, de: De) -> Result<usize, De::Error> {
+        de.deserialize_seq(self)
+    }
+}
+
+impl<'de, D: Dim> Visitor<'de> for BodiesSeed<'_, D> {
+    type Value = usize;
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("a list of saved bodies")
+    }
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<usize, A::Error> {
+        let nb = self.w.bodies.len();
+        let mut k = 0usize;
+        while k < nb {
+            let Some(sb) = seq.next_element::<SavedBody<D>>()? else { break };
+            if sb.id as usize != k {
+                return Err(fail(
+                    self.failed,
+                    format!("bodies[{k}].id"),
+                    format!("expected id {k}, found {}", sb.id),
+                    ("id", k),
+                ));
+            }
+            let kind = self.w.kind_name(k);
+            if sb.kind != kind {
+                let message = format!("the saved body is a `{}`, the scene's body {k} a `{kind}`", sb.kind);
+                return Err(fail(self.failed, format!("bodies[{k}].kind"), message, ("kind", k)));
+            }
+            let rot = sb.rot();
+            let finite = sb.position.as_ref().iter().chain(sb.velocity.as_ref()).all(|x| x.is_finite());
+            if !(finite && D::rot_finite(&rot)) {
+                return Err(fail(
+                    self.failed,
+                    format!("bodies[{k}]"),
+                    "non-finite state".into(),
+                    ("position", k),
+                ));
+            }
+            let b = &mut self.w.bodies;
+            (b.pos[k], b.rot[k], b.vel[k]) = (sb.position, rot, sb.velocity);
+            b.refresh_inverse(k);
+            k += 1;
+        }
+        // (bodies past the scene's are counted for the message)
+        while seq.next_element::<IgnoredAny>()?.is_some() {
+            k += 1;
+        }
+        if k != nb {
+            let message = format!("the saved state has {k} bodies, the scene {nb}: a restart needs the scene that wrote it");
+            return Err(fail(self.failed, "bodies", message, ("bodies", 0)));
+        }
+        Ok(k)
+    }
+}
+
+/// The saved contacts (keys, impulses, bonds: the next step's warm start) as a
+/// contact list, their frames left to [`Streamed::frames`], and their normals.
+struct ContactsSeed<'a, D: Dim> {
+    nb: usize,
+    failed: &'a mut Option<Failed>,
+    dim: std::marker::PhantomData<D>,
+}
+
+impl<'de, D: Dim> DeserializeSeed<'de> for ContactsSeed<'_, D> {
+    type Value = (Contacts<D>, Vec<D::Point>);
+    fn deserialize<De: serde::Deserializer<'de>>(self, de: De) -> Result<Self::Value, De::Error> {
+        de.deserialize_seq(self)
+    }
+}
+
+impl<'de, D: Dim> Visitor<'de> for ContactsSeed<'_, D> {
+    type Value = (Contacts<D>, Vec<D::Point>);
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("a list of saved contacts")
+    }
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+        let (mut c, mut normals) = (Contacts::default(), Vec::new());
+        let mut a = 0usize;
+        while let Some(sc) = seq.next_element::<SavedContact<D>>()? {
+            let [i, j] = sc.bodies;
+            if i as usize >= self.nb || j as usize >= self.nb {
+                let message = format!("body ids must be below {}", self.nb);
+                return Err(fail(self.failed, format!("contacts[{a}].bodies"), message, ("bodies", a + 1)));
+            }
+            let r = match (sc.r, sc.r_n, sc.r_t) {
+                (Some(r), _, _) => r,
+                (None, Some(rn), Some(rt)) if D::N == 2 => D::Local::from_fn(|k| [rn, rt][k]),
+                _ => {
+                    return Err(fail(
+                        self.failed,
+                        format!("contacts[{a}].r"),
+                        "missing impulse `r`".into(),
+                        ("gap", a),
+                    ))
+                }
+            };
+            c.bodies.push([i, j]);
+            c.frame.push(Default::default());
+            c.block.push(Default::default());
+            c.target.push(Default::default());
+            c.r.push(r);
+            c.u_free.push(D::Local::zero());
+            c.gap.push(sc.gap);
+            c.point.push(sc.point);
+            c.key.push(ContactKey {
+                i,
+                j,
+                feature: sc.feature.unwrap_or(0),
+            });
+            c.joint.push(if sc.bonded { Joint::RESTORED } else { Joint::default() });
+            normals.push(sc.normal);
+            a += 1;
+        }
+        Ok((c, normals))
+    }
+}
