@@ -3,6 +3,7 @@
 
 pub mod history;
 pub mod vtk;
+pub mod vtk_xml;
 
 /// Writes a file atomically: `write` fills a temporary file beside `path` (its name
 /// keeps the extension: `.name.part.ext`), renamed onto `path` once complete, so

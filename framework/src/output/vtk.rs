@@ -21,10 +21,11 @@
 //!
 //! and the series `bodies.pvd`, `walls.pvd`, `contacts.pvd`, `points.pvd`
 //! (rewritten at every frame, so that a stopped run leaves valid series). Files are
-//! written with `vtkio`. On MPI ranks ([`crate::dd::Piece`]) every rank writes its
+//! written as they are encoded ([`super::vtk_xml`]). On MPI ranks ([`crate::dd::Piece`]) every rank writes its
 //! piece `NAME_NNNNNN_RANK.vtp` and rank 0 the `NAME_NNNNNN.pvtp` naming them, which
 //! the series list (ParaView opens the pieces as one dataset).
 
+use super::vtk_xml::{write_piece, Array, Cells, PieceData};
 use super::Writer;
 use crate::dd::DdView;
 use crate::dim::{Coords, Dim, Vector};
@@ -32,7 +33,6 @@ use crate::shape::Glyph;
 use crate::world::World;
 use std::io::Write;
 use std::path::Path;
-use vtkio::model::{Attribute, Attributes, ByteOrder, DataSet, PolyDataPiece, Version, VertexNumbers, Vtk};
 
 /// Writes the VTK frames and `.pvd` series.
 #[derive(Default)]
@@ -42,63 +42,18 @@ pub struct VtkWriter {
     pieces: bool,
 }
 
-fn piece(
-    points: Vec<f64>,
-    verts: Option<VertexNumbers>,
-    lines: Option<VertexNumbers>,
-    polys: Option<VertexNumbers>,
-    point: Vec<Attribute>,
-    cell: Vec<Attribute>,
-) -> Vtk {
-    Vtk {
-        version: Version::new(),
-        title: "nscdd".into(),
-        byte_order: ByteOrder::LittleEndian,
-        file_path: None,
-        data: DataSet::inline(PolyDataPiece {
-            points: points.into(),
-            verts,
-            lines,
-            polys,
-            strips: None,
-            data: Attributes { point, cell },
-        }),
-    }
+/// `n` cells of `per` consecutive points each: (connectivity, offsets).
+fn runs(n: usize, per: u64) -> (Vec<u64>, Vec<u64>) {
+    ((0..per * n as u64).collect(), (1..=n as u64).map(|x| per * x).collect())
 }
 
-fn cells(conn: Vec<u64>, offsets: Vec<u64>) -> Option<VertexNumbers> {
-    Some(VertexNumbers::XML {
-        connectivity: conn,
-        offsets,
-    })
-}
-
-/// `n` cells of `per` consecutive points each.
-fn runs(n: usize, per: u64) -> Option<VertexNumbers> {
-    cells((0..per * n as u64).collect(), (1..=n as u64).map(|x| per * x).collect())
-}
-
-/// Writes a VTK file atomically ([`super::write_atomic`]).
-/// A piece without points gets its counts written as zeros (vtkio leaves them out,
-/// and VTK's readers refuse such a piece: a frame before the first contact, a rank's
-/// piece without walls).
-fn export(v: Vtk, path: &Path) -> std::io::Result<()> {
-    let empty = match &v.data {
-        DataSet::PolyData { pieces, .. } => pieces.iter().all(|p| match p {
-            vtkio::model::Piece::Inline(b) => b.points.is_empty(),
-            _ => false,
-        }),
-        _ => false,
-    };
+/// Writes a piece atomically ([`super::write_atomic`]).
+fn export(path: &Path, p: &PieceData) -> std::io::Result<()> {
     super::write_atomic(path, |tmp| {
-        v.export(tmp)
-            .map_err(|e| std::io::Error::other(format!("writing {}: {e}", path.display())))?;
-        if empty {
-            let text = std::fs::read_to_string(tmp)?;
-            let counts = "<Piece NumberOfPoints=\"0\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">";
-            std::fs::write(tmp, text.replacen("<Piece>", counts, 1))?;
-        }
-        Ok(())
+        let mut f = std::io::BufWriter::new(std::fs::File::create(tmp)?);
+        write_piece(&mut f, p)
+            .and_then(|()| f.flush())
+            .map_err(|e| std::io::Error::other(format!("writing {}: {e}", path.display())))
     })
 }
 
@@ -107,12 +62,30 @@ fn xyz(p: &[f64]) -> [f64; 3] {
     [p[0], p[1], p.get(2).copied().unwrap_or(0.0)]
 }
 
-/// A scalar attribute in 2D, a vector in 3D (ω, rotation vectors).
-fn per_dim(name: &str, n: usize, data: Vec<f64>) -> Attribute {
-    if n == 1 {
-        Attribute::scalars(name, 1).with_data(data)
-    } else {
-        Attribute::vectors(name).with_data(data)
+/// A scalar array in 2D, a vector in 3D (ω, rotation vectors): `n` values a body.
+fn per_dim<'a>(name: &'a str, n: usize, values: &'a [f64]) -> Array<'a> {
+    Array {
+        name,
+        components: if n == 1 { 1 } else { 3 },
+        values,
+    }
+}
+
+/// A scalar array.
+fn scalars<'a>(name: &'a str, values: &'a [f64]) -> Array<'a> {
+    Array {
+        name,
+        components: 1,
+        values,
+    }
+}
+
+/// A vector array (3 values an element).
+fn vectors<'a>(name: &'a str, values: &'a [f64]) -> Array<'a> {
+    Array {
+        name,
+        components: 3,
+        values,
     }
 }
 
@@ -204,25 +177,12 @@ impl VtkWriter {
 /// The point and cell arrays of a file: (name, components) each.
 type Arrays = (Vec<(String, u32)>, Vec<(String, u32)>);
 
-fn described(a: &[Attribute]) -> Vec<(String, u32)> {
-    use vtkio::model::ElementType;
-    a.iter()
-        .filter_map(|x| match x {
-            Attribute::DataArray(d) => Some((
-                d.name.clone(),
-                match d.elem {
-                    ElementType::Scalars { num_comp, .. } => num_comp,
-                    ElementType::Vectors | ElementType::Normals => 3,
-                    _ => 1,
-                },
-            )),
-            Attribute::Field { .. } => None,
-        })
-        .collect()
+fn described(a: &[Array]) -> Vec<(String, u32)> {
+    a.iter().map(|x| (x.name.to_string(), x.components)).collect()
 }
 
 /// The `.pvtp` naming the `ranks` pieces `STEM_RANK.vtp` of a frame (the arrays as
-/// `vtkio` writes them: Float64 points and data).
+/// the pieces have them: Float64 points and data).
 fn pvtp(path: &Path, stem: &str, ranks: u32, point: &[(String, u32)], cell: &[(String, u32)]) -> std::io::Result<()> {
     let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
     writeln!(f, "<?xml version=\"1.0\"?>")?;
@@ -277,29 +237,62 @@ fn bodies<D: Dim>(w: &World<D>, dd: Option<&DdView>, sel: &[usize], bodies: &Pat
         }
     }
     let rdof = D::DOF - D::N;
-    let mut point = vec![
-        Attribute::scalars("id", 1).with_data(sel.iter().map(|&k| f64::from(w.ids.global(k as u32))).collect::<Vec<_>>()),
-        Attribute::scalars("radius", 1).with_data(radius),
-        Attribute::vectors("velocity").with_data(vel),
-        per_dim("angular_velocity", rdof, omega),
-        per_dim("rotation", rdof, rot),
-        Attribute::scalars("material", 1).with_data(sel.iter().map(|&k| b.material[k] as f64).collect::<Vec<_>>()),
-    ];
-    if let Some(d) = dd {
-        // (the view is by global id)
-        let g = |k: usize| w.ids.global(k as u32) as usize;
-        let sub: Vec<f64> = sel
+    let id: Vec<f64> = sel.iter().map(|&k| f64::from(w.ids.global(k as u32))).collect();
+    let material: Vec<f64> = sel.iter().map(|&k| b.material[k] as f64).collect();
+    // (the view is by global id)
+    let g = |k: usize| w.ids.global(k as u32) as usize;
+    let (sub, mult): (Vec<f64>, Vec<f64>) = match dd {
+        Some(d) => sel
             .iter()
-            .map(|&k| d.body_subdomain.get(g(k)).copied().unwrap_or(-1) as f64)
-            .collect();
-        let mult: Vec<f64> = sel.iter().map(|&k| d.multiplicity.get(g(k)).copied().unwrap_or(0) as f64).collect();
-        point.push(Attribute::scalars("subdomain", 1).with_data(sub));
-        point.push(Attribute::scalars("multiplicity", 1).with_data(mult));
+            .map(|&k| {
+                let s = d.body_subdomain.get(g(k)).copied().unwrap_or(-1) as f64;
+                (s, d.multiplicity.get(g(k)).copied().unwrap_or(0) as f64)
+            })
+            .unzip(),
+        None => (vec![], vec![]),
+    };
+    let mut point = vec![
+        scalars("id", &id),
+        scalars("radius", &radius),
+        vectors("velocity", &vel),
+        per_dim("angular_velocity", rdof, &omega),
+        per_dim("rotation", rdof, &rot),
+        scalars("material", &material),
+    ];
+    if dd.is_some() {
+        point.push(scalars("subdomain", &sub));
+        point.push(scalars("multiplicity", &mult));
     }
+    let (conn, off) = runs(n, 1);
+    let verts = Cells {
+        connectivity: &conn,
+        offsets: &off,
+    };
+    let none = Cells::default();
+    export(
+        bodies,
+        &PieceData {
+            points: &pts,
+            cells: [verts, none, none],
+            point_data: &point,
+            cell_data: &[],
+        },
+    )?;
     let out = [(described(&point), vec![]), (vec![], vec![("id".to_string(), 1)])];
-    export(piece(pts, runs(n, 1), None, None, point, vec![]), bodies)?;
-    let wcells = vec![Attribute::scalars("id", 1).with_data(wid)];
-    export(piece(wpts, None, None, cells(wconn, woff), vec![], wcells), walls)?;
+    let polys = Cells {
+        connectivity: &wconn,
+        offsets: &woff,
+    };
+    let cell = [scalars("id", &wid)];
+    export(
+        walls,
+        &PieceData {
+            points: &wpts,
+            cells: [none, none, polys],
+            point_data: &[],
+            cell_data: &cell,
+        },
+    )?;
     Ok(out)
 }
 
@@ -323,31 +316,55 @@ fn contacts<D: Dim>(w: &World<D>, dd: Option<&DdView>, sel: &[usize], lines: &Pa
     let rn: Vec<f64> = sel.iter().map(|&a| c.r[a][0]).collect();
     let fnn: Vec<f64> = rn.iter().map(|r| r / h).collect();
     let gap: Vec<f64> = sel.iter().map(|&a| c.gap[a]).collect();
-    let mut cell = vec![
-        Attribute::scalars("r_n", 1).with_data(rn),
-        Attribute::scalars("r_t", 1).with_data(rt),
-        Attribute::scalars("f_n", 1).with_data(fnn.clone()),
-        Attribute::scalars("gap", 1).with_data(gap.clone()),
-    ];
-    if let Some(d) = dd {
-        let sub: Vec<f64> = sel
+    let sub: Vec<f64> = match dd {
+        Some(d) => sel
             .iter()
             .map(|&a| d.contact_subdomain.get(a).map_or(-1.0, |&s| s as f64))
-            .collect();
-        cell.push(Attribute::scalars("subdomain", 1).with_data(sub));
+            .collect(),
+        None => vec![],
+    };
+    let mut cell = vec![scalars("r_n", &rn), scalars("r_t", &rt), scalars("f_n", &fnn), scalars("gap", &gap)];
+    if dd.is_some() {
+        cell.push(scalars("subdomain", &sub));
     }
+    let none = Cells::default();
+    let (conn, off) = runs(m, 2);
+    let line_cells = Cells {
+        connectivity: &conn,
+        offsets: &off,
+    };
+    export(
+        lines,
+        &PieceData {
+            points: &cpts,
+            cells: [none, line_cells, none],
+            point_data: &[],
+            cell_data: &cell,
+        },
+    )?;
     let lines_arrays = (vec![], described(&cell));
-    export(piece(cpts, None, runs(m, 2), None, vec![], cell), lines)?;
     let bonded: Vec<f64> = sel.iter().map(|&a| c.joint[a].bonded() as u8 as f64).collect();
-    let point = vec![
-        Attribute::vectors("force").with_data(force),
-        Attribute::scalars("f_n", 1).with_data(fnn),
-        Attribute::scalars("gap", 1).with_data(gap),
-        Attribute::scalars("bonded", 1).with_data(bonded),
+    let point = [
+        vectors("force", &force),
+        scalars("f_n", &fnn),
+        scalars("gap", &gap),
+        scalars("bonded", &bonded),
     ];
-    let out = [lines_arrays, (described(&point), vec![])];
-    export(piece(ppts, runs(m, 1), None, None, point, vec![]), points)?;
-    Ok(out)
+    let (conn, off) = runs(m, 1);
+    let verts = Cells {
+        connectivity: &conn,
+        offsets: &off,
+    };
+    export(
+        points,
+        &PieceData {
+            points: &ppts,
+            cells: [verts, none, none],
+            point_data: &point,
+            cell_data: &[],
+        },
+    )?;
+    Ok([lines_arrays, (described(&point), vec![])])
 }
 
 impl<D: Dim> Writer<D> for VtkWriter {
