@@ -24,15 +24,40 @@ pub struct BodyIds {
     global: Vec<u32>,
     /// Bodies in the scene (0 with the identity: the world's own count).
     n_global: u32,
+    /// Slot of each global id (`u32::MAX`: not held; empty with the identity):
+    /// 4 bytes a body of the scene, so that a lookup is one load; kept up to date
+    /// by [`BodyIds::respread`] in the time of the slots changed.
+    slot_of: Vec<u32>,
 }
 
 impl BodyIds {
     /// Slots holding the bodies `global` (strictly ascending, each below
     /// `n_global`); `None` otherwise.
     pub fn spread(global: Vec<u32>, n_global: u32) -> Option<BodyIds> {
+        BodyIds::default().respread(global, n_global)
+    }
+
+    /// [`BodyIds::spread`] reusing this map's table: its time is that of the slots
+    /// before and after, not of the scene's bodies (once the table exists).
+    pub fn respread(mut self, global: Vec<u32>, n_global: u32) -> Option<BodyIds> {
         let ascending = global.windows(2).all(|p| p[0] < p[1]);
         let below = global.last().is_none_or(|&g| g < n_global);
-        (ascending && below).then_some(BodyIds { global, n_global })
+        if !(ascending && below) {
+            return None;
+        }
+        if self.slot_of.len() != n_global as usize {
+            self.slot_of = vec![u32::MAX; n_global as usize];
+        } else {
+            self.global.iter().for_each(|&g| self.slot_of[g as usize] = u32::MAX);
+        }
+        for (k, &g) in global.iter().enumerate() {
+            self.slot_of[g as usize] = k as u32;
+        }
+        Some(BodyIds {
+            global,
+            n_global,
+            slot_of: self.slot_of,
+        })
     }
 
     /// Whether slot = global id (every body held, none other).
@@ -57,7 +82,7 @@ impl BodyIds {
         if self.is_identity() {
             Some(g)
         } else {
-            self.global.binary_search(&g).ok().map(|s| s as u32)
+            self.slot_of.get(g as usize).copied().filter(|&k| k != u32::MAX)
         }
     }
 
@@ -89,5 +114,10 @@ mod tests {
         let ids = BodyIds::spread(vec![0, 3], 5).unwrap();
         assert_eq!(ids.held(), Some(&[0, 3][..]));
         assert_eq!(BodyIds::default().held(), None);
+        // respread: the old slots forgotten, the new ones found
+        let ids = ids.respread(vec![1, 3, 4], 5).unwrap();
+        let slots: Vec<Option<u32>> = (0..6).map(|g| ids.slot(g)).collect();
+        assert_eq!(slots, [None, Some(0), None, Some(1), Some(2), None]);
+        assert_eq!(ids, BodyIds::spread(vec![1, 3, 4], 5).unwrap());
     }
 }

@@ -21,7 +21,7 @@
 
 use super::World;
 use crate::dim::{Coords, Dim, Vector};
-use crate::model::{Bodies, BodyIds, ShapeRef};
+use crate::model::{Bodies, ShapeRef};
 
 /// Whole-scene values a world holding part of the scene can no longer compute
 /// from its bodies (static: computed once, before its first drop).
@@ -267,7 +267,9 @@ impl<D: Dim> World<D> {
         if let Some(bw) = self.box_walls.as_mut() {
             bw.walls.iter_mut().filter(|k| (**k as usize) < new_of_old.len()).for_each(map);
         }
-        self.ids = BodyIds::spread(globals, n_global).expect("slots ascend in global id");
+        self.ids = std::mem::take(&mut self.ids)
+            .respread(globals, n_global)
+            .expect("slots ascend in global id");
         let ids = &self.ids;
         s.active = active
             .as_ref()
