@@ -74,8 +74,8 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     fn rho2(w: &Self::World, g: usize) -> f64;
     fn contacts(w: &Self::World) -> &Self::Contacts;
     fn contacts_mut(w: &mut Self::World) -> &mut Self::Contacts;
-    /// The held bodies' velocities into `out`, by global id (`n_bodies` long; the
-    /// others' left at zero).
+    /// The held bodies' velocities into `out`, by slot ([`Family::slot`]: as many
+    /// as the world holds).
     fn velocities(w: &Self::World, out: &mut Vec<Self::V>);
     fn set_vel(w: &mut Self::World, g: usize, v: Self::V);
     /// The global ids of contact `a` of the world's contacts.
@@ -92,7 +92,7 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     fn residual_parts_in(w: &Self::World, which: &[u32]) -> (f64, f64);
     /// Adds the contacts' Σ ±H r to `out` (indexed by the contacts' body ids).
     fn add_reactions(c: &Self::Contacts, out: &mut [Self::V]);
-    /// Sets the world's per-body reactions from `r` (by global id), and the bodies
+    /// Sets the world's per-body reactions from `r` (by slot), and the bodies
     /// whose reactions are observed (ascending: outputs and drives read them).
     fn set_reactions(w: &mut Self::World, r: Vec<Self::V>);
     fn observed(w: &Self::World) -> Vec<u32>;
@@ -162,8 +162,8 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     /// Detects again in `region`, keeps the raw contacts `keep` accepts and builds
     /// them with the same warm starts as the step's first build and those of
     /// `more_prev` ([`Family::prev_record`]s; one already held is not repeated),
-    /// the velocities back at `v_free` (a distributed repartition: the contacts
-    /// move to their new ranks).
+    /// the velocities back at `v_free` (by slot; a distributed repartition: the
+    /// contacts move to their new ranks).
     fn redetect(
         w: &mut Self::World,
         region: crate::detect::Region,
@@ -277,15 +277,7 @@ impl<D: Dim> Family for Rigid<D> {
     }
     fn velocities(w: &Self::World, out: &mut Vec<Self::V>) {
         out.clear();
-        match w.ids.held() {
-            None => out.extend_from_slice(&w.bodies.vel),
-            Some(held) => {
-                out.resize(Self::n_bodies(w), Self::V::default());
-                for (&g, v) in held.iter().zip(&w.bodies.vel) {
-                    out[g as usize] = *v;
-                }
-            }
-        }
+        out.extend_from_slice(&w.bodies.vel);
     }
     /// (a body the world does not hold is not stepped here: nothing to write)
     fn set_vel(w: &mut Self::World, g: usize, v: Self::V) {
@@ -318,10 +310,7 @@ impl<D: Dim> Family for Rigid<D> {
         crate::step::add_reactions(c, out);
     }
     fn set_reactions(w: &mut Self::World, r: Vec<Self::V>) {
-        w.reaction = match w.ids.held() {
-            None => r,
-            Some(held) => held.iter().map(|&g| r[g as usize]).collect(),
-        };
+        w.reaction = r;
     }
     fn observed(w: &Self::World) -> Vec<u32> {
         w.observed().into_iter().map(|k| w.ids.global(k)).collect()
@@ -465,14 +454,7 @@ impl<D: Dim> Family for Rigid<D> {
         keep: &mut dyn FnMut(ContactKey, [f64; 3]) -> bool,
         (v_free, more_prev): (&[Self::V], &[f64]),
     ) {
-        match w.ids.held() {
-            None => w.bodies.vel.copy_from_slice(v_free),
-            Some(held) => {
-                for (v, &g) in w.bodies.vel.iter_mut().zip(held) {
-                    *v = v_free[g as usize];
-                }
-            }
-        }
+        w.bodies.vel.copy_from_slice(v_free);
         let s = &mut w.scratch;
         if !more_prev.is_empty() {
             s.prev_keys.extend(prev_contacts::<D>(more_prev));

@@ -332,7 +332,8 @@ impl<D: Family> NscddOf<D> {
         self.last = partition::decompose_owned::<D>(w, &self.v_free, grid, owner, ns, &self.store, build.as_deref(), &fo, shells);
         // contacts held per rank: the other ranks' F_Γ are not kept up to date here
         if let (true, Some(rs)) = (self.local.now, self.ranks.as_mut()) {
-            rs.fresh_f_gamma(&mut self.last, &self.store, &self.v_free);
+            let slot = |g: u32| D::slot(w, g as usize).expect("a body of an own subdomain is held");
+            rs.fresh_f_gamma(&mut self.last, &self.store, (&self.v_free, &slot));
         }
         rep.repartitioned = repart;
         if let Some((before, routed)) = before {

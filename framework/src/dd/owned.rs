@@ -138,7 +138,7 @@ impl Owned {
         w: &mut D::World,
         (rs, grid): (&mut RankState, &Grid),
         boxes: &mut Vec<[[f64; 3]; 2]>,
-        v_free: &mut [D::V],
+        v_free: &mut Vec<D::V>,
     ) {
         let alert = D::alert(w);
         let me = rs.cluster.rank();
@@ -151,7 +151,8 @@ impl Owned {
             entered(D::SPACE, (b, &old), (b, &new), alert, me, (&mut was, &mut to));
             for &q in &to {
                 mine.extend([f64::from(q), f64::from(g)]);
-                D::step_record(w, g as usize, &v_free[g as usize], &mut mine);
+                let k = D::slot(w, g as usize).expect("an owned body is held");
+                D::step_record(w, g as usize, &v_free[k], &mut mine);
             }
         }
         let per = 2 + D::STEP_RECORD;
@@ -160,10 +161,14 @@ impl Owned {
         let mut active = D::active(w).map(<[u32]>::to_vec).unwrap_or_default();
         let to_me: Vec<&[f64]> = all.chunks_exact(per).filter(|x| x[0] as u32 == me).collect();
         let entering: Vec<(u32, &[f64])> = to_me.iter().map(|x| (x[1] as u32, &x[2..2 + D::BODY_RECORD])).collect();
+        // the entering bodies take slots among the held ones: V_free (by slot) follows
+        let before: Option<Vec<u32>> = D::held(w).map(<[u32]>::to_vec);
         D::admit(w, &entering);
+        remap::<D>(w, before.as_deref(), v_free);
         for x in to_me {
             let g = x[1] as usize;
-            v_free[g] = D::set_step_record(w, g, &x[2..]);
+            let k = D::slot(w, g).expect("an admitted body is held");
+            v_free[k] = D::set_step_record(w, g, &x[2..]);
             active.push(g as u32);
         }
         active.sort_unstable();
@@ -250,6 +255,21 @@ impl Owned {
         D::hold(w, &active);
         self.keep = keep;
     }
+}
+
+/// `v`, by the slots of `before` (the held ids before bodies entered the world;
+/// `None`: every body), moved to the world's slots now (an entering body's value
+/// left at its default).
+fn remap<D: Family>(w: &D::World, before: Option<&[u32]>, v: &mut Vec<D::V>) {
+    let (Some(before), Some(now)) = (before, D::held(w)) else { return };
+    if before.len() == now.len() {
+        return;
+    }
+    let mut out = vec![D::V::default(); now.len()];
+    for (k, &g) in before.iter().enumerate() {
+        out[D::slot(w, g as usize).expect("a held body stays held")] = v[k];
+    }
+    *v = out;
 }
 
 /// The states of the bodies `send` (and, with `diverged`, of the body found

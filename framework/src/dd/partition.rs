@@ -166,6 +166,7 @@ pub struct FamilyOwners<'a, 'f, D: Family> {
 #[allow(clippy::too_many_arguments)]
 pub fn decompose_owned<D: Family>(
     w: &D::World,
+    // (by slot)
     v_free: &[D::V],
     grid: Grid,
     owner: Vec<u32>,
@@ -215,8 +216,9 @@ pub fn decompose_owned<D: Family>(
         entity_interface(&mut iface, &mut subs, &*fam.fams[f], ec);
     }
     link_chains(&mut subs, &iface);
+    let slot = |g: u32| D::slot(w, g as usize).expect("a body of an own subdomain is held");
     for sub in subs.iter_mut().filter(|s| built(s.id)) {
-        sub.init_velocities(v_free);
+        sub.init_velocities(v_free, &slot);
     }
     Decomposition {
         grid: Some(grid),

@@ -21,7 +21,13 @@ impl RankState {
     /// Sets the starting F_Γ of this rank's copies of the fresh interface bodies
     /// from every copy's kept F_Γ, asked of its subdomain's rank (module docs), and
     /// the starting velocities of the subdomains holding them again. Collective.
-    pub(super) fn fresh_f_gamma<D: Family>(&mut self, d: &mut Decomposition<D>, store: &FGammaStore<D::V>, v_free: &[D::V]) {
+    /// (`v_free` by slot, `slot` the slot of a global id)
+    pub(super) fn fresh_f_gamma<D: Family>(
+        &mut self,
+        d: &mut Decomposition<D>,
+        store: &FGammaStore<D::V>,
+        (v_free, slot): (&[D::V], &dyn Fn(u32) -> usize),
+    ) {
         let iface = &d.iface;
         let mut bodies = Vec::new();
         // (subdomain, body) of the other ranks' copies asked: each one's kept F_Γ,
@@ -75,7 +81,7 @@ impl RankState {
         touched.sort_unstable();
         touched.dedup();
         for s in touched {
-            d.subs[s as usize].init_velocities(v_free);
+            d.subs[s as usize].init_velocities(v_free, slot);
         }
     }
 }

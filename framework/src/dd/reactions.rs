@@ -18,7 +18,10 @@ use super::ranks::RankState;
 /// Sets the world's reactions ([`Family::set_reactions`]) from the subdomains of
 /// `d` (see the module docs).
 pub(super) fn set<D: Family>(d: &Decomposition<D>, w: &mut D::World, ranks: Option<&mut RankState>, observed: &[u32]) {
-    let nb = D::n_bodies(w);
+    // by slot: a subdomain's bodies on this rank are held here (its own, and the
+    // observed bodies of the others, which every rank steps)
+    let slots = D::held(w).map_or(D::n_bodies(w), <[u32]>::len);
+    let slot = |g: u32| D::slot(w, g as usize).expect("a body with a reaction is held");
     let own = |s: u32| ranks.as_ref().is_none_or(|r| r.is_own(s));
     // each own subdomain's share, by local body
     let shares: Vec<Vec<D::V>> = d
@@ -34,18 +37,18 @@ pub(super) fn set<D: Family>(d: &Decomposition<D>, w: &mut D::World, ranks: Opti
         })
         .collect();
     let remote = ranks.map(|r| r.share_reactions(d, &shares, observed));
-    let mut out = vec![D::V::default(); nb];
+    let mut out = vec![D::V::default(); slots];
     for (s, sub) in d.subs.iter().enumerate() {
         match &remote {
             Some(rem) if !rem.is_own(s) => {
                 // the observed bodies' shares from the subdomain's rank
                 for (l, v) in rem.of(s) {
-                    add(&mut out[sub.body_global[l] as usize], v);
+                    add(&mut out[slot(sub.body_global[l])], v);
                 }
             }
             _ => {
                 for (l, v) in shares[s].iter().enumerate() {
-                    add(&mut out[sub.body_global[l] as usize], v.as_ref());
+                    add(&mut out[slot(sub.body_global[l])], v.as_ref());
                 }
             }
         }

@@ -193,10 +193,11 @@ impl<D: Family> Subdomain<D> {
     }
 
     /// V_E = V_free + M̂_E⁻¹ (F_Γ + H_E r) with the warm-start impulses, applied in
-    /// storage order (as the one-domain engine does).
-    pub(crate) fn init_velocities(&mut self, v_free: &[D::V]) {
+    /// storage order (as the one-domain engine does); `v_free` by slot, `slot` the
+    /// slot of a global id.
+    pub(crate) fn init_velocities(&mut self, v_free: &[D::V], slot: &dyn Fn(u32) -> usize) {
         self.vel.clear();
-        self.vel.extend(self.body_global.iter().map(|&g| v_free[g as usize]));
+        self.vel.extend(self.body_global.iter().map(|&g| v_free[slot(g)]));
         for (q, &l) in self.iface.iter().enumerate() {
             let l = l as usize;
             D::apply_impulse(&mut self.vel[l], &self.inv_mass[l], &self.f_gamma[q]);
