@@ -109,8 +109,8 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     fn body_energies(w: &Self::World, g: usize) -> Option<(f64, f64)>;
     fn grain_in_box(w: &Self::World, g: usize, lo: [f64; 3], hi: [f64; 3]) -> f64;
     /// Contacts held per rank ([`super::local`]): the next detection's region, the
-    /// raw contacts kept after it (by key and point), the bodies' boxes (first `N`
-    /// coordinates, the rest 0), and the other processes' last contacts for the warm
+    /// raw contacts kept after it (by key and point), the bodies' boxes (by slot;
+    /// first `N` coordinates, the rest 0), and the other processes' last contacts for the warm
     /// start (records of [`Family::prev_record`]).
     fn set_region(w: &mut Self::World, region: Option<crate::detect::Region>);
     fn alert(w: &Self::World) -> f64;
@@ -363,14 +363,14 @@ impl<D: Dim> Family for Rigid<D> {
             )
         });
     }
-    /// (only the active bodies' boxes are recomputed; by global id)
+    /// (by slot; only the active bodies' boxes are recomputed)
     fn body_boxes(w: &Self::World, out: &mut Vec<[[f64; 3]; 2]>) {
         let b = &w.bodies;
-        out.resize(Self::n_bodies(w), [[0.0; 3]; 2]);
+        out.resize(b.len(), [[0.0; 3]; 2]);
         crate::step::each_body(b.len(), w.scratch.active.as_deref(), |k| {
             let s = b.shape[k];
             let a = w.shapes[s.kind as usize].aabb(s.index, b.pos[k], b.rot[k]);
-            let o = &mut out[w.ids.global(k as u32) as usize];
+            let o = &mut out[k];
             o[0][..D::N].copy_from_slice(a.min.as_ref());
             o[1][..D::N].copy_from_slice(a.max.as_ref());
         });

@@ -41,7 +41,8 @@ pub(super) struct Local {
     pub held: bool,
     /// Whether the step in progress runs local.
     pub now: bool,
-    /// The bodies' boxes at the start of the step (those this rank steps up to date).
+    /// The bodies' boxes at the start of the step, by slot (those this rank steps up
+    /// to date).
     pub boxes: Vec<[[f64; 3]; 2]>,
     /// With contacts held per rank: each body's subdomain for the outputs
     /// ([`super::shells::body_subdomains`]).
@@ -84,7 +85,7 @@ impl Local {
         let mut to = ToRanks::new(rs, D::SPACE);
         let mut rec = Vec::with_capacity(D::PREV_RECORD + 1);
         for (a, &o) in owner.iter().enumerate().take(D::len(c)) {
-            if to.aim(cells, self.pair_box::<D>(D::contact_bodies(w, a), alert)) {
+            if to.aim(cells, self.pair_box::<D>(w, D::contact_bodies(w, a), alert)) {
                 rec.clear();
                 D::prev_record(c, a, &mut rec);
                 rec.push(f64::from(o));
@@ -109,8 +110,9 @@ impl Local {
 
     /// The box of the pair (i, j) grown by `alert`: the region's pair test
     /// ([`Region::meets_pair`]).
-    fn pair_box<D: Family>(&self, [i, j]: [u32; 2], alert: f64) -> ([f64; 3], [f64; 3]) {
-        let (bi, bj) = (&self.boxes[i as usize], &self.boxes[j as usize]);
+    fn pair_box<D: Family>(&self, w: &D::World, [i, j]: [u32; 2], alert: f64) -> ([f64; 3], [f64; 3]) {
+        let slot = |g: u32| D::slot(w, g as usize).expect("a body of a contact is held");
+        let (bi, bj) = (&self.boxes[slot(i)], &self.boxes[slot(j)]);
         Region::pair_box(D::SPACE, (&bi[0], &bi[1]), (&bj[0], &bj[1]), alert)
     }
 }
@@ -169,10 +171,10 @@ impl Local {
     /// `cells` go to that rank; returns the other ranks' that this one receives
     /// (the warm starts its new cells may need; those of its old cells came before
     /// detection).
-    fn prev_for_new_cells<D: Family>(&self, rs: &mut RankState, cells: &CellIndex, own: &[f64], alert: f64) -> Vec<f64> {
-        let mut to = ToRanks::new(rs, D::SPACE);
+    fn prev_for_new_cells<D: Family>(&self, (rs, w): (&mut RankState, &D::World), cells: &CellIndex, own: &[f64]) -> Vec<f64> {
+        let (mut to, alert) = (ToRanks::new(rs, D::SPACE), D::alert(w));
         for x in own.chunks_exact(D::PREV_RECORD) {
-            if to.aim(cells, self.pair_box::<D>([x[0] as u32, x[1] as u32], alert)) {
+            if to.aim(cells, self.pair_box::<D>(w, [x[0] as u32, x[1] as u32], alert)) {
                 to.push(x);
             }
         }
@@ -182,7 +184,14 @@ impl Local {
 
 /// The region a rank detects in: its cells, and the pairs of its kept contacts
 /// that the cells would miss (their grown boxes' intersection has left them).
-pub(super) fn region<D: Family>(rs: &RankState, grid: &Grid, kept: &[(ContactKey, u32)], boxes: &[[[f64; 3]; 2]], alert: f64) -> Region {
+pub(super) fn region<D: Family>(
+    rs: &RankState,
+    grid: &Grid,
+    kept: &[(ContactKey, u32)],
+    (w, boxes): (&D::World, &[[[f64; 3]; 2]]),
+) -> Region {
+    let alert = D::alert(w);
+    let box_of = |g: u32| D::slot(w, g as usize).and_then(|k| boxes.get(k));
     let me = rs.cluster.rank();
     let cells = Region {
         boxes: cells_of(grid, &rs.rank_of, me),
@@ -191,7 +200,7 @@ pub(super) fn region<D: Family>(rs: &RankState, grid: &Grid, kept: &[(ContactKey
     let mut pairs: Vec<[u32; 2]> = kept
         .iter()
         .filter(|e| rs.rank_of.get(e.1 as usize) == Some(&me))
-        .filter(|e| match (boxes.get(e.0.i as usize), boxes.get(e.0.j as usize)) {
+        .filter(|e| match (box_of(e.0.i), box_of(e.0.j)) {
             (Some(a), Some(b)) => !pair_meets(D::SPACE, a, b, alert, &cells),
             _ => false,
         })
@@ -323,7 +332,7 @@ impl<D: Family> super::NscddOf<D> {
         // a repartition detects in the old regions first ([`Self::repartition_local`])
         self.local.now = true;
         rs.local = true;
-        let region = region::<D>(rs, grid, &self.kept, &self.local.boxes, D::alert(w));
+        let region = region::<D>(rs, grid, &self.kept, (w, &self.local.boxes));
         D::set_region(w, Some(region));
     }
 
@@ -385,9 +394,10 @@ impl<D: Family> super::NscddOf<D> {
         }
         let me = rs.cluster.rank();
         let more_prev = match self.local.own_prev.take() {
-            Some(own) => self
-                .local
-                .prev_for_new_cells::<D>(rs, &CellIndex::new(&grid, &rs.rank_of), &own, D::alert(w)),
+            Some(own) => {
+                let cells = CellIndex::new(&grid, &rs.rank_of);
+                self.local.prev_for_new_cells::<D>((rs, w), &cells, &own)
+            }
             None => Vec::new(),
         };
         let region = Region {

@@ -147,7 +147,7 @@ impl Owned {
         let mut mine = Vec::new();
         let (mut was, mut to) = (Vec::new(), Vec::new());
         for &g in &self.mine {
-            let b = &boxes[g as usize];
+            let b = &boxes[D::slot(w, g as usize).expect("an owned body is held")];
             entered(D::SPACE, (b, &old), (b, &new), alert, me, (&mut was, &mut to));
             for &q in &to {
                 mine.extend([f64::from(q), f64::from(g)]);
@@ -202,7 +202,8 @@ impl Owned {
             let Some(cells) = self.cells.as_ref() else { return moved };
             let (mut was, mut to) = (Vec::new(), Vec::new());
             let mut entering = |g: u32| {
-                let (new, old) = (&now[g as usize], &boxes[g as usize]);
+                let k = D::slot(w, g as usize).expect("an owned body is held");
+                let (new, old) = (&now[k], &boxes[k]);
                 entered(D::SPACE, (old, cells), (new, cells), alert, me as u32, (&mut was, &mut to));
                 full_next || !to.is_empty()
             };
@@ -246,7 +247,7 @@ impl Owned {
         D::set_active(w, candidates);
         D::body_boxes(w, boxes);
         crate::step::each_body(nb, D::stepped(w), |g| {
-            let (lo, hi) = grown(D::SPACE, &boxes[g], alert);
+            let (lo, hi) = grown(D::SPACE, &boxes[D::slot(w, g).expect("a stepped body is held")], alert);
             keep[g] |= self.everywhere[g] || mine.meets(D::SPACE, &lo, &hi);
         });
         let active: Vec<u32> = (0..nb as u32).filter(|&g| keep[g as usize]).collect();

@@ -41,8 +41,10 @@ use crate::detect::Region;
 pub(super) struct Near<'a> {
     /// Every rank's cells.
     pub cells: &'a CellIndex,
-    /// The bodies' boxes at the start of the step (those a rank steps up to date).
+    /// The bodies' boxes at the start of the step, by slot (those a rank steps up
+    /// to date), and the slot of a held body.
     pub boxes: &'a [[[f64; 3]; 2]],
+    pub slot: Box<dyn Fn(u32) -> usize + 'a>,
     /// Bodies stepped by every rank, by id.
     pub everywhere: &'a [bool],
     /// The bodies this rank steps (ascending).
@@ -62,7 +64,7 @@ impl Near<'_> {
 
     /// Calls `f` with the ranks whose cells body g's grown box meets.
     fn ranks_of<D: Family>(&self, g: u32, f: impl FnMut(u32)) {
-        let b = &self.boxes[g as usize];
+        let b = &self.boxes[(self.slot)(g)];
         let (lo, hi) = Region::grown_box(D::SPACE, &b[0], &b[1], self.alert);
         self.cells.ranks_meeting(D::SPACE, &lo, &hi, f);
     }
@@ -266,6 +268,7 @@ impl<D: Family> super::NscddOf<D> {
             self.store = store;
             before
         });
+        drop(near);
         Some((asked, before))
     }
 }
@@ -276,6 +279,7 @@ pub(super) fn near_of<'a, D: Family>(local: &'a super::local::Local, w: &'a D::W
     Some(Near {
         cells: local.owned.cells.as_ref()?,
         boxes: &local.boxes,
+        slot: Box::new(move |g| D::slot(w, g as usize).expect("a body near a rank is held")),
         everywhere: local.owned.everywhere(),
         active: D::active(w)?,
         alert: D::alert(w),
