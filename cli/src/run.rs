@@ -32,10 +32,14 @@ pub fn run<D: Dim>(mut s: Scene<D>, reg: &Registry, scene: &Path, out: &Path, qu
             None => Ok(()),
         }
     });
-    let digest = flags.map(|()| {
-        let w = &s.world;
-        let state = |out: &mut dyn std::io::Write| nscdd::output::write_final_json(out, w, None, None::<&()>, (None, None));
-        crate::ranks::digest(scene, state, (&s.decomposition, &w.time, &w.solver))
+    // (what the ranks compare: one process has no one to agree with)
+    let digest = flags.map(|()| match ranks.size() > 1 {
+        true => {
+            let w = &s.world;
+            let state = |out: &mut dyn std::io::Write| nscdd::output::write_final_json(out, w, None, None::<&()>, (None, None));
+            crate::ranks::digest(scene, state, (&s.decomposition, &w.time, &w.solver))
+        }
+        false => 0,
     });
     if let Err(code) = ranks.agree(digest, out) {
         return code;

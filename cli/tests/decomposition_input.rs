@@ -420,6 +420,21 @@ fn decomposed_restart_continues_bitwise() {
     let err = text(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains(&format!("bad.json:{line}")) && err.contains("nscdd"), "{err}");
+    // a kept contact's subdomain past the grid's 4 cells: exit 2, the entry named
+    let mut v: serde_json::Value = serde_json::from_str(&saved).unwrap();
+    v["nscdd"]["kept"][0][1] = serde_json::json!(9);
+    std::fs::write(&bad, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+    let o = nscdd(&[
+        "run".as_ref(),
+        whole.as_os_str(),
+        "--out".as_ref(),
+        dir.join("bad_kept").as_os_str(),
+        "--restart".as_ref(),
+        bad.as_os_str(),
+    ]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("kept[0]: subdomain 9 of a grid of 4 cells"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -49,8 +49,10 @@ pub(super) struct Local {
     pub body_sub: Vec<i32>,
     /// The step in progress needs no `body_sub` (no output frame after it).
     pub skip_view: bool,
-    /// The F_Γ store is a restart's, whole (every rank loaded it): the first
-    /// repartition after it keeps it instead of routing the last step's
+    /// The step in progress is the first after a restart, its F_Γ store the whole
+    /// loaded one (every rank loaded it): if the step re-partitions, the store is
+    /// kept instead of routed from the last step's ranks (there was no last step);
+    /// like every step, the step's end replaces it by the subdomains' F_Γ
     /// ([`super::NscddOf::start_held`]).
     pub whole_store: bool,
     /// A distributed repartition's grid and number of contacts, for the partition.
@@ -214,16 +216,17 @@ pub(super) fn region<D: Family>(
 impl<D: Family> super::NscddOf<D> {
     /// Before a step on ranks (rigid bodies, contacts held per rank) while every
     /// world holds every body: each world reduced to its rank's part
-    /// ([`super::owned`]), on a fresh run's first step ([`Self::start_fresh`]) and,
-    /// with `restart`, on the first step after a restart
-    /// ([`Self::start_restarted`]). Nothing otherwise.
-    pub(super) fn start_held(&mut self, w: &mut D::World, eligible: bool, restart: bool) {
+    /// ([`super::owned`]), on a fresh run's first step ([`Self::start_fresh`]) and
+    /// on the first step after a restart ([`Self::start_restarted`]). Nothing
+    /// otherwise (after any step on ranks the world holds only its part, or the
+    /// ranks are known).
+    pub(super) fn start_held(&mut self, w: &mut D::World, eligible: bool) {
         if self.ranks.is_none() || !(eligible && self.local_contacts) || D::active(w).is_some() {
             return;
         }
         if self.grid.is_none() && self.steps == 0 && D::step(w) == 0 {
             self.start_fresh(w);
-        } else if restart {
+        } else {
             self.start_restarted(w);
         }
     }
@@ -257,8 +260,9 @@ impl<D: Family> super::NscddOf<D> {
     /// by their kept contacts (the same on every rank; results do not depend on
     /// which rank sweeps a subdomain), then each rank keeps the last step's
     /// contacts whose kept subdomain is its own, as if it had stepped them, and its
-    /// halo. The loaded F_Γ store stays whole (a superset of what a rank's store
-    /// holds) until the next repartition routes it ([`super::shells`]).
+    /// halo. The loaded F_Γ store stays whole during the step (a superset of what
+    /// a rank's store holds; not routed if the step re-partitions: [`super::shells`])
+    /// and is replaced at its end, as every step's.
     fn start_restarted(&mut self, w: &mut D::World) {
         let (Some(rs), Some(grid)) = (self.ranks.as_mut(), self.grid.as_ref()) else {
             return;
@@ -420,7 +424,9 @@ impl<D: Family> super::NscddOf<D> {
     pub(super) fn after_integrate(&mut self, w: &mut D::World, moved: Result<(), usize>) -> Result<(), usize> {
         if let Some(rs) = self.ranks.as_mut() {
             rs.totals.bodies_stepped += D::stepped(w).map_or(D::n_bodies(w), |a| a.len()) as u64;
-            rs.totals.bodies_held += D::held(w).map_or(D::n_bodies(w), |a| a.len()) as u64;
+            let held = D::held(w).map_or(D::n_bodies(w), |a| a.len()) as u64;
+            rs.totals.bodies_held += held;
+            rs.totals.bodies_held_max = rs.totals.bodies_held_max.max(held);
         }
         if !self.local.now {
             return moved;

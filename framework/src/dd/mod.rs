@@ -254,7 +254,7 @@ impl<D: Family> NscddOf<D> {
     /// `families`: whether body families are attached (their scenes step every
     /// body on every rank).
     pub fn start_ranks(&mut self, w: &mut D::World, families: bool) {
-        self.start_held(w, !families && !self.by_model, true);
+        self.start_held(w, !families && !self.by_model);
     }
 
     /// Re-partitions every `k` steps (see [`Nscdd::repartition_every`]).
@@ -357,7 +357,7 @@ impl<D: Family> NscddOf<D> {
     /// parts and receives the others' packed results, [`LocalPart::pack`]).
     pub fn step_families(&mut self, w: &mut D::World, fams: &mut [&mut dyn Attached<D>]) -> Result<DdStepReport, Diverged> {
         self.pending = DdStepReport::default();
-        self.start_held(w, fams.is_empty() && !self.by_model, true);
+        self.start_held(w, fams.is_empty() && !self.by_model);
         let base = D::step_with(w, &mut Stage { dd: self, fams });
         self.after_step();
         let base = base?;
@@ -555,7 +555,9 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
     }
 }
 
-/// NSCDD without attached families as a contact stage (`world.step_with(&mut dd)`).
+/// NSCDD without attached families as a contact stage (`world.step_with(&mut dd)`),
+/// for one process: on MPI ranks step with [`NscddOf::step`], which also reduces each
+/// world to its rank's part and keeps the rank state between steps.
 impl<D: Family> ContactStage<D::World> for NscddOf<D> {
     fn before_detection(&mut self, w: &mut D::World) {
         Stage { dd: self, fams: &mut [] }.before_detection(w);

@@ -96,10 +96,11 @@ impl Owned {
         self.own_bodies::<D>(w, rs, grid);
     }
 
-    /// Before the first step of a run (every body held, a provisional `grid` and
-    /// `rs.rank_of` over the bodies' centres): the world keeps only this rank's
-    /// halo and the bodies every rank steps, so that the first step too runs with
-    /// bodies and contacts per rank (and re-partitions over its contacts).
+    /// Before the first step of a run or after a restart (every body held; a
+    /// provisional `grid` over the bodies' centres, or the saved one, and
+    /// `rs.rank_of`): the world keeps only this rank's halo, the bodies of its
+    /// contacts and the bodies every rank steps, so that the first step too runs
+    /// with bodies and contacts per rank.
     pub(super) fn start_held<D: Family>(&mut self, w: &mut D::World, rs: &RankState, grid: &Grid) {
         self.start::<D>(w, rs, grid);
         let mine = Region {
@@ -162,7 +163,7 @@ impl Owned {
         let to_me: Vec<&[f64]> = all.chunks_exact(per).filter(|x| x[0] as u32 == me).collect();
         let entering: Vec<(u32, &[f64])> = to_me.iter().map(|x| (x[1] as u32, &x[2..2 + D::BODY_RECORD])).collect();
         // the entering bodies take slots among the held ones: V_free (by slot) follows
-        let before: Option<Vec<u32>> = D::held(w).map(<[u32]>::to_vec);
+        let before: Option<Vec<u32>> = D::held(w).filter(|_| !entering.is_empty()).map(<[u32]>::to_vec);
         D::admit(w, &entering);
         remap::<D>(w, before.as_deref(), v_free);
         for x in to_me {

@@ -13,9 +13,10 @@ use super::ranks::RankState;
 /// ranks' subdomains' bodies it held, summed over the steps (`shell_bodies`), and
 /// the steps whose shells were limited to the bodies near it
 /// (`limited_shell_steps`, [`super::shells`]); the bodies its world held, summed
-/// over the steps (`bodies_held`, [`crate::world::held`]).
+/// over the steps (`bodies_held`, [`crate::world::held`]), and the most in one step
+/// (`bodies_held_max`).
 pub fn totals_json(st: &mut RankState) -> String {
-    const H: usize = 20;
+    const H: usize = 21;
     let p = st.cluster.size() as usize;
     let t = &st.totals;
     let (wait_wall, wait_cpu) = st.cluster.waited();
@@ -41,6 +42,7 @@ pub fn totals_json(st: &mut RankState) -> String {
         t.shell_bodies as f64,
         t.limited_shells as f64,
         t.bodies_held as f64,
+        t.bodies_held_max as f64,
         t.peers.len() as f64,
     ];
     mine.extend(t.peers.iter().map(|&x| x as f64));
@@ -75,6 +77,7 @@ pub fn totals_json(st: &mut RankState) -> String {
                 "shell_bodies": x[16] as u64,
                 "limited_shell_steps": x[17] as u64,
                 "bodies_held": x[18] as u64,
+                "bodies_held_max": x[19] as u64,
                 "peers": peers,
                 "last_subdomains": subs,
             })

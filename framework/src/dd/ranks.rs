@@ -80,8 +80,10 @@ pub struct RankTotals {
     /// all before a full step, to rank 0 for the outputs).
     pub bodies_stepped: u64,
     pub bodies_sent: u64,
-    /// Bodies this rank's world held in its steps (slots), summed over the steps.
+    /// Bodies this rank's world held in its steps (slots), summed over the steps,
+    /// and the most it held in one step.
     pub bodies_held: u64,
+    pub bodies_held_max: u64,
     /// Bodies of the other ranks' subdomains (shells) this rank held, summed over
     /// the steps, and the steps whose shells were limited ([`super::shells`]).
     pub shell_bodies: u64,

@@ -7,12 +7,18 @@
 //! saved numbers round-trip exactly through JSON); a decomposed run starts its gluing
 //! multipliers F_Γ from zero and repartitions at the first step, unless the scene
 //! is restarted with [`restart_scene`] and the state holds the NSCDD state of the
-//! same decomposition (`nscdd`, written by a one-process run): then it continues
-//! bitwise as well; body families' states (`families`) are read back the same way.
+//! same decomposition (`nscdd`, gathered from every rank on MPI ranks): then it
+//! continues bitwise as well; body families' states (`families`) are read back the
+//! same way.
 //!
 //! The scene may change anything that is not state: solver settings, the
 //! decomposition, outputs, the end time, drives. It may not change the bodies (their
 //! number and kinds are checked) nor the step h (the saved time must be step × h).
+//!
+//! The file is read as a stream ([`super::restart_stream`]): each body is written
+//! into the world as it is read, so a state that turns out bad leaves the world
+//! partly restarted — after an error, load the scene again before using it (the
+//! command line exits).
 
 use super::restart_stream::{StateSeed, Streamed};
 use crate::dim::Dim;
@@ -66,7 +72,7 @@ pub(super) struct SavedContact<D: Dim> {
 
 /// Loads the saved state in `path` into `w` (a world loaded from the scene that
 /// wrote it), read as a stream ([`super::restart_stream`]). Errors name the file,
-/// the line and the key.
+/// the line and the key; after one the world is partly restarted (module docs).
 pub fn restart<D: Dim>(w: &mut World<D>, path: &Path) -> Result<(), InputError> {
     restart_from(w, Source::File(path), false).map(|_| ())
 }
@@ -125,7 +131,8 @@ fn restart_from<D: Dim>(w: &mut World<D>, src: Source, parts: bool) -> Result<Pa
     };
     let ck = StateChecks::new(src);
     // a state without `dimension` is 2D (states written before it were)
-    if dimension.is_none() && D::N != 2 {
+    let other_dimension = failed.as_ref().is_some_and(|f| f.key == "dimension");
+    if dimension.is_none() && D::N != 2 && !other_dimension {
         return Err(ck.err(
             ck.line_of("dimension", 0),
             "dimension".into(),

@@ -9,7 +9,7 @@ use crate::dim::joint::Joint;
 use crate::dim::{Dim, Vector};
 use crate::model::{ContactKey, Contacts};
 use crate::world::World;
-use serde::de::{DeserializeSeed, IgnoredAny, MapAccess, SeqAccess, Visitor};
+use serde::de::{DeserializeSeed, Error as _, IgnoredAny, MapAccess, SeqAccess, Visitor};
 use std::fmt;
 
 /// A check that failed while reading: its key, its message, and the k-th
@@ -146,38 +146,18 @@ impl<'de, D: Dim> Visitor<'de> for BodiesSeed<'_, D> {
     }
     fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<usize, A::Error> {
         let nb = self.w.bodies.len();
-        let mut k = 0usize;
-        while k < nb {
+        let (mut k, mut first) = (0usize, None::<Failed>);
+        while k < nb && first.is_none() {
             let Some(sb) = seq.next_element::<SavedBody<D>>()? else { break };
-            if sb.id as usize != k {
-                return Err(fail(
-                    self.failed,
-                    format!("bodies[{k}].id"),
-                    format!("expected id {k}, found {}", sb.id),
-                    ("id", k),
-                ));
+            first = body_error(self.w, k, &sb);
+            if first.is_none() {
+                let b = &mut self.w.bodies;
+                (b.pos[k], b.rot[k], b.vel[k]) = (sb.position, sb.rot(), sb.velocity);
+                b.refresh_inverse(k);
             }
-            let kind = self.w.kind_name(k);
-            if sb.kind != kind {
-                let message = format!("the saved body is a `{}`, the scene's body {k} a `{kind}`", sb.kind);
-                return Err(fail(self.failed, format!("bodies[{k}].kind"), message, ("kind", k)));
-            }
-            let rot = sb.rot();
-            let finite = sb.position.as_ref().iter().chain(sb.velocity.as_ref()).all(|x| x.is_finite());
-            if !(finite && D::rot_finite(&rot)) {
-                return Err(fail(
-                    self.failed,
-                    format!("bodies[{k}]"),
-                    "non-finite state".into(),
-                    ("position", k),
-                ));
-            }
-            let b = &mut self.w.bodies;
-            (b.pos[k], b.rot[k], b.vel[k]) = (sb.position, rot, sb.velocity);
-            b.refresh_inverse(k);
             k += 1;
         }
-        // (bodies past the scene's are counted for the message)
+        // (the rest counted: a state of another body count says so first)
         while seq.next_element::<IgnoredAny>()?.is_some() {
             k += 1;
         }
@@ -185,8 +165,37 @@ impl<'de, D: Dim> Visitor<'de> for BodiesSeed<'_, D> {
             let message = format!("the saved state has {k} bodies, the scene {nb}: a restart needs the scene that wrote it");
             return Err(fail(self.failed, "bodies", message, ("bodies", 0)));
         }
+        if let Some(f) = first {
+            *self.failed = Some(f);
+            return Err(A::Error::custom("a failed check"));
+        }
         Ok(k)
     }
+}
+
+/// What is wrong with saved body `k` against the scene's: its id, its kind, a
+/// non-finite state.
+fn body_error<D: Dim>(w: &World<D>, k: usize, sb: &SavedBody<D>) -> Option<Failed> {
+    let failed = |key: String, message: String, at: (&'static str, usize)| {
+        Some(Failed {
+            key,
+            message,
+            at: Some(at),
+        })
+    };
+    if sb.id as usize != k {
+        return failed(format!("bodies[{k}].id"), format!("expected id {k}, found {}", sb.id), ("id", k));
+    }
+    let kind = w.kind_name(k);
+    if sb.kind != kind {
+        let message = format!("the saved body is a `{}`, the scene's body {k} a `{kind}`", sb.kind);
+        return failed(format!("bodies[{k}].kind"), message, ("kind", k));
+    }
+    let finite = sb.position.as_ref().iter().chain(sb.velocity.as_ref()).all(|x| x.is_finite());
+    if !(finite && D::rot_finite(&sb.rot())) {
+        return failed(format!("bodies[{k}]"), "non-finite state".into(), ("position", k));
+    }
+    None
 }
 
 /// The saved contacts (keys, impulses, bonds: the next step's warm start) as a
