@@ -67,6 +67,11 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     /// the world holds it.
     fn global(w: &Self::World, k: usize) -> usize;
     fn slot(w: &Self::World, g: usize) -> Option<usize>;
+    /// The slot of body `g`, which the world holds: every body NSCDD steps, glues
+    /// or exchanges is held (one that is not is a broken invariant: a panic).
+    fn held_slot(w: &Self::World, g: usize) -> usize {
+        Self::slot(w, g).expect(HELD)
+    }
     fn movable(w: &Self::World, g: usize) -> bool;
     fn inv_mass(w: &Self::World, g: usize) -> Self::InvMass;
     /// ρ² = I/m of body g (0 when undefined): the weight of rotations in the gluing

@@ -113,7 +113,7 @@ impl Local {
     /// The box of the pair (i, j) grown by `alert`: the region's pair test
     /// ([`Region::meets_pair`]).
     fn pair_box<D: Family>(&self, w: &D::World, [i, j]: [u32; 2], alert: f64) -> ([f64; 3], [f64; 3]) {
-        let slot = |g: u32| D::slot(w, g as usize).expect("a body of a contact is held");
+        let slot = |g: u32| D::held_slot(w, g as usize);
         let (bi, bj) = (&self.boxes[slot(i)], &self.boxes[slot(j)]);
         Region::pair_box(D::SPACE, (&bi[0], &bi[1]), (&bj[0], &bj[1]), alert)
     }
@@ -246,11 +246,9 @@ impl<D: Family> super::NscddOf<D> {
             return;
         }
         let grid = Grid::from_bounds(lo, hi, s.nx, s.ny, s.nz);
-        let mut loads = vec![0usize; grid.len()];
-        for &g in &movable {
-            loads[grid.cell_of(D::position(w, g)) as usize] += 1;
-        }
-        rs.rank_of = super::rank_balance::balanced_ranks(&loads, rs.cluster.size());
+        // the cells' ranks balanced by their bodies, as a repartition by its contacts
+        let cells: Vec<u32> = movable.iter().map(|&g| grid.cell_of(D::position(w, g))).collect();
+        rs.assign(&cells, grid.len(), true);
         self.local.owned.start_held::<D>(w, rs, &grid);
         self.grid = Some(grid);
     }
@@ -270,20 +268,13 @@ impl<D: Family> super::NscddOf<D> {
         if rs.rank_of.len() == grid.len() || self.grid_empty || self.local.held {
             return;
         }
-        let mut loads = vec![0usize; grid.len()];
-        for &(_, o) in &self.kept {
-            if let Some(l) = loads.get_mut(o as usize) {
-                *l += 1;
-            }
-        }
-        rs.rank_of = super::rank_balance::balanced_ranks(&loads, rs.cluster.size());
-        let me = rs.cluster.rank();
-        let rank_of = &rs.rank_of;
-        let own = |o: u32| rank_of.get(o as usize) == Some(&me);
+        // (the saved subdomains lie in the grid: `NscddOf::load_state` checks)
+        let kept_owners: Vec<u32> = self.kept.iter().map(|e| e.1).collect();
+        rs.assign(&kept_owners, grid.len(), true);
         let owner = super::owner::kept_owners::<D>(D::contacts(w), grid, &self.kept);
-        D::retain_contacts(w, &mut |a| own(owner[a]));
-        self.last.owner = owner.into_iter().filter(|&o| own(o)).collect();
-        self.kept.retain(|e| own(e.1));
+        D::retain_contacts(w, &mut |a| rs.is_own(owner[a]));
+        self.last.owner = owner.into_iter().filter(|&o| rs.is_own(o)).collect();
+        self.kept.retain(|e| rs.is_own(e.1));
         self.local.held = true;
         self.local.whole_store = true;
         self.local.owned.start_held::<D>(w, rs, grid);

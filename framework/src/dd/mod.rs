@@ -332,7 +332,7 @@ impl<D: Family> NscddOf<D> {
         self.last = partition::decompose_owned::<D>(w, &self.v_free, grid, owner, ns, &self.store, build.as_deref(), &fo, shells);
         // contacts held per rank: the other ranks' F_Γ are not kept up to date here
         if let (true, Some(rs)) = (self.local.now, self.ranks.as_mut()) {
-            let slot = |g: u32| D::slot(w, g as usize).expect("a body of an own subdomain is held");
+            let slot = |g: u32| D::held_slot(w, g as usize);
             rs.fresh_f_gamma(&mut self.last, &self.store, (&self.v_free, &slot));
         }
         rep.repartitioned = repart;
@@ -519,9 +519,7 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
     /// (the world's slots; NSCDD's global ids inside)
     fn after_integrate(&mut self, w: &mut D::World, moved: Result<(), usize>) -> Result<(), usize> {
         let moved = moved.map_err(|k| D::global(w, k));
-        self.dd
-            .after_integrate(w, moved)
-            .map_err(|g| D::slot(w, g).expect("the diverging body is held"))
+        self.dd.after_integrate(w, moved).map_err(|g| D::held_slot(w, g))
     }
     /// The counts outputs read ([`census`]), on the moved bodies (collective).
     fn after_update(&mut self, w: &mut D::World) {

@@ -148,11 +148,10 @@ impl Owned {
         let mut mine = Vec::new();
         let (mut was, mut to) = (Vec::new(), Vec::new());
         for &g in &self.mine {
-            let b = &boxes[D::slot(w, g as usize).expect("an owned body is held")];
-            entered(D::SPACE, (b, &old), (b, &new), alert, me, (&mut was, &mut to));
+            let k = D::held_slot(w, g as usize);
+            entered(D::SPACE, (&boxes[k], &old), (&boxes[k], &new), alert, me, (&mut was, &mut to));
             for &q in &to {
                 mine.extend([f64::from(q), f64::from(g)]);
-                let k = D::slot(w, g as usize).expect("an owned body is held");
                 D::step_record(w, g as usize, &v_free[k], &mut mine);
             }
         }
@@ -168,7 +167,7 @@ impl Owned {
         remap::<D>(w, before.as_deref(), v_free);
         for x in to_me {
             let g = x[1] as usize;
-            let k = D::slot(w, g).expect("an admitted body is held");
+            let k = D::held_slot(w, g);
             v_free[k] = D::set_step_record(w, g, &x[2..]);
             active.push(g as u32);
         }
@@ -203,7 +202,7 @@ impl Owned {
             let Some(cells) = self.cells.as_ref() else { return moved };
             let (mut was, mut to) = (Vec::new(), Vec::new());
             let mut entering = |g: u32| {
-                let k = D::slot(w, g as usize).expect("an owned body is held");
+                let k = D::held_slot(w, g as usize);
                 let (new, old) = (&now[k], &boxes[k]);
                 entered(D::SPACE, (old, cells), (new, cells), alert, me as u32, (&mut was, &mut to));
                 full_next || !to.is_empty()
@@ -248,7 +247,7 @@ impl Owned {
         D::set_active(w, candidates);
         D::body_boxes(w, boxes);
         crate::step::each_body(nb, D::stepped(w), |g| {
-            let (lo, hi) = grown(D::SPACE, &boxes[D::slot(w, g).expect("a stepped body is held")], alert);
+            let (lo, hi) = grown(D::SPACE, &boxes[D::held_slot(w, g)], alert);
             keep[g] |= self.everywhere[g] || mine.meets(D::SPACE, &lo, &hi);
         });
         let active: Vec<u32> = (0..nb as u32).filter(|&g| keep[g as usize]).collect();
@@ -269,7 +268,7 @@ fn remap<D: Family>(w: &D::World, before: Option<&[u32]>, v: &mut Vec<D::V>) {
     }
     let mut out = vec![D::V::default(); now.len()];
     for (k, &g) in before.iter().enumerate() {
-        out[D::slot(w, g as usize).expect("a held body stays held")] = v[k];
+        out[D::held_slot(w, g as usize)] = v[k];
     }
     *v = out;
 }

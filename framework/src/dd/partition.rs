@@ -216,7 +216,7 @@ pub fn decompose_owned<D: Family>(
         entity_interface(&mut iface, &mut subs, &*fam.fams[f], ec);
     }
     link_chains(&mut subs, &iface);
-    let slot = |g: u32| D::slot(w, g as usize).expect("a body of an own subdomain is held");
+    let slot = |g: u32| D::held_slot(w, g as usize);
     for sub in subs.iter_mut().filter(|s| built(s.id)) {
         sub.init_velocities(v_free, &slot);
     }

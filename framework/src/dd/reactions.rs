@@ -21,7 +21,7 @@ pub(super) fn set<D: Family>(d: &Decomposition<D>, w: &mut D::World, ranks: Opti
     // by slot: a subdomain's bodies on this rank are held here (its own, and the
     // observed bodies of the others, which every rank steps)
     let slots = D::held(w).map_or(D::n_bodies(w), <[u32]>::len);
-    let slot = |g: u32| D::slot(w, g as usize).expect("a body with a reaction is held");
+    let slot = |g: u32| D::held_slot(w, g as usize);
     let own = |s: u32| ranks.as_ref().is_none_or(|r| r.is_own(s));
     // each own subdomain's share, by local body
     let shares: Vec<Vec<D::V>> = d

@@ -279,7 +279,7 @@ pub(super) fn near_of<'a, D: Family>(local: &'a super::local::Local, w: &'a D::W
     Some(Near {
         cells: local.owned.cells.as_ref()?,
         boxes: &local.boxes,
-        slot: Box::new(move |g| D::slot(w, g as usize).expect("a body near a rank is held")),
+        slot: Box::new(move |g| D::held_slot(w, g as usize)),
         everywhere: local.owned.everywhere(),
         active: D::active(w)?,
         alert: D::alert(w),
