@@ -21,6 +21,7 @@ pub fn write_atomic(path: &std::path::Path, write: impl FnOnce(&std::path::Path)
 }
 
 use crate::dim::{Dim, Vector};
+use crate::model::ShapeRef;
 use crate::world::World;
 use serde::Serialize;
 
@@ -55,6 +56,25 @@ struct BodyOut<'a, D: Dim> {
     velocity: D::Twist,
     fixed: bool,
     shape: serde_json::Value,
+}
+
+impl<'a, D: Dim> BodyOut<'a, D> {
+    /// Body `g` of `w`'s scene from its moving state, shape, material and whether
+    /// it is fixed (its name given where the world holds it).
+    fn new(w: &'a World<D>, g: u32, (pos, rot, vel): (D::Point, D::Rot, D::Twist), sh: ShapeRef, (material, fixed): (u16, bool)) -> Self {
+        BodyOut {
+            id: g,
+            name: None,
+            kind: w.shapes[sh.kind as usize].kind(),
+            material: &w.materials[material as usize].name,
+            position: pos,
+            rotation: D::rot_to_vec(&rot),
+            quaternion: (D::N == 3).then_some(rot),
+            velocity: vel,
+            fixed,
+            shape: w.shapes[sh.kind as usize].describe(sh.index),
+        }
+    }
 }
 
 #[derive(Serialize)]
@@ -101,21 +121,14 @@ impl<D: Dim> Serialize for BodiesOut<'_, D> {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         let (w, b) = (self.0, &self.0.bodies);
         let held = (0..b.len()).map(|k| {
-            let sh = b.shape[k];
             let g = w.ids.global(k as u32);
+            let moving = (b.pos[k], b.rot[k], b.vel[k]);
+            let body = BodyOut::new(w, g, moving, b.shape[k], (b.material[k], w.fixed[k]));
             (
                 g,
-                BodyOut::<D> {
-                    id: g,
+                BodyOut {
                     name: w.names[k].as_deref(),
-                    kind: w.kind_name(k),
-                    material: &w.materials[b.material[k] as usize].name,
-                    position: b.pos[k],
-                    rotation: D::rot_to_vec(&b.rot[k]),
-                    quaternion: (D::N == 3).then_some(b.rot[k]),
-                    velocity: b.vel[k],
-                    fixed: w.fixed[k],
-                    shape: w.shapes[sh.kind as usize].describe(sh.index),
+                    ..body
                 },
             )
         });
@@ -141,20 +154,8 @@ impl<D: Dim> Serialize for BodiesOut<'_, D> {
             )));
         }
         let others = others.into_iter().map(|(g, x)| {
-            let ((pos, rot, vel), sh, material) = crate::world::held::read_output::<D>(x);
-            let body = BodyOut::<D> {
-                id: g,
-                name: None,
-                kind: w.shapes[sh.kind as usize].kind(),
-                material: &w.materials[material as usize].name,
-                position: pos,
-                rotation: D::rot_to_vec(&rot),
-                quaternion: (D::N == 3).then_some(rot),
-                velocity: vel,
-                fixed: false,
-                shape: w.shapes[sh.kind as usize].describe(sh.index),
-            };
-            (g, body)
+            let (moving, sh, material) = crate::world::held::read_output::<D>(x);
+            (g, BodyOut::new(w, g, moving, sh, (material, false)))
         });
         s.collect_seq(merge_by_id(held, others))
     }
