@@ -25,50 +25,7 @@ use crate::dim::Dim;
 use crate::error::InputError;
 use crate::world::World;
 use serde::de::DeserializeSeed;
-use serde::Deserialize;
 use std::path::Path;
-
-#[derive(Deserialize)]
-#[serde(bound = "")]
-pub(super) struct SavedBody<D: Dim> {
-    pub id: u32,
-    pub kind: String,
-    pub position: D::Point,
-    /// The angle in 2D, the rotation vector in 3D.
-    rotation: D::RotVec,
-    /// 3D: the exact orientation (the rotation vector is for reading).
-    #[serde(default)]
-    quaternion: Option<D::Rot>,
-    pub velocity: D::Twist,
-}
-
-impl<D: Dim> SavedBody<D> {
-    /// The saved orientation: the quaternion where given (3D), else the rotation.
-    pub fn rot(&self) -> D::Rot {
-        self.quaternion.unwrap_or_else(|| D::rot_from_vec(&self.rotation))
-    }
-}
-
-#[derive(Deserialize)]
-#[serde(bound = "")]
-pub(super) struct SavedContact<D: Dim> {
-    pub bodies: [u32; 2],
-    #[serde(default)]
-    pub feature: Option<u32>,
-    pub point: D::Point,
-    pub normal: D::Point,
-    /// The impulse in the contact frame (normal first).
-    #[serde(default)]
-    pub r: Option<D::Local>,
-    /// 2D states written before `r`: its two components.
-    #[serde(default)]
-    pub r_n: Option<f64>,
-    #[serde(default)]
-    pub r_t: Option<f64>,
-    pub gap: f64,
-    #[serde(default)]
-    pub bonded: bool,
-}
 
 /// Loads the saved state in `path` into `w` (a world loaded from the scene that
 /// wrote it), read as a stream ([`super::restart_stream`]). Errors name the file,

@@ -4,13 +4,55 @@
 //! held whole (a 55 000-sphere state is a 60 MB file, and every MPI rank reads it).
 //! A check that fails names its key; its line is looked up in the text only then.
 
-use super::restart::{SavedBody, SavedContact};
 use crate::dim::joint::Joint;
 use crate::dim::{Dim, Vector};
 use crate::model::{ContactKey, Contacts};
 use crate::world::World;
 use serde::de::{DeserializeSeed, Error as _, IgnoredAny, MapAccess, SeqAccess, Visitor};
+use serde::Deserialize;
 use std::fmt;
+
+#[derive(Deserialize)]
+#[serde(bound = "")]
+struct SavedBody<D: Dim> {
+    id: u32,
+    kind: String,
+    position: D::Point,
+    /// The angle in 2D, the rotation vector in 3D.
+    rotation: D::RotVec,
+    /// 3D: the exact orientation (the rotation vector is for reading).
+    #[serde(default)]
+    quaternion: Option<D::Rot>,
+    velocity: D::Twist,
+}
+
+impl<D: Dim> SavedBody<D> {
+    /// The saved orientation: the quaternion where given (3D), else the rotation.
+    fn rot(&self) -> D::Rot {
+        self.quaternion.unwrap_or_else(|| D::rot_from_vec(&self.rotation))
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(bound = "")]
+struct SavedContact<D: Dim> {
+    bodies: [u32; 2],
+    #[serde(default)]
+    feature: Option<u32>,
+    point: D::Point,
+    normal: D::Point,
+    /// The impulse in the contact frame (normal first).
+    #[serde(default)]
+    r: Option<D::Local>,
+    /// 2D states written before `r`: its two components.
+    #[serde(default)]
+    r_n: Option<f64>,
+    #[serde(default)]
+    r_t: Option<f64>,
+    gap: f64,
+    #[serde(default)]
+    bonded: bool,
+}
 
 /// A check that failed while reading: its key, its message, and the k-th
 /// occurrence of which key holds its line.
