@@ -407,33 +407,28 @@ fn decomposed_restart_continues_bitwise() {
     // a damaged NSCDD state: exit 2, the file, line and key named
     let saved = std::fs::read_to_string(&state).unwrap();
     let bad = dir.join("bad.json");
-    std::fs::write(&bad, saved.replacen("\"f_gamma\": [", "\"f_gamma\": 7, \"was\": [", 1)).unwrap();
+    let restart_from = |state: &str, out: &str| {
+        std::fs::write(&bad, state).unwrap();
+        let out = dir.join(out);
+        let o = nscdd(&[
+            "run".as_ref(),
+            whole.as_os_str(),
+            "--out".as_ref(),
+            out.as_os_str(),
+            "--restart".as_ref(),
+            bad.as_os_str(),
+        ]);
+        (o.status.code(), text(&o.stderr))
+    };
     let line = saved[..saved.find("\"f_gamma\"").unwrap()].lines().count();
-    let o = nscdd(&[
-        "run".as_ref(),
-        whole.as_os_str(),
-        "--out".as_ref(),
-        dir.join("bad").as_os_str(),
-        "--restart".as_ref(),
-        bad.as_os_str(),
-    ]);
-    let err = text(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    let (code, err) = restart_from(&saved.replacen("\"f_gamma\": [", "\"f_gamma\": 7, \"was\": [", 1), "bad");
+    assert_eq!(code, Some(2), "{err}");
     assert!(err.contains(&format!("bad.json:{line}")) && err.contains("nscdd"), "{err}");
     // a kept contact's subdomain past the grid's 4 cells: exit 2, the entry named
     let mut v: serde_json::Value = serde_json::from_str(&saved).unwrap();
     v["nscdd"]["kept"][0][1] = serde_json::json!(9);
-    std::fs::write(&bad, serde_json::to_string_pretty(&v).unwrap()).unwrap();
-    let o = nscdd(&[
-        "run".as_ref(),
-        whole.as_os_str(),
-        "--out".as_ref(),
-        dir.join("bad_kept").as_os_str(),
-        "--restart".as_ref(),
-        bad.as_os_str(),
-    ]);
-    let err = text(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    let (code, err) = restart_from(&serde_json::to_string_pretty(&v).unwrap(), "bad_kept");
+    assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("kept[0]: subdomain 9 of a grid of 4 cells"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -16,36 +16,28 @@ use mpi_common::*;
 #[test]
 fn a_state_written_by_p_ranks_restarts_on_other_rank_counts() {
     let dir = scratch("restart_ranks");
-    let whole = write(&dir, "pile.toml", PILE2D);
-    let half = write(&dir, "half.toml", &PILE2D.replace("steps = 15", "steps = 8"));
     let flags = ["--subdomains", "2x2", "--scheme", "decentralized"];
-    let one = dir.join("one");
-    ok(
-        &nscdd(&args(&whole, &one, &[&flags[..], &["--threads", "2"]].concat())),
-        "the uninterrupted run",
-    );
-    let reference = final_json(&one);
-    restarts_match(&dir, &whole, &half, &reference, &flags, "");
-    // contacts held per rank (re-partitioned every 3 steps: the state is written
-    // between two repartitions)
-    let whole = write(&dir, "held.toml", &every(PILE2D, 3));
-    let half = write(&dir, "held_half.toml", &every(&PILE2D.replace("steps = 15", "steps = 8"), 3));
-    let one = dir.join("held-one");
-    ok(
-        &nscdd(&args(&whole, &one, &[&flags[..], &["--threads", "2"]].concat())),
-        "held, uninterrupted",
-    );
-    restarts_match(&dir, &whole, &half, &final_json(&one), &flags, "held-");
-    // re-partitioned every 4 steps: the state is written just before a repartition
-    let whole = write(&dir, "rep.toml", &every(PILE2D, 4));
-    let half = write(&dir, "rep_half.toml", &every(&PILE2D.replace("steps = 15", "steps = 8"), 4));
-    let one = dir.join("rep-one");
-    ok(
-        &nscdd(&args(&whole, &one, &[&flags[..], &["--threads", "2"]].concat())),
-        "re-partitioned, uninterrupted",
-    );
-    restarts_match(&dir, &whole, &half, &final_json(&one), &flags, "rep-");
+    // every rank holding every contact; contacts held per rank, re-partitioned every
+    // 3 steps (the state written between two repartitions) and every 4 (just
+    // before one)
+    for (tag, every_k) in [("", None), ("held-", Some(3)), ("rep-", Some(4))] {
+        let scene = |text: &str| every_k.map_or(text.to_string(), |k| every(text, k));
+        let whole = write(&dir, &format!("{tag}pile.toml"), &scene(PILE2D));
+        let half = write(&dir, &format!("{tag}half.toml"), &scene(&PILE2D.replace("steps = 15", "steps = 8")));
+        let reference = uninterrupted(&dir, &whole, &flags, tag);
+        restarts_match(&dir, &whole, &half, &reference, &flags, tag);
+    }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `whole` in one process with 2 threads: its final.json.
+fn uninterrupted(dir: &Path, whole: &Path, flags: &[&str], tag: &str) -> String {
+    let one = dir.join(format!("{tag}one"));
+    ok(
+        &nscdd(&args(whole, &one, &[flags, &["--threads", "2"]].concat())),
+        &format!("{tag}uninterrupted"),
+    );
+    final_json(&one)
 }
 
 /// `half` on P ranks, then `whole` restarted from its state on P′: the reference's
@@ -92,12 +84,7 @@ fn a_3d_state_restarts_on_other_rank_counts() {
     let dir = scratch("restart_ranks3");
     let flags = ["--subdomains", "2x2x1", "--scheme", "decentralized"];
     let whole = write(&dir, "pile3d.toml", &every(&PILE3D.replace("steps = 10", "steps = 16"), 5));
-    let one = dir.join("one");
-    ok(
-        &nscdd(&args(&whole, &one, &[&flags[..], &["--threads", "2"]].concat())),
-        "the uninterrupted run",
-    );
-    let reference = final_json(&one);
+    let reference = uninterrupted(&dir, &whole, &flags, "");
     for (at, tag) in [(10, "rep-"), (12, "mid-")] {
         let half = write(
             &dir,
