@@ -3,11 +3,17 @@
 each other and with LMGC90's iteration counts.
 
     python3 scripts/lmgc_biaxial_compare.py REF_DIR [OTHER_DIR ...]
+    python3 scripts/lmgc_biaxial_compare.py --seeds SEED_DIR,SEED_DIR,... [OTHER_DIR ...]
 
 For each run: mean NLGS sweeps per step (all steps, and per ε1 range as in LMGC90's
 README), mean time per step of the stages (history.csv's t_* columns), and the RMS
 and max deviation of sin φ(ε1) (centred moving average over 51 steps) and ν(ε1)
 from the first run's curves.
+
+With --seeds (runs of the same solver that differ by the seed of their contact
+permutations only), the curves are compared with the seeds' mean instead: each
+seed by its distance to the mean of the *other* seeds (leave one out: the test's
+own scatter), every other run by its distance to the mean of all the seeds.
 """
 import csv
 import os
@@ -20,9 +26,17 @@ LMGC = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "sha
 RANGES = [(0.0, 0.005), (0.005, 0.03), (0.03, 0.1), (0.1, 0.2), (0.2, 0.35)]
 
 
+def number(v):
+    """A history value as a float (NaN for an empty or non-numeric one, e.g. a method's name)."""
+    try:
+        return float(v)
+    except ValueError:
+        return float("nan")
+
+
 def rows_of(d):
     with open(os.path.join(d, "history.csv")) as f:
-        return [{k: float(v) if v not in ("", "NaN") else float("nan") for k, v in r.items()} for r in csv.DictReader(f)]
+        return [{k: number(v) for k, v in r.items()} for r in csv.DictReader(f)]
 
 
 def by_range(eps, vals):
@@ -52,10 +66,52 @@ def lmgc():
     return total, ranges
 
 
+def curves(d):
+    rows = rows_of(d)
+    eps = [r["eps1"] for r in rows]
+    return (eps, smooth([r["sin_phi"] for r in rows], 25)), (eps, [r["solid_fraction"] for r in rows])
+
+
+def mean_curve(cs, npts=400):
+    """The mean of curves (x, y) on a common grid of x (linear interpolation)."""
+    lo, hi = max(c[0][0] for c in cs), min(c[0][-1] for c in cs)
+    grid = [lo + (hi - lo) * i / (npts - 1) for i in range(npts)]
+
+    def at(xs, ys, x):
+        import bisect
+
+        k = min(max(bisect.bisect_left(xs, x) - 1, 0), len(xs) - 2)
+        a, b = xs[k], xs[k + 1]
+        return ys[k] if b == a else ys[k] + (ys[k + 1] - ys[k]) * (x - a) / (b - a)
+
+    return grid, [sum(at(c[0], c[1], x) for c in cs) / len(cs) for x in grid]
+
+
+def scatter(seeds, others):
+    """Distances of sin φ(ε1) and ν(ε1) to the seeds' mean (leave one out for a seed)."""
+    cs = {d: curves(d) for d in seeds + others}
+    print("| run | RMS dev sin φ from the seeds' mean | max | RMS dev ν | max |")
+    print("|---|---|---|---|---|")
+    for d in seeds + others:
+        pool = [cs[e] for e in seeds if e != d]
+        sin_ref, nu_ref = mean_curve([c[0] for c in pool]), mean_curve([c[1] for c in pool])
+        a, b = deviation(sin_ref, cs[d][0])
+        c, e = deviation(nu_ref, cs[d][1])
+        tag = " (seed, leave one out)" if d in seeds else ""
+        print(f"| {d}{tag} | {a:.4f} | {b:.4f} | {c:.5f} | {e:.5f} |")
+
+
 def main():
-    dirs = sys.argv[1:]
+    args = sys.argv[1:]
+    seeds = []
+    if args[:1] == ["--seeds"] and len(args) > 1:
+        seeds, args = args[1].split(","), args[2:]
+    dirs = seeds + args
     if not dirs:
         sys.exit(__doc__)
+    if seeds:
+        scatter(seeds, args)
+        print()
     total, ranges = lmgc()
     head = "| run | steps | sweeps/step | " + " | ".join(f"ε1 {lo}–{hi}" for lo, hi in RANGES) + " | s/step (detect+delassus+nlgs+update) | RMS dev sin φ | max dev sin φ | RMS dev ν | max dev ν |"
     print(head)

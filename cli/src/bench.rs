@@ -121,7 +121,7 @@ pub fn nlgs<D: nscdd::scene::schema::SceneDim>(reg: &Registry, name: &str, scene
     }
     let c = &mut w.contacts;
     let mut order = vec![];
-    nlgs::make_order(&mut order, c.len(), &w.solver, 0);
+    nlgs::make_order(&mut order, c.len(), &w.solver, 0, D::N, |a| c.point3(a));
     let mut vel = w.bodies.vel.clone();
     let t = Instant::now();
     for _ in 0..sweeps {

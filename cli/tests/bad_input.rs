@@ -304,6 +304,18 @@ fn solver_settings_a_method_cannot_use() {
             "solver.ordering",
             "ordering",
         ),
+        (
+            "sort_direction_unsorted",
+            "sort_direction = [0.0, 1.0]",
+            "solver.sort_direction",
+            "sort_direction",
+        ),
+        (
+            "sort_direction_zero",
+            "ordering = \"sorted\"\nsort_direction = [0.0, 0.0]",
+            "solver.sort_direction",
+            "sort_direction",
+        ),
     ] {
         let scene = edit(BASE, "[[materials]]", &format!("[solver]\n{solver}\n\n[[materials]]"));
         check_bad(&Case { name, scene, key, marker });

@@ -132,7 +132,8 @@ impl<D: Dim> World<D> {
         let t1 = Instant::now();
         stage.after_free_velocity(self);
         build_contacts(self);
-        nlgs::make_order(&mut self.scratch.order, self.contacts.len(), &self.solver, self.step);
+        let c = &self.contacts;
+        nlgs::make_order(&mut self.scratch.order, c.len(), &self.solver, self.step, D::N, |a| c.point3(a));
         stage.prepare(self);
         let t2 = Instant::now();
         rep.solve = stage.solve(self);

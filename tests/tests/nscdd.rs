@@ -395,7 +395,7 @@ fn centralized_and_decentralized_agree_bitwise() {
 #[test]
 fn one_subdomain_is_the_plain_engine_with_every_ordering() {
     use nscdd::solver::Ordering;
-    for o in [Ordering::Reversed, Ordering::Shuffled] {
+    for o in [Ordering::Reversed, Ordering::Shuffled, Ordering::Sorted] {
         let (mut a, mut b) = (loaded(0.3), loaded(0.3));
         a.world.solver.ordering = o;
         b.world.solver.ordering = o;
@@ -406,6 +406,28 @@ fn one_subdomain_is_the_plain_engine_with_every_ordering() {
             assert_eq!((ra.solve.sweeps, ra.solve.norms), (rb.solve.sweeps, rb.solve.norms));
         }
         same_state(&a, &b, &format!("{o:?}"));
+    }
+}
+
+/// `sorted` with subdomains: each subdomain visits its own contacts from the bottom
+/// up, and the result does not depend on the threads.
+#[test]
+fn sorted_orders_each_subdomain_along_its_direction() {
+    let run = |threads: usize| {
+        let mut s = loaded(0.3);
+        s.world.solver.ordering = nscdd::solver::Ordering::Sorted;
+        let mut n = Nscdd::new(DdSettings { threads, ..dd(2, 2) });
+        let reps: Vec<_> = (0..3).map(|_| dd_step(&mut n, &mut s).solve.sweeps).collect();
+        (s, n, reps)
+    };
+    let (a, n, ra) = run(1);
+    let (b, _, rb) = run(2);
+    same_state(&a, &b, "sorted, 1 and 2 threads");
+    assert_eq!(ra, rb);
+    for sub in &n.last.subs {
+        let y: Vec<f64> = sub.order.iter().map(|&l| sub.contacts.point[l as usize][1]).collect();
+        assert_eq!(sub.order.len(), sub.contact_global.len(), "subdomain {}", sub.id);
+        assert!(y.windows(2).all(|w| w[0] <= w[1]), "subdomain {}: not from the bottom up", sub.id);
     }
 }
 

@@ -232,6 +232,10 @@ fn settings_a_method_cannot_use_are_refused() {
     refused("relaxation = 2.0", "solver.relaxation");
     refused("relaxation = 0.0", "solver.relaxation");
     refused("method = \"anderson\"\nordering = \"scrambled\"", "solver.ordering");
+    refused("method = \"newton\"\nordering = \"sorted\"", "solver.ordering");
+    refused("sort_direction = [0.0, 1.0]", "solver.sort_direction");
+    refused("ordering = \"sorted\"\nsort_direction = [0.0, 0.0]", "solver.sort_direction");
+    refused("ordering = \"sorted\"\nsort_direction = [0.0, 1.0, 0.0]", "solver.sort_direction");
     // Newton has no place between NSCDD's gluing stages
     let text = deposit("method = \"newton\"").replace("[[materials]]", "[decomposition]\nnx = 2\nny = 1\n\n[[materials]]");
     let mut s = load(&text).unwrap();
@@ -350,5 +354,34 @@ fn over_relaxed_sweeps_step_the_deposit() {
             }
             assert!((top(&s) - top(&plain)).abs() < 1e-3, "{label}: top {} vs {}", top(&s), top(&plain));
         }
+    }
+}
+
+/// `ordering = "sorted"`: from the bottom up (against gravity) unless a direction is
+/// given; the deposit settles as with storage order.
+#[test]
+fn sorted_goes_against_gravity_or_along_the_direction() {
+    let up = load(&deposit("ordering = \"sorted\"")).unwrap();
+    assert_eq!(up.world.solver.sort_direction.as_deref(), Some(&[-0.0, 9.81][..]));
+    let s = load(&deposit("ordering = \"sorted\"\nsort_direction = [1.0, 0.0]")).unwrap();
+    assert_eq!(s.world.solver.sort_axis(2), [1.0, 0.0, 0.0]);
+    for mut s in [up, s] {
+        let mut last = None;
+        for _ in 0..100 {
+            last = Some(s.world.step().unwrap());
+        }
+        assert!(last.unwrap().solve.converged);
+        let d = s.world.solver.sort_axis(2);
+        let c = &s.world.contacts;
+        let order = <nscdd::dd::Rigid2 as nscdd::dd::Family>::order(&s.world);
+        let along: Vec<f64> = order
+            .iter()
+            .map(|&a| {
+                let p = c.point3(a as usize);
+                d[0] * p[0] + d[1] * p[1]
+            })
+            .collect();
+        assert_eq!(along.len(), c.len());
+        assert!(along.windows(2).all(|w| w[0] <= w[1]), "{d:?}: not sorted");
     }
 }

@@ -213,9 +213,7 @@ impl<D: Dim> Family for Rigid<D> {
         c.key[a]
     }
     fn point(c: &Self::Contacts, a: usize) -> [f64; 3] {
-        let mut p = [0.0; 3];
-        p[..D::N].copy_from_slice(c.point[a].as_ref());
-        p
+        c.point3(a)
     }
     fn copy_r(dst: &mut Self::Contacts, ga: usize, src: &Self::Contacts, la: usize) {
         dst.r[ga] = src.r[la];

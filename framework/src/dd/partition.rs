@@ -158,8 +158,9 @@ pub struct FamilyOwners<'a, 'f, D: Family> {
 /// contact, each below `ns`), and the attached families' contacts by theirs;
 /// copies start at V_free + M̂_E⁻¹(F_Γ + H_E r).
 /// Each subdomain visits its contacts in the scene's `ordering` of its own
-/// (`nlgs::make_order_of`: storage order, reversed, or a permutation seeded by the
-/// step and the subdomain id), which needs no other subdomain's contacts.
+/// (`nlgs::make_order_of`: storage order, reversed, a permutation seeded by the
+/// step and the subdomain id, or sorted along a direction), which needs no other
+/// subdomain's contacts.
 /// With `build`, only the subdomains it marks get their copies' M̂_E⁻¹, W_αα and
 /// starting velocities (the others are swept by another process: their structure
 /// alone is kept, for the exchange of results; no attached family then).
@@ -194,7 +195,10 @@ pub fn decompose_owned<D: Family>(
     let (sv, step) = (D::solver(w), D::step(w));
     for sub in subs.iter_mut() {
         if built(sub.id) {
-            crate::solver::nlgs::make_order_of(&mut sub.order, sub.contact_global.len(), sv, step, sub.id as u64);
+            let c = &sub.contacts;
+            crate::solver::nlgs::make_order_of(&mut sub.order, sub.contact_global.len(), sv, step, sub.id as u64, D::SPACE, |a| {
+                D::point(c, a)
+            });
             sub.inv_mass = sub
                 .body_global
                 .iter()

@@ -79,6 +79,12 @@ impl<D: Dim> Contacts<D> {
     pub fn is_empty(&self) -> bool {
         self.bodies.is_empty()
     }
+    /// Contact `a`'s point as three coordinates (z = 0 in 2D).
+    pub fn point3(&self, a: usize) -> [f64; 3] {
+        let mut p = [0.0; 3];
+        p[..D::N].copy_from_slice(self.point[a].as_ref());
+        p
+    }
     pub fn clear(&mut self) {
         each_field!(self, clear);
         self.compliance.clear();

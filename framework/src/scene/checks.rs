@@ -281,7 +281,20 @@ pub(crate) fn time_settings<B>(cx: &Ctx, sf: &SceneFile<B>) -> Result<TimeSettin
     })
 }
 
-pub(crate) fn validate_solver(cx: &Ctx, s: &crate::solver::SolverSettings) -> Result<(), InputError> {
+/// The scene's `[solver]`, checked, with `sort_direction` resolved (a scene of
+/// gravity `gravity`).
+pub(crate) fn solver_settings(
+    cx: &Ctx,
+    s: &crate::solver::SolverSettings,
+    gravity: &[f64],
+) -> Result<crate::solver::SolverSettings, InputError> {
+    validate_solver(cx, s)?;
+    let mut s = s.clone();
+    sort_direction(cx, &mut s, gravity)?;
+    Ok(s)
+}
+
+fn validate_solver(cx: &Ctx, s: &crate::solver::SolverSettings) -> Result<(), InputError> {
     let p = |key: &str| vec![k("solver"), k(key)];
     // below 1e-15 the norms (relative to the impulses' scale) are under the round-off
     // of double precision: no solve reaches it, every step runs to max_sweeps
@@ -326,6 +339,30 @@ pub(crate) fn validate_solver(cx: &Ctx, s: &crate::solver::SolverSettings) -> Re
         return Err(cx.err(&p("ordering"), msg));
     }
     Ok(())
+}
+
+/// `[solver] sort_direction`: read by `ordering = "sorted"` alone, D finite numbers
+/// not all zero; for `sorted` without it, against gravity (from the bottom up), or
+/// (left unset) along the last axis, y in 2D and z in 3D, in a scene without gravity.
+fn sort_direction(cx: &Ctx, s: &mut crate::solver::SolverSettings, gravity: &[f64]) -> Result<(), InputError> {
+    let key = [k("solver"), k("sort_direction")];
+    let n = gravity.len();
+    let sorted = s.ordering == crate::solver::Ordering::Sorted;
+    match s.sort_direction.as_deref() {
+        Some(_) if !sorted => Err(cx.err(
+            &key,
+            "`sort_direction` is the direction of ordering = \"sorted\" only (remove it or set ordering = \"sorted\")",
+        )),
+        Some(d) if d.len() != n || d.iter().any(|x| !x.is_finite()) || d.iter().all(|&x| x == 0.0) => Err(cx.err(
+            &key,
+            format!("must be {n} finite numbers, not all zero (a direction of the scene's {n}D space)"),
+        )),
+        None if sorted && gravity.iter().any(|&g| g != 0.0) => {
+            s.sort_direction = Some(gravity.iter().map(|g| -g).collect());
+            Ok(())
+        }
+        _ => Ok(()),
+    }
 }
 
 pub(crate) fn materials<B>(cx: &Ctx, sf: &SceneFile<B>) -> Result<Vec<Material>, InputError> {

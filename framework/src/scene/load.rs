@@ -21,7 +21,7 @@ pub(crate) fn load_parsed<D: SceneDim>(cx: &Ctx, sf: SceneFile<BodySpec<D>>, reg
         return Err(cx.err(&[k("decomposition"), k("nz")], "`nz` splits along z: 3D scenes only"));
     }
     let time = super::time_settings(cx, &sf)?;
-    super::validate_solver(cx, &sf.solver)?;
+    let solver = super::solver_settings(cx, &sf.solver, gravity.as_ref())?;
     let materials = super::materials(cx, &sf)?;
     let mut b = SceneBuilder::<D>::new(registry, materials);
     let mut drives = vec![];
@@ -89,7 +89,7 @@ pub(crate) fn load_parsed<D: SceneDim>(cx: &Ctx, sf: SceneFile<BodySpec<D>>, reg
         fixed: b.fixed,
         gravity,
         time,
-        solver: sf.solver,
+        solver,
         alert,
         box_walls,
         box_h0: None,

@@ -21,6 +21,12 @@ pub enum Ordering {
     /// LMGC90's "quick scramble": a new random permutation before every block of
     /// `check_every` sweeps (one-domain NLGS).
     Scrambled,
+    /// By the contact points' coordinate along [`SolverSettings::sort_direction`]
+    /// (by default against gravity: from the bottom up), ties in storage order:
+    /// a sweep then carries a change across the sample along that direction in one
+    /// pass (on LMGC90's biaxial test, 22 % fewer sweeps than LMGC90's quick
+    /// scramble; docs/PERFORMANCE.md).
+    Sorted,
 }
 
 /// The contact solver of a step (`[solver] method`).
@@ -70,6 +76,11 @@ pub struct SolverSettings {
     /// (projected) above.
     pub relaxation: f64,
     pub ordering: Ordering,
+    /// The direction along which `sorted` visits the contacts (D numbers; none:
+    /// along the last axis, y in 2D and z in 3D). The scene loader sets it against
+    /// gravity when the scene has gravity and the key is absent; it refuses it with
+    /// another ordering.
+    pub sort_direction: Option<Vec<f64>>,
     pub seed: u64,
     /// `nlgs` (default), `anderson` or `newton`.
     pub method: Method,
@@ -102,6 +113,7 @@ impl Default for SolverSettings {
             check_every: 10,
             relaxation: 1.0,
             ordering: Ordering::Stored,
+            sort_direction: None,
             seed: 0,
             method: Method::Nlgs,
         }
@@ -109,6 +121,16 @@ impl Default for SolverSettings {
 }
 
 impl SolverSettings {
+    /// The direction of `sorted` in a space of `space` dimensions as three
+    /// coordinates: [`SolverSettings::sort_direction`], or the last axis.
+    pub fn sort_axis(&self, space: usize) -> [f64; 3] {
+        let mut d = [0.0; 3];
+        match self.sort_direction.as_deref() {
+            Some(v) => v.iter().take(3).enumerate().for_each(|(i, &x)| d[i] = x),
+            None => d[space.clamp(1, 3) - 1] = 1.0,
+        }
+        d
+    }
     /// The NLGS loop: `sweep` does one sweep over the contacts, accumulating the
     /// check sums when it gets them (every `check_every` sweeps and at the last
     /// one); the loop stops when the criterion holds or after `max_sweeps`. The

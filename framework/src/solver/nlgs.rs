@@ -49,15 +49,25 @@ use rand::seq::SliceRandom;
 use rand::SeedableRng;
 
 /// Fills `order` with the visiting order of this step's contacts (left empty for
-/// storage order).
-pub fn make_order(order: &mut Vec<u32>, n: usize, s: &SolverSettings, step: u64) {
-    make_order_of(order, n, s, step, 0)
+/// storage order); `point(a)` is contact a's point in a space of `space`
+/// dimensions (read by `sorted` only).
+pub fn make_order(order: &mut Vec<u32>, n: usize, s: &SolverSettings, step: u64, space: usize, point: impl Fn(usize) -> [f64; 3]) {
+    make_order_of(order, n, s, step, 0, space, point)
 }
 
 /// [`make_order`] for part `part` of a step's contacts (NSCDD's subdomain `part`):
 /// its own permutation for `shuffled`, seeded by the step and the part (part 0: the
 /// one-domain permutation), so that a subdomain's order needs only its own contacts.
-pub fn make_order_of(order: &mut Vec<u32>, n: usize, s: &SolverSettings, step: u64, part: u64) {
+#[allow(clippy::too_many_arguments)]
+pub fn make_order_of(
+    order: &mut Vec<u32>,
+    n: usize,
+    s: &SolverSettings,
+    step: u64,
+    part: u64,
+    space: usize,
+    point: impl Fn(usize) -> [f64; 3],
+) {
     order.clear();
     match s.ordering {
         // empty: storage order, visited without indirection
@@ -70,6 +80,27 @@ pub fn make_order_of(order: &mut Vec<u32>, n: usize, s: &SolverSettings, step: u
             );
             order.shuffle(&mut rng);
         }
+        Ordering::Sorted => {
+            let d = s.sort_axis(space);
+            let along = |a: usize| {
+                let p = point(a);
+                d[0] * p[0] + d[1] * p[1] + d[2] * p[2]
+            };
+            order.extend(0..n as u32);
+            // the coordinate as an integer of the same order (IEEE 754's total order),
+            // then storage order: one key, no ties
+            order.sort_by_cached_key(|&a| (total_order_bits(along(a as usize)), a));
+        }
+    }
+}
+
+/// An f64's bits as a u64 in the order of the numbers (IEEE 754 total order).
+fn total_order_bits(x: f64) -> u64 {
+    let b = x.to_bits();
+    if b >> 63 == 1 {
+        !b
+    } else {
+        b | (1 << 63)
     }
 }
 
@@ -365,6 +396,24 @@ mod tests {
     }
 
     #[test]
+    fn sorted_visits_along_the_direction_ties_in_storage_order() {
+        let pts = [[0.0, 2.0, 0.0], [5.0, -1.0, 0.0], [1.0, 2.0, 0.0], [-3.0, 0.5, 0.0]];
+        let mut s = SolverSettings {
+            ordering: Ordering::Sorted,
+            ..Default::default()
+        };
+        let mut order = vec![];
+        // none given: the last axis (y in 2D), ties (contacts 0 and 2) in storage order
+        make_order(&mut order, 4, &s, 0, 2, |a| pts[a]);
+        assert_eq!(order, [1, 3, 0, 2]);
+        s.sort_direction = Some(vec![-1.0, 0.0]);
+        make_order(&mut order, 4, &s, 0, 2, |a| pts[a]);
+        assert_eq!(order, [1, 2, 0, 3]);
+        assert_eq!(total_order_bits(-0.0) < total_order_bits(0.0), true);
+        assert!(total_order_bits(-2.0) < total_order_bits(-1.0) && total_order_bits(1.0) < total_order_bits(2.0));
+    }
+
+    #[test]
     fn scrambled_and_shuffled_orders_converge_to_the_same_impulses() {
         let solve_with = |ordering| {
             let (mut c, mut vel, inv) = column(30);
@@ -376,7 +425,7 @@ mod tests {
                 ..Default::default()
             };
             let mut order = vec![];
-            make_order(&mut order, c.len(), &s, 7);
+            make_order(&mut order, c.len(), &s, 7, 2, |a| c.point3(a));
             let rep = solve(&mut c, &mut vel, &inv, &mut order, &s);
             assert!(rep.converged, "{ordering:?}: {rep:?}");
             (c.r, rep.sweeps)
