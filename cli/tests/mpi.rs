@@ -442,3 +442,40 @@ fn deformable_scenes_on_ranks_give_the_one_process_result() {
     assert!(err.contains("no decomposition"), "{err}");
     assert!(!out.join("final.json").exists());
 }
+
+/// Rank 0 merges the other ranks' bodies and contacts as it writes `final.json` and
+/// the checkpoints, a bounded number of records per round (`dd::rank_merge`): with
+/// two records per round (many rounds) the files are still the one process's, byte
+/// for byte, and the rounds show in the reductions.
+#[test]
+fn outputs_merged_in_small_rounds_are_the_one_process_files() {
+    let dir = scratch("merge");
+    let text = every(PILE2D, 4).replace("[output]\n", "[output]\ncheckpoint_every = 8\n");
+    let scene = write(&dir, "held.toml", &text);
+    let flags = ["--subdomains", "2x2"];
+    let one = dir.join("one");
+    ok(&nscdd(&args(&scene, &one, &flags)), "the one-process run");
+    let reduce = |out: &Path| -> u64 {
+        let r: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("ranks.json")).expect("ranks.json")).expect("json");
+        r["per_rank"][0]["reduce_messages"].as_u64().expect("reduce_messages")
+    };
+    let mut counts = vec![];
+    for chunk in [None, Some("2")] {
+        let out = dir.join(format!("ranks4-{}", chunk.unwrap_or("default")));
+        let mut c = mpirun_command(&[(4, args(&scene, &out, &flags))]);
+        if let Some(k) = chunk {
+            c.env("NSCDD_MERGE_RECORDS", k);
+        }
+        ok(&run_limited(c), "4 ranks");
+        assert!(
+            final_json(&out) == final_json(&one),
+            "{chunk:?}: final.json differs from one process"
+        );
+        let read = |d: &Path| std::fs::read(d.join("checkpoint.json")).expect("checkpoint.json");
+        assert!(read(&out) == read(&one), "{chunk:?}: checkpoint.json differs from one process");
+        counts.push(reduce(&out));
+    }
+    assert!(counts[1] > counts[0] + 20, "rounds of two records: {counts:?} reductions");
+    let _ = std::fs::remove_dir_all(&dir);
+}

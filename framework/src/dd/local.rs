@@ -452,11 +452,12 @@ impl<D: Family> super::NscddOf<D> {
         Some(mine)
     }
 
-    /// With bodies held per rank, every body's record from its owner to rank 0
-    /// (collective; before rank 0 writes the state): `[g, record…]` chunks on rank 0
-    /// ([`Family::output_record`]), `None` elsewhere or when every rank holds every
+    /// With bodies held per rank, the records of the bodies this rank owns (the
+    /// writer of their outputs), `[g, record…]` ascending in g
+    /// ([`Family::output_record`]), for rank 0's merge of every rank's
+    /// ([`super::rank_merge`]); `None` in one process or when every rank holds every
     /// body.
-    pub fn gather_bodies(&mut self, w: &D::World) -> Option<Vec<f64>> {
+    pub fn own_body_records(&mut self, w: &D::World) -> Option<Vec<f64>> {
         let mine = self.owned_bodies(w)?;
         let rs = self.ranks.as_mut()?;
         let mut out = Vec::new();
@@ -464,26 +465,16 @@ impl<D: Family> super::NscddOf<D> {
             out.push(g as f64);
             D::output_record(w, g, &mut out);
         }
-        let root = rs.cluster.rank() == 0;
-        if !root {
+        if rs.cluster.rank() != 0 {
             rs.totals.bodies_sent += (out.len() / (1 + D::OUTPUT_RECORD)) as u64;
         }
-        let all = rs.gather_any_on_root(&out);
-        root.then_some(all)
+        Some(out)
     }
 
     /// Whether the world holds this rank's contacts only (the last step ran with
-    /// contacts held per rank): outputs of every contact gather them
-    /// ([`super::NscddOf::gather_on_root`]).
+    /// contacts held per rank): outputs of every contact merge every rank's on rank
+    /// 0 ([`super::rank_merge`]).
     pub fn holds_own_contacts(&self) -> bool {
         self.local.held
-    }
-
-    /// Every rank's `mine` concatenated on rank 0 (collective; None elsewhere, or in
-    /// one process).
-    pub fn gather_on_root(&mut self, mine: &[f64]) -> Option<Vec<f64>> {
-        let rs = self.ranks.as_mut()?;
-        let all = rs.gather_any_on_root(mine);
-        (rs.cluster.rank() == 0).then_some(all)
     }
 }

@@ -60,6 +60,7 @@ mod rank_ask;
 mod rank_balance;
 mod rank_fresh;
 mod rank_link;
+pub mod rank_merge;
 mod rank_reduce;
 mod rank_share;
 mod rank_totals;

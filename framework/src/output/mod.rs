@@ -24,6 +24,7 @@ use crate::dim::{Dim, Vector};
 use crate::model::ShapeRef;
 use crate::world::World;
 use serde::Serialize;
+use std::cell::RefCell;
 
 /// Writes extra outputs every `output.every` steps (`[output] writers = [...]`).
 pub trait Writer<D: Dim>: Send {
@@ -96,14 +97,14 @@ struct ContactOut<D: Dim> {
 
 #[derive(Serialize)]
 #[serde(bound = "")]
-struct FinalOut<'a, D: Dim, N: Serialize> {
+struct FinalOut<'a, 'p, D: Dim, N: Serialize> {
     dimension: u8,
     step: u64,
     time: f64,
     #[serde(skip_serializing_if = "Option::is_none")]
     box_h0: Option<f64>,
-    bodies: BodiesOut<'a, D>,
-    contacts: Vec<ContactOut<D>>,
+    bodies: BodiesOut<'a, 'p, D>,
+    contacts: ContactsOut<'a, 'p, D>,
     /// The body families' states, by section ([`crate::family::SceneFamily::save_state`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     families: Option<&'a serde_json::Map<String, serde_json::Value>>,
@@ -112,13 +113,19 @@ struct FinalOut<'a, D: Dim, N: Serialize> {
     nscdd: Option<&'a N>,
 }
 
-/// The bodies of `final.json`, each made as it is written (no list of them held):
-/// the world's, and those of `records` it does not hold (other processes' bodies,
-/// `[g, output record…]` chunks, [`World::output_record`]).
-struct BodiesOut<'a, D: Dim>(&'a World<D>, &'a [f64]);
+/// Records pulled one at a time, ascending by key: `pull(out)` puts the next one
+/// in `out`, false at the end (rank 0's merge of every rank's records,
+/// [`crate::dd::rank_merge`]).
+pub type Pull<'a> = &'a mut dyn FnMut(&mut Vec<f64>) -> bool;
 
-impl<D: Dim> Serialize for BodiesOut<'_, D> {
+/// The bodies of `final.json`, each made as it is written (no list of them held):
+/// the world's, and the pulled ones it does not hold (other processes' bodies,
+/// `[g, output record…]`, [`World::output_record`]).
+struct BodiesOut<'a, 'p, D: Dim>(&'a World<D>, RefCell<Option<Pull<'p>>>);
+
+impl<D: Dim> Serialize for BodiesOut<'_, '_, D> {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeSeq as _;
         let (w, b) = (self.0, &self.0.bodies);
         let held = (0..b.len()).map(|k| {
             let g = w.ids.global(k as u32);
@@ -132,32 +139,81 @@ impl<D: Dim> Serialize for BodiesOut<'_, D> {
                 },
             )
         });
+        let Some(pull) = self.1.borrow_mut().take() else {
+            return s.collect_seq(held.map(|(_, t)| t));
+        };
         // the others, by id (a body not held is neither named nor fixed: those every
-        // process holds)
-        let mut others: Vec<(u32, &[f64])> = self
-            .1
-            .chunks_exact(1 + World::<D>::OUTPUT_RECORD)
-            .map(|x| (x[0] as u32, &x[1..]))
-            .filter(|(g, _)| w.ids.slot(*g).is_none())
-            .collect();
-        others.sort_unstable_by_key(|x| x.0);
-        others.dedup_by_key(|x| x.0);
-        // with records (rank 0 of several), every body once: a body neither held nor
-        // sent would be lost from the file
-        let n = w.ids.n_global(b.len());
-        if !self.1.is_empty() && b.len() + others.len() != n {
-            use serde::ser::Error as _;
-            return Err(S::Error::custom(format!(
-                "internal error: {} bodies held and {} received of {n}",
-                b.len(),
-                others.len()
-            )));
-        }
-        let others = others.into_iter().map(|(g, x)| {
-            let (moving, sh, material) = crate::world::held::read_output::<D>(x);
-            (g, BodyOut::new(w, g, moving, sh, (material, false)))
+        // process holds), each once
+        let (mut rec, mut last, received) = (Vec::new(), None, std::cell::Cell::new(0usize));
+        let others = std::iter::from_fn(|| loop {
+            if !pull(&mut rec) {
+                return None;
+            }
+            let g = rec[0] as u32;
+            if w.ids.slot(g).is_some() || last == Some(g) {
+                continue;
+            }
+            last = Some(g);
+            received.set(received.get() + 1);
+            let (moving, sh, material) = crate::world::held::read_output::<D>(&rec[1..]);
+            return Some((g, BodyOut::new(w, g, moving, sh, (material, false))));
         });
-        s.collect_seq(merge_by_id(held, others))
+        let mut seq = s.serialize_seq(None)?;
+        for body in merge_by_id(held, others) {
+            seq.serialize_element(&body)?;
+        }
+        // every body once: a body neither held nor sent would be lost from the file
+        let n = w.ids.n_global(b.len());
+        if b.len() + received.get() != n {
+            use serde::ser::Error as _;
+            let msg = format!("internal error: {} bodies held and {} received of {n}", b.len(), received.get());
+            return Err(S::Error::custom(msg));
+        }
+        seq.end()
+    }
+}
+
+/// The contacts of `final.json` in key order (candidate, antagonist, feature), the
+/// same list whichever process held which contact: the world's, or the pulled
+/// records ([`contact_records`] of every process, merged by key).
+enum ContactsOut<'a, 'p, D: Dim> {
+    World(&'a World<D>, Vec<u32>),
+    Pulled(RefCell<Option<Pull<'p>>>),
+}
+
+impl<D: Dim> Serialize for ContactsOut<'_, '_, D> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut rec = Vec::new();
+        match self {
+            ContactsOut::World(w, order) => s.collect_seq(order.iter().map(|&a| {
+                rec.clear();
+                contact_records(w, std::iter::once(a as usize), &mut rec);
+                contact_out::<D>(&rec)
+            })),
+            ContactsOut::Pulled(pull) => {
+                let mut pull = pull.borrow_mut().take();
+                s.collect_seq(std::iter::from_fn(|| {
+                    let pull = pull.as_mut()?;
+                    pull(&mut rec).then(|| contact_out::<D>(&rec))
+                }))
+            }
+        }
+    }
+}
+
+/// A contact of `final.json` from its record ([`contact_records`]).
+fn contact_out<D: Dim>(x: &[f64]) -> ContactOut<D> {
+    let n = D::N;
+    let v = |k: usize| &x[3 + k * n..3 + (k + 1) * n];
+    ContactOut::<D> {
+        bodies: [x[0] as u32, x[1] as u32],
+        feature: x[2] as u32,
+        point: D::Point::from_fn(|d| v(0)[d]),
+        normal: D::Point::from_fn(|d| v(1)[d]),
+        r: D::Local::from_fn(|d| v(2)[d]),
+        impulse: D::Point::from_fn(|d| v(3)[d]),
+        gap: x[3 + 4 * n],
+        bonded: x[4 + 4 * n] != 0.0,
     }
 }
 
@@ -180,7 +236,7 @@ fn merge_by_id<T>(a: impl Iterator<Item = (u32, T)>, b: impl Iterator<Item = (u3
 /// `impulse` in world axes (N·s), gap (m), `bonded` for an intact joint). It is
 /// also a restart file ([`crate::scene::restart`]).
 pub fn final_json<D: Dim>(w: &World<D>) -> String {
-    final_json_of(w, None, None::<&()>, None)
+    final_json_of(w, None, None::<&()>)
 }
 
 /// Values per contact of [`contact_records`].
@@ -205,57 +261,38 @@ pub fn contact_records<D: Dim>(w: &World<D>, which: impl Iterator<Item = usize>,
     }
 }
 
-/// [`final_json`] with the body families' states under `families` (by section), the
-/// NSCDD solver's under `nscdd`, and the contacts from `records` ([`contact_records`]
-/// of every process) when given, else from the world: [`write_final_json`] as text.
+/// [`final_json`] with the body families' states under `families` (by section) and
+/// the NSCDD solver's under `nscdd`: [`write_final_json`] as text.
 pub fn final_json_of<D: Dim, N: Serialize>(
     w: &World<D>,
     families: Option<&serde_json::Map<String, serde_json::Value>>,
     nscdd: Option<&N>,
-    records: Option<&[f64]>,
 ) -> String {
     let mut out = Vec::new();
-    write_final_json(&mut out, w, families, nscdd, (records, None)).expect("writing to memory");
+    write_final_json(&mut out, w, families, nscdd, (None, None)).expect("writing to memory");
     String::from_utf8(out).expect("serde_json writes UTF-8")
 }
 
 /// Writes [`final_json_of`] to `out` as it is made: no copy of the state (a 55 000-
-/// sphere state is ≈ 140 MB of text) is held in memory, only the contacts' records;
-/// `bodies`: other processes' bodies' records (`[g, output record…]`,
-/// [`World::output_record`]) written beside the world's.
-pub fn write_final_json<D: Dim, N: Serialize>(
+/// sphere state is ≈ 140 MB of text) is held in memory. `contacts`: every process's
+/// contact records ([`contact_records`]) pulled in key order, instead of the world's
+/// contacts; `bodies`: other processes' bodies' records (`[g, output record…]`,
+/// [`World::output_record`]) pulled in id order, written beside the world's.
+pub fn write_final_json<'p, D: Dim, N: Serialize>(
     out: impl std::io::Write,
     w: &World<D>,
     families: Option<&serde_json::Map<String, serde_json::Value>>,
     nscdd: Option<&N>,
-    (records, bodies): (Option<&[f64]>, Option<&[f64]>),
+    (contacts, bodies): (Option<Pull<'p>>, Option<Pull<'p>>),
 ) -> std::io::Result<()> {
-    let mut own = Vec::new();
-    let records = records.unwrap_or_else(|| {
-        contact_records(w, 0..w.contacts.len(), &mut own);
-        &own
-    });
-    let n = D::N;
-    let mut contacts: Vec<ContactOut<D>> = records
-        .chunks_exact(contact_record_len(n))
-        .map(|x| {
-            let v = |k: usize| &x[3 + k * n..3 + (k + 1) * n];
-            ContactOut::<D> {
-                bodies: [x[0] as u32, x[1] as u32],
-                feature: x[2] as u32,
-                point: D::Point::from_fn(|d| v(0)[d]),
-                normal: D::Point::from_fn(|d| v(1)[d]),
-                r: D::Local::from_fn(|d| v(2)[d]),
-                impulse: D::Point::from_fn(|d| v(3)[d]),
-                gap: x[3 + 4 * n],
-                bonded: x[4 + 4 * n] != 0.0,
-            }
-        })
-        .collect();
-    drop(own);
-    // in key order (candidate, antagonist, feature): the same list whichever
-    // process held which contact
-    contacts.sort_unstable_by_key(|c| (c.bodies, c.feature));
+    let contacts = match contacts {
+        Some(pull) => ContactsOut::Pulled(RefCell::new(Some(pull))),
+        None => {
+            let mut order: Vec<u32> = (0..w.contacts.len() as u32).collect();
+            order.sort_unstable_by_key(|&a| w.contacts.key[a as usize]);
+            ContactsOut::World(w, order)
+        }
+    };
     use std::io::Write as _;
     let mut out = std::io::BufWriter::with_capacity(1 << 16, out);
     let state = FinalOut {
@@ -263,7 +300,7 @@ pub fn write_final_json<D: Dim, N: Serialize>(
         step: w.step,
         time: w.t,
         box_h0: w.box_h0,
-        bodies: BodiesOut(w, bodies.unwrap_or_default()),
+        bodies: BodiesOut(w, RefCell::new(bodies)),
         contacts,
         families,
         nscdd,

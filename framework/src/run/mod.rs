@@ -194,7 +194,9 @@ pub(crate) fn write_rank_totals<D: crate::dd::Family>(dd: &mut Option<crate::dd:
 }
 
 /// Writes the state on rank 0. Collective on MPI ranks (the NSCDD state is gathered
-/// from every rank): every rank calls it at the same step.
+/// from every rank, and the bodies and contacts other ranks hold are merged on rank
+/// 0 as it writes them, [`crate::dd::rank_merge`]): every rank calls it at the same
+/// step.
 pub(crate) fn save_state<D: Dim>(
     dir: &Path,
     name: &str,
@@ -202,26 +204,50 @@ pub(crate) fn save_state<D: Dim>(
     families: &[Box<dyn SceneFamily<D>>],
     dd: &mut Option<NscddOf<Rigid<D>>>,
 ) -> Result<(), RunError> {
-    let root = dd.as_mut().and_then(|n| n.ranks_mut()).is_none_or(|r| r.cluster.rank() == 0);
-    // bodies held per rank: every body's record from its owner to rank 0
-    let bodies = dd.as_mut().and_then(|n| n.gather_bodies(w));
-    // contacts held per rank: every rank's gathered on rank 0
-    let records = match dd.as_mut().filter(|n| n.holds_own_contacts()) {
-        Some(n) => {
-            let mut mine = Vec::new();
-            crate::output::contact_records(w, 0..w.contacts.len(), &mut mine);
-            n.gather_on_root(&mine)
-        }
-        None => None,
+    // bodies held per rank: every body's record from its owner; contacts held per
+    // rank: every rank's, in key order
+    let bodies = dd.as_mut().and_then(|n| n.own_body_records(w));
+    let contacts = dd.as_ref().filter(|n| n.holds_own_contacts()).map(|_| {
+        let mut order: Vec<usize> = (0..w.contacts.len()).collect();
+        order.sort_unstable_by_key(|&a| w.contacts.key[a]);
+        let mut mine = Vec::new();
+        crate::output::contact_records(w, order.into_iter(), &mut mine);
+        mine
+    });
+    let state = dd.as_mut().and_then(|n| n.gather_state());
+    let states = (!families.is_empty()).then(|| crate::family::states(families));
+    let Some(rs) = dd.as_mut().and_then(|n| n.ranks_mut()) else {
+        return save_state_with(dir, name, |f| {
+            crate::output::write_final_json(f, w, states.as_ref(), state.as_ref(), (None, None))
+        });
     };
-    let dd = dd.as_mut().and_then(|n| n.gather_state());
-    if !root {
+    let (pull_bodies, pull_contacts) = (bodies.is_some(), contacts.is_some());
+    let body_rec = 1 + World::<D>::OUTPUT_RECORD;
+    let contact_rec = crate::output::contact_record_len(D::N);
+    let [mut mb, mut mc] = rs.merges([
+        (bodies.unwrap_or_default(), body_rec, 1),
+        (contacts.unwrap_or_default(), contact_rec, 3),
+    ]);
+    if rs.cluster.rank() != 0 {
+        mb.serve(rs);
+        mc.serve(rs);
         return Ok(());
     }
-    let states = (!families.is_empty()).then(|| crate::family::states(families));
-    save_state_with(dir, name, |f| {
-        crate::output::write_final_json(f, w, states.as_ref(), dd.as_ref(), (records.as_deref(), bodies.as_deref()))
-    })
+    let rs = std::cell::RefCell::new(rs);
+    let mut next_body = |out: &mut Vec<f64>| mb.next(&mut rs.borrow_mut(), out);
+    let mut next_contact = |out: &mut Vec<f64>| mc.next(&mut rs.borrow_mut(), out);
+    let pulls: (Option<crate::output::Pull>, Option<crate::output::Pull>) = (
+        pull_contacts.then_some(&mut next_contact as crate::output::Pull),
+        pull_bodies.then_some(&mut next_body as crate::output::Pull),
+    );
+    let written = save_state_with(dir, name, |f| {
+        crate::output::write_final_json(f, w, states.as_ref(), state.as_ref(), pulls)
+    });
+    // every merge ended for every rank, the file written or not
+    let rs = rs.into_inner();
+    mb.finish(rs);
+    mc.finish(rs);
+    written
 }
 
 /// Runs `scene` for its number of steps, writing `history.csv`, the writers' frames
