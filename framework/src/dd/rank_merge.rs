@@ -19,6 +19,10 @@ use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 use std::time::Instant;
 
+/// Records pulled one at a time, ascending by key: `pull(out)` puts the next one
+/// in `out`, false at the end (on rank 0, [`Merge::next`]).
+pub type Pull<'a> = &'a mut dyn FnMut(&mut Vec<f64>) -> bool;
+
 /// The values rank 0 holds for one merge at most (per round, over every rank).
 const BUDGET_VALUES: usize = 1 << 17;
 

@@ -4,13 +4,16 @@
 //! schedules them. Saved in `final.json` and checkpoints under `nscdd`
 //! ([`crate::run`]) with the decomposition it belongs to; a restart with another
 //! decomposition starts F_Γ from zero. On MPI ranks each rank holds F_Γ of its own
-//! subdomains only: [`NscddOf::gather_state`] collects them on rank 0, so that the
-//! state written by P ranks is the one-process state, and every rank loads all of
-//! it (a restart on P′ ranks, or in one process, continues bitwise).
+//! subdomains only: [`NscddOf::state_on_ranks`] collects them on rank 0, which
+//! merges every rank's kept contacts as it writes them, so that the state written
+//! by P ranks is the one-process state, and every rank loads all of it (a restart on
+//! P′ ranks, or in one process, continues bitwise).
 
+use super::rank_merge::Pull;
 use super::{FGammaStore, Family, Grid, NscddOf};
 use crate::model::ContactKey;
 use serde::{Deserialize, Serialize};
+use std::cell::RefCell;
 
 /// The solver's state as saved (module docs): written and read by serde directly,
 /// never held as a JSON tree (a 55 000-sphere state keeps ≈ 150 000 contacts here).
@@ -31,9 +34,59 @@ pub struct NscddState {
     balance: super::Balance,
 }
 
+/// [`NscddState`] as written with its kept contacts pulled one at a time (rank 0's
+/// merge of every rank's, [`NscddOf::state_on_ranks`]): the same fields in the same
+/// order, so the same text.
+#[derive(Serialize)]
+pub struct StateOut<'s, 'p> {
+    grid_of: &'s [u32; 3],
+    by_model: bool,
+    steps: u64,
+    grid: &'s Option<Grid>,
+    grid_empty: bool,
+    kept: KeptOut<'p>,
+    f_gamma: &'s [(u32, u32, Vec<f64>)],
+    balance: &'s super::Balance,
+}
+
+/// Kept contacts pulled as `[i, j, feature, subdomain]` records, ascending by key.
+pub struct KeptOut<'p>(RefCell<Option<Pull<'p>>>);
+
+impl Serialize for KeptOut<'_> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut pull = self.0.borrow_mut().take();
+        let mut rec = Vec::new();
+        s.collect_seq(std::iter::from_fn(|| {
+            let pull = pull.as_mut()?;
+            let key = |x: &[f64]| ContactKey {
+                i: x[0] as u32,
+                j: x[1] as u32,
+                feature: x[2] as u32,
+            };
+            pull(&mut rec).then(|| (key(&rec), rec[3] as u32))
+        }))
+    }
+}
+
+impl NscddState {
+    /// The state as written, its kept contacts (none held here) from `kept`.
+    pub fn with_kept<'s, 'p>(&'s self, kept: Pull<'p>) -> StateOut<'s, 'p> {
+        StateOut {
+            grid_of: &self.grid_of,
+            by_model: self.by_model,
+            steps: self.steps,
+            grid: &self.grid,
+            grid_empty: self.grid_empty,
+            kept: KeptOut(RefCell::new(Some(kept))),
+            f_gamma: &self.f_gamma,
+            balance: &self.balance,
+        }
+    }
+}
+
 impl<D: Family> NscddOf<D> {
     /// The state of the solver between steps (module docs); `None` on several MPI
-    /// ranks (each holds only its subdomains' F_Γ: see [`NscddOf::gather_state`]).
+    /// ranks (each holds only its subdomains' F_Γ: see [`NscddOf::state_on_ranks`]).
     pub fn save_state(&self) -> Option<NscddState> {
         if self.ranks.is_some() {
             return None;
@@ -55,13 +108,13 @@ impl<D: Family> NscddOf<D> {
         }
     }
 
-    /// The state on rank 0 (None elsewhere), collected from every rank's own
-    /// subdomains; [`NscddOf::save_state`] in one process. Collective on MPI ranks:
-    /// every rank calls it at the same step.
-    pub fn gather_state(&mut self) -> Option<NscddState> {
-        let Some(rs) = self.ranks.as_mut() else {
-            return self.save_state();
-        };
+    /// On MPI ranks (collective; `None` in one process): the state on rank 0 without
+    /// its kept contacts (F_Γ collected from every rank's own subdomains), and this
+    /// rank's kept contacts as `[i, j, feature, subdomain]` records ascending by key,
+    /// which rank 0 merges as it writes them ([`NscddState::with_kept`],
+    /// [`super::rank_merge`]): the state written by P ranks is the one-process state.
+    pub fn state_on_ranks(&mut self) -> Option<(Option<NscddState>, Vec<f64>)> {
+        let rs = self.ranks.as_mut()?;
         let me = rs.cluster.rank();
         let dofs = D::V::default().as_ref().len();
         // (body, subdomain, F_Γ) of this rank's subdomains, flat
@@ -73,32 +126,21 @@ impl<D: Family> NscddOf<D> {
         let all = rs.gather_any_on_root(&mine);
         // the kept subdomains of this rank's contacts (all of them when every rank
         // holds every contact: each is some rank's)
-        let mut mine = Vec::new();
-        for (k, o) in self.kept.iter().filter(|e| rs.rank_of.get(e.1 as usize) == Some(&me)) {
-            mine.extend([f64::from(k.i), f64::from(k.j), f64::from(k.feature), f64::from(*o)]);
-        }
-        let kept = rs.gather_any_on_root(&mine);
+        let mut own: Vec<&(ContactKey, u32)> = self.kept.iter().filter(|e| rs.rank_of.get(e.1 as usize) == Some(&me)).collect();
+        own.sort_unstable_by_key(|e| e.0);
+        let kept = own
+            .iter()
+            .flat_map(|(k, o)| [f64::from(k.i), f64::from(k.j), f64::from(k.feature), f64::from(*o)])
+            .collect();
         if me != 0 {
-            return None;
+            return Some((None, kept));
         }
         let mut f_gamma: Vec<(u32, u32, Vec<f64>)> = all
             .chunks_exact(2 + dofs)
             .map(|c| (c[0] as u32, c[1] as u32, c[2..].to_vec()))
             .collect();
         f_gamma.sort_unstable_by_key(|e| (e.0, e.1));
-        let mut kept: Vec<(ContactKey, u32)> = kept
-            .chunks_exact(4)
-            .map(|x| {
-                let key = ContactKey {
-                    i: x[0] as u32,
-                    j: x[1] as u32,
-                    feature: x[2] as u32,
-                };
-                (key, x[3] as u32)
-            })
-            .collect();
-        kept.sort_unstable_by_key(|e| e.0);
-        Some(self.saved(f_gamma, kept))
+        Some((Some(self.saved(f_gamma, Vec::new())), kept))
     }
 
     /// Puts a saved state back (a solver made from the same decomposition, before its

@@ -108,15 +108,15 @@ struct FinalOut<'a, 'p, D: Dim, N: Serialize> {
     /// The body families' states, by section ([`crate::family::SceneFamily::save_state`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     families: Option<&'a serde_json::Map<String, serde_json::Value>>,
-    /// The NSCDD solver's state ([`crate::dd::NscddOf::gather_state`]).
+    /// The NSCDD solver's state ([`crate::dd::NscddOf::save_state`], or on ranks
+    /// [`crate::dd::NscddOf::state_on_ranks`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     nscdd: Option<&'a N>,
 }
 
-/// Records pulled one at a time, ascending by key: `pull(out)` puts the next one
-/// in `out`, false at the end (rank 0's merge of every rank's records,
-/// [`crate::dd::rank_merge`]).
-pub type Pull<'a> = &'a mut dyn FnMut(&mut Vec<f64>) -> bool;
+/// Records pulled one at a time, ascending by key (rank 0's merge of every rank's
+/// records, [`crate::dd::rank_merge`]).
+pub use crate::dd::rank_merge::Pull;
 
 /// The bodies of `final.json`, each made as it is written (no list of them held):
 /// the world's, and the pulled ones it does not hold (other processes' bodies,

@@ -193,10 +193,10 @@ pub(crate) fn write_rank_totals<D: crate::dd::Family>(dd: &mut Option<crate::dd:
     Ok(())
 }
 
-/// Writes the state on rank 0. Collective on MPI ranks (the NSCDD state is gathered
-/// from every rank, and the bodies and contacts other ranks hold are merged on rank
-/// 0 as it writes them, [`crate::dd::rank_merge`]): every rank calls it at the same
-/// step.
+/// Writes the state on rank 0. Collective on MPI ranks (F_Γ is gathered from every
+/// rank, and the bodies, contacts and kept contacts other ranks hold are merged on
+/// rank 0 as it writes them, [`crate::dd::rank_merge`]): every rank calls it at the
+/// same step.
 pub(crate) fn save_state<D: Dim>(
     dir: &Path,
     name: &str,
@@ -214,39 +214,50 @@ pub(crate) fn save_state<D: Dim>(
         crate::output::contact_records(w, order.into_iter(), &mut mine);
         mine
     });
-    let state = dd.as_mut().and_then(|n| n.gather_state());
-    let states = (!families.is_empty()).then(|| crate::family::states(families));
-    let Some(rs) = dd.as_mut().and_then(|n| n.ranks_mut()) else {
+    let states = || (!families.is_empty()).then(|| crate::family::states(families));
+    let Some((state, kept)) = dd.as_mut().and_then(|n| n.state_on_ranks()) else {
+        let (state, states) = (dd.as_ref().and_then(|n| n.save_state()), states());
         return save_state_with(dir, name, |f| {
             crate::output::write_final_json(f, w, states.as_ref(), state.as_ref(), (None, None))
         });
     };
+    let Some(rs) = dd.as_mut().and_then(|n| n.ranks_mut()) else {
+        return Ok(());
+    };
     let (pull_bodies, pull_contacts) = (bodies.is_some(), contacts.is_some());
     let body_rec = 1 + World::<D>::OUTPUT_RECORD;
     let contact_rec = crate::output::contact_record_len(D::N);
-    let [mut mb, mut mc] = rs.merges([
+    let [mut mb, mut mc, mut mk] = rs.merges([
         (bodies.unwrap_or_default(), body_rec, 1),
         (contacts.unwrap_or_default(), contact_rec, 3),
+        (kept, 4, 3),
     ]);
+    // rank 0 pulls bodies, contacts and kept contacts in the order of the file
     if rs.cluster.rank() != 0 {
         mb.serve(rs);
         mc.serve(rs);
+        mk.serve(rs);
         return Ok(());
     }
+    let states = states();
     let rs = std::cell::RefCell::new(rs);
     let mut next_body = |out: &mut Vec<f64>| mb.next(&mut rs.borrow_mut(), out);
     let mut next_contact = |out: &mut Vec<f64>| mc.next(&mut rs.borrow_mut(), out);
+    let mut next_kept = |out: &mut Vec<f64>| mk.next(&mut rs.borrow_mut(), out);
     let pulls: (Option<crate::output::Pull>, Option<crate::output::Pull>) = (
         pull_contacts.then_some(&mut next_contact as crate::output::Pull),
         pull_bodies.then_some(&mut next_body as crate::output::Pull),
     );
+    let state = state.as_ref().map(|s| s.with_kept(&mut next_kept));
     let written = save_state_with(dir, name, |f| {
         crate::output::write_final_json(f, w, states.as_ref(), state.as_ref(), pulls)
     });
+    drop(state);
     // every merge ended for every rank, the file written or not
     let rs = rs.into_inner();
     mb.finish(rs);
     mc.finish(rs);
+    mk.finish(rs);
     written
 }
 
