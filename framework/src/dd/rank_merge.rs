@@ -155,6 +155,11 @@ impl Merge {
         let mut counts = vec![0; p];
         counts[0] = p + 1;
         rs.cluster.all_gather(&ask, &counts, &mut flags);
+        if me == 0 {
+            // rank 0's requests to every other rank
+            rs.totals.reduce.messages += p as u64 - 1;
+            rs.totals.reduce.values += (p as u64 - 1) * (p as u64 + 1);
+        }
         if flags[0] != 0.0 {
             self.stopped = true;
             rs.totals.reduce_seconds += t0.elapsed().as_secs_f64();
@@ -168,7 +173,11 @@ impl Merge {
         self.sent += n[me];
         let mut all = Vec::new();
         rs.cluster.gather(mine, &counts, &mut all);
-        rs.reduced(mine.len() + 1);
+        // a requested rank's records to rank 0
+        if me != 0 && !mine.is_empty() {
+            rs.totals.reduce.messages += 1;
+            rs.totals.reduce.values += mine.len() as u64;
+        }
         if me == 0 {
             let mut at = 0;
             for r in (0..p).filter(|&r| n[r] > 0) {
