@@ -109,6 +109,10 @@ fn two_and_four_ranks_give_the_one_process_result_2d() {
     let held = write(&dir, "held.toml", &every(PILE2D, 4));
     same_as_threads(&held, &dir, "2x2", "decentralized", &[2, 4]);
     same_as_threads(&held, &dir, "3x2", "centralized", &[4]);
+    // each subdomain visits its contacts from the bottom up, on any rank
+    let sorted = every(PILE2D, 4).replacen("[solver]\n", "[solver]\nordering = \"sorted\"\n", 1);
+    let sorted = write(&dir, "sorted.toml", &sorted);
+    same_as_threads(&sorted, &dir, "2x2", "decentralized", &[4]);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -442,14 +442,20 @@ impl<D: Family> super::NscddOf<D> {
     /// the step had no active set (every rank stepped every body it holds: a full
     /// step, or one that diverged).
     pub(super) fn owned_bodies(&self, w: &D::World) -> Option<Vec<bool>> {
+        let mut mine = vec![false; D::n_bodies(w)];
+        for g in self.owned_ids(w)? {
+            mine[g as usize] = true;
+        }
+        Some(mine)
+    }
+
+    /// [`Self::owned_bodies`] as their ids (ascending).
+    fn owned_ids<'a>(&'a self, w: &'a D::World) -> Option<impl Iterator<Item = u32> + 'a> {
         let active = D::active(w)?;
         let (rs, grid) = (self.ranks.as_ref()?, self.grid.as_ref()?);
         let me = rs.cluster.rank();
-        let mut mine = vec![false; D::n_bodies(w)];
-        for &g in active {
-            mine[g as usize] = rs.rank_of.get(grid.cell_of(D::position(w, g as usize)) as usize) == Some(&me);
-        }
-        Some(mine)
+        let own = move |g: &u32| rs.rank_of.get(grid.cell_of(D::position(w, *g as usize)) as usize) == Some(&me);
+        Some(active.iter().copied().filter(own))
     }
 
     /// With bodies held per rank, the records of the bodies this rank owns (the
@@ -458,13 +464,17 @@ impl<D: Family> super::NscddOf<D> {
     /// ([`super::rank_merge`]); `None` in one process or when every rank holds every
     /// body.
     pub fn own_body_records(&mut self, w: &D::World) -> Option<Vec<f64>> {
-        let mine = self.owned_bodies(w)?;
-        let rs = self.ranks.as_mut()?;
-        let mut out = Vec::new();
-        for g in (0..mine.len()).filter(|&g| mine[g]) {
-            out.push(g as f64);
-            D::output_record(w, g, &mut out);
+        // ascending, as rank 0's merge needs (the active list is)
+        let mut ids: Vec<u32> = self.owned_ids(w)?.collect();
+        if !ids.is_sorted() {
+            ids.sort_unstable();
         }
+        let mut out = Vec::new();
+        for g in ids {
+            out.push(f64::from(g));
+            D::output_record(w, g as usize, &mut out);
+        }
+        let rs = self.ranks.as_mut()?;
         if rs.cluster.rank() != 0 {
             rs.totals.bodies_sent += (out.len() / (1 + D::OUTPUT_RECORD)) as u64;
         }
