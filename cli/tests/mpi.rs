@@ -389,7 +389,8 @@ fn an_unwritable_output_stops_every_rank() {
 /// A scene with deformable bodies by model (2 × 1 cells, 4 subdomains) on 2 and 4
 /// ranks: final.json bitwise that of one process (the deformable bodies' state
 /// included; the families' parts travel as their packed impulses), and the 3D
-/// foundation (2 × 2 cells by model) on 2 ranks; without a decomposition, refused by
+/// foundation (2 × 2 cells by model) on 2 ranks, and the whole 2D foundation (its
+/// state's kept contacts merged on rank 0 alone); without a decomposition, refused by
 /// every rank with exit 2.
 #[cfg(feature = "fem")]
 #[test]
@@ -433,6 +434,28 @@ fn deformable_scenes_on_ranks_give_the_one_process_result() {
         final_json(&out) == final_json(&one3),
         "3D on 2 ranks: final.json differs from one process"
     );
+    // the whole foundation (disks resting on the blocks: kept contacts, every rank
+    // holding every contact): rank 0 merges the kept contacts alone, also in many
+    // rounds (a merge it skipped once hung every rank)
+    let whole = dir.join("whole.toml");
+    std::fs::write(&whole, src.replace("[output]\n", "[output]\nvtk = false\n")).unwrap();
+    let one = dir.join("whole_one");
+    assert!(nscdd(&args(&whole, &one, &[])).status.success());
+    let out = dir.join("whole_ranks2");
+    let mut c = mpirun_command(&[(2, args(&whole, &out, &[]))]);
+    c.env("NSCDD_MERGE_RECORDS", "3");
+    let o = run_limited(c);
+    assert!(o.status.success(), "the whole foundation on 2 ranks: {}", text(&o.stderr));
+    let fin = final_json(&out);
+    assert!(
+        fin == final_json(&one),
+        "the whole foundation on 2 ranks: final.json differs from one process"
+    );
+    let v: serde_json::Value = serde_json::from_str(&fin).expect("final.json");
+    assert!(
+        v["nscdd"]["kept"].as_array().is_some_and(|k| !k.is_empty()),
+        "kept contacts in the state"
+    );
     let plain = dir.join("plain.toml");
     let no_dd = std::fs::read_to_string(&scene).unwrap();
     let cut = no_dd.find("[decomposition]").unwrap();
@@ -447,39 +470,53 @@ fn deformable_scenes_on_ranks_give_the_one_process_result() {
     assert!(!out.join("final.json").exists());
 }
 
-/// Rank 0 merges the other ranks' bodies and contacts as it writes `final.json` and
-/// the checkpoints, a bounded number of records per round (`dd::rank_merge`): with
-/// two records per round (many rounds) the files are still the one process's, byte
-/// for byte, and the rounds show in the reductions.
+/// Rank 0 merges the other ranks' bodies, contacts and kept contacts as it writes
+/// `final.json` and the checkpoints, a bounded number of records per round
+/// (`dd::rank_merge`): with two records per round (many rounds) the files are still
+/// the one process's, byte for byte, and the rounds show in the reductions; also
+/// when the last step repartitions (no bodies or contacts held per rank then, kept
+/// contacts merged alone) and with deformable-free scenes repartitioned every step.
 #[test]
 fn outputs_merged_in_small_rounds_are_the_one_process_files() {
     let dir = scratch("merge");
-    let text = every(PILE2D, 4).replace("[output]\n", "[output]\ncheckpoint_every = 8\n");
-    let scene = write(&dir, "held.toml", &text);
-    let flags = ["--subdomains", "2x2"];
-    let one = dir.join("one");
-    ok(&nscdd(&args(&scene, &one, &flags)), "the one-process run");
-    let reduce = |out: &Path| -> u64 {
-        let r: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(out.join("ranks.json")).expect("ranks.json")).expect("json");
-        r["per_rank"][0]["reduce_messages"].as_u64().expect("reduce_messages")
-    };
-    let mut counts = vec![];
-    for chunk in [None, Some("2")] {
-        let out = dir.join(format!("ranks4-{}", chunk.unwrap_or("default")));
-        let mut c = mpirun_command(&[(4, args(&scene, &out, &flags))]);
-        if let Some(k) = chunk {
-            c.env("NSCDD_MERGE_RECORDS", k);
+    let held = every(PILE2D, 4).replace("[output]\n", "[output]\ncheckpoint_every = 8\n");
+    let cases = [
+        ("held", held.clone()),
+        ("last_repartitions", held.replace("steps = 15", "steps = 16")),
+        ("whole", PILE2D.replace("[output]\n", "[output]\ncheckpoint_every = 8\n")),
+    ];
+    for (name, text) in cases {
+        let scene = write(&dir, &format!("{name}.toml"), &text);
+        let flags = ["--subdomains", "2x2"];
+        let one = dir.join(format!("{name}-one"));
+        ok(&nscdd(&args(&scene, &one, &flags)), "the one-process run");
+        let reduce = |out: &Path| -> u64 {
+            let r: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(out.join("ranks.json")).expect("ranks.json")).expect("json");
+            r["per_rank"][0]["reduce_messages"].as_u64().expect("reduce_messages")
+        };
+        let mut counts = vec![];
+        for chunk in [None, Some("2")] {
+            let out = dir.join(format!("{name}-ranks4-{}", chunk.unwrap_or("default")));
+            let mut c = mpirun_command(&[(4, args(&scene, &out, &flags))]);
+            if let Some(k) = chunk {
+                c.env("NSCDD_MERGE_RECORDS", k);
+            }
+            ok(&run_limited(c), &format!("{name}: 4 ranks"));
+            assert!(
+                final_json(&out) == final_json(&one),
+                "{name} {chunk:?}: final.json differs from one process"
+            );
+            let read = |d: &Path| std::fs::read(d.join("checkpoint.json")).expect("checkpoint.json");
+            assert!(
+                read(&out) == read(&one),
+                "{name} {chunk:?}: checkpoint.json differs from one process"
+            );
+            counts.push(reduce(&out));
         }
-        ok(&run_limited(c), "4 ranks");
-        assert!(
-            final_json(&out) == final_json(&one),
-            "{chunk:?}: final.json differs from one process"
-        );
-        let read = |d: &Path| std::fs::read(d.join("checkpoint.json")).expect("checkpoint.json");
-        assert!(read(&out) == read(&one), "{chunk:?}: checkpoint.json differs from one process");
-        counts.push(reduce(&out));
+        if name == "held" {
+            assert!(counts[1] > counts[0] + 20, "rounds of two records: {counts:?} reductions");
+        }
     }
-    assert!(counts[1] > counts[0] + 20, "rounds of two records: {counts:?} reductions");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -29,7 +29,8 @@
 //! added per cell by the cells' ranks ([`super::census::BodySums`]), the named and
 //! driven bodies are stepped by every rank, a body without contacts is written in
 //! the VTK frames by its owner, and rank 0 gathers every body's record before it
-//! writes `final.json` or a checkpoint ([`super::NscddOf::gather_bodies`]).
+//! writes `final.json` or a checkpoint ([`super::NscddOf::own_body_records`],
+//! merged on rank 0 by [`super::rank_merge`]).
 
 use super::cells::CellIndex;
 use super::family::Family;

@@ -222,28 +222,35 @@ pub(crate) fn save_state<D: Dim>(
         });
     };
     let Some(rs) = dd.as_mut().and_then(|n| n.ranks_mut()) else {
-        return Ok(());
+        // (a state on ranks has ranks)
+        return save_state_with(dir, name, |f| {
+            crate::output::write_final_json(f, w, states().as_ref(), state.as_ref(), (None, None))
+        });
     };
     let (pull_bodies, pull_contacts) = (bodies.is_some(), contacts.is_some());
     let body_rec = 1 + World::<D>::OUTPUT_RECORD;
     let contact_rec = crate::output::contact_record_len(D::N);
-    let [mut mb, mut mc, mut mk] = rs.merges([
+    // in the order of the file: bodies, contacts, kept contacts
+    let mut merges = rs.merges(vec![
         (bodies.unwrap_or_default(), body_rec, 1),
         (contacts.unwrap_or_default(), contact_rec, 3),
         (kept, 4, 3),
     ]);
-    // rank 0 pulls bodies, contacts and kept contacts in the order of the file
     if rs.cluster.rank() != 0 {
-        mb.serve(rs);
-        mc.serve(rs);
-        mk.serve(rs);
+        merges.serve(rs);
         return Ok(());
     }
     let states = states();
-    let rs = std::cell::RefCell::new(rs);
-    let mut next_body = |out: &mut Vec<f64>| mb.next(&mut rs.borrow_mut(), out);
-    let mut next_contact = |out: &mut Vec<f64>| mc.next(&mut rs.borrow_mut(), out);
-    let mut next_kept = |out: &mut Vec<f64>| mk.next(&mut rs.borrow_mut(), out);
+    let both = std::cell::RefCell::new((rs, merges));
+    let pull = |i: usize, out: &mut Vec<f64>| {
+        let (rs, m) = &mut *both.borrow_mut();
+        m.pull(i, rs, out)
+    };
+    let (mut next_body, mut next_contact, mut next_kept) = (
+        |o: &mut Vec<f64>| pull(0, o),
+        |o: &mut Vec<f64>| pull(1, o),
+        |o: &mut Vec<f64>| pull(2, o),
+    );
     let pulls: (Option<crate::output::Pull>, Option<crate::output::Pull>) = (
         pull_contacts.then_some(&mut next_contact as crate::output::Pull),
         pull_bodies.then_some(&mut next_body as crate::output::Pull),
@@ -254,10 +261,8 @@ pub(crate) fn save_state<D: Dim>(
     });
     drop(state);
     // every merge ended for every rank, the file written or not
-    let rs = rs.into_inner();
-    mb.finish(rs);
-    mc.finish(rs);
-    mk.finish(rs);
+    let (rs, mut merges) = both.into_inner();
+    merges.finish(rs);
     written
 }
 

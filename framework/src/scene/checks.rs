@@ -342,27 +342,38 @@ fn validate_solver(cx: &Ctx, s: &crate::solver::SolverSettings) -> Result<(), In
 }
 
 /// `[solver] sort_direction`: read by `ordering = "sorted"` alone, D finite numbers
-/// not all zero; for `sorted` without it, against gravity (from the bottom up), or
-/// (left unset) along the last axis, y in 2D and z in 3D, in a scene without gravity.
+/// not all zero, kept as a unit vector; for `sorted` without it, against gravity
+/// (from the bottom up), or (left unset) along the last axis, y in 2D and z in 3D,
+/// in a scene without gravity.
 fn sort_direction(cx: &Ctx, s: &mut crate::solver::SolverSettings, gravity: &[f64]) -> Result<(), InputError> {
     let key = [k("solver"), k("sort_direction")];
     let n = gravity.len();
     let sorted = s.ordering == crate::solver::Ordering::Sorted;
-    match s.sort_direction.as_deref() {
-        Some(_) if !sorted => Err(cx.err(
-            &key,
-            "`sort_direction` is the direction of ordering = \"sorted\" only (remove it or set ordering = \"sorted\")",
-        )),
-        Some(d) if d.len() != n || d.iter().any(|x| !x.is_finite()) || d.iter().all(|&x| x == 0.0) => Err(cx.err(
+    let given = s.sort_direction.take();
+    if given.is_some() && !sorted {
+        let msg = "`sort_direction` is the direction of ordering = \"sorted\" only (remove it or set ordering = \"sorted\")";
+        return Err(cx.err(&key, msg));
+    }
+    let bad = || {
+        cx.err(
             &key,
             format!("must be {n} finite numbers, not all zero (a direction of the scene's {n}D space)"),
-        )),
-        None if sorted && gravity.iter().any(|&g| g != 0.0) => {
-            s.sort_direction = Some(gravity.iter().map(|g| -g).collect());
-            Ok(())
-        }
-        _ => Ok(()),
+        )
+    };
+    let d = match given {
+        Some(d) if d.len() != n => return Err(bad()),
+        Some(d) => d,
+        None if sorted && gravity.iter().any(|&g| g != 0.0) => gravity.iter().map(|g| -g).collect(),
+        None => return Ok(()),
+    };
+    // scaled by its largest component first: no overflow or underflow on the way
+    let big = d.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if !(big.is_finite() && big > 0.0) {
+        return Err(bad());
     }
+    let norm = d.iter().map(|x| (x / big) * (x / big)).sum::<f64>().sqrt();
+    s.sort_direction = Some(d.iter().map(|x| x / big / norm + 0.0).collect());
+    Ok(())
 }
 
 pub(crate) fn materials<B>(cx: &Ctx, sf: &SceneFile<B>) -> Result<Vec<Material>, InputError> {

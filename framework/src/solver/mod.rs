@@ -77,9 +77,9 @@ pub struct SolverSettings {
     pub relaxation: f64,
     pub ordering: Ordering,
     /// The direction along which `sorted` visits the contacts (D numbers; none:
-    /// along the last axis, y in 2D and z in 3D). The scene loader sets it against
-    /// gravity when the scene has gravity and the key is absent; it refuses it with
-    /// another ordering.
+    /// along the last axis, y in 2D and z in 3D). For `sorted`, the scene loader
+    /// makes it a unit vector and, when the key is absent and the scene has gravity,
+    /// sets it against gravity; it refuses it with another ordering.
     pub sort_direction: Option<Vec<f64>>,
     pub seed: u64,
     /// `nlgs` (default), `anderson` or `newton`.

@@ -82,9 +82,10 @@ pub fn make_order_of(
         }
         Ordering::Sorted => {
             let d = s.sort_axis(space);
+            // (+ 0.0: −0 and +0 are one coordinate)
             let along = |a: usize| {
                 let p = point(a);
-                d[0] * p[0] + d[1] * p[1] + d[2] * p[2]
+                d[0] * p[0] + d[1] * p[1] + d[2] * p[2] + 0.0
             };
             order.extend(0..n as u32);
             // the coordinate as an integer of the same order (IEEE 754's total order),
@@ -409,7 +410,7 @@ mod tests {
         s.sort_direction = Some(vec![-1.0, 0.0]);
         make_order(&mut order, 4, &s, 0, 2, |a| pts[a]);
         assert_eq!(order, [1, 2, 0, 3]);
-        assert_eq!(total_order_bits(-0.0) < total_order_bits(0.0), true);
+        assert!(total_order_bits(-0.0) < total_order_bits(0.0));
         assert!(total_order_bits(-2.0) < total_order_bits(-1.0) && total_order_bits(1.0) < total_order_bits(2.0));
     }
 
