@@ -113,3 +113,32 @@ fn held_less_than_all(out: &Path) {
         );
     }
 }
+
+/// A scene with deformable bodies by model (the 2D foundation: FE blocks under
+/// disks, kept contacts, the families' states) written by 2 ranks continues on 1, 2
+/// and 4 ranks bitwise as the uninterrupted one-process run.
+#[cfg(feature = "fem")]
+#[test]
+fn a_deformable_state_written_by_ranks_restarts_on_other_rank_counts() {
+    let dir = scratch("restart_fe");
+    let src = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/scenes/foundation.toml")).unwrap();
+    let src = src.replace("[output]\n", "[output]\nvtk = false\n");
+    let whole = write(&dir, "whole.toml", &src.replace("duration = 0.5", "steps = 400"));
+    let half = write(&dir, "half.toml", &src.replace("duration = 0.5", "steps = 250"));
+    let reference = uninterrupted(&dir, &whole, &[], "fe-");
+    let a = dir.join("half2");
+    ok(&mpirun(&[(2, args(&half, &a, &[]))]), "250 steps on 2 ranks");
+    let state = a.join("final.json");
+    assert!(final_json(&a).contains("\"deformable\""), "the families' states");
+    for then in [1, 2, 4] {
+        let b = dir.join(format!("then{then}"));
+        let rest = args(&whole, &b, &["--restart", state.to_str().unwrap()]);
+        let o = if then == 1 { nscdd(&rest) } else { mpirun(&[(then, rest)]) };
+        ok(&o, &format!("the restart on {then} rank(s)"));
+        assert!(
+            final_json(&b) == reference,
+            "2 ranks then {then}: final.json differs from the uninterrupted run"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
