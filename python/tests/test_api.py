@@ -398,6 +398,11 @@ def test_review_edge_cases(tmp_path):
     # a setting the scene's run cannot use is a scene error at once
     with pytest.raises(nscdd.SceneError, match="solver.ordering"):
         nscdd.Simulation(deposit(solver={"ordering": "scrambled"}, decomposition={"nx": 2}))
+    # the contacts visited from the bottom up: sort_direction with "sorted" only
+    with pytest.raises(nscdd.SceneError, match="solver.sort_direction"):
+        nscdd.Simulation(deposit(solver={"sort_direction": [0.0, 1.0]}))
+    up = nscdd.Simulation(deposit(steps=30, solver={"ordering": "sorted", "sort_direction": [0.0, 2.0]}), out=str(tmp_path / "up"))
+    assert up.run(progress=False)["steps"] == 30
     # finish before the scene's end writes the last frame
     sim = nscdd.Simulation(deposit(steps=200), out=str(tmp_path / "b"))
     s = sim.run(25, progress=False)
