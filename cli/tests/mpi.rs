@@ -474,8 +474,10 @@ fn deformable_scenes_on_ranks_give_the_one_process_result() {
 /// `final.json` and the checkpoints, a bounded number of records per round
 /// (`dd::rank_merge`): with two records per round (many rounds) the files are still
 /// the one process's, byte for byte, and the rounds show in the reductions; also
-/// when the last step repartitions (no bodies or contacts held per rank then, kept
-/// contacts merged alone) and with deformable-free scenes repartitioned every step.
+/// written just before a repartition and with a repartition at every step. (Rigid
+/// scenes hold bodies and contacts per rank: the kept contacts merged alone, the
+/// other merges over before they start, are the deformable scenes' case,
+/// `deformable_scenes_on_ranks_give_the_one_process_result`.)
 #[test]
 fn outputs_merged_in_small_rounds_are_the_one_process_files() {
     let dir = scratch("merge");

@@ -10,9 +10,10 @@
 //! requests (the merge, and how many records each rank sends, or the merge's end)
 //! and one gather of the requested records; rank 0 asks a rank again only when it
 //! has merged every record it had from it, at most [`per_round`] at a time. So rank
-//! 0 holds at most ranks × [`per_round`] records (≈ 1 MiB, more past 128 ranks)
-//! whatever the sample's size. The other ranks call [`Merges::serve`], which
-//! answers the rounds of each merge in turn until rank 0 ends it. Pulling a merge
+//! 0 holds at most ranks × [`per_round`] records (≈ 1 MiB, up to 1024 records a
+//! rank past 128 / `rec` ranks: ≈ 8 in 3D) whatever the sample's size. The other
+//! ranks call [`Merges::serve`], which answers the rounds of each merge in turn
+//! until rank 0 ends it. Pulling a merge
 //! ends the earlier ones, and [`Merges::finish`] ends every merge, also when rank
 //! 0's writing failed half way: no rank waits for a round that never comes. A
 //! rank's answer follows rank 0's request alone (not its own environment).
@@ -75,6 +76,8 @@ impl RankState {
         let counts: Vec<f64> = inputs.iter().map(|(v, rec, _)| (v.len() / (*rec).max(1)) as f64).collect();
         let (_, all) = self.all_gather_any(&counts);
         let (m, p) = (inputs.len(), self.cluster.size() as usize);
+        // (every rank gives the same number of merges)
+        debug_assert_eq!(all.len(), p * m);
         let list = inputs
             .into_iter()
             .enumerate()
@@ -82,7 +85,7 @@ impl RankState {
                 let left: Vec<usize> = (0..p).map(|r| all[r * m + i] as usize).collect();
                 Merge {
                     rec: rec.max(1),
-                    key: key.clamp(1, 3),
+                    key: key.clamp(1, 3).min(rec.max(1)),
                     per_round: per_round(p, rec),
                     mine,
                     sent: 0,
@@ -112,11 +115,15 @@ impl Merges {
         self.list.get_mut(i).is_some_and(|m| m.next(rs, i, out))
     }
 
-    /// Rank 0: ends every merge for every rank, in order (each once).
-    pub fn finish(&mut self, rs: &mut RankState) {
+    /// Rank 0: ends every merge for every rank, in order (each once); whether every
+    /// record of every merge was pulled (false: the file misses some; its writer
+    /// stopped early, or left a merge out).
+    pub fn finish(&mut self, rs: &mut RankState) -> bool {
+        let whole = self.list.iter().all(|m| m.left.iter().all(|&n| n == 0) && m.heads.is_empty());
         for (k, m) in self.list.iter_mut().enumerate() {
             m.finish(rs, k);
         }
+        whole
     }
 
     /// The other ranks: answers rank 0's rounds of each merge in turn until rank 0
@@ -266,12 +273,13 @@ mod tests {
         }
         assert_eq!(got, [1.0, 10.0, 4.0, 40.0, 9.0, 90.0]);
         assert!(!m.pull(1, &mut rs, &mut out));
+        assert!(m.pull(2, &mut rs, &mut out) && !m.pull(2, &mut rs, &mut out));
         // pulling the last merge first ends the earlier ones
         let mut m2 = rs.merges(vec![(vec![3.0, 30.0], 2, 1), (vec![0.0, 1.0, 0.0, 2.0], 4, 3)]);
         assert!(m2.pull(1, &mut rs, &mut out) && out == [0.0, 1.0, 0.0, 2.0]);
         assert!(m2.list[0].stopped);
-        m.finish(&mut rs);
-        m2.finish(&mut rs);
+        assert!(m.finish(&mut rs), "every record pulled");
+        assert!(!m2.finish(&mut rs), "merge 0's record was never pulled");
         assert!(m.list.iter().chain(&m2.list).all(|x| x.stopped));
     }
 }

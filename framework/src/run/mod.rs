@@ -222,10 +222,7 @@ pub(crate) fn save_state<D: Dim>(
         });
     };
     let Some(rs) = dd.as_mut().and_then(|n| n.ranks_mut()) else {
-        // (a state on ranks has ranks)
-        return save_state_with(dir, name, |f| {
-            crate::output::write_final_json(f, w, states().as_ref(), state.as_ref(), (None, None))
-        });
+        return Err(RunError::Io(format!("internal error: {name}: a state of ranks without ranks")));
     };
     let (pull_bodies, pull_contacts) = (bodies.is_some(), contacts.is_some());
     let body_rec = 1 + World::<D>::OUTPUT_RECORD;
@@ -262,8 +259,11 @@ pub(crate) fn save_state<D: Dim>(
     drop(state);
     // every merge ended for every rank, the file written or not
     let (rs, mut merges) = both.into_inner();
-    merges.finish(rs);
-    written
+    let whole = merges.finish(rs);
+    match written {
+        Ok(()) if !whole => Err(RunError::Io(format!("internal error: {name} misses records of other ranks"))),
+        _ => written,
+    }
 }
 
 /// Runs `scene` for its number of steps, writing `history.csv`, the writers' frames
