@@ -256,7 +256,6 @@ pub(crate) fn save_state<D: Dim>(
     let written = save_state_with(dir, name, |f| {
         crate::output::write_final_json(f, w, states.as_ref(), state.as_ref(), pulls)
     });
-    drop(state);
     // every merge ended for every rank, the file written or not
     let (rs, mut merges) = both.into_inner();
     let whole = merges.finish(rs);
