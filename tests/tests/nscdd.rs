@@ -409,21 +409,29 @@ fn one_subdomain_is_the_plain_engine_with_every_ordering() {
     }
 }
 
-/// `sorted` with subdomains: each subdomain visits its own contacts from the bottom
-/// up, and the result does not depend on the threads.
-#[test]
-fn sorted_orders_each_subdomain_along_its_direction() {
+/// Three steps of the 2 × 2 decomposition in `ordering` on 1 and on 2 threads:
+/// bitwise the same state and sweeps; the solver of the one-thread run, whose
+/// subdomains hold the last step's visiting orders.
+fn ordered_on_1_and_2_threads(ordering: nscdd::solver::Ordering) -> Nscdd {
     let run = |threads: usize| {
         let mut s = loaded(0.3);
-        s.world.solver.ordering = nscdd::solver::Ordering::Sorted;
+        s.world.solver.ordering = ordering;
         let mut n = Nscdd::new(DdSettings { threads, ..dd(2, 2) });
         let reps: Vec<_> = (0..3).map(|_| dd_step(&mut n, &mut s).solve.sweeps).collect();
         (s, n, reps)
     };
     let (a, n, ra) = run(1);
     let (b, _, rb) = run(2);
-    same_state(&a, &b, "sorted, 1 and 2 threads");
+    same_state(&a, &b, &format!("{ordering:?}, 1 and 2 threads"));
     assert_eq!(ra, rb);
+    n
+}
+
+/// `sorted` with subdomains: each subdomain visits its own contacts from the bottom
+/// up, and the result does not depend on the threads.
+#[test]
+fn sorted_orders_each_subdomain_along_its_direction() {
+    let n = ordered_on_1_and_2_threads(nscdd::solver::Ordering::Sorted);
     for sub in &n.last.subs {
         let y: Vec<f64> = sub.order.iter().map(|&l| sub.contacts.point[l as usize][1]).collect();
         assert_eq!(sub.order.len(), sub.contact_global.len(), "subdomain {}", sub.id);
@@ -436,17 +444,7 @@ fn sorted_orders_each_subdomain_along_its_direction() {
 /// result does not depend on the threads.
 #[test]
 fn shuffled_permutes_each_subdomain_on_its_own() {
-    let run = |threads: usize| {
-        let mut s = loaded(0.3);
-        s.world.solver.ordering = nscdd::solver::Ordering::Shuffled;
-        let mut n = Nscdd::new(DdSettings { threads, ..dd(2, 2) });
-        let reps: Vec<_> = (0..3).map(|_| dd_step(&mut n, &mut s).solve.sweeps).collect();
-        (s, n, reps)
-    };
-    let (a, n, ra) = run(1);
-    let (b, _, rb) = run(2);
-    same_state(&a, &b, "shuffled, 1 and 2 threads");
-    assert_eq!(ra, rb);
+    let n = ordered_on_1_and_2_threads(nscdd::solver::Ordering::Shuffled);
     for sub in &n.last.subs {
         let mut o = sub.order.clone();
         o.sort_unstable();

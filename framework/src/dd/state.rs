@@ -119,14 +119,14 @@ impl<D: Family> NscddOf<D> {
         let dofs = D::V::default().as_ref().len();
         // (body, subdomain, F_Γ) of this rank's subdomains, flat
         let mut mine = Vec::new();
-        for (b, e, v) in self.store.iter().filter(|e| rs.rank_of.get(e.1 as usize) == Some(&me)) {
+        for (b, e, v) in self.store.iter().filter(|e| rs.is_own(e.1)) {
             mine.extend([f64::from(b), f64::from(e)]);
             mine.extend_from_slice(v.as_ref());
         }
         let all = rs.gather_any_on_root(&mine);
         // the kept subdomains of this rank's contacts (all of them when every rank
         // holds every contact: each is some rank's)
-        let mut own: Vec<&(ContactKey, u32)> = self.kept.iter().filter(|e| rs.rank_of.get(e.1 as usize) == Some(&me)).collect();
+        let mut own: Vec<&(ContactKey, u32)> = self.kept.iter().filter(|e| rs.is_own(e.1)).collect();
         own.sort_unstable_by_key(|e| e.0);
         let kept = own
             .iter()

@@ -261,6 +261,14 @@ pub fn contact_records<D: Dim>(w: &World<D>, which: impl Iterator<Item = usize>,
     }
 }
 
+/// The world's contacts in key order (candidate, antagonist, feature): the order of
+/// `final.json`'s contacts, whichever process held which.
+pub fn contacts_in_key_order<D: Dim>(w: &World<D>) -> Vec<u32> {
+    let mut order: Vec<u32> = (0..w.contacts.len() as u32).collect();
+    order.sort_unstable_by_key(|&a| w.contacts.key[a as usize]);
+    order
+}
+
 /// [`final_json`] with the body families' states under `families` (by section) and
 /// the NSCDD solver's under `nscdd`: [`write_final_json`] as text.
 pub fn final_json_of<D: Dim, N: Serialize>(
@@ -287,11 +295,7 @@ pub fn write_final_json<'p, D: Dim, N: Serialize>(
 ) -> std::io::Result<()> {
     let contacts = match contacts {
         Some(pull) => ContactsOut::Pulled(RefCell::new(Some(pull))),
-        None => {
-            let mut order: Vec<u32> = (0..w.contacts.len() as u32).collect();
-            order.sort_unstable_by_key(|&a| w.contacts.key[a as usize]);
-            ContactsOut::World(w, order)
-        }
+        None => ContactsOut::World(w, contacts_in_key_order(w)),
     };
     use std::io::Write as _;
     let mut out = std::io::BufWriter::with_capacity(1 << 16, out);

@@ -208,10 +208,9 @@ pub(crate) fn save_state<D: Dim>(
     // rank: every rank's, in key order
     let bodies = dd.as_mut().and_then(|n| n.own_body_records(w));
     let contacts = dd.as_ref().filter(|n| n.holds_own_contacts()).map(|_| {
-        let mut order: Vec<usize> = (0..w.contacts.len()).collect();
-        order.sort_unstable_by_key(|&a| w.contacts.key[a]);
+        let order = crate::output::contacts_in_key_order(w);
         let mut mine = Vec::new();
-        crate::output::contact_records(w, order.into_iter(), &mut mine);
+        crate::output::contact_records(w, order.into_iter().map(|a| a as usize), &mut mine);
         mine
     });
     let states = || (!families.is_empty()).then(|| crate::family::states(families));
