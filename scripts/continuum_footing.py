@@ -1,16 +1,28 @@
 #!/usr/bin/env python3
 """The footing of examples/scenes/footing.toml against its all-discrete reference
-(docs/CONTINUUM.md): load–penetration curves and times.
+(docs/CONTINUUM.md): load–penetration curves, the scatter, times.
 
-Usage: continuum_footing.py OUT_DIR [--deep]
-Writes OUT_DIR/{hyb,disc}_s{3,5}.toml, runs them (target/release/nscdd, built with
-the `fem` feature) one after the other, prints each one's time, sweeps, the footing
-force at 5, 10 and 15 mm of penetration and its mean over 0–10, 10–30, 30–50 and
-10–50 mm, and plots docs/continuum_footing.png (needs matplotlib:
-scripts/biaxial_study.sh installs it in .venv-docs). `--deep`: a 0.6 m layer of
-grains above the band (1300 grains; all-discrete 2420 down to -0.5 m), the footing
-0.3 m higher (0.03 m lower in the all-discrete run, whose layer settles more),
-3.5 s; plots docs/continuum_footing_deep.png.
+Usage: continuum_footing.py OUT_DIR [--shallow] [--seeds 3,5,...] [--jobs N] [--tag T]
+    [--young E] [--hardening PHI0 KAPPA_H PHI | --friction PHI] [--grain-share S] [--plot]
+
+For each seed (default 3 and 5) writes OUT_DIR/{T,disc}_sSEED.toml (T: `hyb` unless
+`--tag`): the example (1300 grains in a 0.6 m layer over the continuum, 3.5 s) and its
+all-discrete reference (2420 grains down to y = -0.5 m on a floor, the footing 0.03 m
+lower: that layer settles more). Runs them (target/release/nscdd, built with the
+`fem` feature) N at a time; a run whose OUT_DIR/NAME.toml is unchanged and whose
+OUT_DIR/NAME/history.csv exists is not run again (the all-discrete references serve
+every variant). Prints each one's time, sweeps, the footing force at 5, 10 and 15 mm
+of penetration and its mean over 0–10, 10–30, 30–50 and 10–50 mm, and, with more
+than two seeds, the scatter: each discrete seed's RMS distance (smoothed force at
+every millimetre up to 50 mm) to the mean of the other seeds, each hybrid's to the
+mean of every discrete seed. `--plot`: docs/continuum_footing.png (needs matplotlib:
+scripts/biaxial_study.sh installs it in .venv-docs).
+
+`--shallow`: the layout until 2026-11-26, a 0.3 m layer (650 grains; all-discrete
+1770), 2 s, 15 mm (plot docs/continuum_footing_shallow.png). The hybrid's
+foundation: `--young`, `--hardening` (initial friction angle, hardening strain,
+friction angle) or `--friction` (perfectly plastic) and `--grain-share` replace the
+example's.
 """
 import csv
 import os
@@ -41,8 +53,19 @@ def discrete(text):
     return text[: text.index("[[continuum]]")]
 
 
+def shallow(text):
+    """The example (a 0.6 m layer over the band) with a 0.3 m layer, as it was until
+    2026-11-26 (650 grains; all-discrete 1770), 2 s."""
+    text = text.replace("count = 1300", "count = 650").replace("box = [0.0, 0.0, 1.0, 0.61]", "box = [0.0, 0.0, 1.0, 0.31]")
+    text = text.replace("position = [0.5, 0.645]", "position = [0.5, 0.345]")
+    for x in ("-0.01", "1.01"):
+        text = text.replace(f"position = [{x}, 0.4]\nrotation = 1.5707963267948966\nlength = 0.8", f"position = [{x}, 0.25]\nrotation = 1.5707963267948966\nlength = 0.5")
+    return text.replace("duration = 3.5", "duration = 2.0")
+
+
 def deepen(text, disc):
-    """The `--deep` variant of the hybrid or all-discrete scene text."""
+    """The example's layout (a 0.6 m layer) from the shallow hybrid or all-discrete
+    scene text."""
     text = text.replace("count = 650", "count = 1300").replace("box = [0.0, 0.0, 1.0, 0.31]", "box = [0.0, 0.0, 1.0, 0.61]")
     text = text.replace("count = 1770", "count = 2420").replace("box = [0.0, -0.5, 1.0, 0.31]", "box = [0.0, -0.5, 1.0, 0.61]")
     text = text.replace("position = [0.5, 0.345]", "position = [0.5, 0.615]" if disc else "position = [0.5, 0.645]")
@@ -64,31 +87,111 @@ def curve(d):
     r = list(csv.DictReader(open(os.path.join(d, "history.csv"))))
     fy = [float(x["footing_fy"]) for x in r]
     y = [float(x["footing_y"]) for x in r]
-    first = next(i for i, f in enumerate(fy) if f > 1)
+    first = next((i for i, f in enumerate(fy) if f > 1), len(r))  # never touched: empty
     sm = lambda i: sum(fy[max(0, i - 25) : i + 26]) / len(fy[max(0, i - 25) : i + 26])
     return [(y[first] - y[i]) * 1000 for i in range(first, len(r))], [sm(i) for i in range(first, len(r))], r
 
 
+def opt(name, n=1, default=None):
+    """The `n` values after `--name` on the command line, or `default`."""
+    if name not in sys.argv:
+        return default
+    i = sys.argv.index(name)
+    v = sys.argv[i + 1 : i + 1 + n]
+    return v if n > 1 else v[0]
+
+
+def hybrid_variant(text):
+    """The hybrid's foundation with the command line's law, if any: `--young E`,
+    `--hardening PHI0 KAPPA_H PHI` or `--friction PHI` (perfectly plastic),
+    `--grain-share S`."""
+    young, hard, phi, share = opt("--young"), opt("--hardening", 3), opt("--friction"), opt("--grain-share")
+    if young:
+        text = re.sub(r"(?m)^young = .*$", f"young = {young}", text)
+    if hard:
+        phi0, kh, phi = hard
+        law = f"plastic = {{ friction = {phi}, initial_friction = {phi0}, hardening_strain = {kh}, dilatancy = 4.0 }}"
+        text = re.sub(r"(?m)^plastic = .*$", law, text)
+    elif phi:
+        text = re.sub(r"(?m)^plastic = .*$", f"plastic = {{ friction = {phi}, dilatancy = 4.0 }}", text)
+    if share:
+        text = re.sub(r"(?m)^(band = .*discrete = 0\.1)(, grain_share = [0-9.e-]+)? }$", rf"\1, grain_share = {share} }}", text)
+    return text
+
+
+def resampled(p, f, top):
+    """The smoothed force at every whole millimetre of penetration from 1 to `top`."""
+    out, k = [], 0
+    for mm in range(1, top + 1):
+        while k < len(p) and p[k] < mm:
+            k += 1
+        if k >= len(p):
+            return None
+        out.append(f[k])
+    return out
+
+
+def rms(a, b):
+    return (sum((x - y) ** 2 for x, y in zip(a, b)) / len(a)) ** 0.5
+
+
+def mean_curve(cs):
+    return [sum(v) / len(v) for v in zip(*cs)]
+
+
+def run_all(jobs, todo, env):
+    """Runs `todo` ([(name, path, out)]), `jobs` at a time; returns {name: wall}."""
+    walls, running = {}, []
+    nscdd = os.path.join(ROOT, "target/release/nscdd")
+
+    def reap(limit):
+        while len(running) > limit:
+            for r in running:
+                if r[1].poll() is not None:
+                    if r[1].returncode != 0:
+                        sys.exit(f"{r[0]} failed ({r[1].returncode})")
+                    walls[r[0]] = time.time() - r[2]
+                    running.remove(r)
+                    break
+            else:
+                time.sleep(0.2)
+
+    for name, path, dest in todo:
+        reap(jobs - 1)
+        running.append((name, subprocess.Popen([nscdd, "run", path, "--out", dest, "--quiet"], env=env), time.time()))
+    reap(0)
+    return walls
+
+
 def main():
-    deep = "--deep" in sys.argv
-    args = [a for a in sys.argv[1:] if a != "--deep"]
-    out = args[0] if args else "out/footing_study"
+    deep = "--shallow" not in sys.argv
+    out = sys.argv[1] if len(sys.argv) > 1 and not sys.argv[1].startswith("--") else "out/footing_study"
+    seeds = [int(x) for x in opt("--seeds", default="3,5").split(",")]
+    jobs = int(opt("--jobs", default="1"))
+    tag = opt("--tag", default="hyb")
     os.makedirs(out, exist_ok=True)
-    src = open(os.path.join(ROOT, "examples/scenes/footing.toml")).read()
+    src = shallow(open(os.path.join(ROOT, "examples/scenes/footing.toml")).read())
     env = dict(os.environ, NSCDD_PYTHON_ENV=os.environ.get("NSCDD_PYTHON_ENV", os.path.join(ROOT, "venv")))
-    runs = []
-    for seed in (3, 5):
-        for kind, text in (("hyb", src), ("disc", discrete(src))):
+    todo, names = [], []
+    for seed in seeds:
+        for kind, text in ((tag, hybrid_variant(src)), ("disc", discrete(src))):
+            # (the shallow layout first, deepened: the all-discrete files stay those of
+            # the runs recorded in docs/CONTINUUM.md)
             if deep:
                 text = deepen(text, kind == "disc")
             name = f"{kind}_s{seed}"
+            names.append(name)
+            dest = os.path.join(out, name)
             path = os.path.join(out, name + ".toml")
-            open(path, "w").write(re.sub(r"(?m)^seed = 3$", f"seed = {seed}", text))
-            t0 = time.time()
-            subprocess.run([os.path.join(ROOT, "target/release/nscdd"), "run", path, "--out", os.path.join(out, name), "--quiet"], env=env, check=True)
-            runs.append((name, time.time() - t0))
-    curves = {}
-    for name, wall in runs:
+            text = re.sub(r"(?m)^seed = 3$", f"seed = {seed}", text)
+            same = lambda t: [x for x in t.splitlines() if not x.startswith("#")]
+            if os.path.exists(os.path.join(dest, "history.csv")) and os.path.exists(path) and same(open(path).read()) == same(text):
+                continue  # run once: the all-discrete reference serves every variant
+            open(path, "w").write(text)
+            todo.append((name, path, dest))
+    walls = run_all(jobs, todo, env)
+    curves, top = {}, 50 if deep else 15
+    for name in names:
         p, f, r = curve(os.path.join(out, name))
         curves[name] = (p, f)
         sweeps = sum(int(float(x["sweeps"])) for x in r)
@@ -97,7 +200,27 @@ def main():
             k = next((i for i, x in enumerate(p) if x >= mm), None)
             at.append(f"{f[k]:.0f}" if k is not None else "-")
         means = " / ".join(mean_force(os.path.join(out, name), lo, hi) for lo, hi in ((0, 10), (10, 30), (30, 50), (10, 50)))
-        print(f"{name}: {wall:.1f} s, {sweeps} sweeps, bodies {r[0]['bodies']}, force at 5/10/15 mm: {' / '.join(at)} N/m, mean over 0-10/10-30/30-50/10-50 mm: {means} N/m")
+        wall = f"{walls[name]:.1f} s" if name in walls else "(earlier run)"
+        print(f"{name}: {wall}, {sweeps} sweeps, bodies {r[0]['bodies']}, force at 5/10/15 mm: {' / '.join(at)} N/m, mean over 0-10/10-30/30-50/10-50 mm: {means} N/m")
+    # the scatter: each discrete seed's RMS distance (force over 1..top mm) to the
+    # mean of the other discrete seeds; each hybrid's to the mean of them all
+    disc = {s: resampled(*curves[f"disc_s{s}"], top) for s in seeds}
+    hyb = {s: resampled(*curves[f"{tag}_s{s}"], top) for s in seeds}
+    short = [f"disc_s{s}" for s, c in disc.items() if c is None] + [f"{tag}_s{s}" for s, c in hyb.items() if c is None]
+    if short:
+        print(f"not {top} mm deep by the end (left out of the scatter): {', '.join(short)}")
+    ds = [s for s in seeds if disc[s]]
+    if len(ds) > 2:
+        loo = [rms(disc[s], mean_curve([disc[t] for t in ds if t != s])) for s in ds]
+        print(f"RMS over 1-{top} mm, each discrete seed to the mean of the others: {min(loo):.0f}-{max(loo):.0f}, mean {sum(loo) / len(loo):.0f} N/m")
+        m = mean_curve([disc[s] for s in ds])
+        d = [rms(hyb[s], m) for s in seeds if hyb[s]]
+        if d:
+            print(f"RMS over 1-{top} mm, each {tag} to the discrete mean: {min(d):.0f}-{max(d):.0f}, mean {sum(d) / len(d):.0f} N/m")
+            hm = mean_curve([c for c in hyb.values() if c])
+            print(f"mean {tag} curve to the discrete mean: {rms(hm, m):.0f} N/m; mean force {sum(hm) / len(hm):.0f} against {sum(m) / len(m):.0f} N/m")
+    if "--plot" not in sys.argv:
+        return
     try:
         import matplotlib
 
@@ -105,16 +228,23 @@ def main():
         import matplotlib.pyplot as plt
     except ImportError:
         return
-    fig, ax = plt.subplots(figsize=(6, 4))
-    style = {"disc_s3": ("k-", "all-discrete, seed 3"), "disc_s5": ("k--", "all-discrete, seed 5"), "hyb_s3": ("r-", "grains + continuum, seed 3"), "hyb_s5": ("r--", "grains + continuum, seed 5")}
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
     for name, (p, f) in curves.items():
-        st, lab = style[name]
-        ax.plot(p, f, st, label=lab)
+        hy = name.startswith(tag)
+        ax.plot(p, f, "r-" if hy else "k-", lw=0.6, alpha=0.45, label=("grains + continuum, each seed" if hy else "all-discrete, each seed") if name.endswith(f"_s{seeds[0]}") else None)
+    x = list(range(1, top + 1))
+    if len(ds) > 1:
+        ax.plot(x, mean_curve([disc[s] for s in ds]), "k-", lw=2.2, label=f"all-discrete, mean of {len(ds)}")
+    hs = [c for c in hyb.values() if c]
+    if len(hs) > 1:
+        ax.plot(x, mean_curve(hs), "r-", lw=2.2, label=f"grains + continuum, mean of {len(hs)}")
+    ax.set_xlim(0, top)
+    ax.set_ylim(0, 1.05 * max(v for p, f in curves.values() for x, v in zip(p, f) if x <= top))
     ax.set_xlabel("penetration since first contact (mm)")
     ax.set_ylabel("footing force (N/m, mean over 51 steps)")
     ax.legend()
     fig.tight_layout()
-    fig.savefig(os.path.join(ROOT, "docs/continuum_footing_deep.png" if deep else "docs/continuum_footing.png"), dpi=110)
+    fig.savefig(os.path.join(ROOT, "docs/continuum_footing.png" if deep else "docs/continuum_footing_shallow.png"), dpi=110)
 
 
 if __name__ == "__main__":

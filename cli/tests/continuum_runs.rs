@@ -9,11 +9,11 @@ mod common;
 fn footing(steps: u32, output: &str, extra: &str) -> String {
     let src = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/scenes/footing.toml")).unwrap();
     assert!(
-        src.contains("duration = 2.0") && src.contains("[output]\nevery = 50\n"),
+        src.contains("duration = 3.5") && src.contains("[output]\nevery = 50\n"),
         "the footing example changed"
     );
     let s = src
-        .replace("duration = 2.0", &format!("steps = {steps}"))
+        .replace("duration = 3.5", &format!("steps = {steps}"))
         .replace("[output]\nevery = 50\n", &format!("[output]\nvtk = false\n{output}"));
     format!("{s}\n{extra}\n")
 }
