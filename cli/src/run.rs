@@ -27,16 +27,23 @@ pub fn run<D: Dim>(mut s: Scene<D>, reg: &Registry, scene: &Path, out: &Path, qu
         match f.restart {
             Some(state) => {
                 nscdd::scene::restart::check_out_dir(out, state).map_err(|m| format!("--out: {m}"))?;
-                nscdd::scene::restart_scene(&mut s, state).map_err(|e| e.to_string())
+                // each rank reads the state's contacts its subdomains get, where it can
+                let on = (ranks.size() > 1).then(|| (ranks.size(), ranks.rank()));
+                nscdd::scene::restart_scene_on(&mut s, state, on).map_err(|e| e.to_string())
             }
-            None => Ok(()),
+            None => Ok(false),
         }
     });
-    // (what the ranks compare: one process has no one to agree with)
-    let digest = flags.map(|()| match ranks.size() > 1 {
+    // (what the ranks compare: one process has no one to agree with; contacts read
+    // in part differ between ranks and are left out)
+    let digest = flags.map(|in_part| match ranks.size() > 1 {
         true => {
             let w = &s.world;
-            let state = |out: &mut dyn std::io::Write| nscdd::output::write_final_json(out, w, None, None::<&()>, (None, None));
+            let state = |out: &mut dyn std::io::Write| {
+                let mut none = |_: &mut Vec<f64>| false;
+                let contacts: Option<nscdd::output::Pull> = if in_part { Some(&mut none) } else { None };
+                nscdd::output::write_final_json(out, w, None, None::<&()>, (contacts, None))
+            };
             crate::ranks::digest(scene, state, (&s.decomposition, &w.time, &w.solver))
         }
         false => 0,

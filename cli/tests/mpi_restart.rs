@@ -63,6 +63,9 @@ fn restarts_match(dir: &Path, whole: &Path, half: &Path, reference: &str, flags:
         if then == 4 && std::fs::read_to_string(whole).unwrap().contains("repartition_every") {
             held_less_than_all(&b);
         }
+        if then > 1 {
+            contacts_read_in_part(&state, &b);
+        }
     }
     // the restarted runs' frames, the one at the restart included, in pieces that
     // hold each body and contact once
@@ -94,6 +97,24 @@ fn a_3d_state_restarts_on_other_rank_counts() {
         restarts_match(&dir, &whole, &half, &reference, &flags, tag);
     }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The restart from `state` in `out` read the state's contacts in part: each rank
+/// loaded only its own (`restart_contacts` in ranks.json), each contact one rank.
+fn contacts_read_in_part(state: &Path, out: &Path) {
+    let saved: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(state).unwrap()).expect("state");
+    let nc = saved["contacts"].as_array().expect("contacts").len() as u64;
+    let ranks: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("ranks.json")).expect("ranks.json")).expect("json");
+    let loaded: Vec<u64> = ranks["per_rank"]
+        .as_array()
+        .expect("ranks")
+        .iter()
+        .map(|r| r["restart_contacts"].as_u64().expect("restart_contacts"))
+        .collect();
+    assert!(nc > 0, "{}: a state without contacts", state.display());
+    assert_eq!(loaded.iter().sum::<u64>(), nc, "{}: {loaded:?} of {nc}", out.display());
+    assert!(loaded.iter().all(|&n| n < nc), "{}: {loaded:?} of {nc}", out.display());
 }
 
 /// Each rank of the run in `out` held fewer bodies than all at every step (the

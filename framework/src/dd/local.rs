@@ -254,7 +254,8 @@ impl<D: Family> super::NscddOf<D> {
     }
 
     /// The first step after a restart (the saved grid, no ranks yet; every rank
-    /// loaded every body and the last step's contacts): the cells' ranks balanced
+    /// loaded every body and the last step's contacts, or only its own when the CLI
+    /// read the state in part, [`super::RestartPart`]: the same rule): the cells' ranks balanced
     /// by their kept contacts (the same on every rank; results do not depend on
     /// which rank sweeps a subdomain), then each rank keeps the last step's
     /// contacts whose kept subdomain is its own, as if it had stepped them, and its
@@ -271,6 +272,7 @@ impl<D: Family> super::NscddOf<D> {
         // (the saved subdomains lie in the grid: `NscddOf::load_state` checks)
         let kept_owners: Vec<u32> = self.kept.iter().map(|e| e.1).collect();
         rs.assign(&kept_owners, grid.len(), true);
+        rs.totals.restart_contacts = D::len(D::contacts(w)) as u64;
         let owner = super::owner::kept_owners::<D>(D::contacts(w), grid, &self.kept);
         D::retain_contacts(w, &mut |a| rs.is_own(owner[a]));
         self.last.owner = owner.into_iter().filter(|&o| rs.is_own(o)).collect();

@@ -70,7 +70,7 @@ mod report;
 pub mod schemes;
 mod shells;
 mod state;
-pub use state::NscddState;
+pub use state::{NscddState, RestartPart};
 pub mod subdomain;
 pub mod team;
 pub mod transport;

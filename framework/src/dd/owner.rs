@@ -26,7 +26,8 @@ pub fn owner_of(kept: &[(ContactKey, u32)], grid: &Grid, key: ContactKey, p: [f6
 pub struct OwnerOf<'a> {
     kept: &'a [(ContactKey, u32)],
     grid: &'a Grid,
-    at: usize,
+    /// Where the last key was found (or would be): the next search starts there.
+    pub(super) at: usize,
 }
 
 impl<'a> OwnerOf<'a> {

@@ -14,9 +14,10 @@ use super::ranks::RankState;
 /// the steps whose shells were limited to the bodies near it
 /// (`limited_shell_steps`, [`super::shells`]); the bodies its world held, summed
 /// over the steps (`bodies_held`, [`crate::world::held`]), and the most in one step
-/// (`bodies_held_max`).
+/// (`bodies_held_max`); the restart's contacts its world loaded (`restart_contacts`:
+/// the state read in part, [`super::RestartPart`], gives each contact to one rank).
 pub fn totals_json(st: &mut RankState) -> String {
-    const H: usize = 21;
+    const H: usize = 22;
     let p = st.cluster.size() as usize;
     let t = &st.totals;
     let (wait_wall, wait_cpu) = st.cluster.waited();
@@ -43,6 +44,7 @@ pub fn totals_json(st: &mut RankState) -> String {
         t.limited_shells as f64,
         t.bodies_held as f64,
         t.bodies_held_max as f64,
+        t.restart_contacts as f64,
         t.peers.len() as f64,
     ];
     mine.extend(t.peers.iter().map(|&x| x as f64));
@@ -78,6 +80,7 @@ pub fn totals_json(st: &mut RankState) -> String {
                 "limited_shell_steps": x[17] as u64,
                 "bodies_held": x[18] as u64,
                 "bodies_held_max": x[19] as u64,
+                "restart_contacts": x[20] as u64,
                 "peers": peers,
                 "last_subdomains": subs,
             })

@@ -84,6 +84,10 @@ pub struct RankTotals {
     /// and the most it held in one step.
     pub bodies_held: u64,
     pub bodies_held_max: u64,
+    /// The contacts of the restart's state this rank's world held before its first
+    /// step kept its own (all of them unless the state was read in part,
+    /// [`super::RestartPart`]); 0 without a restart.
+    pub restart_contacts: u64,
     /// Bodies of the other ranks' subdomains (shells) this rank held, summed over
     /// the steps, and the steps whose shells were limited ([`super::shells`]).
     pub shell_bodies: u64,

@@ -84,6 +84,61 @@ impl NscddState {
     }
 }
 
+/// The contacts one MPI rank keeps of a saved state (a restart on P ranks with
+/// contacts held per rank, [`NscddState::rank_part`]): those of the subdomains the
+/// first step after the restart gives the rank — the kept subdomain of a contact
+/// whose key the state keeps, else the saved grid's cell of its point
+/// ([`super::owner`]), the cells' ranks balanced by the kept contacts as
+/// `NscddOf::start_restarted` balances them. A restart that streams the state keeps
+/// only those ([`crate::scene::restart_scene_on`]), instead of every contact of the
+/// sample on every rank until the first step drops the others.
+pub struct RestartPart {
+    grid: Grid,
+    kept: Vec<(ContactKey, u32)>,
+    rank_of: Vec<u32>,
+    me: u32,
+    at: usize,
+}
+
+impl RestartPart {
+    /// Whether this rank keeps the contact of `key` at point `p` (keys mostly
+    /// ascending, as a state lists them: the search gallops from the last one).
+    pub fn keeps(&mut self, key: ContactKey, p: [f64; 3]) -> bool {
+        let mut owner = super::owner::OwnerOf::new(&self.kept, &self.grid);
+        owner.at = self.at;
+        let o = owner.of(key, p);
+        self.at = owner.at;
+        self.rank_of.get(o as usize) == Some(&self.me)
+    }
+}
+
+impl NscddState {
+    /// The part of rank `me` of `ranks` when a run of the decomposition `grid_of`
+    /// (`by_model`) restarts from this state with contacts held per rank; `None`
+    /// when every rank must load every contact (one rank; by model; a state of
+    /// another decomposition or without a grid; a malformed state, which
+    /// `NscddOf::load_state` refuses).
+    pub fn rank_part(&self, grid_of: [u32; 3], by_model: bool, ranks: u32, me: u32) -> Option<RestartPart> {
+        let grid = self.grid.as_ref()?;
+        if ranks < 2 || by_model || self.by_model || self.grid_of != grid_of || self.grid_empty {
+            return None;
+        }
+        let mut loads = vec![0usize; grid.len()];
+        for e in &self.kept {
+            *loads.get_mut(e.1 as usize)? += 1;
+        }
+        let mut kept = self.kept.clone();
+        kept.sort_unstable_by_key(|x| x.0);
+        Some(RestartPart {
+            grid: grid.clone(),
+            kept,
+            rank_of: super::rank_balance::balanced_ranks(&loads, ranks),
+            me,
+            at: 0,
+        })
+    }
+}
+
 impl<D: Family> NscddOf<D> {
     /// The state of the solver between steps (module docs); `None` on several MPI
     /// ranks (each holds only its subdomains' F_Γ: see [`NscddOf::state_on_ranks`]).

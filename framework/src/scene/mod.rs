@@ -23,7 +23,7 @@ use builder::Origin;
 pub use checks::parse_scheme;
 pub(crate) use checks::*;
 use locate::{locate, path_string, Seg};
-pub use restart::{restart, restart_scene};
+pub use restart::{restart, restart_scene, restart_scene_on};
 use schema::{BodySpec, SceneDim, SceneFile};
 
 /// Output settings of a scene.

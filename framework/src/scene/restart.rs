@@ -31,7 +31,7 @@ use std::path::Path;
 /// wrote it), read as a stream ([`super::restart_stream`]). Errors name the file,
 /// the line and the key; after one the world is partly restarted (module docs).
 pub fn restart<D: Dim>(w: &mut World<D>, path: &Path) -> Result<(), InputError> {
-    restart_from(w, Source::File(path), false).map(|_| ())
+    restart_from(w, Source::File(path), false, None).map(|_| ())
 }
 
 /// Where a saved state is read from: its file (streamed, never held whole) or a
@@ -61,14 +61,21 @@ impl Source<'_> {
 /// The parts of a state besides the world's: the NSCDD state and the families'.
 type Parts = (Option<crate::dd::NscddState>, serde_json::Map<String, serde_json::Value>);
 
-/// [`restart`] from `src`; with `parts`, the `nscdd` and `families` parts too.
-fn restart_from<D: Dim>(w: &mut World<D>, src: Source, parts: bool) -> Result<Parts, InputError> {
+/// [`restart`] from `src`; with `parts`, the `nscdd` and `families` parts too; with
+/// `part`, only the contacts an MPI rank keeps.
+fn restart_from<D: Dim>(
+    w: &mut World<D>,
+    src: Source,
+    parts: bool,
+    part: Option<&mut crate::dd::RestartPart>,
+) -> Result<Parts, InputError> {
     let (mut failed, mut dimension) = (None, None);
     let seed = StateSeed {
         w: &mut *w,
         parts,
         failed: &mut failed,
         dimension: &mut dimension,
+        part,
     };
     let read = match &src {
         Source::File(p) => {
@@ -145,7 +152,26 @@ pub fn check_out_dir(out: &Path, state: &Path) -> Result<(), String> {
 /// state without a family of the scene, or with one the scene does not have, is
 /// another scene's: an error. The file is read once, as a stream.
 pub fn restart_scene<D: Dim>(scene: &mut super::Scene<D>, path: &Path) -> Result<(), InputError> {
-    let (nscdd, states) = restart_from(&mut scene.world, Source::File(path), true)?;
+    restart_scene_on(scene, path, None).map(|_| ())
+}
+
+/// [`restart_scene`] as rank `me` of `ranks` MPI ranks (`on`; `None`: one process).
+/// When the run will hold its contacts per rank (a decomposition by geometry, no
+/// body families, the state of the same decomposition), the state's `nscdd` part is
+/// read first (the rest of the file skipped) and then, as the file streams, each
+/// rank keeps only the contacts its subdomains get in the first step
+/// ([`crate::dd::RestartPart`]): the sample's contacts are never all on one rank.
+/// Returns whether the contacts were read in part (the world then differs between
+/// ranks by its contacts).
+pub fn restart_scene_on<D: Dim>(scene: &mut super::Scene<D>, path: &Path, on: Option<(u32, u32)>) -> Result<bool, InputError> {
+    let mut part = match (on, &scene.decomposition) {
+        (Some((ranks, me)), Some(c)) if ranks > 1 && scene.families.is_empty() && !c.by_model => {
+            let grid_of = [c.dd.nx, c.dd.ny, c.dd.nz];
+            nscdd_of(path).and_then(|s| s.rank_part(grid_of, c.by_model, ranks, me))
+        }
+        _ => None,
+    };
+    let (nscdd, states) = restart_from(&mut scene.world, Source::File(path), true, part.as_mut())?;
     scene.dd_state = nscdd;
     let ck = StateChecks::new(Source::File(path));
     for (name, _) in &states {
@@ -166,12 +192,57 @@ pub fn restart_scene<D: Dim>(scene: &mut super::Scene<D>, path: &Path) -> Result
         f.load_state(state)
             .map_err(|m| ck.err(ck.line_of(f.section(), 0), key.clone(), m))?;
     }
-    Ok(())
+    Ok(part.is_some())
+}
+
+/// The `nscdd` part of the saved state at `path` alone (`None` when absent or
+/// unreadable: the whole reading then reports what is wrong). A `final.json` or
+/// checkpoint is pretty-printed, so its top-level keys are the lines starting with
+/// two spaces and a quote: the file is scanned for the `nscdd` key and only its
+/// value parsed (18 MB of a 137 MB state: the bodies and contacts are not parsed
+/// twice); another layout is parsed whole, the rest skipped.
+fn nscdd_of(path: &Path) -> Option<crate::dd::NscddState> {
+    use serde::Deserialize;
+    use std::io::{Read, Seek};
+    const KEY: &[u8] = b"\n  \"nscdd\": ";
+    let mut f = std::fs::File::open(path).ok()?;
+    let finder = memchr::memmem::Finder::new(KEY);
+    let mut buf = vec![0u8; 1 << 20];
+    let (mut kept, mut start, mut pretty) = (0usize, 0u64, None);
+    loop {
+        let n = f.read(&mut buf[kept..]).ok()?;
+        let len = kept + n;
+        let pretty = *pretty.get_or_insert_with(|| buf[..len].starts_with(b"{\n  \""));
+        if let Some(i) = finder.find(&buf[..len]) {
+            f.seek(std::io::SeekFrom::Start(start + (i + KEY.len()) as u64)).ok()?;
+            let mut de = serde_json::Deserializer::from_reader(std::io::BufReader::with_capacity(1 << 16, f));
+            return Option::<crate::dd::NscddState>::deserialize(&mut de).ok().flatten();
+        }
+        if n == 0 || !pretty {
+            break;
+        }
+        // the last bytes may begin the key
+        let carry = (KEY.len() - 1).min(len);
+        buf.copy_within(len - carry..len, 0);
+        start += (len - carry) as u64;
+        kept = carry;
+    }
+    if pretty.unwrap_or(false) {
+        return None;
+    }
+    #[derive(serde::Deserialize)]
+    struct Only {
+        #[serde(default)]
+        nscdd: Option<crate::dd::NscddState>,
+    }
+    f.seek(std::io::SeekFrom::Start(0)).ok()?;
+    let only: Only = serde_json::from_reader(std::io::BufReader::with_capacity(1 << 16, f)).ok()?;
+    only.nscdd
 }
 
 /// [`restart`] from the text of a saved state; `file` names it in messages.
 pub fn restart_str<D: Dim>(w: &mut World<D>, text: &str, file: &str) -> Result<(), InputError> {
-    restart_from(w, Source::Text(text, file), false).map(|_| ())
+    restart_from(w, Source::Text(text, file), false, None).map(|_| ())
 }
 
 /// The checks every restart file gets, whatever the dimension: errors name the

@@ -94,6 +94,9 @@ pub(super) struct StateSeed<'a, D: Dim> {
     pub parts: bool,
     pub failed: &'a mut Option<Failed>,
     pub dimension: &'a mut Option<u64>,
+    /// On an MPI rank: the contacts it keeps (the others are read and checked,
+    /// then left out).
+    pub part: Option<&'a mut crate::dd::RestartPart>,
 }
 
 impl<'de, D: Dim> DeserializeSeed<'de> for StateSeed<'_, D> {
@@ -108,7 +111,7 @@ impl<'de, D: Dim> Visitor<'de> for StateSeed<'_, D> {
     fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
         f.write_str("a saved state (a JSON object)")
     }
-    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Streamed<D>, A::Error> {
+    fn visit_map<A: MapAccess<'de>>(mut self, mut map: A) -> Result<Streamed<D>, A::Error> {
         let mut s = Streamed {
             step: None,
             time: None,
@@ -143,6 +146,7 @@ impl<'de, D: Dim> Visitor<'de> for StateSeed<'_, D> {
                     s.contacts = Some(map.next_value_seed(ContactsSeed::<D> {
                         nb,
                         failed: &mut *self.failed,
+                        part: self.part.as_deref_mut(),
                         dim: std::marker::PhantomData,
                     })?);
                 }
@@ -245,6 +249,7 @@ fn body_error<D: Dim>(w: &World<D>, k: usize, sb: &SavedBody<D>) -> Option<Faile
 struct ContactsSeed<'a, D: Dim> {
     nb: usize,
     failed: &'a mut Option<Failed>,
+    part: Option<&'a mut crate::dd::RestartPart>,
     dim: std::marker::PhantomData<D>,
 }
 
@@ -260,7 +265,7 @@ impl<'de, D: Dim> Visitor<'de> for ContactsSeed<'_, D> {
     fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
         f.write_str("a list of saved contacts")
     }
-    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+    fn visit_seq<A: SeqAccess<'de>>(mut self, mut seq: A) -> Result<Self::Value, A::Error> {
         let (mut c, mut normals) = (Contacts::default(), Vec::new());
         let mut a = 0usize;
         while let Some(sc) = seq.next_element::<SavedContact<D>>()? {
@@ -281,6 +286,19 @@ impl<'de, D: Dim> Visitor<'de> for ContactsSeed<'_, D> {
                     ))
                 }
             };
+            let key = ContactKey {
+                i,
+                j,
+                feature: sc.feature.unwrap_or(0),
+            };
+            if let Some(part) = self.part.as_deref_mut() {
+                let mut p = [0.0; 3];
+                p[..D::N].copy_from_slice(sc.point.as_ref());
+                if !part.keeps(key, p) {
+                    a += 1;
+                    continue;
+                }
+            }
             c.bodies.push([i, j]);
             c.frame.push(Default::default());
             c.block.push(Default::default());
@@ -289,11 +307,7 @@ impl<'de, D: Dim> Visitor<'de> for ContactsSeed<'_, D> {
             c.u_free.push(D::Local::zero());
             c.gap.push(sc.gap);
             c.point.push(sc.point);
-            c.key.push(ContactKey {
-                i,
-                j,
-                feature: sc.feature.unwrap_or(0),
-            });
+            c.key.push(key);
             c.joint.push(if sc.bonded { Joint::RESTORED } else { Joint::default() });
             normals.push(sc.normal);
             a += 1;
