@@ -298,6 +298,21 @@ fn a_rank_count_that_does_not_fit_the_decomposition_is_bad_input() {
     assert!(err.contains("4 ranks for 2 subdomains"), "{err}");
     assert_eq!(err.matches("4 ranks for 2 subdomains").count(), 1, "rank 0 says it once: {err}");
     assert!(!err.contains("panicked"), "{err}");
+    // the same from a state of that decomposition: the restart reads no rank's
+    // part of it (too few subdomains) and the run refuses the count
+    let (half, state) = (
+        write(&dir, "half.toml", &PILE2D.replace("steps = 15", "steps = 8")),
+        dir.join("state"),
+    );
+    ok(&nscdd(&args(&half, &state, &["--subdomains", "2x1"])), "the state in one process");
+    let saved = state.join("final.json");
+    let o = mpirun(&[(
+        4,
+        args(&scene, &out, &["--subdomains", "2x1", "--restart", saved.to_str().unwrap()]),
+    )]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("4 ranks for 2 subdomains") && !err.contains("internal error"), "{err}");
     // no decomposition at all
     let o = mpirun(&[(2, args(&scene, &out, &[]))]);
     let err = text(&o.stderr);

@@ -123,6 +123,11 @@ impl NscddState {
         if ranks < 2 || by_model || self.by_model || self.grid_of != grid_of || self.grid_empty {
             return None;
         }
+        // a grid of other cells, or too few for the ranks: the run refuses it (exit 2)
+        let cells: u64 = grid_of.iter().map(|&n| u64::from(n)).product();
+        if grid.len() as u64 != cells || cells < u64::from(ranks) {
+            return None;
+        }
         let mut loads = vec![0usize; grid.len()];
         for e in &self.kept {
             *loads.get_mut(e.1 as usize)? += 1;

@@ -198,25 +198,24 @@ pub fn restart_scene_on<D: Dim>(scene: &mut super::Scene<D>, path: &Path, on: Op
 /// The `nscdd` part of the saved state at `path` alone (`None` when absent or
 /// unreadable: the whole reading then reports what is wrong). A `final.json` or
 /// checkpoint is pretty-printed, so its top-level keys are the lines starting with
-/// two spaces and a quote: the file is scanned for the `nscdd` key and only its
-/// value parsed (18 MB of a 137 MB state: the bodies and contacts are not parsed
-/// twice); another layout is parsed whole, the rest skipped.
+/// two spaces and a quote: the file is scanned for the `nscdd` key (the last one,
+/// whose value the streaming reader keeps) and only its value parsed (18 MB of a
+/// 137 MB state: the bodies and contacts are not parsed twice); another layout is
+/// parsed whole, the rest skipped (a key given twice: no part).
 fn nscdd_of(path: &Path) -> Option<crate::dd::NscddState> {
     use serde::Deserialize;
     use std::io::{Read, Seek};
     const KEY: &[u8] = b"\n  \"nscdd\": ";
     let mut f = std::fs::File::open(path).ok()?;
-    let finder = memchr::memmem::Finder::new(KEY);
     let mut buf = vec![0u8; 1 << 20];
-    let (mut kept, mut start, mut pretty) = (0usize, 0u64, None);
+    let (mut kept, mut start, mut pretty, mut last) = (0usize, 0u64, None, None);
     loop {
         let n = f.read(&mut buf[kept..]).ok()?;
         let len = kept + n;
         let pretty = *pretty.get_or_insert_with(|| buf[..len].starts_with(b"{\n  \""));
-        if let Some(i) = finder.find(&buf[..len]) {
-            f.seek(std::io::SeekFrom::Start(start + (i + KEY.len()) as u64)).ok()?;
-            let mut de = serde_json::Deserializer::from_reader(std::io::BufReader::with_capacity(1 << 16, f));
-            return Option::<crate::dd::NscddState>::deserialize(&mut de).ok().flatten();
+        // the last occurrence, as the streaming reader keeps the last value
+        if let Some(i) = memchr::memmem::rfind(&buf[..len], KEY) {
+            last = Some(start + (i + KEY.len()) as u64);
         }
         if n == 0 || !pretty {
             break;
@@ -226,6 +225,11 @@ fn nscdd_of(path: &Path) -> Option<crate::dd::NscddState> {
         buf.copy_within(len - carry..len, 0);
         start += (len - carry) as u64;
         kept = carry;
+    }
+    if let Some(at) = last {
+        f.seek(std::io::SeekFrom::Start(at)).ok()?;
+        let mut de = serde_json::Deserializer::from_reader(std::io::BufReader::with_capacity(1 << 16, f));
+        return Option::<crate::dd::NscddState>::deserialize(&mut de).ok().flatten();
     }
     if pretty.unwrap_or(false) {
         return None;
