@@ -3,7 +3,8 @@
 (docs/CONTINUUM.md): load–penetration curves, the scatter, times.
 
 Usage: continuum_footing.py OUT_DIR [--shallow] [--seeds 3,5,...] [--jobs N] [--tag T]
-    [--young E] [--hardening PHI0 KAPPA_H PHI | --friction PHI] [--grain-share S] [--plot]
+    [--young E] [--hardening PHI0 KAPPA_H PHI | --friction PHI] [--grain-share S]
+    [--coupling node|grain] [--plot]
 
 For each seed (default 3 and 5) writes OUT_DIR/{T,disc}_sSEED.toml (T: `hyb` unless
 `--tag`): the example (1300 grains in a 0.6 m layer over the continuum, 3.5 s) and its
@@ -21,8 +22,8 @@ scripts/biaxial_study.sh installs it in .venv-docs).
 `--shallow`: the layout until 2026-11-26, a 0.3 m layer (650 grains; all-discrete
 1770), 2 s, 15 mm (plot docs/continuum_footing_shallow.png). The hybrid's
 foundation: `--young`, `--hardening` (initial friction angle, hardening strain,
-friction angle) or `--friction` (perfectly plastic) and `--grain-share` replace the
-example's.
+friction angle) or `--friction` (perfectly plastic), `--grain-share` and
+`--coupling` replace the example's.
 """
 import csv
 import os
@@ -104,8 +105,11 @@ def opt(name, n=1, default=None):
 def hybrid_variant(text):
     """The hybrid's foundation with the command line's law, if any: `--young E`,
     `--hardening PHI0 KAPPA_H PHI` or `--friction PHI` (perfectly plastic),
-    `--grain-share S`."""
+    `--grain-share S`, `--coupling node|grain`."""
     young, hard, phi, share = opt("--young"), opt("--hardening", 3), opt("--friction"), opt("--grain-share")
+    coupling = opt("--coupling")
+    if coupling:
+        text = re.sub(r"(?m)^(band = .*)$", rf'\1\ncoupling = "{coupling}"', text, count=1)
     if young:
         text = re.sub(r"(?m)^young = .*$", f"young = {young}", text)
     if hard:
