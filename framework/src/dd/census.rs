@@ -96,15 +96,21 @@ fn loaded<D: Family>(w: &D::World, d: &Decomposition<D>, s: usize) -> (Vec<u32>,
     (count, ngg)
 }
 
-/// The loaded contacts of the bodies held by several subdomains, summed over them
-/// (their other ranks' counts asked of their ranks, [`super::shells::copy_counts`];
-/// 0 for the other bodies).
-fn shared_totals<D: Family>(d: &Decomposition<D>, w: &D::World, ranks: Option<&mut RankState>, counts: &[Option<Vec<u32>>]) -> Vec<u32> {
-    let mut total = vec![0u32; D::n_bodies(w)];
-    for (g, _, n) in super::shells::copy_counts(d, ranks, counts) {
-        total[g as usize] += n;
+/// The bodies held by several subdomains and by one of this rank's, ascending: (body,
+/// its first subdomain, its loaded contacts summed over its copies; the other
+/// ranks' counts asked of their ranks, [`super::shells::copy_counts`]). Only these
+/// bodies, not one entry per scene body: a step's census allocates nothing N-sized
+/// here.
+fn shared_totals<D: Family>(d: &Decomposition<D>, ranks: Option<&mut RankState>, counts: &[Option<Vec<u32>>]) -> Vec<(u32, u32, u32)> {
+    let mut out: Vec<(u32, u32, u32)> = Vec::new();
+    // (copies sorted by body, then subdomain: a body's first entry is its first subdomain)
+    for (g, s, n) in super::shells::copy_counts(d, ranks, counts) {
+        match out.last_mut() {
+            Some(x) if x.0 == g => x.2 += n,
+            _ => out.push((g, s, n)),
+        }
     }
-    total
+    out
 }
 
 /// The census of the step of `d` (on ranks: collective).
@@ -142,24 +148,24 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
             (Some(c), n)
         })
         .unzip();
-    let total = shared_totals(d, w, ranks.as_deref_mut(), &counts);
+    let shared = shared_totals(d, ranks.as_deref_mut(), &counts);
     // per subdomain: contacts, loaded grain–grain contacts, non-rattler grains and
     // their loaded contacts, each body counted by its first subdomain
-    let mut first = vec![u32::MAX; D::n_bodies(w)];
-    for s in (0..ns).rev() {
-        for &g in &d.subs[s].body_global {
-            first[g as usize] = s as u32;
-        }
-    }
     let inner = |g: usize| bulk.is_some_and(|(lo, hi)| (0..3).all(|k| D::position(w, g)[k] > lo[k] && D::position(w, g)[k] < hi[k]));
     let aggregate = |s: usize, v: &mut Vec<f64>| {
         let sub = &d.subs[s];
         let (c, ngg) = (counts[s].as_ref().expect("an own subdomain"), ngg_of[s]);
         let mut a = [0u64; 6]; // n_m, sum_m, then the bulk counts
         for (l, &g) in sub.body_global.iter().enumerate() {
-            let g = g as usize;
-            let n = if d.mult[g] >= 2 { total[g] } else { c[l] } as u64;
-            if first[g] != s as u32 || !D::is_grain(w, g) {
+            // (a body held by one subdomain: its own count; by several: their sum)
+            let (first, n) = match d.mult[g as usize] >= 2 {
+                true => shared
+                    .binary_search_by_key(&g, |x| x.0)
+                    .map_or((s as u32, c[l]), |i| (shared[i].1, shared[i].2)),
+                false => (s as u32, c[l]),
+            };
+            let (g, n) = (g as usize, u64::from(n));
+            if first != s as u32 || !D::is_grain(w, g) {
                 continue;
             }
             if n >= 2 {
