@@ -302,3 +302,61 @@ impl<'a> StateChecks<'a> {
         Ok(expected)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::nscdd_of;
+    use crate::model::ContactKey;
+
+    /// A 2 × 1 grid's state keeping contact (0, 1) in cell 1.
+    const STATE: &str = r#"{"grid_of": [2, 1, 1], "by_model": false, "steps": 4,
+        "grid": {"nx": 2, "ny": 1, "nz": 1, "origin": [0.0, 0.0, 0.0], "cell": [1.0, 1.0, 1.0]},
+        "grid_empty": false, "kept": [[{"i": 0, "j": 1, "feature": 0}, 1]], "f_gamma": []}"#;
+
+    fn read(name: &str, text: &str) -> Option<crate::dd::NscddState> {
+        let dir = std::env::temp_dir().join(format!("nscdd_nscdd_of_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        let s = nscdd_of(&path);
+        let _ = std::fs::remove_file(&path);
+        s
+    }
+
+    /// The `nscdd` part is found in a pretty state (also across the scan's 1 MiB
+    /// chunks), in a compact one (parsed whole), the last of two keys as the
+    /// streaming reader keeps it; none when absent. Its rank part gives every
+    /// contact to one rank of two: the kept one by its subdomain, another by its cell.
+    #[test]
+    fn the_nscdd_part_alone_and_its_rank_parts() {
+        let pretty = |before: &str, value: &str| format!("{{\n  \"step\": 3,{before}\n  \"nscdd\": {value}\n}}\n");
+        assert!(read("a.json", &pretty("", STATE)).is_some());
+        assert!(read("b.json", &pretty(&format!("\n  \"nscdd\": {STATE},"), "null")).is_none());
+        assert!(read("c.json", &pretty("\n  \"nscdd\": null,", STATE)).is_some());
+        assert!(read("d.json", "{\n  \"step\": 3\n}\n").is_none());
+        assert!(read("e.json", &format!("{{\"step\":3,\"nscdd\":{STATE}}}")).is_some());
+        // the key across the first chunk's end (its newline 5 bytes before 1 MiB)
+        let pad = "x".repeat((1 << 20) - 19);
+        let text = format!("{{\n  \"pad\": \"{pad}\",\n  \"nscdd\": {STATE}\n}}\n");
+        assert_eq!(text.find("\n  \"nscdd\"").unwrap(), (1 << 20) - 5);
+        let state = read("f.json", &text).expect("the key across two chunks");
+        let key = |i, j| ContactKey { i, j, feature: 0 };
+        let mut parts: Vec<_> = (0..2).map(|me| state.rank_part([2, 1, 1], false, 2, me).expect("a part")).collect();
+        let mut keeps = |k: ContactKey, p: [f64; 3]| parts.iter_mut().map(|r| r.keeps(k, p)).collect::<Vec<bool>>();
+        let (kept, cell0, cell1) = (
+            keeps(key(0, 1), [0.5, 0.5, 0.0]),
+            keeps(key(2, 3), [0.5, 0.5, 0.0]),
+            keeps(key(2, 3), [1.5, 0.5, 0.0]),
+        );
+        for (what, k) in [("kept", &kept), ("cell 0", &cell0), ("cell 1", &cell1)] {
+            assert_eq!(k.iter().filter(|&&x| x).count(), 1, "{what}: {k:?}");
+        }
+        // kept in cell 1 although its point lies in cell 0: with the contacts of cell 1
+        assert_eq!(kept, cell1);
+        assert_ne!(cell0, cell1);
+        // one rank, another decomposition, more ranks than cells: every contact read
+        assert!(state.rank_part([2, 1, 1], false, 1, 0).is_none());
+        assert!(state.rank_part([1, 2, 1], false, 2, 0).is_none());
+        assert!(state.rank_part([2, 1, 1], false, 4, 0).is_none());
+    }
+}
