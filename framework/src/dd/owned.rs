@@ -48,7 +48,7 @@ pub(super) struct Owned {
     mine: Vec<u32>,
     /// Bodies stepped by every rank (fixed, driven, unbounded), by id.
     everywhere: Vec<bool>,
-    /// The next step's bodies, by id (a buffer).
+    /// The next step's bodies, by the world's slot (a buffer).
     keep: Vec<bool>,
 }
 
@@ -229,13 +229,19 @@ impl Owned {
     fn next_active<D: Family>(&mut self, w: &mut D::World, mine: &Region, received: &[u32], boxes: &mut Vec<[[f64; 3]; 2]>) {
         let nb = D::n_bodies(w);
         let alert = D::alert(w);
+        // marked by the world's slot (ascending in global id: ≈ N/P flags, not N),
+        // a contact's body the world would not hold apart (none expected)
         let mut keep = std::mem::take(&mut self.keep);
         keep.clear();
-        keep.resize(nb, false);
+        keep.resize(D::held(w).map_or(nb, <[u32]>::len), false);
+        let mut unheld = Vec::new();
         let c = D::contacts(w);
         for a in 0..D::len(c) {
             for g in D::contact_bodies(w, a) {
-                keep[g as usize] = true;
+                match D::slot(w, g as usize) {
+                    Some(k) => keep[k] = true,
+                    None => unheld.push(g),
+                }
             }
         }
         let candidates: Option<Vec<u32>> = D::active(w).map(|a| {
@@ -248,10 +254,16 @@ impl Owned {
         D::set_active(w, candidates);
         D::body_boxes(w, boxes);
         crate::step::each_body(nb, D::stepped(w), |g| {
-            let (lo, hi) = grown(D::SPACE, &boxes[D::held_slot(w, g)], alert);
-            keep[g] |= self.everywhere[g] || mine.meets(D::SPACE, &lo, &hi);
+            let k = D::held_slot(w, g);
+            let (lo, hi) = grown(D::SPACE, &boxes[k], alert);
+            keep[k] |= self.everywhere[g] || mine.meets(D::SPACE, &lo, &hi);
         });
-        let active: Vec<u32> = (0..nb as u32).filter(|&g| keep[g as usize]).collect();
+        let mut active: Vec<u32> = (0..keep.len()).filter(|&k| keep[k]).map(|k| D::global(w, k) as u32).collect();
+        if !unheld.is_empty() {
+            active.extend(unheld);
+            active.sort_unstable();
+            active.dedup();
+        }
         D::set_active(w, Some(active.clone()));
         // the world holds only them (they come back with their records)
         D::hold(w, &active);
