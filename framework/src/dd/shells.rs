@@ -343,25 +343,26 @@ pub(super) fn copy_counts<D: Family>(
     ranks: Option<&mut RankState>,
     counts: &[Option<Vec<u32>>],
 ) -> Vec<(u32, u32, u32)> {
-    let nb = d.mult.len();
     let own = |s: usize| counts[s].is_some();
-    let mut held = vec![false; nb];
     let mut out = Vec::new();
     for (s, sub) in d.subs.iter().enumerate().filter(|(s, _)| own(*s)) {
         let c = counts[s].as_deref().unwrap_or_default();
         for (l, &g) in sub.body_global.iter().enumerate() {
             if d.mult[g as usize] >= 2 {
-                held[g as usize] = true;
                 out.push((g, s as u32, c[l]));
             }
         }
     }
     if let Some(rs) = ranks {
-        // the other ranks' copies of those bodies: (subdomain, their local id)
+        // those bodies (ascending: no flag per scene body), and the other ranks'
+        // copies of them: (subdomain, their local id)
+        let mut held: Vec<u32> = out.iter().map(|x| x.0).collect();
+        held.sort_unstable();
+        held.dedup();
         let (mut asks, mut bodies) = (Vec::new(), Vec::new());
         for (s, sub) in d.subs.iter().enumerate().filter(|(s, _)| !own(*s)) {
             for (l, &g) in sub.body_global.iter().enumerate() {
-                if held[g as usize] {
+                if held.binary_search(&g).is_ok() {
                     asks.push((s as u32, sub.remote_id(l as u32)));
                     bodies.push(g);
                 }
