@@ -76,8 +76,8 @@ def deepen(text, disc):
     return text.replace("duration = 2.0", "duration = 3.5")
 
 
-def mean_force(d, lo, hi):
-    p, _, r = curve(d)
+def mean_force(p, r, lo, hi):
+    """The raw footing force's mean over penetrations lo..hi mm (`p`, `r`: [`curve`]'s)."""
     fy = [float(x["footing_fy"]) for x in r]
     first = len(r) - len(p)
     v = [fy[first + i] for i, x in enumerate(p) if lo <= x <= hi]
@@ -203,7 +203,7 @@ def main():
         for mm in (5, 10, 15):
             k = next((i for i, x in enumerate(p) if x >= mm), None)
             at.append(f"{f[k]:.0f}" if k is not None else "-")
-        means = " / ".join(mean_force(os.path.join(out, name), lo, hi) for lo, hi in ((0, 10), (10, 30), (30, 50), (10, 50)))
+        means = " / ".join(mean_force(p, r, lo, hi) for lo, hi in ((0, 10), (10, 30), (30, 50), (10, 50)))
         wall = f"{walls[name]:.1f} s" if name in walls else "(earlier run)"
         print(f"{name}: {wall}, {sweeps} sweeps, bodies {r[0]['bodies']}, force at 5/10/15 mm: {' / '.join(at)} N/m, mean over 0-10/10-30/30-50/10-50 mm: {means} N/m")
     # the scatter: each discrete seed's RMS distance (force over 1..top mm) to the

@@ -24,6 +24,18 @@ pub fn contiguous_ranks(loads: &[usize], ranks: u32) -> Vec<u32> {
     out
 }
 
+/// Rank of each of `ns` subdomains balanced by the items each owns (`owner`: an
+/// item's subdomain, below `ns`): [`balanced_ranks`] over their counts. The rule of
+/// a repartition ([`super::RankState::assign`]) and of the restart's part of a
+/// rank ([`super::RestartPart`]), which must agree.
+pub fn ranks_by_owner(owner: impl IntoIterator<Item = u32>, ns: usize, ranks: u32) -> Vec<u32> {
+    let mut loads = vec![0usize; ns];
+    for o in owner {
+        loads[o as usize] += 1;
+    }
+    balanced_ranks(&loads, ranks)
+}
+
 /// Rank of each subdomain: the contiguous runs of [`contiguous_ranks`] (few peers)
 /// unless their largest load exceeds by more than 5 % that of a greedy assignment
 /// (largest subdomain first to the least loaded rank, ties to the smaller rank),

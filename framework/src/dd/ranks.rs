@@ -153,11 +153,7 @@ impl RankState {
     /// which subdomains are this rank's.
     pub fn assign(&mut self, owner: &[u32], ns: usize, repartition: bool) -> Vec<bool> {
         if repartition || self.rank_of.len() != ns {
-            let mut loads = vec![0usize; ns];
-            for &o in owner {
-                loads[o as usize] += 1;
-            }
-            self.rank_of = balanced_ranks(&loads, self.cluster.size());
+            self.rank_of = super::rank_balance::ranks_by_owner(owner.iter().copied(), ns, self.cluster.size());
         }
         let me = self.cluster.rank();
         self.rank_of.iter().map(|&r| r == me).collect()

@@ -128,16 +128,16 @@ impl NscddState {
         if grid.len() as u64 != cells || cells < u64::from(ranks) {
             return None;
         }
-        let mut loads = vec![0usize; grid.len()];
-        for e in &self.kept {
-            *loads.get_mut(e.1 as usize)? += 1;
+        // (a kept subdomain past the grid: `NscddOf::load_state` refuses the state)
+        if self.kept.iter().any(|e| e.1 as u64 >= cells) {
+            return None;
         }
         let mut kept = self.kept.clone();
         kept.sort_unstable_by_key(|x| x.0);
         Some(RestartPart {
             grid: grid.clone(),
+            rank_of: super::rank_balance::ranks_by_owner(kept.iter().map(|e| e.1), grid.len(), ranks),
             kept,
-            rank_of: super::rank_balance::balanced_ranks(&loads, ranks),
             me,
             at: 0,
         })
