@@ -186,7 +186,7 @@ pub(super) fn write_back_held<D: Family>(
     held: Option<(&dyn Fn(u32) -> bool, &[(u32, u32)])>,
 ) {
     let one = |w: &mut D::World, s: &super::Subdomain<D>, l: usize, g: usize| {
-        if d.mult[g] == 1 || !D::movable(w, g) {
+        if s.copy_mult[l] == 1 || !D::movable(w, g) {
             D::set_vel(w, g, s.vel[l]);
         }
     };

@@ -72,7 +72,7 @@ impl BodySums<'_> {
             if let (Some((lo, hi)), true) = (bulk, D::is_grain(w, g)) {
                 x[2] += D::grain_in_box(w, g, lo, hi);
                 let inner = (0..3).all(|k| p[k] > lo[k] && p[k] < hi[k]);
-                x[3] += (inner && d.mult.get(g).is_none_or(|&m| m == 0)) as u8 as f64;
+                x[3] += (inner && d.mult_of(g as u32) == 0) as u8 as f64;
             }
         });
         out
@@ -158,7 +158,7 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
         let mut a = [0u64; 6]; // n_m, sum_m, then the bulk counts
         for (l, &g) in sub.body_global.iter().enumerate() {
             // (a body held by one subdomain: its own count; by several: their sum)
-            let (first, n) = match d.mult[g as usize] >= 2 {
+            let (first, n) = match sub.copy_mult[l] >= 2 {
                 true => shared
                     .binary_search_by_key(&g, |x| x.0)
                     .map_or((s as u32, c[l]), |i| (shared[i].1, shared[i].2)),
@@ -202,7 +202,7 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
         // the inner grains without contacts are rattlers
         let idle = idle.unwrap_or_else(|| {
             (0..D::n_bodies(w))
-                .filter(|&g| d.mult[g] == 0 && D::is_grain(w, g) && inner(g))
+                .filter(|&g| d.mult_of(g as u32) == 0 && D::is_grain(w, g) && inner(g))
                 .count() as u64
         });
         out.bulk = Some([b[0], b[1], b[2] + idle, b[3] + idle]);

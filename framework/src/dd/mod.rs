@@ -381,7 +381,7 @@ impl<D: Family> NscddOf<D> {
         rep.subdomains = d.subs.iter().filter(|s| s.n_contacts() > 0).count();
         rep.interface_bodies = d.iface.len();
         rep.links = d.iface.links();
-        rep.max_multiplicity = d.mult.iter().copied().max().unwrap_or(0);
+        rep.max_multiplicity = d.mult.iter().map(|x| x.1).max().unwrap_or(0);
         let mut fresh = d.iface.fresh.iter().any(|&f| f);
         let mut total = D::len(D::contacts(w)) + self.fam_points.len();
         if let (true, Some(rs)) = (self.local.now, self.ranks.as_mut()) {

@@ -118,10 +118,20 @@ pub struct Decomposition<D: Family> {
     pub grid: Option<Grid>,
     /// Subdomain of each global contact.
     pub owner: Vec<u32>,
-    /// Number of subdomains holding a copy of each global body (0: none).
-    pub mult: Vec<u32>,
+    /// (body, m) of every body copied in the step, ascending body id: m the number
+    /// of subdomains holding a copy (a body not listed has none). As many entries as
+    /// the step's bodies on this process (≈ N/P on a rank), not one per scene body;
+    /// each copy's m is also its subdomain's [`Subdomain::copy_mult`].
+    pub mult: Vec<(u32, u32)>,
     pub subs: Vec<Subdomain<D>>,
     pub iface: Interface,
+}
+
+impl<D: Family> Decomposition<D> {
+    /// Body g's number of copies (0: none).
+    pub fn mult_of(&self, g: u32) -> u32 {
+        self.mult.binary_search_by_key(&g, |x| x.0).map_or(0, |i| self.mult[i].1)
+    }
 }
 
 impl<D: Family> Default for Decomposition<D> {
@@ -178,19 +188,20 @@ pub fn decompose_owned<D: Family>(
     shells: Option<Shells<'_, D>>,
 ) -> Decomposition<D> {
     let built = |s: u32| build.is_none_or(|b| b[s as usize]);
-    let nb = D::n_bodies(w);
-    let (mut subs, mut mult, mut copy_of) = split_contacts::<D>(w, &owner, ns, nb);
+    let (mut subs, mut copy_of) = split_contacts::<D>(w, &owner, ns);
     if let Some(fill) = shells {
         // contacts held per rank: the other ranks' subdomains get their bodies only
         fill(&mut subs);
         for sub in subs.iter().filter(|s| !built(s.id)) {
             for (l, &g) in sub.body_global.iter().enumerate() {
-                mult[g as usize] += 1;
                 copy_of.push((g, sub.id, l as u32));
             }
         }
     }
-    let ent_copies = split_families(w, &mut subs, &mut mult, &mut copy_of, fam);
+    let ent_copies = split_families(w, &mut subs, &mut copy_of, fam);
+    // copies grouped by body, in subdomain order; each copy's multiplicity
+    copy_of.sort_unstable_by_key(|e| (e.0, e.1));
+    let mult = multiplicities(&mut subs, &copy_of);
     // copies' M̂_E⁻¹ and W_αα; each subdomain's visiting order
     let (sv, step) = (D::solver(w), D::step(w));
     for sub in subs.iter_mut() {
@@ -202,9 +213,10 @@ pub fn decompose_owned<D: Family>(
             sub.inv_mass = sub
                 .body_global
                 .iter()
-                .map(|&g| D::scale_inv(D::inv_mass(w, g as usize), mult[g as usize] as f64))
+                .zip(&sub.copy_mult)
+                .map(|(&g, &m)| D::scale_inv(D::inv_mass(w, g as usize), m as f64))
                 .collect();
-            let split: Vec<bool> = sub.body_global.iter().map(|&g| mult[g as usize] >= 2).collect();
+            let split: Vec<bool> = sub.copy_mult.iter().map(|&m| m >= 2).collect();
             sub.copy_delassus(&split);
             let Subdomain { parts, inv_mass, .. } = sub;
             for (f, p) in parts.0.iter_mut() {
@@ -214,8 +226,7 @@ pub fn decompose_owned<D: Family>(
         }
     }
     // interface bodies: copies grouped by body, in subdomain order
-    copy_of.sort_unstable_by_key(|e| (e.0, e.1));
-    let mut iface = interface::<D>(w, &mut subs, &copy_of, &mult, store);
+    let mut iface = interface::<D>(w, &mut subs, &copy_of, store);
     for (f, ec) in ent_copies.iter().enumerate() {
         entity_interface(&mut iface, &mut subs, &*fam.fams[f], ec);
     }
@@ -233,6 +244,24 @@ pub fn decompose_owned<D: Family>(
     }
 }
 
+/// Each copy's multiplicity ([`Subdomain::copy_mult`]) and (body, m) of every
+/// body, from the copies sorted by body.
+fn multiplicities<D: Family>(subs: &mut [Subdomain<D>], copy_of: &[(u32, u32, u32)]) -> Vec<(u32, u32)> {
+    for sub in subs.iter_mut() {
+        sub.copy_mult.clear();
+        sub.copy_mult.resize(sub.body_global.len(), 0);
+    }
+    let mut out = Vec::new();
+    for run in copy_of.chunk_by(|a, b| a.0 == b.0) {
+        let m = run.len() as u32;
+        out.push((run[0].0, m));
+        for &(_, s, l) in run {
+            subs[s as usize].copy_mult[l as usize] = m;
+        }
+    }
+    out
+}
+
 /// The copies of one family's entities: multiplicity per entity and the copies as
 /// (entity, subdomain, index of the part in the subdomain, local entity).
 #[derive(Default)]
@@ -246,7 +275,6 @@ struct EntityCopies {
 fn split_families<D: Family>(
     w: &D::World,
     subs: &mut [Subdomain<D>],
-    mult: &mut [u32],
     copy_of: &mut Vec<(u32, u32, u32)>,
     fam: &FamilyOwners<'_, '_, D>,
 ) -> Vec<EntityCopies> {
@@ -256,8 +284,9 @@ fn split_families<D: Family>(
     }
     // the local id of each body's copy in the subdomain `cur` (a family's parts come
     // in ascending subdomain order: one refill per subdomain)
-    let nb = mult.len();
-    let (mut stamp, mut local) = (vec![u32::MAX; nb], vec![0u32; nb]);
+    // (by the world's slot: a family's contact's bodies are held)
+    let nh = held_len::<D>(w);
+    let (mut stamp, mut local) = (vec![u32::MAX; nh], vec![0u32; nh]);
     let mut cur = u32::MAX;
     for (f, a) in fam.fams.iter().enumerate() {
         let mut copy = |s: u32, g: u32| -> u32 {
@@ -265,19 +294,20 @@ fn split_families<D: Family>(
             if s != cur {
                 cur = s;
                 for (l, &b) in sub.body_global.iter().enumerate() {
-                    stamp[b as usize] = s;
-                    local[b as usize] = l as u32;
+                    if let Some(k) = D::slot(w, b as usize) {
+                        stamp[k] = s;
+                        local[k] = l as u32;
+                    }
                 }
             }
-            let gi = g as usize;
-            if stamp[gi] != s {
-                stamp[gi] = s;
-                local[gi] = sub.body_global.len() as u32;
+            let k = D::held_slot(w, g as usize);
+            if stamp[k] != s {
+                stamp[k] = s;
+                local[k] = sub.body_global.len() as u32;
                 sub.body_global.push(g);
-                mult[gi] += 1;
-                copy_of.push((g, s, local[gi]));
+                copy_of.push((g, s, local[k]));
             }
-            local[gi]
+            local[k]
         };
         let parts = a.split(w, &fam.owner[f], &mut copy);
         let mut ec = EntityCopies {
@@ -335,11 +365,17 @@ fn entity_interface<D: Family>(iface: &mut Interface, subs: &mut [Subdomain<D>],
     }
 }
 
+/// The bodies the world holds (its slots).
+fn held_len<D: Family>(w: &D::World) -> usize {
+    D::held(w).map_or_else(|| D::n_bodies(w), <[u32]>::len)
+}
+
 /// The contacts of each subdomain in storage order, with a copy of each of their
-/// bodies made on first sight; returns the subdomains, each body's number of
-/// copies and the copies as (body, subdomain, local id).
+/// bodies made on first sight; returns the subdomains and the copies as (body,
+/// subdomain, local id). The scratch is by the world's slot (a contact's bodies are
+/// held): ≈ N/P on a rank, not one entry per scene body.
 #[allow(clippy::type_complexity)]
-fn split_contacts<D: Family>(w: &D::World, owner: &[u32], ns: usize, nb: usize) -> (Vec<Subdomain<D>>, Vec<u32>, Vec<(u32, u32, u32)>) {
+fn split_contacts<D: Family>(w: &D::World, owner: &[u32], ns: usize) -> (Vec<Subdomain<D>>, Vec<(u32, u32, u32)>) {
     let mut subs: Vec<Subdomain<D>> = (0..ns)
         .map(|s| Subdomain {
             id: s as u32,
@@ -348,8 +384,8 @@ fn split_contacts<D: Family>(w: &D::World, owner: &[u32], ns: usize, nb: usize) 
         .collect();
     let c = D::contacts(w);
     // contacts in storage order, copies on first sight
-    let (mut stamp, mut local) = (vec![u32::MAX; nb], vec![0u32; nb]);
-    let mut mult = vec![0u32; nb];
+    let nh = held_len::<D>(w);
+    let (mut stamp, mut local) = (vec![u32::MAX; nh], vec![0u32; nh]);
     let mut by_sub: Vec<Vec<u32>> = vec![Vec::new(); ns];
     for (a, &s) in owner.iter().enumerate() {
         by_sub[s as usize].push(a as u32);
@@ -362,34 +398,27 @@ fn split_contacts<D: Family>(w: &D::World, owner: &[u32], ns: usize, nb: usize) 
         for &a in &by_sub[s] {
             let a = a as usize;
             let mut id = |g: u32| {
-                let gi = g as usize;
-                if stamp[gi] != s as u32 {
-                    stamp[gi] = s as u32;
-                    local[gi] = sub.body_global.len() as u32;
+                let k = D::held_slot(w, g as usize);
+                if stamp[k] != s as u32 {
+                    stamp[k] = s as u32;
+                    local[k] = sub.body_global.len() as u32;
                     sub.body_global.push(g);
-                    mult[gi] += 1;
-                    copy_of.push((g, s as u32, local[gi]));
+                    copy_of.push((g, s as u32, local[k]));
                 }
-                local[gi]
+                local[k]
             };
             let [bi, bj] = D::contact_bodies(w, a);
             let (li, lj) = (id(bi), id(bj));
             sub.push_contact(c, a, li, lj);
         }
     }
-    (subs, mult, copy_of)
+    (subs, copy_of)
 }
 
 /// The interface: the movable bodies copied in several subdomains (copies sorted
 /// by body, in subdomain order), with the copies' F_Γ from the previous step
 /// where the same subdomains held them.
-fn interface<D: Family>(
-    w: &D::World,
-    subs: &mut [Subdomain<D>],
-    copy_of: &[(u32, u32, u32)],
-    mult: &[u32],
-    store: &FGammaStore<D::V>,
-) -> Interface {
+fn interface<D: Family>(w: &D::World, subs: &mut [Subdomain<D>], copy_of: &[(u32, u32, u32)], store: &FGammaStore<D::V>) -> Interface {
     for sub in subs.iter_mut() {
         sub.iface_off.push(0);
     }
@@ -397,12 +426,8 @@ fn interface<D: Family>(
         start: vec![0],
         ..Default::default()
     };
-    let mut p = 0;
-    while p < copy_of.len() {
-        let g = copy_of[p].0;
-        let m = mult[g as usize] as usize;
-        let copies = &copy_of[p..p + m];
-        p += m;
+    for copies in copy_of.chunk_by(|a, b| a.0 == b.0) {
+        let (g, m) = (copies[0].0, copies.len());
         if m < 2 || !D::movable(w, g as usize) {
             continue;
         }

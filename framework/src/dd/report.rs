@@ -130,7 +130,7 @@ impl<D: super::Family> super::NscddOf<D> {
         let d = &self.last;
         let mut v = DdView {
             body_subdomain: vec![-1; nb],
-            multiplicity: (0..nb).map(|b| d.mult.get(b).copied().unwrap_or(0)).collect(),
+            multiplicity: (0..nb).map(|b| d.mult_of(b as u32)).collect(),
             contact_subdomain: Vec::new(),
             piece: self.ranks.as_ref().map(|rs| Piece {
                 rank: rs.cluster.rank(),

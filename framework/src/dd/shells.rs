@@ -315,7 +315,7 @@ pub(super) fn interface_totals<D: Family>(rs: &mut RankState, d: &Decomposition<
         fresh |= ifc.fresh[ib] && ks.clone().any(|k| own(ifc.sub[k]));
     }
     let m = d.subs.iter().filter(|s| own(s.id));
-    let max = m.flat_map(|s| s.body_global.iter().map(|&g| d.mult[g as usize])).max().unwrap_or(0);
+    let max = m.flat_map(|s| s.copy_mult.iter().copied()).max().unwrap_or(0);
     let mine = [
         contacts as f64,
         bodies as f64,
@@ -348,7 +348,7 @@ pub(super) fn copy_counts<D: Family>(
     for (s, sub) in d.subs.iter().enumerate().filter(|(s, _)| own(*s)) {
         let c = counts[s].as_deref().unwrap_or_default();
         for (l, &g) in sub.body_global.iter().enumerate() {
-            if d.mult[g as usize] >= 2 {
+            if sub.copy_mult[l] >= 2 {
                 out.push((g, s as u32, c[l]));
             }
         }

@@ -39,6 +39,9 @@ pub struct Subdomain<D: Family> {
     pub order: Vec<u32>,
     /// Global id of each local body copy.
     pub body_global: Vec<u32>,
+    /// Per local body copy: the body's number of copies in the step (its
+    /// multiplicity m; [`super::partition::Decomposition::mult`]).
+    pub copy_mult: Vec<u32>,
     /// Another rank's subdomain limited to the bodies this rank needs
     /// ([`super::shells`]): each body's local id on the subdomain's rank. Empty when
     /// the ids are those of the subdomain's rank ([`Subdomain::remote_id`]).
