@@ -31,20 +31,21 @@ pub fn run<D: Dim>(mut s: Scene<D>, reg: &Registry, scene: &Path, out: &Path, qu
                 let on = (ranks.size() > 1).then(|| (ranks.size(), ranks.rank()));
                 nscdd::scene::restart_scene_on(&mut s, state, on).map_err(|e| e.to_string())
             }
-            None => Ok(false),
+            None => Ok(None),
         }
     });
     // (what the ranks compare: one process has no one to agree with; contacts read
-    // in part differ between ranks and are left out)
+    // in part differ between ranks: their world is hashed without them, and the
+    // digest of every contact the file held, which each rank read, added)
     let digest = flags.map(|in_part| match ranks.size() > 1 {
         true => {
             let w = &s.world;
             let state = |out: &mut dyn std::io::Write| {
                 let mut none = |_: &mut Vec<f64>| false;
-                let contacts: Option<nscdd::output::Pull> = if in_part { Some(&mut none) } else { None };
+                let contacts: Option<nscdd::output::Pull> = if in_part.is_some() { Some(&mut none) } else { None };
                 nscdd::output::write_final_json(out, w, None, None::<&()>, (contacts, None))
             };
-            crate::ranks::digest(scene, state, (&s.decomposition, &w.time, &w.solver))
+            crate::ranks::digest(scene, state, (&s.decomposition, &w.time, &w.solver, in_part))
         }
         false => 0,
     });

@@ -30,6 +30,38 @@ fn a_state_written_by_p_ranks_restarts_on_other_rank_counts() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Two copies of a state that differ in one contact's impulse, read in part by
+/// two ranks (an MPMD launch): the ranks' agreement tells them apart (exit 2), as
+/// every rank hashes every contact it reads, kept or not.
+#[test]
+fn ranks_reading_states_that_differ_in_a_contact_disagree() {
+    let dir = scratch("restart_digest");
+    let flags = ["--subdomains", "2x2", "--scheme", "decentralized"];
+    let whole = write(&dir, "pile.toml", &every(PILE2D, 3));
+    let half = write(&dir, "half.toml", &every(&PILE2D.replace("steps = 15", "steps = 8"), 3));
+    let a = dir.join("first");
+    ok(&mpirun(&[(2, args(&half, &a, &flags))]), "8 steps on 2 ranks");
+    let state = a.join("final.json");
+    let mut saved: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&state).unwrap()).expect("state");
+    let last = saved["contacts"].as_array_mut().expect("contacts").last_mut().expect("a contact");
+    let rn = last["r"][0].as_f64().expect("r");
+    last["r"][0] = serde_json::json!(rn * 1.5 + 1e-3);
+    let other = dir.join("other.json");
+    std::fs::write(&other, serde_json::to_string_pretty(&saved).unwrap()).unwrap();
+    let out = dir.join("then");
+    let with = |st: &Path| args(&whole, &out, &[&flags[..], &["--restart", st.to_str().unwrap()]].concat());
+    // the same state on both ranks: it runs, reading the contacts in part
+    ok(&mpirun(&[(1, with(&state)), (1, with(&state))]), "the same state");
+    contacts_read_in_part(&state, &out);
+    let out2 = dir.join("then2");
+    let with2 = |st: &Path| args(&whole, &out2, &[&flags[..], &["--restart", st.to_str().unwrap()]].concat());
+    let o = mpirun(&[(1, with2(&state)), (1, with2(&other))]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("different scenes"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// `whole` in one process with 2 threads: its final.json.
 fn uninterrupted(dir: &Path, whole: &Path, flags: &[&str], tag: &str) -> String {
     let one = dir.join(format!("{tag}one"));

@@ -98,6 +98,8 @@ pub struct RestartPart {
     rank_of: Vec<u32>,
     me: u32,
     at: usize,
+    /// A hash of every contact read, kept or not ([`RestartPart::digest`]).
+    seen: std::collections::hash_map::DefaultHasher,
 }
 
 impl RestartPart {
@@ -109,6 +111,22 @@ impl RestartPart {
         let o = owner.of(key, p);
         self.at = owner.at;
         self.rank_of.get(o as usize) == Some(&self.me)
+    }
+
+    /// Adds a contact read (kept by this rank or not) to the digest: the same on
+    /// every rank, so that the ranks' agreement on the initial state still covers
+    /// every contact of the file ([`RestartPart::digest`]).
+    pub fn saw(&mut self, values: impl IntoIterator<Item = u64>) {
+        use std::hash::Hasher;
+        for v in values {
+            self.seen.write_u64(v);
+        }
+    }
+
+    /// The digest of every contact read ([`RestartPart::saw`]).
+    pub fn digest(&self) -> u64 {
+        use std::hash::Hasher;
+        self.seen.finish()
     }
 }
 
@@ -140,6 +158,7 @@ impl NscddState {
             kept,
             me,
             at: 0,
+            seen: Default::default(),
         })
     }
 }

@@ -161,9 +161,10 @@ pub fn restart_scene<D: Dim>(scene: &mut super::Scene<D>, path: &Path) -> Result
 /// read first (the rest of the file skipped) and then, as the file streams, each
 /// rank keeps only the contacts its subdomains get in the first step
 /// ([`crate::dd::RestartPart`]): the sample's contacts are never all on one rank.
-/// Returns whether the contacts were read in part (the world then differs between
-/// ranks by its contacts).
-pub fn restart_scene_on<D: Dim>(scene: &mut super::Scene<D>, path: &Path, on: Option<(u32, u32)>) -> Result<bool, InputError> {
+/// Returns, when the contacts were read in part (the world then differs between
+/// ranks by its contacts), a digest of every contact read, kept or not: the same on
+/// every rank reading the same file.
+pub fn restart_scene_on<D: Dim>(scene: &mut super::Scene<D>, path: &Path, on: Option<(u32, u32)>) -> Result<Option<u64>, InputError> {
     let mut part = match (on, &scene.decomposition) {
         (Some((ranks, me)), Some(c)) if ranks > 1 && scene.families.is_empty() && !c.by_model => {
             let grid_of = [c.dd.nx, c.dd.ny, c.dd.nz];
@@ -192,7 +193,7 @@ pub fn restart_scene_on<D: Dim>(scene: &mut super::Scene<D>, path: &Path, on: Op
         f.load_state(state)
             .map_err(|m| ck.err(ck.line_of(f.section(), 0), key.clone(), m))?;
     }
-    Ok(part.is_some())
+    Ok(part.map(|p| p.digest()))
 }
 
 /// The `nscdd` part of the saved state at `path` alone (`None` when absent or
