@@ -132,7 +132,7 @@ impl Owned {
     /// A distributed repartition in the step (the new `grid` and `rs.rank_of` set,
     /// before the new regions' detection): the bodies of each rank's new halo it
     /// lacks, at the start of the step with their V⁻ and V_free, from their owners
-    /// (one all-gather of those bodies only); then the new cells and owners. `boxes`:
+    /// (point to point: each record to the rank it is for); then the new cells and owners. `boxes`:
     /// the active bodies' boxes at the start of the step (the received ones added).
     /// Collective.
     pub(super) fn repartition<D: Family>(
@@ -146,30 +146,34 @@ impl Owned {
         let me = rs.cluster.rank();
         let new = CellIndex::new(grid, &rs.rank_of);
         let Some(old) = self.cells.take() else { return };
-        let mut mine = Vec::new();
+        // each body's record to the ranks whose new halo it enters, point to point
+        // (after the provisional grid of a fresh run's first step, most bodies move)
+        let mut out = vec![Vec::new(); rs.cluster.size() as usize];
         let (mut was, mut to) = (Vec::new(), Vec::new());
         for &g in &self.mine {
             let k = D::held_slot(w, g as usize);
             entered(D::SPACE, (&boxes[k], &old), (&boxes[k], &new), alert, me, (&mut was, &mut to));
             for &q in &to {
-                mine.extend([f64::from(q), f64::from(g)]);
-                D::step_record(w, g as usize, &v_free[k], &mut mine);
+                let o: &mut Vec<f64> = &mut out[q as usize];
+                o.push(f64::from(g));
+                D::step_record(w, g as usize, &v_free[k], o);
             }
         }
-        let per = 2 + D::STEP_RECORD;
-        rs.totals.bodies_sent += (mine.len() / per) as u64;
-        let (_, all) = rs.all_gather_any(&mine);
+        let per = 1 + D::STEP_RECORD;
+        rs.totals.bodies_sent += out.iter().map(|o| o.len() / per).sum::<usize>() as u64;
+        // (the senders in rank order, each in its own: the order of an all-gather)
+        let (_, inbox) = rs.send_ranks(out);
         let mut active = D::active(w).map(<[u32]>::to_vec).unwrap_or_default();
-        let to_me: Vec<&[f64]> = all.chunks_exact(per).filter(|x| x[0] as u32 == me).collect();
-        let entering: Vec<(u32, &[f64])> = to_me.iter().map(|x| (x[1] as u32, &x[2..2 + D::BODY_RECORD])).collect();
+        let to_me: Vec<&[f64]> = inbox.iter().flat_map(|b| b.chunks_exact(per)).collect();
+        let entering: Vec<(u32, &[f64])> = to_me.iter().map(|x| (x[0] as u32, &x[1..1 + D::BODY_RECORD])).collect();
         // the entering bodies take slots among the held ones: V_free (by slot) follows
         let before: Option<Vec<u32>> = D::held(w).filter(|_| !entering.is_empty()).map(<[u32]>::to_vec);
         D::admit(w, &entering);
         remap::<D>(w, before.as_deref(), v_free);
         for x in to_me {
-            let g = x[1] as usize;
+            let g = x[0] as usize;
             let k = D::held_slot(w, g);
-            v_free[k] = D::set_step_record(w, g, &x[2..]);
+            v_free[k] = D::set_step_record(w, g, &x[1..]);
             active.push(g as u32);
         }
         active.sort_unstable();
