@@ -276,7 +276,12 @@ fn command() -> ExitCode {
                 threads: threads.as_deref(),
                 restart: restart.as_deref(),
             };
-            match load_any(&scene, &reg) {
+            // on ranks, a fresh scene is first surveyed: each rank then builds its part
+            let loaded = match ranks.size() > 1 && restart.is_none() {
+                true => survey_any(&scene, &reg),
+                false => load_any(&scene, &reg),
+            };
+            match loaded {
                 Ok(nscdd::scene::AnyScene::D2(s)) => run::run(s, &reg, &scene, &out, quiet, flags, &ranks),
                 Ok(nscdd::scene::AnyScene::D3(s)) => run::run(s, &reg, &scene, &out, quiet, flags, &ranks),
                 // every rank learns that a rank failed; rank 0 prints the message
@@ -335,12 +340,26 @@ pub(crate) fn load_any(
     scene: &std::path::Path,
     reg: &nscdd::registry::Registry,
 ) -> Result<nscdd::scene::AnyScene, nscdd::error::InputError> {
-    nscdd::scene::load_any(scene, reg).map_err(|mut e| {
-        if e.key == "deformable" && !cfg!(feature = "fem") {
-            e.message = "deformable bodies need the fem_deformable plugin: build nscdd with `cargo build --release --features nscdd-cli/fem` (and Python's scikit-fem, see the README)".into();
-        }
-        e
-    })
+    nscdd::scene::load_any(scene, reg).map_err(fem_hint)
+}
+
+/// [`load_any`] on MPI ranks: the scene's survey ([`nscdd::scene::part`]; each rank
+/// builds its part once the decomposition flags apply), or the whole scene for one
+/// with body families.
+fn survey_any(scene: &std::path::Path, reg: &nscdd::registry::Registry) -> Result<nscdd::scene::AnyScene, nscdd::error::InputError> {
+    match nscdd::scene::part::survey_any(scene, reg).map_err(fem_hint)? {
+        Some(s) => Ok(s),
+        None => load_any(scene, reg),
+    }
+}
+
+/// A scene with deformable bodies given to a program built without them: the way
+/// to build it.
+fn fem_hint(mut e: nscdd::error::InputError) -> nscdd::error::InputError {
+    if e.key == "deformable" && !cfg!(feature = "fem") {
+        e.message = "deformable bodies need the fem_deformable plugin: build nscdd with `cargo build --release --features nscdd-cli/fem` (and Python's scikit-fem, see the README)".into();
+    }
+    e
 }
 
 /// What `check` says of a scene's body families ("; 2 deformable bodies (…)").

@@ -1,7 +1,6 @@
 //! `nscdd run`: one driver for 2D and 3D scenes.
 
 use crate::ranks::Ranks;
-use nscdd::dim::Dim;
 use nscdd::registry::Registry;
 use nscdd::scene::Scene;
 use std::path::Path;
@@ -17,13 +16,25 @@ pub struct Flags<'a> {
 
 /// Runs a loaded scene with the command line's decomposition flags (as one of
 /// `ranks`).
-pub fn run<D: Dim>(mut s: Scene<D>, reg: &Registry, scene: &Path, out: &Path, quiet: bool, f: Flags<'_>, ranks: &Ranks) -> ExitCode {
+pub fn run<D: nscdd::scene::schema::SceneDim>(
+    mut s: Scene<D>,
+    reg: &Registry,
+    scene: &Path,
+    out: &Path,
+    quiet: bool,
+    f: Flags<'_>,
+    ranks: &Ranks,
+) -> ExitCode {
     // a family's body (a deformable one) may be copied into any number of subdomains
-    let movable = match s.families.is_empty() {
-        true => (0..s.world.bodies.len()).filter(|&b| s.world.bodies.movable(b)).count(),
-        false => usize::MAX,
+    let movable = match (s.families.is_empty(), &s.survey) {
+        (true, Some(sv)) => sv.movable,
+        (true, None) => (0..s.world.bodies.len()).filter(|&b| s.world.bodies.movable(b)).count(),
+        (false, _) => usize::MAX,
     };
     let flags = crate::apply_decomposition_to(&mut s.decomposition, movable, D::N == 3, f.subdomains, f.scheme, f.threads).and_then(|()| {
+        // a surveyed scene (fresh, on ranks): this rank's part, or the whole scene
+        let on = (ranks.size(), ranks.rank());
+        nscdd::scene::part::load_on(&mut s, reg, on).map_err(|e| e.to_string())?;
         match f.restart {
             Some(state) => {
                 nscdd::scene::restart::check_out_dir(out, state).map_err(|m| format!("--out: {m}"))?;
@@ -45,7 +56,11 @@ pub fn run<D: Dim>(mut s: Scene<D>, reg: &Registry, scene: &Path, out: &Path, qu
                 let contacts: Option<nscdd::output::Pull> = if in_part.is_some() { Some(&mut none) } else { None };
                 nscdd::output::write_final_json(out, w, None, None::<&()>, (contacts, None))
             };
-            crate::ranks::digest(scene, state, (&s.decomposition, &w.time, &w.solver, in_part))
+            match s.survey.as_ref().filter(|_| s.part.is_some()) {
+                // a part: the survey's digest of every body instead of the world's
+                Some(sv) => crate::ranks::digest(scene, |_| Ok(()), (&s.decomposition, &w.time, &w.solver, sv.digest)),
+                None => crate::ranks::digest(scene, state, (&s.decomposition, &w.time, &w.solver, in_part)),
+            }
         }
         false => 0,
     });

@@ -156,6 +156,16 @@ fn two_and_four_ranks_give_the_one_process_result_3d() {
         // its peak memory: a few MiB at least, less than this machine's
         assert!(cpu("peak_rss_mib") > 1.0 && cpu("peak_rss_mib") < 1e6, "{r}");
     }
+    // the scene loaded in part: each rank built its halo and the bodies every rank
+    // steps, never the whole scene; together every body
+    let loaded: Vec<u64> = ranks["per_rank"]
+        .as_array()
+        .expect("ranks")
+        .iter()
+        .map(|r| r["loaded_bodies"].as_u64().expect("loaded_bodies"))
+        .collect();
+    assert!(loaded.iter().all(|&n| n > 0 && n < nb), "{loaded:?} of {nb}");
+    assert!(loaded.iter().sum::<u64>() >= nb, "{loaded:?} of {nb}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -240,15 +240,26 @@ impl<D: Family> super::NscddOf<D> {
     fn start_fresh(&mut self, w: &mut D::World) {
         let Some(rs) = self.ranks.as_mut() else { return };
         let s = &self.settings;
-        let movable: Vec<usize> = (0..D::n_bodies(w)).filter(|&g| D::movable(w, g)).collect();
-        let (lo, hi) = Grid::bounds(movable.iter().map(|&g| D::position(w, g)));
-        if movable.is_empty() || (0..3).any(|k| !(lo[k].is_finite() && hi[k].is_finite())) {
-            return;
-        }
-        let grid = Grid::from_bounds(lo, hi, s.nx, s.ny, s.nz);
+        let cells = [s.nx, s.ny, s.nz];
         // the cells' ranks balanced by their bodies, as a repartition by its contacts
-        let cells: Vec<u32> = movable.iter().map(|&g| grid.cell_of(D::position(w, g))).collect();
-        rs.assign(&cells, grid.len(), true);
+        // (computed by the loader when the world holds this rank's part only)
+        let part = match self.loaded.take() {
+            Some(p) => p,
+            None => {
+                let centres: Vec<[f64; 3]> = (0..D::n_bodies(w))
+                    .filter(|&g| D::movable(w, g))
+                    .map(|g| D::position(w, g))
+                    .collect();
+                let Some(p) = super::first_part::provisional(&centres, cells, rs.cluster.size()) else {
+                    return;
+                };
+                p
+            }
+        };
+        debug_assert_eq!(part.cells, cells, "the loader's grid is the decomposition's");
+        let grid = part.grid();
+        rs.rank_of = part.rank_of;
+        rs.totals.loaded_bodies = D::held(w).map_or_else(|| D::n_bodies(w), <[u32]>::len) as u64;
         self.local.owned.start_held::<D>(w, rs, &grid);
         self.grid = Some(grid);
     }

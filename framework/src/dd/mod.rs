@@ -48,6 +48,7 @@ mod census;
 pub mod cluster;
 mod config;
 pub mod family;
+pub mod first_part;
 pub mod gluing;
 mod grid;
 mod local;
@@ -70,6 +71,7 @@ mod report;
 pub mod schemes;
 mod shells;
 mod state;
+pub use first_part::LoadedPart;
 pub use state::{NscddState, RestartPart};
 pub mod subdomain;
 pub mod team;
@@ -180,6 +182,8 @@ pub struct NscddOf<D: Family> {
     /// ([`local`]; rigid bodies only), and that mode's state.
     pub local_contacts: bool,
     local: local::Local,
+    /// A fresh scene loaded in part on this rank ([`Self::start_from`]).
+    loaded: Option<LoadedPart>,
 }
 
 /// NSCDD of 2D rigid bodies.
@@ -214,6 +218,7 @@ impl<D: Family> NscddOf<D> {
             ranks: None,
             local_contacts: true,
             local: local::Local::default(),
+            loaded: None,
         }
     }
 
@@ -254,6 +259,13 @@ impl<D: Family> NscddOf<D> {
     /// too is written in pieces by the bodies' owners instead of whole by rank 0.
     /// `families`: whether body families are attached (their scenes step every
     /// body on every rank).
+    /// A fresh scene whose world holds this rank's part since loading
+    /// ([`crate::scene::part`]): the first step starts from the provisional grid
+    /// and ranks the loader computed, as it would compute them from the whole world.
+    pub fn start_from(&mut self, part: LoadedPart) {
+        self.loaded = Some(part);
+    }
+
     pub fn start_ranks(&mut self, w: &mut D::World, families: bool) {
         self.start_held(w, !families && !self.by_model);
     }

@@ -15,9 +15,11 @@ use super::ranks::RankState;
 /// (`limited_shell_steps`, [`super::shells`]); the bodies its world held, summed
 /// over the steps (`bodies_held`, [`crate::world::held`]), and the most in one step
 /// (`bodies_held_max`); the restart's contacts its world loaded (`restart_contacts`:
-/// the state read in part, [`super::RestartPart`], gives each contact to one rank).
+/// the state read in part, [`super::RestartPart`], gives each contact to one rank);
+/// the bodies its world held before a fresh run's first step (`loaded_bodies`: a
+/// scene loaded in part, [`crate::scene::part`], gives each rank its halo).
 pub fn totals_json(st: &mut RankState) -> String {
-    const H: usize = 22;
+    const H: usize = 23;
     let p = st.cluster.size() as usize;
     let t = &st.totals;
     let (wait_wall, wait_cpu) = st.cluster.waited();
@@ -45,6 +47,7 @@ pub fn totals_json(st: &mut RankState) -> String {
         t.bodies_held as f64,
         t.bodies_held_max as f64,
         t.restart_contacts as f64,
+        t.loaded_bodies as f64,
         t.peers.len() as f64,
     ];
     mine.extend(t.peers.iter().map(|&x| x as f64));
@@ -81,6 +84,7 @@ pub fn totals_json(st: &mut RankState) -> String {
                 "bodies_held": x[18] as u64,
                 "bodies_held_max": x[19] as u64,
                 "restart_contacts": x[20] as u64,
+                "loaded_bodies": x[21] as u64,
                 "peers": peers,
                 "last_subdomains": subs,
             })

@@ -88,6 +88,9 @@ pub struct RankTotals {
     /// step kept its own (all of them unless the state was read in part,
     /// [`super::RestartPart`]); 0 without a restart.
     pub restart_contacts: u64,
+    /// The bodies this rank's world held before a fresh run's first step: all of
+    /// them unless the scene was loaded in part ([`crate::scene::part`]).
+    pub loaded_bodies: u64,
     /// Bodies of the other ranks' subdomains (shells) this rank held, summed over
     /// the steps, and the steps whose shells were limited ([`super::shells`]).
     pub shell_bodies: u64,

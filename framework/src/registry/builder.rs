@@ -31,6 +31,49 @@ pub(crate) fn material_param(materials: &[Material], params: &toml::Table, key: 
     material_id(materials, name).ok_or_else(|| ParamError::new(key, format!("unknown material `{name}`; declare it in [[materials]]")))
 }
 
+/// A rank's part of the scene ([`SceneBuilder::part`], issue 20): the builder holds
+/// only the bodies `keep` accepts (given each body's global id and bounding box,
+/// first `D::N` coordinates), and keeps of every body of the scene what the loader's
+/// whole-scene checks and the ranks' first grid read (≈ 60 B a body, dropped after
+/// loading).
+pub struct Part {
+    pub(crate) keep: Box<dyn Fn(u32, &[[f64; 3]; 2]) -> bool>,
+    /// Global ids of the bodies held (ascending: the held bodies' slots).
+    pub(crate) globals: Vec<u32>,
+    /// Per scene body, by global id.
+    pub(crate) centre: Vec<[f64; 3]>,
+    pub(crate) mass: Vec<f64>,
+    pub(crate) rho2: Vec<f64>,
+    pub(crate) volume: Vec<f64>,
+    pub(crate) shape: Vec<ShapeRef>,
+    pub(crate) material: Vec<u16>,
+    pub(crate) movable: Vec<bool>,
+    /// The bodies with unbounded boxes, and the named ones with their names.
+    pub(crate) unbounded: Vec<u32>,
+    pub(crate) named: Vec<(u32, String)>,
+    /// The driven bodies (set once the scene is loaded).
+    pub(crate) driven: Vec<u32>,
+}
+
+impl Part {
+    pub(crate) fn new(keep: Box<dyn Fn(u32, &[[f64; 3]; 2]) -> bool>) -> Part {
+        Part {
+            keep,
+            globals: vec![],
+            centre: vec![],
+            mass: vec![],
+            rho2: vec![],
+            volume: vec![],
+            shape: vec![],
+            material: vec![],
+            movable: vec![],
+            unbounded: vec![],
+            named: vec![],
+            driven: vec![],
+        }
+    }
+}
+
 /// Bodies under construction, with the shape stores of the kinds they use.
 pub struct SceneBuilder<'r, D: Dim> {
     pub(crate) registry: &'r Registry,
@@ -43,6 +86,10 @@ pub struct SceneBuilder<'r, D: Dim> {
     pub(crate) origins: Vec<Origin>,
     pub(crate) origin: Origin,
     pub(crate) drives: Vec<BodyDrive>,
+    /// A rank's part ([`Part`]); `None`: every body held (`bodies`, `names` and
+    /// `fixed` are then by global id; with a part, by the held bodies' slots, and
+    /// `origins` and `drives` by global id in both).
+    pub(crate) part: Option<Part>,
 }
 
 /// The 2D builder.
@@ -63,7 +110,53 @@ impl<'r, D: Dim> SceneBuilder<'r, D> {
             origins: vec![],
             origin: Origin::Body(0),
             drives: vec![],
+            part: None,
         }
+    }
+
+    /// The slot of body `g` (a global id) if the builder holds it.
+    pub(crate) fn slot(&self, g: u32) -> Option<usize> {
+        match &self.part {
+            None => ((g as usize) < self.bodies.len()).then_some(g as usize),
+            Some(p) => p.globals.binary_search(&g).ok(),
+        }
+    }
+
+    /// Mass, ρ², volume, shape, material and whether impulses move it, of body `g`
+    /// (held or not).
+    pub(crate) fn mass_of(&self, g: usize) -> f64 {
+        self.part.as_ref().map_or_else(|| self.bodies.mass[g], |p| p.mass[g])
+    }
+    pub(crate) fn shape_of(&self, g: usize) -> ShapeRef {
+        self.part.as_ref().map_or_else(|| self.bodies.shape[g], |p| p.shape[g])
+    }
+    pub(crate) fn material_of(&self, g: usize) -> u16 {
+        self.part.as_ref().map_or_else(|| self.bodies.material[g], |p| p.material[g])
+    }
+    pub(crate) fn movable_of(&self, g: usize) -> bool {
+        self.part.as_ref().map_or_else(|| self.bodies.movable(g), |p| p.movable[g])
+    }
+
+    /// Body `g`'s name, held or not.
+    pub(crate) fn name_of(&self, g: usize) -> Option<&str> {
+        match &self.part {
+            None => self.names[g].as_deref(),
+            Some(p) => p.named.iter().find(|x| x.0 as usize == g).map(|x| x.1.as_str()),
+        }
+    }
+
+    /// The body named `name`, held or not.
+    pub(crate) fn named(&self, name: &str) -> Option<u32> {
+        match &self.part {
+            None => self.names.iter().position(|n| n.as_deref() == Some(name)).map(|p| p as u32),
+            Some(p) => p.named.iter().find(|x| x.1 == name).map(|x| x.0),
+        }
+    }
+
+    /// The mass, inertia and volume a body of `shape` and `material` gets.
+    pub(crate) fn mass_properties(&self, shape: ShapeRef, material: u16) -> crate::shape::MassProps<D> {
+        let store = &self.shapes[shape.kind as usize];
+        store.mass_properties(shape.index, self.materials[material as usize].density)
     }
 
     /// Material id by name.
@@ -108,7 +201,7 @@ impl<'r, D: Dim> SceneBuilder<'r, D> {
     /// it with their counts (and grids) before building anything.
     pub fn reserve(&self, key: &str, count: f64, extra: f64) -> Result<(), ParamError> {
         let per = super::limits::bytes_per_body::<D>();
-        let need = (self.bodies.len() as f64 + count.max(0.0)) * per + extra.max(0.0);
+        let need = (self.body_count() as f64 + count.max(0.0)) * per + extra.max(0.0);
         let what = match (count > 0.0, extra > count * per) {
             (false, _) => "the generator's grid".to_string(),
             (true, false) => format!("{count} bodies"),
@@ -134,25 +227,59 @@ impl<'r, D: Dim> SceneBuilder<'r, D> {
             pos = D::Point::from_fn(|k| pos[k] + dc[k]);
             q = D::rot_mul(&q, &rc);
         }
+        let g = self.origins.len() as u32;
+        self.origins.push(self.origin);
+        if let Some(p) = self.part.as_mut() {
+            // (the box of the orientation the body will hold)
+            let a = store.aabb(shape.index, pos, D::normalize_rot(q));
+            let mut bx = [[0.0; 3]; 2];
+            bx[0][..D::N].copy_from_slice(a.min.as_ref());
+            bx[1][..D::N].copy_from_slice(a.max.as_ref());
+            let mut c = [0.0; 3];
+            c[..D::N].copy_from_slice(pos.as_ref());
+            p.centre.push(c);
+            p.mass.push(mp.mass);
+            p.rho2.push(D::rho2(mp.mass, &mp.inertia));
+            p.volume.push(mp.volume);
+            p.shape.push(shape);
+            p.material.push(material);
+            p.movable.push(true);
+            if !a.is_bounded() {
+                p.unbounded.push(g);
+            }
+            if !(p.keep)(g, &bx) {
+                return g;
+            }
+            p.globals.push(g);
+        }
         self.names.push(None);
         self.fixed.push(false);
-        self.origins.push(self.origin);
-        self.bodies.push(pos, q, vel, mp.mass, mp.inertia, mp.volume, shape, material)
+        self.bodies.push(pos, q, vel, mp.mass, mp.inertia, mp.volume, shape, material);
+        g
     }
 
     /// Makes a body immovable.
     pub fn set_fixed(&mut self, b: u32) {
-        self.fixed[b as usize] = true;
-        self.bodies.set_fixed(b as usize);
+        if let Some(p) = self.part.as_mut() {
+            p.movable[b as usize] = false;
+        }
+        if let Some(k) = self.slot(b) {
+            self.fixed[k] = true;
+            self.bodies.set_fixed(k);
+        }
     }
 
+    /// The scene's bodies so far (held or not).
     pub fn body_count(&self) -> usize {
-        self.bodies.len()
+        self.origins.len()
     }
 
     /// Position of body b.
     pub fn position(&self, b: u32) -> D::Point {
-        self.bodies.pos[b as usize]
+        match &self.part {
+            Some(p) => D::Point::from_fn(|k| p.centre[b as usize][k]),
+            None => self.bodies.pos[b as usize],
+        }
     }
 
     /// Drives the degrees of freedom of a body (2D: x, y, rot; 3D: x, y, z, rx,
@@ -164,11 +291,18 @@ impl<'r, D: Dim> SceneBuilder<'r, D> {
 
     /// Sets a body's initial velocity (v, ω in world axes).
     pub fn set_velocity(&mut self, b: u32, vel: D::Twist) {
-        self.bodies.vel[b as usize] = vel;
+        if let Some(k) = self.slot(b) {
+            self.bodies.vel[k] = vel;
+        }
     }
 
     /// Sets a body's name (for outputs and `[output] box`).
     pub fn set_name(&mut self, b: u32, name: &str) {
-        self.names[b as usize] = Some(name.to_string());
+        if let Some(p) = self.part.as_mut() {
+            p.named.push((b, name.to_string()));
+        }
+        if let Some(k) = self.slot(b) {
+            self.names[k] = Some(name.to_string());
+        }
     }
 }

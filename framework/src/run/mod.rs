@@ -354,6 +354,10 @@ pub(crate) fn scene_solver<D: Dim>(
     if let Some(msg) = refusal {
         return Err(RunError::Param(crate::error::ParamError::new("solver.method", msg)));
     }
+    // a fresh scene loaded in part: the first step starts from the loader's grid
+    if let (Some(n), Some(part)) = (dd.as_mut(), scene.part.take()) {
+        n.start_from(part);
+    }
     // a restarted run of the same decomposition continues its F_Γ
     if let (Some(n), Some(state)) = (dd.as_mut(), scene.dd_state.take()) {
         n.load_state(state)

@@ -130,7 +130,7 @@ pub(crate) fn check_alert_work(cx: &Ctx, alert: f64, pts: &[[f64; 3]], sizes: &[
 /// Initial interpenetrations beyond `detection.overlap_tolerance` × the smaller
 /// shape size, among the detected `(i, j, gap)` of materials that interact.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn check_overlaps(
+pub(crate) fn check_overlaps<'n>(
     cx: &Ctx,
     d: &schema::DetectionSpec,
     contacts: impl Iterator<Item = (usize, usize, f64)>,
@@ -138,7 +138,7 @@ pub(crate) fn check_overlaps(
     laws: &[Option<std::sync::Arc<dyn crate::law::Law>>],
     nm: usize,
     material: impl Fn(usize) -> usize,
-    names: &[Option<String>],
+    name: &dyn Fn(usize) -> Option<&'n str>,
     origins: &[Origin],
 ) -> Result<(), InputError> {
     let tol = d.overlap_tolerance;
@@ -151,7 +151,7 @@ pub(crate) fn check_overlaps(
         }
         let lim = tol * sizes[i].min(sizes[j]);
         if gap < -lim {
-            let label = |x: usize| match &names[x] {
+            let label = |x: usize| match name(x) {
                 Some(n) => format!("{x} (`{n}`)"),
                 None => format!("{x}"),
             };

@@ -2,7 +2,7 @@
 //! bodies, the generators, the laws and detectors, the initial overlaps, the box
 //! sample and the drives, each error naming the file, the line and the key.
 
-use super::builder::{Origin, SceneBuilder};
+use super::builder::{Origin, Part, SceneBuilder};
 use super::locate::Seg;
 use super::schema::{BodySpec, SceneDim, SceneFile};
 use super::{at, k, BodyInfo, Ctx, OutputSettings, Scene};
@@ -12,10 +12,24 @@ use crate::drive::BodyDrive;
 use crate::error::InputError;
 use crate::model::ShapeRef;
 use crate::registry::{ParamError, Registry};
+use crate::world::held::WholeScene;
 use crate::world::{BoxWalls, World};
 
 /// The scene of a parsed file of dimension `D`.
 pub(crate) fn load_parsed<D: SceneDim>(cx: &Ctx, sf: SceneFile<BodySpec<D>>, registry: &Registry) -> Result<Scene<D>, InputError> {
+    load_parsed_part(cx, sf, registry, None).map(|x| x.0)
+}
+
+/// [`load_parsed`], holding only the bodies `part` keeps when it is given (a rank's
+/// part, [`super::part`]): the whole-scene checks read every body's [`Part`]
+/// columns, the world holds the part (its slots the kept global ids, the whole
+/// scene's sums in [`WholeScene`]), and `part` comes back with every body's columns.
+pub(crate) fn load_parsed_part<D: SceneDim>(
+    cx: &Ctx,
+    sf: SceneFile<BodySpec<D>>,
+    registry: &Registry,
+    part: Option<Part>,
+) -> Result<(Scene<D>, Option<Part>), InputError> {
     let gravity = gravity::<D>(cx, &sf)?;
     if D::N == 2 && sf.decomposition.as_ref().is_some_and(|d| d.nz.is_some()) {
         return Err(cx.err(&[k("decomposition"), k("nz")], "`nz` splits along z: 3D scenes only"));
@@ -24,12 +38,13 @@ pub(crate) fn load_parsed<D: SceneDim>(cx: &Ctx, sf: SceneFile<BodySpec<D>>, reg
     let solver = super::solver_settings(cx, &sf.solver, gravity.as_ref())?;
     let materials = super::materials(cx, &sf)?;
     let mut b = SceneBuilder::<D>::new(registry, materials);
+    b.part = part;
     let mut drives = vec![];
     add_bodies(cx, &sf, &mut b, &mut drives)?;
     generate(cx, &sf, registry, &mut b)?;
     drives.append(&mut b.drives);
     // a scene of a body family's bodies alone (deformable bodies) has no rigid ones
-    if b.bodies.is_empty() && !cx.families {
+    if b.body_count() == 0 && !cx.families {
         return Err(cx.err(&[], "the scene has no bodies"));
     }
     check_masses(cx, &b)?;
@@ -42,45 +57,28 @@ pub(crate) fn load_parsed<D: SceneDim>(cx: &Ctx, sf: SceneFile<BodySpec<D>>, reg
         );
         return Err(cx.err(&[k("solver"), k("method")], msg));
     }
-    // every pair of materials that can touch needs a law; every pair of kinds a detector
-    let n = b.bodies.len();
-    let info: Vec<BodyInfo> = (0..n)
-        .map(|i| BodyInfo {
-            material: b.bodies.material[i] as usize,
-            kind: b.bodies.shape[i].kind as usize,
-            movable: b.bodies.movable(i) || drives.iter().any(|d: &BodyDrive| d.body as usize == i),
-            origin: b.origins[i],
-        })
-        .collect();
-    let kinds: Vec<&'static str> = b.shapes.iter().map(|x| x.kind()).collect();
-    let table = DetectorTable {
-        nk: kinds.len(),
-        table: super::laws_and_detectors(cx, &info, &b.materials, &kinds, &laws, &declared, |x, y| {
-            registry.detector::<D>(x, y)
-        })?,
-    };
-    let sizes: Vec<f64> = (0..n)
-        .map(|i| b.shapes[b.bodies.shape[i].kind as usize].size(b.bodies.shape[i].index))
-        .collect();
-    let alert = super::alert_distance(cx, &sf.detection, &sizes)?;
-    super::checks::check_alert_work(cx, alert, &movable_centres(&b), &sizes, D::N)?;
-    // initial interpenetrations beyond the tolerance
-    let mut raw = vec![];
-    Detector::default().detect(&b.bodies, &b.shapes, &table, 0.0, &mut raw);
-    let contacts = raw.iter().map(|rc| (rc.i as usize, rc.j as usize, rc.gap));
-    let material = |x: usize| b.bodies.material[x] as usize;
-    super::check_overlaps(cx, &sf.detection, contacts, &sizes, &laws, nm, material, &b.names, &b.origins)?;
-    let box_walls = box_walls::<D>(cx, &sf, &b.names)?;
+    let n = b.body_count();
+    let (table, sizes, alert) = detectors_and_alert(cx, &sf, registry, &b, &drives, (&laws, &declared))?;
+    check_overlaps(cx, &sf, &b, &table, &sizes, &laws)?;
+    let box_walls = box_walls::<D>(cx, &sf, |name| b.named(name))?;
     super::check_pressure_drives(cx, &drives, box_walls.as_ref(), &b.origins, D::DOF_NAMES, D::BOX_KEY)?;
     check_writers::<D>(cx, &sf, registry)?;
-    let movable = (0..n).filter(|&i| b.bodies.movable(i)).count();
+    let movable = (0..n).filter(|&i| b.movable_of(i)).count();
     let decomposition = match &sf.decomposition {
         None => None,
         Some(d) => Some(super::decomposition(cx, d, movable)?),
     };
+    if let Some(p) = b.part.as_mut() {
+        p.driven = drives.iter().map(|d| d.body).collect();
+    }
+    let (ids, whole, drives, box_walls) = match &b.part {
+        None => (Default::default(), None, drives, box_walls),
+        Some(p) => held_part::<D>(p, &b, drives, box_walls),
+    };
+    let held = b.bodies.len();
     let world = World {
         bodies: b.bodies,
-        ids: Default::default(),
+        ids,
         names: b.names,
         shapes: b.shapes,
         materials: b.materials,
@@ -97,23 +95,129 @@ pub(crate) fn load_parsed<D: SceneDim>(cx: &Ctx, sf: SceneFile<BodySpec<D>>, reg
         t: 0.0,
         step: 0,
         contacts: Default::default(),
-        reaction: vec![D::Twist::zero(); n],
+        reaction: vec![D::Twist::zero(); held],
         contact_shares: vec![],
-        whole: None,
+        whole,
         scratch: Default::default(),
     };
-    Ok(Scene {
-        world,
-        output: OutputSettings {
-            every: sf.output.every,
-            vtk: sf.output.vtk,
-            writers: sf.output.writers,
-            checkpoint_every: sf.output.checkpoint_every,
+    Ok((
+        Scene {
+            world,
+            output: OutputSettings {
+                every: sf.output.every,
+                vtk: sf.output.vtk,
+                writers: sf.output.writers,
+                checkpoint_every: sf.output.checkpoint_every,
+            },
+            decomposition,
+            families: vec![],
+            dd_state: None,
+            part: None,
+            survey: None,
         },
-        decomposition,
-        families: vec![],
-        dd_state: None,
-    })
+        b.part,
+    ))
+}
+
+/// Every pair of materials that can touch needs a law, every pair of kinds a
+/// detector: the detector table, every body's size and the alert distance (every
+/// body's, held or not).
+#[allow(clippy::type_complexity)]
+fn detectors_and_alert<D: SceneDim>(
+    cx: &Ctx,
+    sf: &SceneFile<BodySpec<D>>,
+    registry: &Registry,
+    b: &SceneBuilder<'_, D>,
+    drives: &[BodyDrive],
+    (laws, declared): (&[Option<std::sync::Arc<dyn crate::law::Law>>], &[bool]),
+) -> Result<(DetectorTable<D>, Vec<f64>, f64), InputError> {
+    let n = b.body_count();
+    let info: Vec<BodyInfo> = (0..n)
+        .map(|i| BodyInfo {
+            material: b.material_of(i) as usize,
+            kind: b.shape_of(i).kind as usize,
+            movable: b.movable_of(i) || drives.iter().any(|d: &BodyDrive| d.body as usize == i),
+            origin: b.origins[i],
+        })
+        .collect();
+    let kinds: Vec<&'static str> = b.shapes.iter().map(|x| x.kind()).collect();
+    let table = DetectorTable {
+        nk: kinds.len(),
+        table: super::laws_and_detectors(cx, &info, &b.materials, &kinds, laws, declared, |x, y| registry.detector::<D>(x, y))?,
+    };
+    let sizes: Vec<f64> = (0..n)
+        .map(|i| b.shapes[b.shape_of(i).kind as usize].size(b.shape_of(i).index))
+        .collect();
+    let alert = super::alert_distance(cx, &sf.detection, &sizes)?;
+    super::checks::check_alert_work(cx, alert, &movable_centres(b), &sizes, D::N)?;
+    Ok((table, sizes, alert))
+}
+
+/// Initial interpenetrations beyond the tolerance (a rank: among the bodies it
+/// holds; every overlapping pair is held by the rank of the cell holding a point of
+/// both).
+fn check_overlaps<D: SceneDim>(
+    cx: &Ctx,
+    sf: &SceneFile<BodySpec<D>>,
+    b: &SceneBuilder<'_, D>,
+    table: &DetectorTable<D>,
+    sizes: &[f64],
+    laws: &[Option<std::sync::Arc<dyn crate::law::Law>>],
+) -> Result<(), InputError> {
+    let mut raw = vec![];
+    Detector::default().detect(&b.bodies, &b.shapes, table, 0.0, &mut raw);
+    let global = |k: u32| b.part.as_ref().map_or(k, |p| p.globals[k as usize]) as usize;
+    let contacts = raw.iter().map(|rc| (global(rc.i), global(rc.j), rc.gap));
+    let material = |x: usize| b.material_of(x) as usize;
+    let name = |x: usize| b.name_of(x);
+    let nm = b.materials.len();
+    super::check_overlaps(cx, &sf.detection, contacts, sizes, laws, nm, material, &name, &b.origins)
+}
+
+/// The world's ids, the whole scene's sums, and the drives and box walls by slot,
+/// of a part: every driven or named body is held (a rank keeps them), those of a
+/// survey holding none are left out.
+fn held_part<D: Dim>(
+    p: &Part,
+    b: &SceneBuilder<'_, D>,
+    drives: Vec<BodyDrive>,
+    box_walls: Option<BoxWalls>,
+) -> (crate::model::BodyIds, Option<WholeScene>, Vec<BodyDrive>, Option<BoxWalls>) {
+    let n = p.centre.len();
+    let slot = |g: u32| p.globals.binary_search(&g).ok().map(|k| k as u32);
+    let ids = crate::model::BodyIds::default()
+        .respread(p.globals.clone(), n as u32)
+        .expect("held bodies ascend in global id");
+    // as `World::whole_of_held` adds them, in id order
+    let mut w = WholeScene {
+        grain_volume: -0.0,
+        ..Default::default()
+    };
+    for g in 0..n {
+        let s = p.shape[g];
+        let store = &b.shapes[s.kind as usize];
+        if store.is_grain() && p.movable[g] && !drives.iter().any(|d| d.body as usize == g) {
+            w.grains += 1;
+            w.grain_volume += p.volume[g];
+            w.max_grain_size = w.max_grain_size.max(store.size(s.index));
+        }
+    }
+    (w.movable, w.rho2) = (p.movable.clone(), p.rho2.clone());
+    let drives = drives
+        .into_iter()
+        .filter_map(|mut d| {
+            d.body = slot(d.body)?;
+            Some(d)
+        })
+        .collect();
+    let box_walls = box_walls.and_then(|mut bw| {
+        // (the unused walls of a 2D box stay u32::MAX)
+        for k in bw.walls.iter_mut().filter(|k| (**k as usize) < n) {
+            *k = slot(*k)?;
+        }
+        Some(bw)
+    });
+    (ids, Some(w), drives, box_walls)
 }
 
 /// Every writer of `[output] writers` is registered for the dimension.
@@ -153,7 +257,11 @@ fn generate<D: SceneDim>(cx: &Ctx, sf: &SceneFile<BodySpec<D>>, registry: &Regis
 
 /// `[output] box` (2D) / `box3` (3D): the walls of a box sample, by body name
 /// (the other dimension's key refused).
-fn box_walls<D: SceneDim>(cx: &Ctx, sf: &SceneFile<BodySpec<D>>, names: &[Option<String>]) -> Result<Option<BoxWalls>, InputError> {
+fn box_walls<D: SceneDim>(
+    cx: &Ctx,
+    sf: &SceneFile<BodySpec<D>>,
+    named: impl Fn(&str) -> Option<u32>,
+) -> Result<Option<BoxWalls>, InputError> {
     let other_box = match D::N {
         2 => sf.output.box3.is_some(),
         _ => sf.output.box_walls.is_some(),
@@ -172,11 +280,7 @@ fn box_walls<D: SceneDim>(cx: &Ctx, sf: &SceneFile<BodySpec<D>>, names: &[Option
     };
     let mut walls = [u32::MAX; 6];
     for (slot, (key, name)) in keys.into_iter().enumerate() {
-        walls[slot] = names
-            .iter()
-            .position(|n| n.as_deref() == Some(name))
-            .map(|p| p as u32)
-            .ok_or_else(|| cx.err(&[k("output"), k(D::BOX_KEY), k(key)], format!("no body is named `{name}`")))?;
+        walls[slot] = named(name).ok_or_else(|| cx.err(&[k("output"), k(D::BOX_KEY), k(key)], format!("no body is named `{name}`")))?;
     }
     Ok(Some(BoxWalls { walls, strain_from }))
 }
@@ -217,7 +321,8 @@ fn add_bodies<D: SceneDim>(
             return Err(cx.err(&p("position"), "position, rotation and velocity must be finite"));
         }
         let id = b.add_body(ShapeRef { kind, index }, material, spec.position, spec.rotation, spec.velocity);
-        let (m, inertia) = (b.bodies.mass[id as usize], b.bodies.inertia[id as usize]);
+        let mp = b.mass_properties(ShapeRef { kind, index }, material);
+        let (m, inertia) = (mp.mass, mp.inertia);
         if !(m > 0.0 && m.is_finite() && inertia.coords().iter().all(|x| *x > 0.0 && x.is_finite())) {
             return Err(cx.err(
                 &p("shape"),
@@ -225,7 +330,7 @@ fn add_bodies<D: SceneDim>(
             ));
         }
         if let Some(name) = &spec.name {
-            if b.names.iter().any(|x| x.as_deref() == Some(name.as_str())) {
+            if b.named(name).is_some() {
                 return Err(cx.err(&p("name"), format!("two bodies are named `{name}`")));
             }
             b.set_name(id, name);
@@ -253,14 +358,14 @@ fn add_bodies<D: SceneDim>(
 
 /// A movable body needs a mass (a shape of 1e-308 m has none left).
 fn check_masses<D: Dim>(cx: &Ctx, b: &SceneBuilder<'_, D>) -> Result<(), InputError> {
-    let m = &b.bodies.mass;
-    match (0..b.bodies.len()).find(|&i| b.bodies.movable(i) && !(m[i] > 0.0 && m[i].is_finite())) {
+    let m = |i: usize| b.mass_of(i);
+    match (0..b.body_count()).find(|&i| b.movable_of(i) && !(m(i) > 0.0 && m(i).is_finite())) {
         None => Ok(()),
         Some(i) => Err(cx.err(
             &super::origin_path(b.origins[i], "shape"),
             format!(
                 "a movable body of mass {:e} kg (its shape's volume times its density): make the shape larger or the body fixed",
-                m[i]
+                m(i)
             ),
         )),
     }
@@ -268,11 +373,11 @@ fn check_masses<D: Dim>(cx: &Ctx, b: &SceneBuilder<'_, D>) -> Result<(), InputEr
 
 /// The movable bodies' centres (z = 0 in 2D).
 fn movable_centres<D: Dim>(b: &SceneBuilder<'_, D>) -> Vec<[f64; 3]> {
-    (0..b.bodies.len())
-        .filter(|&i| b.bodies.movable(i))
+    (0..b.body_count())
+        .filter(|&i| b.movable_of(i))
         .map(|i| {
             let mut p = [0.0; 3];
-            for (x, y) in p.iter_mut().zip(b.bodies.pos[i].as_ref()) {
+            for (x, y) in p.iter_mut().zip(b.position(i as u32).as_ref()) {
                 *x = *y;
             }
             p

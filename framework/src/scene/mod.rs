@@ -11,6 +11,7 @@ pub use crate::registry::builder;
 mod checks;
 mod load;
 pub mod locate;
+pub mod part;
 pub mod restart;
 mod restart_stream;
 pub mod schema;
@@ -49,6 +50,12 @@ pub struct Scene<D: Dim = D2> {
     /// A restarted scene: the NSCDD state of the saved run ([`restart_scene`]),
     /// given to the solver of the same decomposition at the first step.
     pub dd_state: Option<crate::dd::NscddState>,
+    /// A rank's part of a fresh scene ([`part`]): the first step's provisional grid
+    /// and its cells' ranks, given to the solver, which starts from them.
+    pub part: Option<crate::dd::LoadedPart>,
+    /// The first pass of a scene loaded on ranks ([`part::survey_any`]): what every
+    /// rank knows of every body before it builds its part.
+    pub survey: Option<part::Survey>,
 }
 
 /// A loaded 3D scene.
@@ -135,6 +142,18 @@ pub(crate) fn origin_path(o: Origin, key: &str) -> Vec<Seg> {
     }
 }
 
+/// The file's `dimension` is `D`'s.
+fn dimension_is<D: SceneDim>(cx: &Ctx, sf: &SceneFile<BodySpec<D>>) -> Result<(), InputError> {
+    if sf.dimension as usize != D::N {
+        let msg = match sf.dimension {
+            2 | 3 => format!("a {} scene was expected here (`dimension = {}`)", D::NAME, D::N),
+            d => format!("dimension {d} is not supported: 2 or 3"),
+        };
+        return Err(cx.err(&[k("dimension")], msg));
+    }
+    Ok(())
+}
+
 /// A loaded scene of either dimension.
 pub enum AnyScene {
     D2(Scene),
@@ -209,13 +228,7 @@ impl<D: SceneDim> Scene<D> {
             file,
             families: !sf.sections.is_empty(),
         };
-        if sf.dimension as usize != D::N {
-            let msg = match sf.dimension {
-                2 | 3 => format!("a {} scene was expected here (`dimension = {}`)", D::NAME, D::N),
-                d => format!("dimension {d} is not supported: 2 or 3"),
-            };
-            return Err(cx.err(&[k("dimension")], msg));
-        }
+        dimension_is::<D>(&cx, &sf)?;
         let sections = std::mem::take(&mut sf.sections);
         for name in sections.keys() {
             if registry.family::<D>(name).is_none() {

@@ -1,0 +1,156 @@
+//! A fresh scene loaded on MPI ranks in part (issue 20): no rank ever holds every
+//! body of the scene.
+//!
+//! 1. **Survey** ([`survey_any`]): every rank reads the file and runs its bodies and
+//!    generators holding none of them ([`crate::scene::builder::Part`]); it keeps
+//!    of every body only what the whole-scene checks and the first grid read (≈ 60
+//!    B a body: centre, mass, ρ², volume, shape, material, whether it moves), and
+//!    runs those checks (laws and detectors, masses, the alert distance), so that
+//!    every rank refuses the same bad scene with the same message.
+//! 2. The command line's decomposition flags apply ([`crate::dd::DdConfig`]).
+//! 3. **Part** ([`load_on`]): the provisional grid over the movable bodies'
+//!    centres and its cells' ranks ([`crate::dd::first_part::provisional`], the
+//!    first step's own rule), then the file again, each rank holding only the
+//!    bodies whose box, grown by the alert distance, meets its cells (the halo's
+//!    own test) and those every rank steps (immovable, driven, named, unbounded):
+//!    what the first step keeps of a whole world, so results stay bitwise those of
+//!    one process. The overlap check runs on the bodies a rank holds (an
+//!    overlapping pair is held by the rank of a cell holding a point of both).
+//!
+//! Scenes with body families, by-model subdomains or no decomposition are loaded
+//! whole, as before. The ranks agree on the survey's digest of every body.
+
+use super::builder::Part;
+use super::schema::{BodySpec, SceneDim, SceneFile};
+use super::{AnyScene, Ctx, Scene, Scene3};
+use crate::dim::{D2, D3};
+use crate::error::InputError;
+use crate::registry::Registry;
+use std::hash::Hasher;
+
+/// What the survey of a scene gives every rank.
+#[derive(Clone, Debug, Default)]
+pub struct Survey {
+    /// The scene's text and file name (read again for the part).
+    text: String,
+    file: String,
+    /// The movable bodies' centres, in id order (the provisional grid's points).
+    centres: Vec<[f64; 3]>,
+    /// The bodies every rank holds (ascending).
+    everywhere: Vec<u32>,
+    /// The movable bodies (the decomposition flags' check).
+    pub movable: usize,
+    /// A digest of every body's columns and of the bodies every rank holds.
+    pub digest: u64,
+}
+
+/// The survey of the scene at `path` (any dimension): a scene whose world holds no
+/// body, its [`Scene::survey`] set; `None` for a scene with body families (loaded
+/// whole: they step every body on every rank).
+pub fn survey_any(path: &std::path::Path, registry: &Registry) -> Result<Option<AnyScene>, InputError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| InputError {
+        file: file.clone(),
+        line: None,
+        key: String::new(),
+        message: format!("cannot read the file: {e}"),
+    })?;
+    let dim = toml::from_str::<toml::Table>(&text)
+        .ok()
+        .and_then(|t| t.get("dimension").and_then(|d| d.as_integer()));
+    Ok(match dim {
+        Some(3) => survey::<D3>(&text, &file, registry)?.map(AnyScene::D3),
+        _ => survey::<D2>(&text, &file, registry)?.map(AnyScene::D2),
+    })
+}
+
+/// Loads `text` with `part` (every body's columns kept, those it accepts held);
+/// `None` for a scene with body families.
+fn load_with<D: SceneDim>(text: &str, file: &str, registry: &Registry, part: Part) -> Result<Option<(Scene<D>, Part)>, InputError> {
+    let sf: SceneFile<BodySpec<D>> = super::parse(text, file)?;
+    let cx = Ctx {
+        text,
+        file,
+        families: !sf.sections.is_empty(),
+    };
+    super::dimension_is::<D>(&cx, &sf)?;
+    if cx.families {
+        return Ok(None);
+    }
+    let (scene, part) = super::load::load_parsed_part(&cx, sf, registry, Some(part))?;
+    Ok(Some((scene, part.expect("the part given"))))
+}
+
+fn survey<D: SceneDim>(text: &str, file: &str, registry: &Registry) -> Result<Option<Scene<D>>, InputError> {
+    let Some((mut scene, p)) = load_with::<D>(text, file, registry, Part::new(Box::new(|_, _| false)))? else {
+        return Ok(None);
+    };
+    let driven = &p.driven;
+    let mut everywhere: Vec<u32> = (0..p.centre.len() as u32).filter(|&g| !p.movable[g as usize]).collect();
+    everywhere.extend(driven.iter().chain(&p.unbounded).copied().chain(p.named.iter().map(|x| x.0)));
+    everywhere.sort_unstable();
+    everywhere.dedup();
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    for g in 0..p.centre.len() {
+        let (s, c) = (p.shape[g], &p.centre[g]);
+        c.iter()
+            .chain([&p.mass[g], &p.rho2[g], &p.volume[g]])
+            .for_each(|x| h.write_u64(x.to_bits()));
+        h.write_u64(u64::from(s.kind) << 48 | u64::from(s.index) << 16 | u64::from(p.material[g]));
+        h.write_u8(u8::from(p.movable[g]));
+    }
+    everywhere.iter().for_each(|&g| h.write_u32(g));
+    let centres: Vec<[f64; 3]> = (0..p.centre.len()).filter(|&g| p.movable[g]).map(|g| p.centre[g]).collect();
+    scene.survey = Some(Survey {
+        text: text.to_string(),
+        file: file.to_string(),
+        movable: centres.len(),
+        centres,
+        everywhere,
+        digest: h.finish(),
+    });
+    Ok(Some(scene))
+}
+
+/// After [`survey_any`] and the decomposition flags: loads the scene as rank `me`
+/// of `ranks`, holding its part when the first step will run per rank (a
+/// decomposition by geometry; [`Scene::part`] then hands the provisional grid to
+/// the solver), or whole (the scene as [`super::load_any`] loads it). The flags'
+/// decomposition is kept. Returns whether the scene is held in part.
+pub fn load_on<D: SceneDim>(s: &mut Scene<D>, registry: &Registry, (ranks, me): (u32, u32)) -> Result<bool, InputError> {
+    let Some(sv) = s.survey.take() else { return Ok(false) };
+    let decomposition = s.decomposition.take();
+    // (a grid of fewer cells than ranks is refused when the run starts)
+    let first = decomposition
+        .as_ref()
+        .filter(|c| ranks > 1 && !c.by_model && c.dd.nx as u64 * c.dd.ny as u64 * c.dd.nz as u64 >= u64::from(ranks))
+        .and_then(|c| crate::dd::first_part::provisional(&sv.centres, [c.dd.nx, c.dd.ny, c.dd.nz], ranks));
+    let Some(first) = first else {
+        *s = Scene::<D>::load_str(&sv.text, &sv.file, registry)?;
+        s.decomposition = decomposition;
+        return Ok(false);
+    };
+    // (a margin on the alert distance: a body kept in excess leaves at the first step)
+    let halo = crate::dd::first_part::Halo::new(&first, me, D::N, s.world.alert * 1.01);
+    let everywhere = sv.everywhere.clone();
+    let keep = move |g: u32, b: &[[f64; 3]; 2]| everywhere.binary_search(&g).is_ok() || halo.meets(b);
+    let (scene, _) = load_with::<D>(&sv.text, &sv.file, registry, Part::new(Box::new(keep)))?.expect("surveyed without families");
+    *s = scene;
+    s.decomposition = decomposition;
+    s.part = Some(first);
+    s.survey = Some(Survey {
+        centres: Vec::new(),
+        everywhere: Vec::new(),
+        text: String::new(),
+        ..sv
+    });
+    Ok(true)
+}
+
+/// [`load_on`] for a scene of either dimension.
+pub fn load_any_on(s: &mut AnyScene, registry: &Registry, on: (u32, u32)) -> Result<bool, InputError> {
+    match s {
+        AnyScene::D2(x) => load_on::<D2>(x, registry, on),
+        AnyScene::D3(x) => load_on::<D3>(x as &mut Scene3, registry, on),
+    }
+}
