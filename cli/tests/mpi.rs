@@ -113,6 +113,11 @@ fn two_and_four_ranks_give_the_one_process_result_2d() {
     let sorted = every(PILE2D, 4).replacen("[solver]\n", "[solver]\nordering = \"sorted\"\n", 1);
     let sorted = write(&dir, "sorted.toml", &sorted);
     same_as_threads(&sorted, &dir, "2x2", "decentralized", &[4]);
+    // an alert distance as large as the pile: each rank's halo, loaded in part, is
+    // every body (a world of every slot, its ids not the identity)
+    let wide = every(PILE2D, 4).replacen("[solver]\n", "[detection]\nalert = 0.5\n[solver]\n", 1);
+    let wide = write(&dir, "wide.toml", &wide);
+    same_as_threads(&wide, &dir, "2x1", "decentralized", &[2]);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

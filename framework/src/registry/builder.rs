@@ -1,12 +1,13 @@
 //! Incremental construction of a scene (2D or 3D), used by the loader for explicit
 //! bodies and by plugins' generators.
 
-use crate::dim::{Dim, Vector, D2, D3};
+use crate::dim::{Coords, Dim, Vector, D2, D3};
 use crate::drive::{BodyDrive, DofDrive};
 use crate::model::{Bodies, ShapeRef};
 use crate::registry::{ParamError, Registry, ShapeStore};
 use crate::world::Material;
 use std::collections::BTreeMap;
+use std::hash::Hasher;
 
 /// Which scene entry made a body (for messages).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -38,6 +39,13 @@ pub(crate) fn material_param(materials: &[Material], params: &toml::Table, key: 
 /// loading).
 pub struct Part {
     pub(crate) keep: Box<dyn Fn(u32, &[[f64; 3]; 2]) -> bool>,
+    /// The share of the scene's bodies a rank holds, for the memory estimate of
+    /// [`SceneBuilder::reserve`] (0 for the survey, which holds none; 1/P for a
+    /// rank's part, its halo left out).
+    pub(crate) share: f64,
+    /// A hash of what the columns leave out (orientations, velocities, names,
+    /// drives, box walls): the ranks' agreement on the scene.
+    pub(crate) hash: std::collections::hash_map::DefaultHasher,
     /// Global ids of the bodies held (ascending: the held bodies' slots).
     pub(crate) globals: Vec<u32>,
     /// Per scene body, by global id.
@@ -56,9 +64,11 @@ pub struct Part {
 }
 
 impl Part {
-    pub(crate) fn new(keep: Box<dyn Fn(u32, &[[f64; 3]; 2]) -> bool>) -> Part {
+    pub(crate) fn new(keep: Box<dyn Fn(u32, &[[f64; 3]; 2]) -> bool>, share: f64) -> Part {
         Part {
             keep,
+            share,
+            hash: Default::default(),
             globals: vec![],
             centre: vec![],
             mass: vec![],
@@ -73,6 +83,10 @@ impl Part {
         }
     }
 }
+
+/// Bytes a body's [`Part`] columns take (centre, mass, ρ², volume, shape,
+/// material, whether it moves, and its origin).
+const PART_COLUMNS: f64 = 80.0;
 
 /// Bodies under construction, with the shape stores of the kinds they use.
 pub struct SceneBuilder<'r, D: Dim> {
@@ -201,7 +215,12 @@ impl<'r, D: Dim> SceneBuilder<'r, D> {
     /// it with their counts (and grids) before building anything.
     pub fn reserve(&self, key: &str, count: f64, extra: f64) -> Result<(), ParamError> {
         let per = super::limits::bytes_per_body::<D>();
-        let need = (self.body_count() as f64 + count.max(0.0)) * per + extra.max(0.0);
+        let n = self.body_count() as f64 + count.max(0.0);
+        // (a rank's part: every body's columns, and its share of the bodies)
+        let need = match &self.part {
+            None => n * per,
+            Some(p) => n * (PART_COLUMNS + per * p.share),
+        } + extra.max(0.0);
         let what = match (count > 0.0, extra > count * per) {
             (false, _) => "the generator's grid".to_string(),
             (true, false) => format!("{count} bodies"),
@@ -231,7 +250,9 @@ impl<'r, D: Dim> SceneBuilder<'r, D> {
         self.origins.push(self.origin);
         if let Some(p) = self.part.as_mut() {
             // (the box of the orientation the body will hold)
-            let a = store.aabb(shape.index, pos, D::normalize_rot(q));
+            let rot = D::normalize_rot(q);
+            let a = store.aabb(shape.index, pos, rot);
+            rot.coords().iter().chain(vel.as_ref()).for_each(|x| p.hash.write_u64(x.to_bits()));
             let mut bx = [[0.0; 3]; 2];
             bx[0][..D::N].copy_from_slice(a.min.as_ref());
             bx[1][..D::N].copy_from_slice(a.max.as_ref());
@@ -291,6 +312,10 @@ impl<'r, D: Dim> SceneBuilder<'r, D> {
 
     /// Sets a body's initial velocity (v, ω in world axes).
     pub fn set_velocity(&mut self, b: u32, vel: D::Twist) {
+        if let Some(p) = self.part.as_mut() {
+            p.hash.write_u32(b);
+            vel.as_ref().iter().for_each(|x| p.hash.write_u64(x.to_bits()));
+        }
         if let Some(k) = self.slot(b) {
             self.bodies.vel[k] = vel;
         }
@@ -300,6 +325,8 @@ impl<'r, D: Dim> SceneBuilder<'r, D> {
     pub fn set_name(&mut self, b: u32, name: &str) {
         if let Some(p) = self.part.as_mut() {
             p.named.push((b, name.to_string()));
+            p.hash.write_u32(b);
+            p.hash.write(name.as_bytes());
         }
         if let Some(k) = self.slot(b) {
             self.names[k] = Some(name.to_string());

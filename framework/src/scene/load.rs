@@ -69,7 +69,9 @@ pub(crate) fn load_parsed_part<D: SceneDim>(
         Some(d) => Some(super::decomposition(cx, d, movable)?),
     };
     if let Some(p) = b.part.as_mut() {
+        use std::hash::Hasher;
         p.driven = drives.iter().map(|d| d.body).collect();
+        p.hash.write(format!("{drives:?} {box_walls:?}").as_bytes());
     }
     let (ids, whole, drives, box_walls) = match &b.part {
         None => (Default::default(), None, drives, box_walls),

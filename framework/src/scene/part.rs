@@ -82,7 +82,7 @@ fn load_with<D: SceneDim>(text: &str, file: &str, registry: &Registry, part: Par
 }
 
 fn survey<D: SceneDim>(text: &str, file: &str, registry: &Registry) -> Result<Option<Scene<D>>, InputError> {
-    let Some((mut scene, p)) = load_with::<D>(text, file, registry, Part::new(Box::new(|_, _| false)))? else {
+    let Some((mut scene, p)) = load_with::<D>(text, file, registry, Part::new(Box::new(|_, _| false), 0.0))? else {
         return Ok(None);
     };
     let driven = &p.driven;
@@ -90,7 +90,8 @@ fn survey<D: SceneDim>(text: &str, file: &str, registry: &Registry) -> Result<Op
     everywhere.extend(driven.iter().chain(&p.unbounded).copied().chain(p.named.iter().map(|x| x.0)));
     everywhere.sort_unstable();
     everywhere.dedup();
-    let mut h = std::collections::hash_map::DefaultHasher::new();
+    // (orientations, velocities, names, drives and box walls: hashed as read)
+    let mut h = p.hash.clone();
     for g in 0..p.centre.len() {
         let (s, c) = (p.shape[g], &p.centre[g]);
         c.iter()
@@ -134,7 +135,8 @@ pub fn load_on<D: SceneDim>(s: &mut Scene<D>, registry: &Registry, (ranks, me): 
     let halo = crate::dd::first_part::Halo::new(&first, me, D::N, s.world.alert * 1.01);
     let everywhere = sv.everywhere.clone();
     let keep = move |g: u32, b: &[[f64; 3]; 2]| everywhere.binary_search(&g).is_ok() || halo.meets(b);
-    let (scene, _) = load_with::<D>(&sv.text, &sv.file, registry, Part::new(Box::new(keep)))?.expect("surveyed without families");
+    let share = 1.0 / f64::from(ranks);
+    let (scene, _) = load_with::<D>(&sv.text, &sv.file, registry, Part::new(Box::new(keep), share))?.expect("surveyed without families");
     *s = scene;
     s.decomposition = decomposition;
     s.part = Some(first);

@@ -293,7 +293,6 @@ impl<'de, D: Dim> Visitor<'de> for ContactsSeed<'_, D> {
             };
             if let Some(part) = self.part.as_deref_mut() {
                 // every contact read goes into the ranks' digest, kept or not
-                let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<u64>>();
                 part.saw([
                     u64::from(i),
                     u64::from(j),
@@ -301,12 +300,8 @@ impl<'de, D: Dim> Visitor<'de> for ContactsSeed<'_, D> {
                     u64::from(sc.bonded),
                     sc.gap.to_bits(),
                 ]);
-                part.saw(
-                    bits(r.as_ref())
-                        .into_iter()
-                        .chain(bits(sc.point.as_ref()))
-                        .chain(bits(sc.normal.as_ref())),
-                );
+                let values = r.as_ref().iter().chain(sc.point.as_ref()).chain(sc.normal.as_ref());
+                part.saw(values.map(|v| v.to_bits()));
                 let mut p = [0.0; 3];
                 p[..D::N].copy_from_slice(sc.point.as_ref());
                 if !part.keeps(key, p) {
