@@ -96,8 +96,21 @@ pub(crate) fn alert_distance(cx: &Ctx, d: &schema::DetectionSpec, sizes: &[f64])
 /// the sample (a packing has fewer than 6 per body) is an input error naming
 /// `detection.alert` (an alert of 10⁸ m on 2000 disks made 2·10⁶ contacts per step,
 /// a run of minutes per step).
-pub(crate) fn check_alert_work(cx: &Ctx, alert: f64, pts: &[[f64; 3]], sizes: &[f64], dim: usize) -> Result<(), InputError> {
-    let n = pts.len() as f64;
+pub(crate) fn check_alert_work(
+    cx: &Ctx,
+    alert: f64,
+    pts: impl Iterator<Item = [f64; 3]>,
+    sizes: &[f64],
+    dim: usize,
+) -> Result<(), InputError> {
+    // (one pass over the centres: their number and bounding box)
+    let (mut n, mut lo, mut hi) = (0.0, [f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for p in pts {
+        n += 1.0;
+        for d in 0..3 {
+            (lo[d], hi[d]) = (lo[d].min(p[d]), hi[d].max(p[d]));
+        }
+    }
     if n < 2.0 {
         return Ok(());
     }
@@ -105,10 +118,7 @@ pub(crate) fn check_alert_work(cx: &Ctx, alert: f64, pts: &[[f64; 3]], sizes: &[
     let reach = 2.0 * (alert + size);
     let mut share = 1.0;
     for d in 0..dim {
-        let (lo, hi) = pts
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p[d]), b.max(p[d])));
-        let extent = (hi - lo).max(size);
+        let extent = (hi[d] - lo[d]).max(size);
         if extent > 0.0 && extent.is_finite() {
             share *= (reach / extent).min(1.0);
         }

@@ -134,15 +134,25 @@ fn detectors_and_alert<D: SceneDim>(
     (laws, declared): (&[Option<std::sync::Arc<dyn crate::law::Law>>], &[bool]),
 ) -> Result<(DetectorTable<D>, Vec<f64>, f64), InputError> {
     let n = b.body_count();
+    let kinds: Vec<&'static str> = b.shapes.iter().map(|x| x.kind()).collect();
+    // the first two bodies (in id order) of each (material, kind, movable): all the
+    // check reads (a material's first body, whether two are made of it), not N
+    let nm = b.materials.len();
+    let mut seen = vec![0u8; nm * kinds.len() * 2];
     let info: Vec<BodyInfo> = (0..n)
-        .map(|i| BodyInfo {
-            material: b.material_of(i) as usize,
-            kind: b.shape_of(i).kind as usize,
-            movable: b.movable_of(i) || drives.iter().any(|d: &BodyDrive| d.body as usize == i),
-            origin: b.origins[i],
+        .filter_map(|i| {
+            let (material, kind) = (b.material_of(i) as usize, b.shape_of(i).kind as usize);
+            let movable = b.movable_of(i) || drives.iter().any(|d: &BodyDrive| d.body as usize == i);
+            let c = &mut seen[(kind * nm + material) * 2 + usize::from(movable)];
+            *c = c.saturating_add(1);
+            (*c <= 2).then_some(BodyInfo {
+                material,
+                kind,
+                movable,
+                origin: b.origins[i],
+            })
         })
         .collect();
-    let kinds: Vec<&'static str> = b.shapes.iter().map(|x| x.kind()).collect();
     let table = DetectorTable {
         nk: kinds.len(),
         table: super::laws_and_detectors(cx, &info, &b.materials, &kinds, laws, declared, |x, y| registry.detector::<D>(x, y))?,
@@ -151,7 +161,7 @@ fn detectors_and_alert<D: SceneDim>(
         .map(|i| b.shapes[b.shape_of(i).kind as usize].size(b.shape_of(i).index))
         .collect();
     let alert = super::alert_distance(cx, &sf.detection, &sizes)?;
-    super::checks::check_alert_work(cx, alert, &movable_centres(b), &sizes, D::N)?;
+    super::checks::check_alert_work(cx, alert, movable_centres(b), &sizes, D::N)?;
     Ok((table, sizes, alert))
 }
 
@@ -374,15 +384,12 @@ fn check_masses<D: Dim>(cx: &Ctx, b: &SceneBuilder<'_, D>) -> Result<(), InputEr
 }
 
 /// The movable bodies' centres (z = 0 in 2D).
-fn movable_centres<D: Dim>(b: &SceneBuilder<'_, D>) -> Vec<[f64; 3]> {
-    (0..b.body_count())
-        .filter(|&i| b.movable_of(i))
-        .map(|i| {
-            let mut p = [0.0; 3];
-            for (x, y) in p.iter_mut().zip(b.position(i as u32).as_ref()) {
-                *x = *y;
-            }
-            p
-        })
-        .collect()
+fn movable_centres<'a, D: Dim>(b: &'a SceneBuilder<'_, D>) -> impl Iterator<Item = [f64; 3]> + 'a {
+    (0..b.body_count()).filter(|&i| b.movable_of(i)).map(|i| {
+        let mut p = [0.0; 3];
+        for (x, y) in p.iter_mut().zip(b.position(i as u32).as_ref()) {
+            *x = *y;
+        }
+        p
+    })
 }

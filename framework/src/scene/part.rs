@@ -82,7 +82,7 @@ fn load_with<D: SceneDim>(text: &str, file: &str, registry: &Registry, part: Par
 }
 
 fn survey<D: SceneDim>(text: &str, file: &str, registry: &Registry) -> Result<Option<Scene<D>>, InputError> {
-    let Some((mut scene, p)) = load_with::<D>(text, file, registry, Part::new(Box::new(|_, _| false), 0.0))? else {
+    let Some((mut scene, mut p)) = load_with::<D>(text, file, registry, Part::new(Box::new(|_, _| false), 0.0))? else {
         return Ok(None);
     };
     let driven = &p.driven;
@@ -101,7 +101,13 @@ fn survey<D: SceneDim>(text: &str, file: &str, registry: &Registry) -> Result<Op
         h.write_u8(u8::from(p.movable[g]));
     }
     everywhere.iter().for_each(|&g| h.write_u32(g));
-    let centres: Vec<[f64; 3]> = (0..p.centre.len()).filter(|&g| p.movable[g]).map(|g| p.centre[g]).collect();
+    // the movable bodies' centres, in place (not a second N-sized list)
+    let mut centres = std::mem::take(&mut p.centre);
+    let mut g = 0;
+    centres.retain(|_| {
+        g += 1;
+        p.movable[g - 1]
+    });
     scene.survey = Some(Survey {
         text: text.to_string(),
         file: file.to_string(),
