@@ -3,8 +3,9 @@
 //! of the ranks on the scene before stepping, and the failures of one rank.
 //!
 //! Failures: a rank that cannot load the scene (or its flags) stops every rank at the
-//! agreement that follows loading (exit code 2, the failing rank's message on
-//! stderr); ranks that read different scenes stop there too. A rank that fails
+//! agreement that follows loading (exit code 2; rank 0 prints the first failing
+//! rank's message, naming the rank, and writes it in OUT/error.txt); ranks that read
+//! different scenes stop there too. A rank that fails
 //! while the others step (an unwritable output on rank 0, a panic in a plugin)
 //! prints its message and aborts every rank (`MPI_Abort`): never a hang. A
 //! divergence stops every rank at the same step (the diverging body's state goes to
@@ -92,12 +93,14 @@ impl Ranks {
         };
         let (_, failed) = cl.min_max(loaded.is_err() as u64);
         if failed == 1 {
-            let r = self.rank();
-            return Err(match loaded {
-                Err(e) if r == 0 => crate::report::input_error_in(out, e),
-                Err(e) => crate::input_error(format!("rank {r}: {e}")),
-                Ok(_) if r == 0 => crate::report::input_error_in(out, "another rank could not load the scene (its message is above)"),
-                Ok(_) => ExitCode::from(2),
+            // rank 0 reports the first failing rank's message (on stderr and in
+            // OUT/error.txt): a check of the bodies a rank holds (a scene loaded in
+            // part) may fail on some ranks only
+            let (first, message) = first_failure(cl.as_mut(), loaded.as_ref().err());
+            return Err(match (self.rank(), first) {
+                (0, 0) => crate::report::input_error_in(out, message),
+                (0, k) => crate::report::input_error_in(out, format!("rank {k}: {message}")),
+                _ => ExitCode::from(2),
             });
         }
         let digest = loaded.unwrap_or(0);
@@ -126,6 +129,22 @@ impl Ranks {
         eprintln!("error: {msg}");
         ExitCode::from(code as u8)
     }
+}
+
+/// The lowest rank whose `error` is set, and its message, on every rank (two
+/// all-gathers: the lengths, then the messages' bytes). Collective.
+fn first_failure(cl: &mut dyn Cluster, error: Option<&String>) -> (u32, String) {
+    let p = cl.size() as usize;
+    let bytes: Vec<f64> = error.map(|e| e.bytes().map(f64::from).collect()).unwrap_or_default();
+    let mut lens = Vec::new();
+    cl.all_gather(&[f64::from(u8::from(error.is_some())), bytes.len() as f64], &vec![2; p], &mut lens);
+    let counts: Vec<usize> = lens.chunks_exact(2).map(|x| x[1] as usize).collect();
+    let mut all = Vec::new();
+    cl.all_gather(&bytes, &counts, &mut all);
+    let first = lens.chunks_exact(2).position(|x| x[0] > 0.0).unwrap_or(0);
+    let start: usize = counts[..first].iter().sum();
+    let text: Vec<u8> = all[start..start + counts[first]].iter().map(|&b| b as u8).collect();
+    (first as u32, String::from_utf8_lossy(&text).into_owned())
 }
 
 /// A panic unwinding through a multi-rank run (a plugin's, or a bug) on one rank:

@@ -355,8 +355,8 @@ fn anderson_on_ranks_gives_the_one_process_result() {
 }
 
 /// Rank 1 reads a scene with an error (an MPMD launch: the ranks run different
-/// files): every rank stops with exit code 2 and rank 1's message names the file,
-/// line and key.
+/// files): every rank stops with exit code 2 and rank 1's message, naming the file,
+/// line and key, is printed once by rank 0 and kept in OUT/error.txt.
 #[test]
 fn a_bad_scene_on_one_rank_stops_every_rank() {
     let dir = scratch("badscene");
@@ -377,6 +377,10 @@ fn a_bad_scene_on_one_rank_stops_every_rank() {
     );
     assert!(t0.elapsed() < Duration::from_secs(60), "promptly");
     assert!(!out.join("final.json").exists());
+    // printed once, by rank 0, and kept in OUT/error.txt
+    assert_eq!(err.matches("must be ≥ 0").count(), 1, "{err}");
+    let kept = std::fs::read_to_string(out.join("error.txt")).expect("error.txt");
+    assert!(kept.contains("rank 1:") && kept.contains("friction"), "{kept}");
     // two valid but different scenes: the ranks disagree
     let other = write(&dir, "other.toml", &PILE2D.replace("friction = 0.3", "friction = 0.5"));
     let o = mpirun(&[
