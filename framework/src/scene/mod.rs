@@ -63,6 +63,12 @@ pub type Scene3 = Scene<D3>;
 
 /// Reads and loads a 2D scene file.
 pub fn load(path: &std::path::Path, registry: &Registry) -> Result<Scene, InputError> {
+    let (text, file) = read_file(path)?;
+    load_str(&text, &file, registry)
+}
+
+/// The text of the scene file at `path` and its name for messages.
+pub(crate) fn read_file(path: &std::path::Path) -> Result<(String, String), InputError> {
     let file = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|e| InputError {
         file: file.clone(),
@@ -70,7 +76,15 @@ pub fn load(path: &std::path::Path, registry: &Registry) -> Result<Scene, InputE
         key: String::new(),
         message: format!("cannot read the file: {e}"),
     })?;
-    load_str(&text, &file, registry)
+    Ok((text, file))
+}
+
+/// The `dimension` key of a scene's text (`None` when it does not parse or has
+/// none: the 2D loader reports what is wrong).
+pub(crate) fn dimension_of(text: &str) -> Option<i64> {
+    toml::from_str::<toml::Table>(text)
+        .ok()
+        .and_then(|t| t.get("dimension").and_then(|d| d.as_integer()))
 }
 
 #[derive(Clone, Copy)]
@@ -162,22 +176,13 @@ pub enum AnyScene {
 
 /// Reads and loads a scene file of either dimension (its `dimension` key).
 pub fn load_any(path: &std::path::Path, registry: &Registry) -> Result<AnyScene, InputError> {
-    let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| InputError {
-        file: file.clone(),
-        line: None,
-        key: String::new(),
-        message: format!("cannot read the file: {e}"),
-    })?;
+    let (text, file) = read_file(path)?;
     load_any_str(&text, &file, registry)
 }
 
 /// [`load_any`] from the text of a scene.
 pub fn load_any_str(text: &str, file: &str, registry: &Registry) -> Result<AnyScene, InputError> {
-    let dim = toml::from_str::<toml::Table>(text)
-        .ok()
-        .and_then(|t| t.get("dimension").and_then(|d| d.as_integer()));
-    match dim {
+    match dimension_of(text) {
         Some(3) => Scene3::load_str(text, file, registry).map(AnyScene::D3),
         _ => load_str(text, file, registry).map(AnyScene::D2),
     }

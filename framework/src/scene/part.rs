@@ -48,17 +48,8 @@ pub struct Survey {
 /// body, its [`Scene::survey`] set; `None` for a scene with body families (loaded
 /// whole: they step every body on every rank).
 pub fn survey_any(path: &std::path::Path, registry: &Registry) -> Result<Option<AnyScene>, InputError> {
-    let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| InputError {
-        file: file.clone(),
-        line: None,
-        key: String::new(),
-        message: format!("cannot read the file: {e}"),
-    })?;
-    let dim = toml::from_str::<toml::Table>(&text)
-        .ok()
-        .and_then(|t| t.get("dimension").and_then(|d| d.as_integer()));
-    Ok(match dim {
+    let (text, file) = super::read_file(path)?;
+    Ok(match super::dimension_of(&text) {
         Some(3) => survey::<D3>(&text, &file, registry)?.map(AnyScene::D3),
         _ => survey::<D2>(&text, &file, registry)?.map(AnyScene::D2),
     })
