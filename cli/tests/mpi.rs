@@ -135,9 +135,7 @@ fn two_and_four_ranks_give_the_one_process_result_3d() {
     let out = dir.join("ranks4-2x2x2-decentralized");
     let fin: serde_json::Value = serde_json::from_str(&final_json(&out)).expect("final.json");
     let nb = fin["bodies"].as_array().expect("bodies").len() as u64;
-    let ranks: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("ranks.json")).expect("ranks.json")).expect("json");
-    for r in ranks["per_rank"].as_array().expect("ranks") {
+    for r in &per_rank(&out) {
         let (steps, stepped) = (r["steps"].as_u64().expect("steps"), r["bodies_stepped"].as_u64().expect("stepped"));
         assert!(
             stepped < steps * nb,
@@ -163,12 +161,7 @@ fn two_and_four_ranks_give_the_one_process_result_3d() {
     }
     // the scene loaded in part: each rank built its halo and the bodies every rank
     // steps, never the whole scene; together every body
-    let loaded: Vec<u64> = ranks["per_rank"]
-        .as_array()
-        .expect("ranks")
-        .iter()
-        .map(|r| r["loaded_bodies"].as_u64().expect("loaded_bodies"))
-        .collect();
+    let loaded = per_rank_count(&out, "loaded_bodies");
     assert!(loaded.iter().all(|&n| n > 0 && n < nb), "{loaded:?} of {nb}");
     assert!(loaded.iter().sum::<u64>() >= nb, "{loaded:?} of {nb}");
     let _ = std::fs::remove_dir_all(&dir);
@@ -243,12 +236,6 @@ fn threads_inside_ranks_give_the_one_process_result() {
         "2 ranks × 2 threads: final.json differs from one process"
     );
     let _ = std::fs::remove_dir_all(&dir);
-}
-
-fn per_rank(out: &Path) -> Vec<serde_json::Value> {
-    let t = std::fs::read_to_string(out.join("ranks.json")).expect("ranks.json");
-    let v: serde_json::Value = serde_json::from_str(&t).expect("ranks.json is JSON");
-    v["per_rank"].as_array().expect("per_rank").clone()
 }
 
 fn peers(r: &serde_json::Value) -> Vec<u64> {
@@ -526,11 +513,7 @@ fn outputs_merged_in_small_rounds_are_the_one_process_files() {
         let flags = ["--subdomains", "2x2"];
         let one = dir.join(format!("{name}-one"));
         ok(&nscdd(&args(&scene, &one, &flags)), "the one-process run");
-        let reduce = |out: &Path| -> u64 {
-            let r: serde_json::Value =
-                serde_json::from_str(&std::fs::read_to_string(out.join("ranks.json")).expect("ranks.json")).expect("json");
-            r["per_rank"][0]["reduce_messages"].as_u64().expect("reduce_messages")
-        };
+        let reduce = |out: &Path| -> u64 { per_rank_count(out, "reduce_messages")[0] };
         let mut counts = vec![];
         for chunk in [None, Some("2")] {
             let out = dir.join(format!("{name}-ranks4-{}", chunk.unwrap_or("default")));

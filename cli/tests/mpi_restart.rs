@@ -136,14 +136,7 @@ fn a_3d_state_restarts_on_other_rank_counts() {
 fn contacts_read_in_part(state: &Path, out: &Path) {
     let saved: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(state).unwrap()).expect("state");
     let nc = saved["contacts"].as_array().expect("contacts").len() as u64;
-    let ranks: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("ranks.json")).expect("ranks.json")).expect("json");
-    let loaded: Vec<u64> = ranks["per_rank"]
-        .as_array()
-        .expect("ranks")
-        .iter()
-        .map(|r| r["restart_contacts"].as_u64().expect("restart_contacts"))
-        .collect();
+    let loaded = per_rank_count(out, "restart_contacts");
     assert!(nc > 0, "{}: a state without contacts", state.display());
     assert_eq!(loaded.iter().sum::<u64>(), nc, "{}: {loaded:?} of {nc}", out.display());
     assert!(loaded.iter().all(|&n| n < nc), "{}: {loaded:?} of {nc}", out.display());
@@ -154,16 +147,8 @@ fn contacts_read_in_part(state: &Path, out: &Path) {
 fn held_less_than_all(out: &Path) {
     let fin: serde_json::Value = serde_json::from_str(&final_json(out)).expect("final.json");
     let nb = fin["bodies"].as_array().expect("bodies").len() as u64;
-    let ranks: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("ranks.json")).expect("ranks.json")).expect("json");
-    for r in ranks["per_rank"].as_array().expect("ranks") {
-        let most = r["bodies_held_max"].as_u64().expect("bodies_held_max");
-        assert!(
-            most < nb,
-            "{}: rank {}: {most} bodies held in a step, of {nb}",
-            out.display(),
-            r["rank"]
-        );
+    for (r, most) in per_rank_count(out, "bodies_held_max").into_iter().enumerate() {
+        assert!(most < nb, "{}: rank {r}: {most} bodies held in a step, of {nb}", out.display());
     }
 }
 

@@ -164,6 +164,21 @@ pub fn final_json(out: &Path) -> String {
     std::fs::read_to_string(out.join("final.json")).unwrap_or_else(|e| panic!("{}: {e}", out.display()))
 }
 
+/// Each rank's entry of the run's `ranks.json` (in rank order).
+pub fn per_rank(out: &Path) -> Vec<serde_json::Value> {
+    let t = std::fs::read_to_string(out.join("ranks.json")).expect("ranks.json");
+    let v: serde_json::Value = serde_json::from_str(&t).expect("ranks.json is JSON");
+    v["per_rank"].as_array().expect("per_rank").clone()
+}
+
+/// Each rank's count `key` in the run's `ranks.json` (in rank order).
+pub fn per_rank_count(out: &Path, key: &str) -> Vec<u64> {
+    per_rank(out)
+        .iter()
+        .map(|r| r[key].as_u64().unwrap_or_else(|| panic!("{key}: {r}")))
+        .collect()
+}
+
 /// `text` re-partitioned every `k` steps: in between, each rank holds only its
 /// subdomains' contacts (`dd::local`).
 pub fn every(text: &str, k: u32) -> String {
