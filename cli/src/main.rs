@@ -276,8 +276,8 @@ fn command() -> ExitCode {
                 threads: threads.as_deref(),
                 restart: restart.as_deref(),
             };
-            // on ranks, a fresh scene is first surveyed: each rank then builds its part
-            let loaded = match ranks.size() > 1 && restart.is_none() {
+            // on ranks, a scene is first surveyed: each rank then builds its part
+            let loaded = match ranks.size() > 1 {
                 true => survey_any(&scene, &reg),
                 false => load_any(&scene, &reg),
             };

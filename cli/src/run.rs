@@ -32,17 +32,17 @@ pub fn run<D: nscdd::scene::schema::SceneDim>(
         (false, _) => usize::MAX,
     };
     let flags = crate::apply_decomposition_to(&mut s.decomposition, movable, D::N == 3, f.subdomains, f.scheme, f.threads).and_then(|()| {
-        // a surveyed scene (fresh, on ranks): this rank's part, or the whole scene
+        // a surveyed scene (on ranks): this rank's part, or the whole scene
         let on = (ranks.size(), ranks.rank());
-        nscdd::scene::part::load_on(&mut s, reg, on).map_err(|e| e.to_string())?;
         match f.restart {
             Some(state) => {
                 nscdd::scene::restart::check_out_dir(out, state).map_err(|m| format!("--out: {m}"))?;
                 // each rank reads the state's contacts its subdomains get, where it can
-                let on = (ranks.size() > 1).then(|| (ranks.size(), ranks.rank()));
-                nscdd::scene::restart_scene_on(&mut s, state, on).map_err(|e| e.to_string())
+                nscdd::scene::part::restart_on(&mut s, reg, on, state).map_err(|e| e.to_string())
             }
-            None => Ok(None),
+            None => nscdd::scene::part::load_on(&mut s, reg, on)
+                .map(|_| None)
+                .map_err(|e| e.to_string()),
         }
     });
     // (what the ranks compare: one process has no one to agree with; contacts read
@@ -56,7 +56,7 @@ pub fn run<D: nscdd::scene::schema::SceneDim>(
                 let contacts: Option<nscdd::output::Pull> = if in_part.is_some() { Some(&mut none) } else { None };
                 nscdd::output::write_final_json(out, w, None, None::<&()>, (contacts, None))
             };
-            match s.survey.as_ref().filter(|_| s.part.is_some()) {
+            match s.survey.as_ref().filter(|_| s.world.ids.held().is_some()) {
                 // a part: the survey's digest of every body instead of the world's
                 Some(sv) => crate::ranks::digest(scene, |_| Ok(()), (&s.decomposition, &w.time, &w.solver, sv.digest)),
                 None => crate::ranks::digest(scene, state, (&s.decomposition, &w.time, &w.solver, in_part)),

@@ -30,9 +30,10 @@ fn a_state_written_by_p_ranks_restarts_on_other_rank_counts() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Two copies of a state that differ in one contact's impulse, read in part by
-/// two ranks (an MPMD launch): the ranks' agreement tells them apart (exit 2), as
-/// every rank hashes every contact it reads, kept or not.
+/// Two copies of a state that differ in one contact's impulse, or in one body's
+/// velocity, read in part by two ranks (an MPMD launch): the ranks' agreement
+/// tells them apart (exit 2), as every rank hashes every contact and body it
+/// reads, kept or not.
 #[test]
 fn ranks_reading_states_that_differ_in_a_contact_disagree() {
     let dir = scratch("restart_digest");
@@ -59,6 +60,54 @@ fn ranks_reading_states_that_differ_in_a_contact_disagree() {
     let err = text(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("different scenes"), "{err}");
+    // the bodies too are read in part: states that differ in one body's velocity
+    let mut saved: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&state).unwrap()).expect("state");
+    let v = saved["bodies"][3]["velocity"][0].as_f64().expect("velocity");
+    saved["bodies"][3]["velocity"][0] = serde_json::json!(v + 1e-9);
+    std::fs::write(&other, serde_json::to_string_pretty(&saved).unwrap()).unwrap();
+    let o = mpirun(&[(1, with2(&state)), (1, with2(&other))]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("different scenes"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A state the restart refuses, read by ranks that would load the scene in part
+/// (a body's id out of order, a body's kind changed, a body too few): each is
+/// refused with the one-process message (exit 2), as the first pass over the
+/// state leaves such a state to the whole restart.
+#[test]
+fn a_bad_state_on_ranks_is_refused_as_in_one_process() {
+    let dir = scratch("restart_bad");
+    let flags = ["--subdomains", "2x2", "--scheme", "decentralized"];
+    let whole = write(&dir, "pile.toml", &every(PILE2D, 3));
+    let half = write(&dir, "half.toml", &every(&PILE2D.replace("steps = 15", "steps = 8"), 3));
+    let a = dir.join("first");
+    ok(&mpirun(&[(2, args(&half, &a, &flags))]), "8 steps on 2 ranks");
+    let saved: serde_json::Value = serde_json::from_str(&final_json(&a)).expect("state");
+    let bad = |what: &str, edit: &dyn Fn(&mut Vec<serde_json::Value>)| {
+        let mut s = saved.clone();
+        edit(s["bodies"].as_array_mut().expect("bodies"));
+        let state = dir.join(format!("{what}.json"));
+        std::fs::write(&state, serde_json::to_string_pretty(&s).unwrap()).unwrap();
+        let with = |out: &str| {
+            args(
+                &whole,
+                &dir.join(out),
+                &[&flags[..], &["--restart", state.to_str().unwrap()]].concat(),
+            )
+        };
+        let (one, on4) = (nscdd(&with(&format!("{what}1"))), mpirun(&[(4, with(&format!("{what}4")))]));
+        let (e1, e4) = (text(&one.stderr), text(&on4.stderr));
+        assert_eq!((one.status.code(), on4.status.code()), (Some(2), Some(2)), "{what}: {e1} / {e4}");
+        let message = e1.lines().find(|l| l.contains(".json")).expect("the message names the file");
+        assert!(e4.contains(message.trim()), "{what}: one process: {e1}; 4 ranks: {e4}");
+    };
+    bad("id", &|b| b[5]["id"] = serde_json::json!(6));
+    bad("kind", &|b| b[7]["kind"] = serde_json::json!("polygon"));
+    bad("count", &|b| {
+        b.pop();
+    });
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -97,6 +146,7 @@ fn restarts_match(dir: &Path, whole: &Path, half: &Path, reference: &str, flags:
         }
         if then > 1 {
             contacts_read_in_part(&state, &b);
+            bodies_loaded_in_part(&b, then == 4);
         }
     }
     // the restarted runs' frames, the one at the restart included, in pieces that
@@ -140,6 +190,17 @@ fn contacts_read_in_part(state: &Path, out: &Path) {
     assert!(nc > 0, "{}: a state without contacts", state.display());
     assert_eq!(loaded.iter().sum::<u64>(), nc, "{}: {loaded:?} of {nc}", out.display());
     assert!(loaded.iter().all(|&n| n < nc), "{}: {loaded:?} of {nc}", out.display());
+}
+
+/// The restart in `out` loaded the scene in part: every body on some rank, and
+/// (`fewer`: one cell a rank) each rank fewer than all (`loaded_bodies` in
+/// ranks.json, before the first step's drop).
+fn bodies_loaded_in_part(out: &Path, fewer: bool) {
+    let fin: serde_json::Value = serde_json::from_str(&final_json(out)).expect("final.json");
+    let nb = fin["bodies"].as_array().expect("bodies").len() as u64;
+    let loaded = per_rank_count(out, "loaded_bodies");
+    assert!(loaded.iter().sum::<u64>() >= nb, "{}: {loaded:?} of {nb}", out.display());
+    assert!(!fewer || loaded.iter().all(|&n| n < nb), "{}: {loaded:?} of {nb}", out.display());
 }
 
 /// Each rank of the run in `out` held fewer bodies than all at every step (the

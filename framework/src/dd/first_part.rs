@@ -55,8 +55,13 @@ pub struct Halo {
 
 impl Halo {
     pub fn new(part: &LoadedPart, me: u32, space: usize, alert: f64) -> Halo {
+        Halo::of(&part.grid(), &part.rank_of, me, space, alert)
+    }
+
+    /// Rank `me`'s cells of `grid` whose ranks are `rank_of`.
+    pub fn of(grid: &Grid, rank_of: &[u32], me: u32, space: usize, alert: f64) -> Halo {
         let mine = Region {
-            boxes: super::cells::cells_of(&part.grid(), &part.rank_of, me),
+            boxes: super::cells::cells_of(grid, rank_of, me),
             pairs: Vec::new(),
         };
         Halo { mine, space, alert }

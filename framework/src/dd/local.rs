@@ -284,6 +284,7 @@ impl<D: Family> super::NscddOf<D> {
         let kept_owners: Vec<u32> = self.kept.iter().map(|e| e.1).collect();
         rs.assign(&kept_owners, grid.len(), true);
         rs.totals.restart_contacts = D::len(D::contacts(w)) as u64;
+        rs.totals.loaded_bodies = D::held(w).map_or_else(|| D::n_bodies(w), <[u32]>::len) as u64;
         let owner = super::owner::kept_owners::<D>(D::contacts(w), grid, &self.kept);
         D::retain_contacts(w, &mut |a| rs.is_own(owner[a]));
         self.last.owner = owner.into_iter().filter(|&o| rs.is_own(o)).collect();

@@ -16,8 +16,9 @@ use super::ranks::RankState;
 /// over the steps (`bodies_held`, [`crate::world::held`]), and the most in one step
 /// (`bodies_held_max`); the restart's contacts its world loaded (`restart_contacts`:
 /// the state read in part, [`super::RestartPart`], gives each contact to one rank);
-/// the bodies its world held before a fresh run's first step (`loaded_bodies`: a
-/// scene loaded in part, [`crate::scene::part`], gives each rank its halo).
+/// the bodies its world held before the first step of a fresh run or after a
+/// restart (`loaded_bodies`: a scene loaded in part, [`crate::scene::part`], gives
+/// each rank its halo).
 pub fn totals_json(st: &mut RankState) -> String {
     const H: usize = 23;
     let p = st.cluster.size() as usize;

@@ -92,6 +92,7 @@ impl NscddState {
 /// `NscddOf::start_restarted` balances them. A restart that streams the state keeps
 /// only those ([`crate::scene::restart_scene_on`]), instead of every contact of the
 /// sample on every rank until the first step drops the others.
+#[derive(Clone)]
 pub struct RestartPart {
     grid: Grid,
     kept: Vec<(ContactKey, u32)>,
@@ -127,6 +128,13 @@ impl RestartPart {
     pub fn digest(&self) -> u64 {
         use std::hash::Hasher;
         self.seen.finish()
+    }
+
+    /// This rank's cells in the first step after the restart, against which the
+    /// saved bodies' boxes grown by `alert` are tested (the halo the step keeps:
+    /// [`crate::scene::part::restart_on`] builds only those bodies).
+    pub fn halo(&self, space: usize, alert: f64) -> super::first_part::Halo {
+        super::first_part::Halo::of(&self.grid, &self.rank_of, self.me, space, alert)
     }
 }
 

@@ -13,6 +13,7 @@ mod load;
 pub mod locate;
 pub mod part;
 pub mod restart;
+mod restart_scan;
 mod restart_stream;
 pub mod schema;
 

@@ -17,8 +17,16 @@
 //!    one process. The overlap check runs on the bodies a rank holds (an
 //!    overlapping pair is held by the rank of a cell holding a point of both).
 //!
-//! Scenes with body families, by-model subdomains or no decomposition are loaded
-//! whole, as before. The ranks agree on the survey's digest of every body.
+//! 4. **A restart** ([`restart_on`]) of the state of the same decomposition: a first
+//!    pass over the state marks the bodies of the rank's first step after the
+//!    restart (its halo of the saved grid at the saved poses, those every rank
+//!    steps, those of the contacts it keeps: [`super::restart_scan`]); the rank
+//!    builds only those, and the restart writes their saved state and its contacts.
+//!
+//! Scenes with body families, by-model subdomains or no decomposition, and restarts
+//! from a state of another decomposition, are loaded whole, as before. The ranks
+//! agree on the survey's digest of every body (and, restarted, on every saved
+//! body's and contact's).
 
 use super::builder::Part;
 use super::schema::{BodySpec, SceneDim, SceneFile};
@@ -38,6 +46,8 @@ pub struct Survey {
     centres: Vec<[f64; 3]>,
     /// The bodies every rank holds (ascending).
     everywhere: Vec<u32>,
+    /// Every body's shape, by global id (a restart's boxes at the saved poses).
+    shapes: Vec<crate::model::ShapeRef>,
     /// The movable bodies (the decomposition flags' check).
     pub movable: usize,
     /// A digest of every body's columns and of the bodies every rank holds.
@@ -105,6 +115,7 @@ fn survey<D: SceneDim>(text: &str, file: &str, registry: &Registry) -> Result<Op
         movable: centres.len(),
         centres,
         everywhere,
+        shapes: std::mem::take(&mut p.shape),
         digest: h.finish(),
     });
     Ok(Some(scene))
@@ -124,8 +135,7 @@ pub fn load_on<D: SceneDim>(s: &mut Scene<D>, registry: &Registry, (ranks, me): 
         .filter(|c| ranks > 1 && !c.by_model && c.dd.nx as u64 * c.dd.ny as u64 * c.dd.nz as u64 >= u64::from(ranks))
         .and_then(|c| crate::dd::first_part::provisional(&sv.centres, [c.dd.nx, c.dd.ny, c.dd.nz], ranks));
     let Some(first) = first else {
-        *s = Scene::<D>::load_str(&sv.text, &sv.file, registry)?;
-        s.decomposition = decomposition;
+        load_whole(s, registry, &sv, decomposition)?;
         return Ok(false);
     };
     // (a margin on the alert distance: a body kept in excess leaves at the first step)
@@ -138,12 +148,83 @@ pub fn load_on<D: SceneDim>(s: &mut Scene<D>, registry: &Registry, (ranks, me): 
     s.decomposition = decomposition;
     s.part = Some(first);
     s.survey = Some(Survey {
-        centres: Vec::new(),
-        everywhere: Vec::new(),
-        text: String::new(),
-        ..sv
+        file: sv.file,
+        movable: sv.movable,
+        digest: sv.digest,
+        ..Default::default()
     });
     Ok(true)
+}
+
+/// The surveyed scene loaded whole (as [`super::load_any`] loads it), with the
+/// flags' `decomposition`.
+fn load_whole<D: SceneDim>(
+    s: &mut Scene<D>,
+    registry: &Registry,
+    sv: &Survey,
+    decomposition: Option<crate::dd::DdConfig>,
+) -> Result<(), InputError> {
+    *s = Scene::<D>::load_str(&sv.text, &sv.file, registry)?;
+    s.decomposition = decomposition;
+    Ok(())
+}
+
+/// [`load_on`] for a run restarted from the state at `path`, then the restart
+/// ([`super::restart_scene_on`]; returns what it returns). When the state's
+/// contacts are read in part (the state of the same decomposition by geometry), a
+/// surveyed scene is loaded in part too: a first pass over the state marks the
+/// bodies of the rank's first step ([`super::restart_scan`]: its halo of the
+/// saved grid at the saved poses, those every rank steps, those of its kept
+/// contacts), the rank builds only those, and the restart writes the saved state
+/// of its bodies. The ranks then agree on the survey's digest, every saved body's
+/// and every contact's. Otherwise the scene is loaded whole, as before. (The
+/// scene's own overlap check, of the initial positions the state replaces, runs
+/// on the bodies each rank holds.)
+pub fn restart_on<D: SceneDim>(
+    s: &mut Scene<D>,
+    registry: &Registry,
+    (ranks, me): (u32, u32),
+    path: &std::path::Path,
+) -> Result<Option<u64>, InputError> {
+    let on = (ranks > 1).then_some((ranks, me));
+    let Some(sv) = s.survey.take() else {
+        return super::restart_scene_on(s, path, on);
+    };
+    let rp = super::restart::rank_part_of(path, s, on);
+    let scanned = rp.as_ref().and_then(|rp| {
+        // (a margin on the alert distance: a body kept in excess leaves at the first step)
+        let halo = rp.halo(D::N, s.world.alert * 1.01);
+        let scene = super::restart_scan::Scene {
+            shapes: &sv.shapes,
+            stores: &s.world.shapes,
+            everywhere: &sv.everywhere,
+            halo: &halo,
+        };
+        super::restart_scan::scan::<D>(path, &scene, rp.clone())
+    });
+    let decomposition = s.decomposition.take();
+    let Some(scanned) = scanned else {
+        load_whole(s, registry, &sv, decomposition)?;
+        return super::restart_scene_on(s, path, on);
+    };
+    let keep = scanned.keep;
+    let keep = move |g: u32, _: &[[f64; 3]; 2]| keep.binary_search(&g).is_ok();
+    let share = 1.0 / f64::from(ranks);
+    let (scene, _) = load_with::<D>(&sv.text, &sv.file, registry, Part::new(Box::new(keep), share))?.expect("surveyed without families");
+    *s = scene;
+    s.decomposition = decomposition;
+    let contacts = super::restart::restart_scene_with(s, path, rp)?;
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    let w = &s.world;
+    let state = [sv.digest, scanned.digest, contacts.unwrap_or(0), w.step, w.t.to_bits()];
+    state.iter().chain(&w.box_h0.map(f64::to_bits)).for_each(|&x| h.write_u64(x));
+    s.survey = Some(Survey {
+        file: sv.file,
+        movable: sv.movable,
+        digest: h.finish(),
+        ..Default::default()
+    });
+    Ok(contacts)
 }
 
 /// [`load_on`] for a scene of either dimension.

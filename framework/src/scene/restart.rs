@@ -165,13 +165,30 @@ pub fn restart_scene<D: Dim>(scene: &mut super::Scene<D>, path: &Path) -> Result
 /// ranks by its contacts), a digest of every contact read, kept or not: the same on
 /// every rank reading the same file.
 pub fn restart_scene_on<D: Dim>(scene: &mut super::Scene<D>, path: &Path, on: Option<(u32, u32)>) -> Result<Option<u64>, InputError> {
-    let mut part = match (on, &scene.decomposition) {
+    let part = rank_part_of(path, scene, on);
+    restart_scene_with(scene, path, part)
+}
+
+/// The contacts rank `me` of `ranks` (`on`) keeps of the state at `path`, when the
+/// run will hold its contacts per rank ([`restart_scene_on`]); `None`: every
+/// contact read.
+pub(super) fn rank_part_of<D: Dim>(path: &Path, scene: &super::Scene<D>, on: Option<(u32, u32)>) -> Option<crate::dd::RestartPart> {
+    match (on, &scene.decomposition) {
         (Some((ranks, me)), Some(c)) if ranks > 1 && scene.families.is_empty() && !c.by_model => {
             let grid_of = [c.dd.nx, c.dd.ny, c.dd.nz];
             nscdd_of(path).and_then(|s| s.rank_part(grid_of, c.by_model, ranks, me))
         }
         _ => None,
-    };
+    }
+}
+
+/// [`restart_scene_on`] with the rank's `part` of the contacts given (its world may
+/// hold part of the scene's bodies: those of its first step, [`super::part::restart_on`]).
+pub(super) fn restart_scene_with<D: Dim>(
+    scene: &mut super::Scene<D>,
+    path: &Path,
+    mut part: Option<crate::dd::RestartPart>,
+) -> Result<Option<u64>, InputError> {
     let (nscdd, states) = restart_from(&mut scene.world, Source::File(path), true, part.as_mut())?;
     scene.dd_state = nscdd;
     let ck = StateChecks::new(Source::File(path));

@@ -14,21 +14,21 @@ use std::fmt;
 
 #[derive(Deserialize)]
 #[serde(bound = "")]
-struct SavedBody<D: Dim> {
-    id: u32,
-    kind: String,
-    position: D::Point,
+pub(super) struct SavedBody<D: Dim> {
+    pub id: u32,
+    pub kind: String,
+    pub position: D::Point,
     /// The angle in 2D, the rotation vector in 3D.
     rotation: D::RotVec,
     /// 3D: the exact orientation (the rotation vector is for reading).
     #[serde(default)]
     quaternion: Option<D::Rot>,
-    velocity: D::Twist,
+    pub velocity: D::Twist,
 }
 
 impl<D: Dim> SavedBody<D> {
     /// The saved orientation: the quaternion where given (3D), else the rotation.
-    fn rot(&self) -> D::Rot {
+    pub fn rot(&self) -> D::Rot {
         self.quaternion.unwrap_or_else(|| D::rot_from_vec(&self.rotation))
     }
 }
@@ -142,9 +142,10 @@ impl<'de, D: Dim> Visitor<'de> for StateSeed<'_, D> {
                     s.bodies = Some(map.next_value_seed(seed)?);
                 }
                 "contacts" => {
-                    let nb = self.w.bodies.len();
+                    let nb = self.w.ids.n_global(self.w.bodies.len());
                     s.contacts = Some(map.next_value_seed(ContactsSeed::<D> {
                         nb,
+                        ids: &self.w.ids,
                         failed: &mut *self.failed,
                         part: self.part.as_deref_mut(),
                         dim: std::marker::PhantomData,
@@ -191,15 +192,18 @@ impl<'de, D: Dim> Visitor<'de> for BodiesSeed<'_, D> {
         f.write_str("a list of saved bodies")
     }
     fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<usize, A::Error> {
-        let nb = self.w.bodies.len();
+        // (a world holding part of the scene: the scan checked the bodies it lacks)
+        let nb = self.w.ids.n_global(self.w.bodies.len());
         let (mut k, mut first) = (0usize, None::<Failed>);
         while k < nb && first.is_none() {
             let Some(sb) = seq.next_element::<SavedBody<D>>()? else { break };
-            first = body_error(self.w, k, &sb);
-            if first.is_none() {
-                let b = &mut self.w.bodies;
-                (b.pos[k], b.rot[k], b.vel[k]) = (sb.position, sb.rot(), sb.velocity);
-                b.refresh_inverse(k);
+            if let Some(slot) = self.w.ids.slot(k as u32).map(|s| s as usize) {
+                first = body_error(self.w, (k, slot), &sb);
+                if first.is_none() {
+                    let b = &mut self.w.bodies;
+                    (b.pos[slot], b.rot[slot], b.vel[slot]) = (sb.position, sb.rot(), sb.velocity);
+                    b.refresh_inverse(slot);
+                }
             }
             k += 1;
         }
@@ -219,9 +223,9 @@ impl<'de, D: Dim> Visitor<'de> for BodiesSeed<'_, D> {
     }
 }
 
-/// What is wrong with saved body `k` against the scene's: its id, its kind, a
-/// non-finite state.
-fn body_error<D: Dim>(w: &World<D>, k: usize, sb: &SavedBody<D>) -> Option<Failed> {
+/// What is wrong with saved body `k` (held in `slot`) against the scene's: its id,
+/// its kind, a non-finite state.
+fn body_error<D: Dim>(w: &World<D>, (k, slot): (usize, usize), sb: &SavedBody<D>) -> Option<Failed> {
     let failed = |key: String, message: String, at: (&'static str, usize)| {
         Some(Failed {
             key,
@@ -232,7 +236,7 @@ fn body_error<D: Dim>(w: &World<D>, k: usize, sb: &SavedBody<D>) -> Option<Faile
     if sb.id as usize != k {
         return failed(format!("bodies[{k}].id"), format!("expected id {k}, found {}", sb.id), ("id", k));
     }
-    let kind = w.kind_name(k);
+    let kind = w.kind_name(slot);
     if sb.kind != kind {
         let message = format!("the saved body is a `{}`, the scene's body {k} a `{kind}`", sb.kind);
         return failed(format!("bodies[{k}].kind"), message, ("kind", k));
@@ -248,6 +252,8 @@ fn body_error<D: Dim>(w: &World<D>, k: usize, sb: &SavedBody<D>) -> Option<Faile
 /// contact list, their frames left to [`Streamed::frames`], and their normals.
 struct ContactsSeed<'a, D: Dim> {
     nb: usize,
+    /// The world's slots of the contacts' bodies (global ids in their keys).
+    ids: &'a crate::model::BodyIds,
     failed: &'a mut Option<Failed>,
     part: Option<&'a mut crate::dd::RestartPart>,
     dim: std::marker::PhantomData<D>,
@@ -309,7 +315,12 @@ impl<'de, D: Dim> Visitor<'de> for ContactsSeed<'_, D> {
                     continue;
                 }
             }
-            c.bodies.push([i, j]);
+            let (Some(si), Some(sj)) = (self.ids.slot(i), self.ids.slot(j)) else {
+                // (a rank holds the bodies of the contacts it keeps: the scan's)
+                let message = "the state changed while it was read".to_string();
+                return Err(fail(self.failed, format!("contacts[{a}].bodies"), message, ("bodies", a + 1)));
+            };
+            c.bodies.push([si, sj]);
             c.frame.push(Default::default());
             c.block.push(Default::default());
             c.target.push(Default::default());
