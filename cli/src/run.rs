@@ -50,15 +50,17 @@ pub fn run<D: nscdd::scene::schema::SceneDim>(
     // digest of every contact the file held, which each rank read, added)
     let digest = flags.map(|in_part| match ranks.size() > 1 {
         true => {
-            let w = &s.world;
+            let (w, dd_state) = (&s.world, &s.dd_state);
             let state = |out: &mut dyn std::io::Write| {
                 let mut none = |_: &mut Vec<f64>| false;
                 let contacts: Option<nscdd::output::Pull> = if in_part.is_some() { Some(&mut none) } else { None };
-                nscdd::output::write_final_json(out, w, None, None::<&()>, (contacts, None))
+                nscdd::output::write_final_json(out, w, None, dd_state.as_ref(), (contacts, None))
             };
+            // (a part: the saved NSCDD state, which chose each rank's bodies and contacts)
+            let nscdd_only = |out: &mut dyn std::io::Write| serde_json::to_writer(out, dd_state).map_err(std::io::Error::from);
             match s.survey.as_ref().filter(|_| s.world.ids.held().is_some()) {
                 // a part: the survey's digest of every body instead of the world's
-                Some(sv) => crate::ranks::digest(scene, |_| Ok(()), (&s.decomposition, &w.time, &w.solver, sv.digest)),
+                Some(sv) => crate::ranks::digest(scene, nscdd_only, (&s.decomposition, &w.time, &w.solver, sv.digest)),
                 None => crate::ranks::digest(scene, state, (&s.decomposition, &w.time, &w.solver, in_part)),
             }
         }

@@ -30,10 +30,10 @@ fn a_state_written_by_p_ranks_restarts_on_other_rank_counts() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Two copies of a state that differ in one contact's impulse, or in one body's
-/// velocity, read in part by two ranks (an MPMD launch): the ranks' agreement
-/// tells them apart (exit 2), as every rank hashes every contact and body it
-/// reads, kept or not.
+/// Two copies of a state that differ in one contact's impulse, in one body's
+/// velocity or in one interface multiplier, read in part by two ranks (an MPMD
+/// launch): the ranks' agreement tells them apart (exit 2), as every rank hashes
+/// every contact and body it reads, kept or not, and the NSCDD state.
 #[test]
 fn ranks_reading_states_that_differ_in_a_contact_disagree() {
     let dir = scratch("restart_digest");
@@ -64,6 +64,15 @@ fn ranks_reading_states_that_differ_in_a_contact_disagree() {
     let mut saved: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&state).unwrap()).expect("state");
     let v = saved["bodies"][3]["velocity"][0].as_f64().expect("velocity");
     saved["bodies"][3]["velocity"][0] = serde_json::json!(v + 1e-9);
+    std::fs::write(&other, serde_json::to_string_pretty(&saved).unwrap()).unwrap();
+    let o = mpirun(&[(1, with2(&state)), (1, with2(&other))]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("different scenes"), "{err}");
+    // and in the NSCDD state alone (one interface multiplier)
+    let mut saved: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&state).unwrap()).expect("state");
+    let f = saved["nscdd"]["f_gamma"][0][2][0].as_f64().expect("an interface multiplier");
+    saved["nscdd"]["f_gamma"][0][2][0] = serde_json::json!(f + 1e-9);
     std::fs::write(&other, serde_json::to_string_pretty(&saved).unwrap()).unwrap();
     let o = mpirun(&[(1, with2(&state)), (1, with2(&other))]);
     let err = text(&o.stderr);

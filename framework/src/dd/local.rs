@@ -214,8 +214,9 @@ pub(super) fn region<D: Family>(
 }
 
 impl<D: Family> super::NscddOf<D> {
-    /// Before a step on ranks (rigid bodies, contacts held per rank) while every
-    /// world holds every body: each world reduced to its rank's part
+    /// Before a step on ranks (rigid bodies, contacts held per rank) while no
+    /// step has reduced the world (it holds every body, or its part as the scene
+    /// was loaded, [`crate::scene::part`]): each world reduced to its rank's part
     /// ([`super::owned`]), on a fresh run's first step ([`Self::start_fresh`]) and
     /// on the first step after a restart ([`Self::start_restarted`]). Nothing
     /// otherwise (after any step on ranks the world holds only its part, or the
@@ -265,8 +266,9 @@ impl<D: Family> super::NscddOf<D> {
     }
 
     /// The first step after a restart (the saved grid, no ranks yet; every rank
-    /// loaded every body and the last step's contacts, or only its own when the CLI
-    /// read the state in part, [`super::RestartPart`]: the same rule): the cells' ranks balanced
+    /// loaded every body and the last step's contacts, or only its own bodies and
+    /// contacts when the CLI read the state in part, [`super::RestartPart`] and
+    /// [`crate::scene::part::restart_on`]: the same rule): the cells' ranks balanced
     /// by their kept contacts (the same on every rank; results do not depend on
     /// which rank sweeps a subdomain), then each rank keeps the last step's
     /// contacts whose kept subdomain is its own, as if it had stepped them, and its

@@ -23,7 +23,8 @@
 //! rank's new halo it lacks (their state at the start of the step, V⁻ and V_free);
 //! the first step of a fresh run starts from a provisional grid over the bodies'
 //! centres ([`Owned::start_held`]), the first step after a restart from the saved
-//! grid (every rank loaded every body, then keeps its part).
+//! grid (a rank's world holds every body, or already only its part when the scene
+//! was loaded in part, [`crate::scene::part`]; it then keeps its part).
 //!
 //! The outputs never read a body its rank does not hold: the sums over bodies are
 //! added per cell by the cells' ranks ([`super::census::BodySums`]), the named and
@@ -97,8 +98,8 @@ impl Owned {
         self.own_bodies::<D>(w, rs, grid);
     }
 
-    /// Before the first step of a run or after a restart (every body held; a
-    /// provisional `grid` over the bodies' centres, or the saved one, and
+    /// Before the first step of a run or after a restart (every body held, or the
+    /// rank's part as loaded; a provisional `grid` over the bodies' centres, or the saved one, and
     /// `rs.rank_of`): the world keeps only this rank's halo, the bodies of its
     /// contacts and the bodies every rank steps, so that the first step too runs
     /// with bodies and contacts per rank.

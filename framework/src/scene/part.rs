@@ -179,7 +179,8 @@ fn load_whole<D: SceneDim>(
 /// of its bodies. The ranks then agree on the survey's digest, every saved body's
 /// and every contact's. Otherwise the scene is loaded whole, as before. (The
 /// scene's own overlap check, of the initial positions the state replaces, runs
-/// on the bodies each rank holds.)
+/// on the bodies each rank holds, chosen at the saved positions: an overlap of
+/// the initial positions may go unreported, where one process refuses it.)
 pub fn restart_on<D: SceneDim>(
     s: &mut Scene<D>,
     registry: &Registry,
@@ -194,7 +195,7 @@ pub fn restart_on<D: SceneDim>(
     let scanned = rp.as_ref().and_then(|rp| {
         // (a margin on the alert distance: a body kept in excess leaves at the first step)
         let halo = rp.halo(D::N, s.world.alert * 1.01);
-        let scene = super::restart_scan::Scene {
+        let scene = super::restart_scan::ScanInput {
             shapes: &sv.shapes,
             stores: &s.world.shapes,
             everywhere: &sv.everywhere,
@@ -205,10 +206,10 @@ pub fn restart_on<D: SceneDim>(
     let decomposition = s.decomposition.take();
     let Some(scanned) = scanned else {
         load_whole(s, registry, &sv, decomposition)?;
-        return super::restart_scene_on(s, path, on);
+        return super::restart::restart_scene_with(s, path, rp);
     };
     let keep = scanned.keep;
-    let keep = move |g: u32, _: &[[f64; 3]; 2]| keep.binary_search(&g).is_ok();
+    let keep = move |g: u32, _: &[[f64; 3]; 2]| keep[g as usize];
     let share = 1.0 / f64::from(ranks);
     let (scene, _) = load_with::<D>(&sv.text, &sv.file, registry, Part::new(Box::new(keep), share))?.expect("surveyed without families");
     *s = scene;

@@ -189,6 +189,10 @@ pub(super) fn restart_scene_with<D: Dim>(
     path: &Path,
     mut part: Option<crate::dd::RestartPart>,
 ) -> Result<Option<u64>, InputError> {
+    debug_assert!(
+        part.is_some() || scene.world.ids.held().is_none(),
+        "a part world reads its contacts in part"
+    );
     let (nscdd, states) = restart_from(&mut scene.world, Source::File(path), true, part.as_mut())?;
     scene.dd_state = nscdd;
     let ck = StateChecks::new(Source::File(path));

@@ -11,15 +11,18 @@
 //! The scan checks what the second pass would check of a body it does not hold
 //! (its id, its kind, a finite state, the bodies' count): a state that fails any
 //! check is restarted whole instead, so that its error is reported as in one
-//! process. It never holds the file's text or a list of its bodies: ≈ 1 byte a body.
+//! process. It never holds the file's text or a list of its bodies: 1 byte a body.
+//! (The two passes read the file twice: a state replaced between them is not told
+//! apart; the run's outputs never replace the state it restarts from.)
 //!
 //! ```text
 //! let halo = part.halo(D::N, alert * 1.01);
-//! let kept = scan::<D>(path, &world.shapes, &survey, &halo, part.clone());
-//! // kept.keep: the bodies to build (ascending); kept.digest: every saved body's bits
+//! let input = ScanInput { shapes: &survey_shapes, stores: &world.shapes, everywhere, halo: &halo };
+//! let kept = scan::<D>(path, &input, part.clone());
+//! // kept.keep[g]: build body g; kept.digest: every saved body's bits
 //! ```
 
-use super::restart_stream::SavedBody;
+use super::restart_stream::{body_error, SavedBody};
 use crate::dd::first_part::Halo;
 use crate::dd::RestartPart;
 use crate::dim::{Coords, Dim};
@@ -43,15 +46,15 @@ struct ContactAt<D: Dim> {
 
 /// What a rank builds of a scene restarted in part.
 pub(super) struct Scanned {
-    /// The bodies to build (ascending global ids).
-    pub keep: Vec<u32>,
+    /// Whether to build each body (by global id).
+    pub keep: Vec<bool>,
     /// A digest of every saved body's id and state (the same on every rank).
     pub digest: u64,
 }
 
 /// What the scan reads of the scene: every body's shape (by global id), the shape
 /// stores, the bodies every rank steps (ascending) and the rank's halo.
-pub(super) struct Scene<'a, D: Dim> {
+pub(super) struct ScanInput<'a, D: Dim> {
     pub shapes: &'a [ShapeRef],
     pub stores: &'a [Box<dyn ShapeStore<D>>],
     pub everywhere: &'a [u32],
@@ -61,7 +64,7 @@ pub(super) struct Scene<'a, D: Dim> {
 /// The scan of the state at `path` (module docs); `None` when the state cannot be
 /// read in part: a check fails or the file is not a saved state of this scene (the
 /// whole restart then reports why).
-pub(super) fn scan<D: Dim>(path: &Path, scene: &Scene<'_, D>, part: RestartPart) -> Option<Scanned> {
+pub(super) fn scan<D: Dim>(path: &Path, scene: &ScanInput<'_, D>, part: RestartPart) -> Option<Scanned> {
     let f = std::fs::File::open(path).ok()?;
     let mut de = serde_json::Deserializer::from_reader(std::io::BufReader::with_capacity(1 << 16, f));
     let mut s = Scan {
@@ -79,16 +82,15 @@ pub(super) fn scan<D: Dim>(path: &Path, scene: &Scene<'_, D>, part: RestartPart)
     if !(s.bodies && s.contacts && (s.dimension || D::N == 2)) {
         return None;
     }
-    let keep = (0..s.keep.len() as u32).filter(|&g| s.keep[g as usize]).collect();
     Some(Scanned {
-        keep,
+        keep: s.keep,
         digest: s.hash.finish(),
     })
 }
 
 /// The scan's state: the bodies marked so far (by global id) and the digest.
 struct Scan<'s, 'a, D: Dim> {
-    scene: &'s Scene<'a, D>,
+    scene: &'s ScanInput<'a, D>,
     part: RestartPart,
     keep: Vec<bool>,
     hash: std::collections::hash_map::DefaultHasher,
@@ -166,12 +168,11 @@ impl<'de, D: Dim> Visitor<'de> for Bodies<'_, '_, '_, D> {
                 return Err(A::Error::custom("more bodies than the scene"));
             };
             let store = &sc.stores[shape.kind as usize];
-            let rot = sb.rot();
-            let values = sb.position.as_ref().iter().chain(rot.coords()).chain(sb.velocity.as_ref());
-            let finite = sb.position.as_ref().iter().chain(sb.velocity.as_ref()).all(|x| x.is_finite());
-            if sb.id as usize != k || sb.kind != store.kind() || !(finite && D::rot_finite(&rot)) {
+            if body_error(k, store.kind(), &sb).is_some() {
                 return Err(A::Error::custom("a body the restart refuses"));
             }
+            let rot = sb.rot();
+            let values = sb.position.as_ref().iter().chain(rot.coords()).chain(sb.velocity.as_ref());
             s.hash.write_u32(sb.id);
             values.for_each(|x| s.hash.write_u64(x.to_bits()));
             // the box the first step computes (the world's orientation as read)

@@ -198,7 +198,7 @@ impl<'de, D: Dim> Visitor<'de> for BodiesSeed<'_, D> {
         while k < nb && first.is_none() {
             let Some(sb) = seq.next_element::<SavedBody<D>>()? else { break };
             if let Some(slot) = self.w.ids.slot(k as u32).map(|s| s as usize) {
-                first = body_error(self.w, (k, slot), &sb);
+                first = body_error(k, self.w.kind_name(slot), &sb);
                 if first.is_none() {
                     let b = &mut self.w.bodies;
                     (b.pos[slot], b.rot[slot], b.vel[slot]) = (sb.position, sb.rot(), sb.velocity);
@@ -223,9 +223,10 @@ impl<'de, D: Dim> Visitor<'de> for BodiesSeed<'_, D> {
     }
 }
 
-/// What is wrong with saved body `k` (held in `slot`) against the scene's: its id,
-/// its kind, a non-finite state.
-fn body_error<D: Dim>(w: &World<D>, (k, slot): (usize, usize), sb: &SavedBody<D>) -> Option<Failed> {
+/// What is wrong with saved body `k` against the scene's body of kind `kind`: its
+/// id, its kind, a non-finite state (the restart's checks of a body, and the first
+/// pass's of a restart loaded in part, [`super::restart_scan`]).
+pub(super) fn body_error<D: Dim>(k: usize, kind: &str, sb: &SavedBody<D>) -> Option<Failed> {
     let failed = |key: String, message: String, at: (&'static str, usize)| {
         Some(Failed {
             key,
@@ -236,7 +237,6 @@ fn body_error<D: Dim>(w: &World<D>, (k, slot): (usize, usize), sb: &SavedBody<D>
     if sb.id as usize != k {
         return failed(format!("bodies[{k}].id"), format!("expected id {k}, found {}", sb.id), ("id", k));
     }
-    let kind = w.kind_name(slot);
     if sb.kind != kind {
         let message = format!("the saved body is a `{}`, the scene's body {k} a `{kind}`", sb.kind);
         return failed(format!("bodies[{k}].kind"), message, ("kind", k));
