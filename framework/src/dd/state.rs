@@ -92,7 +92,6 @@ impl NscddState {
 /// `NscddOf::start_restarted` balances them. A restart that streams the state keeps
 /// only those ([`crate::scene::restart_scene_on`]), instead of every contact of the
 /// sample on every rank until the first step drops the others.
-#[derive(Clone)]
 pub struct RestartPart {
     grid: Grid,
     kept: Vec<(ContactKey, u32)>,
@@ -122,6 +121,13 @@ impl RestartPart {
         for v in values {
             self.seen.write_u64(v);
         }
+    }
+
+    /// Back to the state before the first contact was decided (the search's
+    /// start; the decisions never depend on it), for a second pass over the same
+    /// contacts. The digest is left as it is.
+    pub fn rewind(&mut self) {
+        self.at = 0;
     }
 
     /// The digest of every contact read ([`RestartPart::saw`]).

@@ -191,8 +191,8 @@ pub fn restart_on<D: SceneDim>(
     let Some(sv) = s.survey.take() else {
         return super::restart_scene_on(s, path, on);
     };
-    let rp = super::restart::rank_part_of(path, s, on);
-    let scanned = rp.as_ref().and_then(|rp| {
+    let mut rp = super::restart::rank_part_of(path, s, on);
+    let scanned = rp.as_mut().and_then(|rp| {
         // (a margin on the alert distance: a body kept in excess leaves at the first step)
         let halo = rp.halo(D::N, s.world.alert * 1.01);
         let scene = super::restart_scan::ScanInput {
@@ -201,7 +201,7 @@ pub fn restart_on<D: SceneDim>(
             everywhere: &sv.everywhere,
             halo: &halo,
         };
-        super::restart_scan::scan::<D>(path, &scene, rp.clone())
+        super::restart_scan::scan::<D>(path, &scene, rp)
     });
     let decomposition = s.decomposition.take();
     let Some(scanned) = scanned else {

@@ -18,7 +18,7 @@
 //! ```text
 //! let halo = part.halo(D::N, alert * 1.01);
 //! let input = ScanInput { shapes: &survey_shapes, stores: &world.shapes, everywhere, halo: &halo };
-//! let kept = scan::<D>(path, &input, part.clone());
+//! let kept = scan::<D>(path, &input, &mut part);
 //! // kept.keep[g]: build body g; kept.digest: every saved body's bits
 //! ```
 
@@ -64,7 +64,9 @@ pub(super) struct ScanInput<'a, D: Dim> {
 /// The scan of the state at `path` (module docs); `None` when the state cannot be
 /// read in part: a check fails or the file is not a saved state of this scene (the
 /// whole restart then reports why).
-pub(super) fn scan<D: Dim>(path: &Path, scene: &ScanInput<'_, D>, part: RestartPart) -> Option<Scanned> {
+/// `part` decides the contacts as the restart's pass will (no copy of its kept
+/// contacts; [`RestartPart::rewind`] after).
+pub(super) fn scan<D: Dim>(path: &Path, scene: &ScanInput<'_, D>, part: &mut RestartPart) -> Option<Scanned> {
     let f = std::fs::File::open(path).ok()?;
     let mut de = serde_json::Deserializer::from_reader(std::io::BufReader::with_capacity(1 << 16, f));
     let mut s = Scan {
@@ -76,8 +78,9 @@ pub(super) fn scan<D: Dim>(path: &Path, scene: &ScanInput<'_, D>, part: RestartP
         bodies: false,
         contacts: false,
     };
-    DeserializeSeed::deserialize(&mut s, &mut de).ok()?;
-    de.end().ok()?;
+    let read = DeserializeSeed::deserialize(&mut s, &mut de).and_then(|()| de.end());
+    s.part.rewind();
+    read.ok()?;
     // (a state without `dimension` is 2D's)
     if !(s.bodies && s.contacts && (s.dimension || D::N == 2)) {
         return None;
@@ -91,7 +94,7 @@ pub(super) fn scan<D: Dim>(path: &Path, scene: &ScanInput<'_, D>, part: RestartP
 /// The scan's state: the bodies marked so far (by global id) and the digest.
 struct Scan<'s, 'a, D: Dim> {
     scene: &'s ScanInput<'a, D>,
-    part: RestartPart,
+    part: &'s mut RestartPart,
     keep: Vec<bool>,
     hash: std::collections::hash_map::DefaultHasher,
     dimension: bool,
