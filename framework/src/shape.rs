@@ -72,6 +72,14 @@ impl<D: Dim> Aabb<D> {
     pub fn extent(&self) -> f64 {
         (0..D::N).map(|k| self.max[k] - self.min[k]).fold(0.0, f64::max)
     }
+    /// Min and max corners in three coordinates (z = 0 in 2D): the boxes the
+    /// decomposition's regions test.
+    pub fn corners3(&self) -> [[f64; 3]; 2] {
+        let mut b = [[0.0; 3]; 2];
+        b[0][..D::N].copy_from_slice(self.min.as_ref());
+        b[1][..D::N].copy_from_slice(self.max.as_ref());
+        b
+    }
 }
 
 /// Mass properties of one shape for a density (2D: per unit depth), in the shape's

@@ -372,10 +372,7 @@ impl<D: Dim> Family for Rigid<D> {
         out.resize(b.len(), [[0.0; 3]; 2]);
         crate::step::each_body(b.len(), w.scratch.active.as_deref(), |k| {
             let s = b.shape[k];
-            let a = w.shapes[s.kind as usize].aabb(s.index, b.pos[k], b.rot[k]);
-            let o = &mut out[k];
-            o[0][..D::N].copy_from_slice(a.min.as_ref());
-            o[1][..D::N].copy_from_slice(a.max.as_ref());
+            out[k] = w.shapes[s.kind as usize].aabb(s.index, b.pos[k], b.rot[k]).corners3();
         });
     }
     fn set_active(w: &mut Self::World, active: Option<Vec<u32>>) {

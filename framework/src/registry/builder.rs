@@ -253,9 +253,7 @@ impl<'r, D: Dim> SceneBuilder<'r, D> {
             let rot = D::normalize_rot(q);
             let a = store.aabb(shape.index, pos, rot);
             rot.coords().iter().chain(vel.as_ref()).for_each(|x| p.hash.write_u64(x.to_bits()));
-            let mut bx = [[0.0; 3]; 2];
-            bx[0][..D::N].copy_from_slice(a.min.as_ref());
-            bx[1][..D::N].copy_from_slice(a.max.as_ref());
+            let bx = a.corners3();
             let mut c = [0.0; 3];
             c[..D::N].copy_from_slice(pos.as_ref());
             p.centre.push(c);

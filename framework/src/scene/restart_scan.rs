@@ -179,10 +179,7 @@ impl<'de, D: Dim> Visitor<'de> for Bodies<'_, '_, '_, D> {
             s.hash.write_u32(sb.id);
             values.for_each(|x| s.hash.write_u64(x.to_bits()));
             // the box the first step computes (the world's orientation as read)
-            let a = store.aabb(shape.index, sb.position, rot);
-            let mut bx = [[0.0; 3]; 2];
-            bx[0][..D::N].copy_from_slice(a.min.as_ref());
-            bx[1][..D::N].copy_from_slice(a.max.as_ref());
+            let bx = store.aabb(shape.index, sb.position, rot).corners3();
             s.keep[k] |= sc.halo.meets(&bx);
             k += 1;
         }
