@@ -37,47 +37,40 @@ fn a_state_written_by_p_ranks_restarts_on_other_rank_counts() {
 #[test]
 fn ranks_reading_states_that_differ_in_a_contact_disagree() {
     let dir = scratch("restart_digest");
-    let flags = ["--subdomains", "2x2", "--scheme", "decentralized"];
-    let whole = write(&dir, "pile.toml", &every(PILE2D, 3));
-    let half = write(&dir, "half.toml", &every(&PILE2D.replace("steps = 15", "steps = 8"), 3));
-    let a = dir.join("first");
-    ok(&mpirun(&[(2, args(&half, &a, &flags))]), "8 steps on 2 ranks");
-    let state = a.join("final.json");
-    let mut saved: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&state).unwrap()).expect("state");
-    let last = saved["contacts"].as_array_mut().expect("contacts").last_mut().expect("a contact");
-    let rn = last["r"][0].as_f64().expect("r");
-    last["r"][0] = serde_json::json!(rn * 1.5 + 1e-3);
-    let other = dir.join("other.json");
-    std::fs::write(&other, serde_json::to_string_pretty(&saved).unwrap()).unwrap();
+    let (whole, state) = pile_state_on_two_ranks(&dir);
+    let flags = FLAGS2X2;
     let out = dir.join("then");
-    let with = |st: &Path| args(&whole, &out, &[&flags[..], &["--restart", st.to_str().unwrap()]].concat());
+    let with = |st: &Path, out: &Path| args(&whole, out, &[&flags[..], &["--restart", st.to_str().unwrap()]].concat());
     // the same state on both ranks: it runs, reading the contacts in part
-    ok(&mpirun(&[(1, with(&state)), (1, with(&state))]), "the same state");
+    ok(&mpirun(&[(1, with(&state, &out)), (1, with(&state, &out))]), "the same state");
     contacts_read_in_part(&state, &out);
-    let out2 = dir.join("then2");
-    let with2 = |st: &Path| args(&whole, &out2, &[&flags[..], &["--restart", st.to_str().unwrap()]].concat());
-    let o = mpirun(&[(1, with2(&state)), (1, with2(&other))]);
-    let err = text(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(err.contains("different scenes"), "{err}");
-    // the bodies too are read in part: states that differ in one body's velocity
-    let mut saved: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&state).unwrap()).expect("state");
-    let v = saved["bodies"][3]["velocity"][0].as_f64().expect("velocity");
-    saved["bodies"][3]["velocity"][0] = serde_json::json!(v + 1e-9);
-    std::fs::write(&other, serde_json::to_string_pretty(&saved).unwrap()).unwrap();
-    let o = mpirun(&[(1, with2(&state)), (1, with2(&other))]);
-    let err = text(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(err.contains("different scenes"), "{err}");
-    // and in the NSCDD state alone (one interface multiplier)
-    let mut saved: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&state).unwrap()).expect("state");
-    let f = saved["nscdd"]["f_gamma"][0][2][0].as_f64().expect("an interface multiplier");
-    saved["nscdd"]["f_gamma"][0][2][0] = serde_json::json!(f + 1e-9);
-    std::fs::write(&other, serde_json::to_string_pretty(&saved).unwrap()).unwrap();
-    let o = mpirun(&[(1, with2(&state)), (1, with2(&other))]);
-    let err = text(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(err.contains("different scenes"), "{err}");
+    // a copy changed by `edit` on the second rank: the ranks disagree
+    let (other, out2) = (dir.join("other.json"), dir.join("then2"));
+    let disagree = |edit: &dyn Fn(&mut serde_json::Value)| {
+        let mut saved: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&state).unwrap()).expect("state");
+        edit(&mut saved);
+        std::fs::write(&other, serde_json::to_string_pretty(&saved).unwrap()).unwrap();
+        let o = mpirun(&[(1, with(&state, &out2)), (1, with(&other, &out2))]);
+        let err = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(err.contains("different scenes"), "{err}");
+    };
+    // one contact's impulse
+    disagree(&|s| {
+        let last = s["contacts"].as_array_mut().expect("contacts").last_mut().expect("a contact");
+        let rn = last["r"][0].as_f64().expect("r");
+        last["r"][0] = serde_json::json!(rn * 1.5 + 1e-3);
+    });
+    // the bodies too are read in part: one body's velocity
+    disagree(&|s| {
+        let v = s["bodies"][3]["velocity"][0].as_f64().expect("velocity");
+        s["bodies"][3]["velocity"][0] = serde_json::json!(v + 1e-9);
+    });
+    // and the NSCDD state alone (one interface multiplier)
+    disagree(&|s| {
+        let f = s["nscdd"]["f_gamma"][0][2][0].as_f64().expect("an interface multiplier");
+        s["nscdd"]["f_gamma"][0][2][0] = serde_json::json!(f + 1e-9);
+    });
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -88,22 +81,19 @@ fn ranks_reading_states_that_differ_in_a_contact_disagree() {
 #[test]
 fn a_bad_state_on_ranks_is_refused_as_in_one_process() {
     let dir = scratch("restart_bad");
-    let flags = ["--subdomains", "2x2", "--scheme", "decentralized"];
-    let whole = write(&dir, "pile.toml", &every(PILE2D, 3));
-    let half = write(&dir, "half.toml", &every(&PILE2D.replace("steps = 15", "steps = 8"), 3));
-    let a = dir.join("first");
-    ok(&mpirun(&[(2, args(&half, &a, &flags))]), "8 steps on 2 ranks");
-    let saved: serde_json::Value = serde_json::from_str(&final_json(&a)).expect("state");
+    let (whole, state) = pile_state_on_two_ranks(&dir);
+    let flags = FLAGS2X2;
+    let saved: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&state).unwrap()).expect("state");
     let bad = |what: &str, edit: &dyn Fn(&mut Vec<serde_json::Value>)| {
         let mut s = saved.clone();
         edit(s["bodies"].as_array_mut().expect("bodies"));
-        let state = dir.join(format!("{what}.json"));
-        std::fs::write(&state, serde_json::to_string_pretty(&s).unwrap()).unwrap();
+        let bad_state = dir.join(format!("{what}.json"));
+        std::fs::write(&bad_state, serde_json::to_string_pretty(&s).unwrap()).unwrap();
         let with = |out: &str| {
             args(
                 &whole,
                 &dir.join(out),
-                &[&flags[..], &["--restart", state.to_str().unwrap()]].concat(),
+                &[&flags[..], &["--restart", bad_state.to_str().unwrap()]].concat(),
             )
         };
         let (one, on4) = (nscdd(&with(&format!("{what}1"))), mpirun(&[(4, with(&format!("{what}4")))]));
@@ -118,6 +108,19 @@ fn a_bad_state_on_ranks_is_refused_as_in_one_process() {
         b.pop();
     });
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The 2 × 2 decomposition, decentralized, of the tests restarting the pile.
+const FLAGS2X2: [&str; 4] = ["--subdomains", "2x2", "--scheme", "decentralized"];
+
+/// The 2D pile re-partitioned every 3 steps, 15 steps (`whole`, written in `dir`),
+/// and its state after 8 steps on 2 ranks ([`FLAGS2X2`]).
+fn pile_state_on_two_ranks(dir: &Path) -> (std::path::PathBuf, std::path::PathBuf) {
+    let whole = write(dir, "pile.toml", &every(PILE2D, 3));
+    let half = write(dir, "half.toml", &every(&PILE2D.replace("steps = 15", "steps = 8"), 3));
+    let a = dir.join("first");
+    ok(&mpirun(&[(2, args(&half, &a, &FLAGS2X2))]), "8 steps on 2 ranks");
+    (whole, a.join("final.json"))
 }
 
 /// `whole` in one process with 2 threads: its final.json.
