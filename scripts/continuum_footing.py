@@ -4,7 +4,7 @@
 
 Usage: continuum_footing.py OUT_DIR [--shallow] [--seeds 3,5,...] [--jobs N] [--tag T]
     [--young E] [--hardening PHI0 KAPPA_H PHI | --friction PHI] [--grain-share S]
-    [--coupling node|grain] [--plot]
+    [--coupling node|grain] [--depth D --disc-footing Y --duration T] [--plot]
 
 For each seed (default 3 and 5) writes OUT_DIR/{T,disc}_sSEED.toml (T: `hyb` unless
 `--tag`): the example (1300 grains in a 0.6 m layer over the continuum, 3.5 s) and its
@@ -23,7 +23,10 @@ scripts/biaxial_study.sh installs it in .venv-docs).
 1770), 2 s, 15 mm (plot docs/continuum_footing_shallow.png). The hybrid's
 foundation: `--young`, `--hardening` (initial friction angle, hardening strain,
 friction angle) or `--friction` (perfectly plastic), `--grain-share` and
-`--coupling` replace the example's.
+`--coupling` replace the example's. `--depth D`: the foundation D m deep (the
+example: 0.5) in both runs, the all-discrete footing at `--disc-footing` (0.615:
+its layer settles more), both run `--duration` s (3.5); the references are then
+named discD_sSEED.
 """
 import csv
 import os
@@ -74,6 +77,30 @@ def deepen(text, disc):
         text = text.replace(f"position = [{x}, 0.25]\nrotation = 1.5707963267948966\nlength = 0.5", f"position = [{x}, 0.4]\nrotation = 1.5707963267948966\nlength = 0.8")
         text = text.replace(f"position = [{x}, -0.1]\nrotation = 1.5707963267948966\nlength = 1.0", f"position = [{x}, 0.15]\nrotation = 1.5707963267948966\nlength = 1.3")
     return text.replace("duration = 2.0", "duration = 3.5")
+
+
+def foundation(text, disc, depth, footing, duration):
+    """The example's layout (from [`deepen`]) over a foundation `depth` m deep (the
+    example: 0.5): the continuum's mesh (cells of 5 cm) or the all-discrete grains
+    (as many a square metre as in the example's reference) down to y = -depth; the
+    all-discrete footing at `footing` (that layer settles more, the deeper the
+    more), both run for `duration` s."""
+    n = round((depth + 0.1) / 0.05)
+    text = text.replace(
+        "mesh = { rectangle = { origin = [0.0, -0.5], size = [1.0, 0.6], cells = [20, 12] } }",
+        f"mesh = {{ rectangle = {{ origin = [0.0, {-depth}], size = [1.0, {depth + 0.1:.4g}], cells = [20, {n}] }} }}",
+    )
+    text = text.replace("count = 2420", f"count = {round(2420 * (0.61 + depth) / 1.11)}")
+    text = text.replace("box = [0.0, -0.5, 1.0, 0.61]", f"box = [0.0, {-depth}, 1.0, 0.61]")
+    text = text.replace("position = [0.5, -0.51]", f"position = [0.5, {-depth - 0.01:.4g}]")
+    for x in ("-0.01", "1.01"):
+        text = text.replace(
+            f"position = [{x}, 0.15]\nrotation = 1.5707963267948966\nlength = 1.3",
+            f"position = [{x}, {(0.8 - depth) / 2:.4g}]\nrotation = 1.5707963267948966\nlength = {0.8 + depth:.4g}",
+        )
+    if disc:
+        text = text.replace("position = [0.5, 0.615]", f"position = [0.5, {footing}]")
+    return text.replace("duration = 3.5", f"duration = {duration}")
 
 
 def mean_force(p, r, lo, hi):
@@ -173,16 +200,20 @@ def main():
     seeds = [int(x) for x in opt("--seeds", default="3,5").split(",")]
     jobs = int(opt("--jobs", default="1"))
     tag = opt("--tag", default="hyb")
+    depth = opt("--depth")
+    disc_name = f"disc{depth}" if depth else "disc"
     os.makedirs(out, exist_ok=True)
     src = shallow(open(os.path.join(ROOT, "examples/scenes/footing.toml")).read())
     env = dict(os.environ, NSCDD_PYTHON_ENV=os.environ.get("NSCDD_PYTHON_ENV", os.path.join(ROOT, "venv")))
     todo, names = [], []
     for seed in seeds:
-        for kind, text in ((tag, hybrid_variant(src)), ("disc", discrete(src))):
+        for kind, text in ((tag, hybrid_variant(src)), (disc_name, discrete(src))):
             # (the shallow layout first, deepened: the all-discrete files stay those of
             # the runs recorded in docs/CONTINUUM.md)
             if deep:
-                text = deepen(text, kind == "disc")
+                text = deepen(text, kind != tag)
+            if depth:
+                text = foundation(text, kind != tag, float(depth), opt("--disc-footing", default="0.615"), opt("--duration", default="3.5"))
             name = f"{kind}_s{seed}"
             names.append(name)
             dest = os.path.join(out, name)
@@ -208,9 +239,9 @@ def main():
         print(f"{name}: {wall}, {sweeps} sweeps, bodies {r[0]['bodies']}, force at 5/10/15 mm: {' / '.join(at)} N/m, mean over 0-10/10-30/30-50/10-50 mm: {means} N/m")
     # the scatter: each discrete seed's RMS distance (force over 1..top mm) to the
     # mean of the other discrete seeds; each hybrid's to the mean of them all
-    disc = {s: resampled(*curves[f"disc_s{s}"], top) for s in seeds}
+    disc = {s: resampled(*curves[f"{disc_name}_s{s}"], top) for s in seeds}
     hyb = {s: resampled(*curves[f"{tag}_s{s}"], top) for s in seeds}
-    short = [f"disc_s{s}" for s, c in disc.items() if c is None] + [f"{tag}_s{s}" for s, c in hyb.items() if c is None]
+    short = [f"{disc_name}_s{s}" for s, c in disc.items() if c is None] + [f"{tag}_s{s}" for s, c in hyb.items() if c is None]
     if short:
         print(f"not {top} mm deep by the end (left out of the scatter): {', '.join(short)}")
     ds = [s for s in seeds if disc[s]]
