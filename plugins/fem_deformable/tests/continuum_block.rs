@@ -247,6 +247,55 @@ fn an_initial_stress_balances_the_sides_loads() {
     );
 }
 
+/// A geostatic `initial_stress` (`{ k0, surcharge }`): a block on a fixed base
+/// between rollers, under gravity and a top load equal to the surcharge, stands
+/// still when it starts at σ_v = −(q + ρ g d), σ_h = K0 σ_v, where it sags by
+/// ≈ (ρ g H²/2 + q H)/M_oed without; the same with Drucker–Prager (φ = 30°, inside
+/// its cone at K0 = 0.6, a plastic state at ν/(1 − ν) = 0.43); refused without
+/// gravity or with a bad key.
+#[test]
+fn a_geostatic_initial_stress_holds_a_ground_under_its_weight() {
+    let sides = "drive = { left = [0.0, \"free\"], right = [0.0, \"free\"] }";
+    let run = |extra: &str| {
+        let mut r = Run::new(&block_scene(&format!("{sides}\nload = {{ top = [0.0, -5000.0] }}\n{extra}")));
+        for _ in 0..100 {
+            r.step();
+        }
+        let u = r.cont().bodies[0].u.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        (r, u)
+    };
+    let (_, free) = run("");
+    let (_, held) = run("initial_stress = { surcharge = 5000.0 }");
+    let (dp, held_dp) = run("initial_stress = { surcharge = 5000.0, k0 = 0.6 }\nplastic = { friction = 30.0, dilatancy = 4.0 }");
+    let (_, wrong) = run("initial_stress = { surcharge = 0.0 }");
+    println!(
+        "largest displacement: none {free:.3e}, geostatic {held:.3e}, Drucker–Prager {held_dp:.3e}, without the surcharge {wrong:.3e}"
+    );
+    // M_oed = E (1 − ν)/((1 + ν)(1 − 2ν)) = 1.35 MPa: the static sag 1.5e-3 (weight)
+    // + 1.9e-3 m (the 5 kPa); cells of 5 cm hold the linear σ0 to ≈ 1e-6 m
+    assert!(free > 2e-3, "{free:e}");
+    assert!(held < 1e-3 * free && held_dp < 1e-3 * free, "{held:e} {held_dp:e}");
+    assert!(wrong > 0.3 * free, "{wrong:e}");
+    assert_eq!(dp.cont().plastic[0].as_ref().unwrap().yielding, 0);
+    let bad = |extra: &str| {
+        Scene::<nscdd::dim::D2>::load_str(&block_scene(extra), "t.toml", &registry())
+            .err()
+            .expect("refused")
+    };
+    assert_eq!(bad("initial_stress = { k0 = -1.0 }").key, "continuum[0].initial_stress.k0");
+    assert_eq!(
+        bad("initial_stress = { surcharge = -1.0 }").key,
+        "continuum[0].initial_stress.surcharge"
+    );
+    assert_eq!(bad("initial_stress = { depth = 1.0 }").key, "continuum[0].initial_stress.depth");
+    let weightless = format!("gravity = [0.0, 0.0]\n{}", block_scene("initial_stress = { k0 = 0.5 }"));
+    let e = Scene::<nscdd::dim::D2>::load_str(&weightless, "t.toml", &registry())
+        .err()
+        .expect("refused");
+    assert_eq!(e.key, "continuum[0].initial_stress");
+    assert!(e.message.contains("gravity"), "{}", e.message);
+}
+
 /// A drive's `"free"` component: the block squeezed between frictionless platens
 /// (`["free", v]`) spreads sideways freely (no horizontal reaction), where held
 /// platens hold it.

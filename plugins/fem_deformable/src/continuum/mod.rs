@@ -26,6 +26,7 @@
 
 pub mod band;
 pub mod family;
+pub mod initial;
 pub mod plastic;
 pub mod scene;
 pub mod sides;

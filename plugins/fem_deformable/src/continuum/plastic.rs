@@ -139,14 +139,15 @@ impl Plastic {
         self
     }
 
-    /// An initial stress σ0 in every cell: the eigenstrain ε_p = −D⁻¹σ0, so that
+    /// An initial stress σ0, one a cell: the eigenstrain ε_p = −D⁻¹σ0, so that
     /// σ = σ0 + D(ε − ε_p⁺) with ε_p⁺ the strains that yielding adds, and
-    /// f_p = −Σ_e α_e A_e Bᵀ σ0 balances the tractions σ0 n on the sides at u = 0.
-    pub fn prestress(&mut self, sigma0: &[[f64; 3]; 3]) {
-        let e0 = self.compliance(sigma0);
-        for (ep, s) in self.eps_p.iter_mut().zip(&mut self.sigma) {
-            *ep = std::array::from_fn(|a| std::array::from_fn(|b| -e0[a][b]));
-            *s = *sigma0;
+    /// f_p = −Σ_e α_e A_e Bᵀ σ0 balances the tractions σ0 n on the sides (a uniform
+    /// σ0) or the region's weight (a geostatic one) at u = 0.
+    pub fn prestress(&mut self, sigma0: &[[[f64; 3]; 3]]) {
+        for (e, s0) in sigma0.iter().enumerate().take(self.sigma.len()) {
+            let e0 = self.compliance(s0);
+            self.eps_p[e] = std::array::from_fn(|a| std::array::from_fn(|b| -e0[a][b]));
+            self.sigma[e] = *s0;
         }
     }
 

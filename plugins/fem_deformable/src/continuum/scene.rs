@@ -92,30 +92,12 @@ fn plastic_of(i: usize, e: &toml::Table) -> Result<Option<DpSpec>, EntryError> {
     Ok(Some(d))
 }
 
-/// `initial_stress` (Pa, tension positive): 2D `[xx, yy, xy]` (plane strain:
-/// zz = ν (xx + yy)), 3D `[xx, yy, zz, xy, yz, xz]`, as a 3 × 3 tensor.
-fn initial_stress_of(i: usize, e: &toml::Table, dim: usize) -> Result<Option<[[f64; 3]; 3]>, EntryError> {
-    let Some(v) = e.get("initial_stress") else { return Ok(None) };
-    let n = if dim == 2 { 3 } else { 6 };
-    let what = if dim == 2 { "[xx, yy, xy]" } else { "[xx, yy, zz, xy, yz, xz]" };
-    let s: Vec<f64> = v
-        .as_array()
-        .map(|a| a.iter().filter_map(|x| x.as_float().or(x.as_integer().map(|k| k as f64))).collect())
-        .filter(|a: &Vec<f64>| a.len() == n && a.len() == v.as_array().map_or(0, |b| b.len()) && a.iter().all(|x| x.is_finite()))
-        .ok_or_else(|| entry_error(i, "initial_stress", format!("{n} numbers {what} (Pa, tension positive)")))?;
-    let t = match dim {
-        2 => [[s[0], s[2], 0.0], [s[2], s[1], 0.0], [0.0, 0.0, f64::NAN]],
-        _ => [[s[0], s[3], s[5]], [s[3], s[1], s[4]], [s[5], s[4], s[2]]],
-    };
-    Ok(Some(t))
-}
-
-/// A region's Drucker–Prager state (None: elastic), at its initial stress if any
-/// (an elastic region with one gets a cone it never leaves, c = ∞).
+/// A region's Drucker–Prager state (None: elastic), at its initial stress if any,
+/// one a cell (an elastic region with one gets a cone it never leaves, c = ∞).
 fn plastic_state(
     b: &FeBody,
     dp: Option<DpSpec>,
-    sigma0: Option<[[f64; 3]; 3]>,
+    sigma0: Option<Vec<[[f64; 3]; 3]>>,
     alpha: &[f64],
 ) -> Result<Option<super::plastic::Plastic>, (&'static str, String)> {
     let el = b.elastic;
@@ -126,7 +108,7 @@ fn plastic_state(
             "the Drucker–Prager and prestressed continuum is in plane strain (no `plane = \"stress\"`)".into(),
         ));
     }
-    let dp = dp.or(sigma0.map(|_| DpSpec {
+    let dp = dp.or(sigma0.as_ref().map(|_| DpSpec {
         friction: 0.0,
         dilatancy: 0.0,
         cohesion: f64::INFINITY,
@@ -141,8 +123,8 @@ fn plastic_state(
         }
     });
     if let (Some(p), Some(mut s0)) = (p.as_mut(), sigma0) {
-        if s0[2][2].is_nan() {
-            s0[2][2] = el.poisson * (s0[0][0] + s0[1][1]);
+        for s in s0.iter_mut().filter(|s| s[2][2].is_nan()) {
+            s[2][2] = el.poisson * (s[0][0] + s[1][1]);
         }
         p.prestress(&s0);
     }
@@ -165,7 +147,7 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
         let band = band_of(i, e, N)?;
         let coupling = coupling_of(i, e)?;
         let dp = plastic_of(i, e)?;
-        let sigma0 = initial_stress_of(i, e, N)?;
+        let sigma0 = super::initial::of(i, e, N)?;
         let drives = super::sides::sides_of(i, e, "drive", N)?;
         let from = match e.get("drive_from") {
             None => 0.0,
@@ -200,6 +182,13 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
         let shares = super::sides::load(&mut b, &loads, &|x| band.alpha(x)).map_err(|m| at("load", m))?;
         driven.push(super::sides::drive(&mut b, &drives, from, &shares).map_err(|m| at("drive", m))?);
         b.factorize(w.time.h, w.time.theta).map_err(|m| at("", m))?;
+        let sigma0 = match sigma0 {
+            Some(s) => Some(
+                super::initial::per_cell(&s, &b.mesh, &frames, b.elastic.density, b.elastic.poisson, w.gravity.as_ref())
+                    .map_err(|m| at("initial_stress", m))?,
+            ),
+            None => None,
+        };
         plastic.push(plastic_state(&b, dp, sigma0, &alpha).map_err(|(k, m)| at(k, m))?);
         let mut grains: Vec<BandGrain> = Vec::new();
         for g in 0..w.bodies.len() {
