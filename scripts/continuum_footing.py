@@ -4,7 +4,8 @@
 
 Usage: continuum_footing.py OUT_DIR [--shallow] [--seeds 3,5,...] [--jobs N] [--tag T]
     [--young E] [--hardening PHI0 KAPPA_H PHI | --friction PHI] [--grain-share S]
-    [--coupling node|grain] [--depth D --disc-footing Y --duration T] [--plot]
+    [--coupling node|grain] [--geostatic Q] [--depth D --disc-footing Y --duration T]
+    [--plot]
 
 For each seed (default 3 and 5) writes OUT_DIR/{T,disc}_sSEED.toml (T: `hyb` unless
 `--tag`): the example (1300 grains in a 0.6 m layer over the continuum, 3.5 s) and its
@@ -22,8 +23,8 @@ scripts/biaxial_study.sh installs it in .venv-docs).
 `--shallow`: the layout until 2026-11-26, a 0.3 m layer (650 grains; all-discrete
 1770), 2 s, 15 mm (plot docs/continuum_footing_shallow.png). The hybrid's
 foundation: `--young`, `--hardening` (initial friction angle, hardening strain,
-friction angle) or `--friction` (perfectly plastic), `--grain-share` and
-`--coupling` replace the example's. `--depth D`: the foundation D m deep (the
+friction angle) or `--friction` (perfectly plastic), `--grain-share`,
+`--coupling` and `--geostatic` replace the example's. `--depth D`: the foundation D m deep (the
 example: 0.5) in both runs, the all-discrete footing at `--disc-footing` (0.615:
 its layer settles more), both run `--duration` s (3.5); the references are then
 named discD_sSEED.
@@ -132,9 +133,12 @@ def opt(name, n=1, default=None):
 def hybrid_variant(text):
     """The hybrid's foundation with the command line's law, if any: `--young E`,
     `--hardening PHI0 KAPPA_H PHI` or `--friction PHI` (perfectly plastic),
-    `--grain-share S`, `--coupling node|grain`."""
+    `--grain-share S`, `--coupling node|grain`, `--geostatic Q` (the foundation
+    starts at its geostatic stress under a surcharge of Q Pa)."""
     young, hard, phi, share = opt("--young"), opt("--hardening", 3), opt("--friction"), opt("--grain-share")
-    coupling = opt("--coupling")
+    coupling, geostatic = opt("--coupling"), opt("--geostatic")
+    if geostatic:
+        text = re.sub(r"(?m)^(band = .*)$", rf"\1\ninitial_stress = {{ surcharge = {geostatic} }}", text, count=1)
     if coupling:
         text = re.sub(r"(?m)^(band = .*)$", rf'\1\ncoupling = "{coupling}"', text, count=1)
     if young:
