@@ -51,10 +51,12 @@ pub fn run<D: nscdd::scene::schema::SceneDim>(
     let digest = flags.map(|in_part| match ranks.size() > 1 {
         true => {
             let (w, dd_state) = (&s.world, &s.dd_state);
+            // (the body families' states too: every rank holds them whole)
+            let families = (!s.families.is_empty()).then(|| nscdd::family::states(&s.families));
             let state = |out: &mut dyn std::io::Write| {
                 let mut none = |_: &mut Vec<f64>| false;
                 let contacts: Option<nscdd::output::Pull> = if in_part.is_some() { Some(&mut none) } else { None };
-                nscdd::output::write_final_json(out, w, None, dd_state.as_ref(), (contacts, None))
+                nscdd::output::write_final_json(out, w, families.as_ref(), dd_state.as_ref(), (contacts, None))
             };
             // (a part: the saved NSCDD state, which chose each rank's bodies and contacts)
             let nscdd_only = |out: &mut dyn std::io::Write| serde_json::to_writer(out, dd_state).map_err(std::io::Error::from);

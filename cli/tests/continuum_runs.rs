@@ -80,3 +80,35 @@ fn continuum_scenes_on_ranks_give_the_one_process_result() {
         }
     }
 }
+
+/// Two copies of a continuum scene's state that differ only in the region's state
+/// (one tie impulse changed by 1e-9), each read by one of two ranks (an MPMD
+/// launch): the ranks' agreement on the initial state tells them apart (exit 2),
+/// as it hashes the body families' states too.
+#[cfg(feature = "mpi")]
+#[test]
+fn ranks_reading_continuum_states_that_differ_disagree() {
+    use mpi_common::*;
+    let dir = scratch("continuum_digest");
+    let dec = "[decomposition]\nnx = 2";
+    let (early, scene) = (
+        write(&dir, "first.toml", &footing(5, "", dec)),
+        write(&dir, "footing.toml", &footing(10, "", dec)),
+    );
+    let first = dir.join("first");
+    ok(&nscdd(&args(&early, &first, &[])), "the first run");
+    let state = first.join("final.json");
+    let with = |st: &std::path::Path, out: &str| args(&scene, &dir.join(out), &["--restart", st.to_str().unwrap()]);
+    ok(&mpirun(&[(1, with(&state, "same")), (1, with(&state, "same"))]), "the same state");
+    let mut saved: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&state).unwrap()).expect("state");
+    // one tie's impulse
+    let r = &mut saved["families"]["continuum"]["ties"][0][0];
+    *r = serde_json::json!(r.as_f64().expect("a tie impulse") + 1e-9);
+    let other = dir.join("other.json");
+    std::fs::write(&other, serde_json::to_string_pretty(&saved).unwrap()).unwrap();
+    let o = mpirun(&[(1, with(&state, "differ")), (1, with(&other, "differ"))]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("different scenes"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
