@@ -27,7 +27,8 @@ friction angle) or `--friction` (perfectly plastic), `--grain-share`,
 `--coupling` and `--geostatic` replace the example's. `--depth D`: the foundation D m deep (the
 example: 0.5) in both runs, the all-discrete footing at `--disc-footing` (0.615:
 its layer settles more), both run `--duration` s (3.5); the references are then
-named discD_sSEED.
+named discD_fY_tT_sSEED; `--plot` then writes OUT_DIR/continuum_footing.png (also
+with `--geostatic`).
 """
 import csv
 import os
@@ -205,7 +206,17 @@ def main():
     jobs = int(opt("--jobs", default="1"))
     tag = opt("--tag", default="hyb")
     depth = opt("--depth")
-    disc_name = f"disc{depth}" if depth else "disc"
+    if depth and not deep:
+        sys.exit("--depth applies to the example's layout, not with --shallow")
+    if not depth and (opt("--disc-footing") or opt("--duration")):
+        sys.exit("--disc-footing and --duration go with --depth")
+    # (the reference's name says its depth, footing and duration: runs of other
+    # settings do not overwrite it)
+    if depth:
+        depth = f"{float(depth):g}"
+        disc_name = f"disc{depth}_f{float(opt('--disc-footing', default='0.615')):g}_t{float(opt('--duration', default='3.5')):g}"
+    else:
+        disc_name = "disc"
     os.makedirs(out, exist_ok=True)
     src = shallow(open(os.path.join(ROOT, "examples/scenes/footing.toml")).read())
     env = dict(os.environ, NSCDD_PYTHON_ENV=os.environ.get("NSCDD_PYTHON_ENV", os.path.join(ROOT, "venv")))
@@ -283,7 +294,10 @@ def main():
     ax.set_ylabel("footing force (N/m, mean over 51 steps)")
     ax.legend()
     fig.tight_layout()
-    fig.savefig(os.path.join(ROOT, "docs/continuum_footing.png" if deep else "docs/continuum_footing_shallow.png"), dpi=110)
+    # (the example's own layouts in docs/, a variant's with its runs)
+    variant = depth or opt("--geostatic")
+    png = os.path.join(out, "continuum_footing.png") if variant else os.path.join(ROOT, "docs/continuum_footing.png" if deep else "docs/continuum_footing_shallow.png")
+    fig.savefig(png, dpi=110)
 
 
 if __name__ == "__main__":

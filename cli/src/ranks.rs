@@ -109,7 +109,7 @@ impl Ranks {
             return Err(if self.root() {
                 crate::report::input_error_in(
                     out,
-                    "the ranks read different scenes or options: every rank must run the same scene with the same flags",
+                    "the ranks read different scenes, options or restart states: every rank must run the same scene with the same flags and state",
                 )
             } else {
                 ExitCode::from(2)

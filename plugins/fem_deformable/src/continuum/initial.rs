@@ -15,7 +15,10 @@
 //! ν/(1 − ν), the elastic one under lateral confinement). In plane strain σ_zz is
 //! ν(σ_xx + σ_yy), as for a uniform σ0. ρ|g|d is the medium's whole weight: in the
 //! overlap band the continuum carries its share α of it (its stress is weighted by
-//! α), the band grains the rest through their ties.
+//! α), the band grains the rest through their ties. The depth is measured from the
+//! highest node: the field balances the region's weight when its top is flat and
+//! level (a sloped or stepped top is left with unbalanced tractions on its lower
+//! faces, which the first steps take up).
 
 use super::scene::CellFrame;
 use crate::mesh::Mesh;
@@ -33,11 +36,16 @@ pub enum InitialStress {
 }
 
 const KEY: &str = "initial_stress";
+const NO_GRAVITY: &str = "a geostatic initial stress needs gravity (the scene's `gravity` is zero)";
 
-/// Entry `i`'s `initial_stress`, if any: an array (uniform) or a table (geostatic).
-pub fn of(i: usize, e: &toml::Table, dim: usize) -> Result<Option<InitialStress>, EntryError> {
+/// Entry `i`'s `initial_stress`, if any: an array (uniform) or a table (geostatic,
+/// which needs `gravity`).
+pub fn of(i: usize, e: &toml::Table, dim: usize, gravity: &[f64]) -> Result<Option<InitialStress>, EntryError> {
     let Some(v) = e.get(KEY) else { return Ok(None) };
     if let Some(t) = v.as_table() {
+        if !gravity.iter().any(|&x| x != 0.0) {
+            return Err(entry_error(i, KEY, NO_GRAVITY));
+        }
         return geostatic_of(i, t).map(Some);
     }
     let n = if dim == 2 { 3 } else { 6 };
@@ -65,28 +73,20 @@ fn geostatic_of(i: usize, t: &toml::Table) -> Result<InitialStress, EntryError> 
     let (mut k0, mut surcharge) = (None, 0.0);
     for (k, v) in t {
         let x = number(v).filter(|x| x.is_finite());
-        match (k.as_str(), x) {
-            ("k0", Some(x)) if x > 0.0 => k0 = Some(x),
-            ("k0", _) => {
-                return Err(entry_error(
-                    i,
-                    &format!("{KEY}.k0"),
-                    "the earth pressure coefficient at rest K0 > 0",
-                ))
+        let m = match (k.as_str(), x) {
+            ("k0", Some(x)) if x >= 0.0 => {
+                k0 = Some(x);
+                continue;
             }
-            ("surcharge", Some(x)) if x >= 0.0 => surcharge = x,
-            ("surcharge", _) => {
-                return Err(entry_error(
-                    i,
-                    &format!("{KEY}.surcharge"),
-                    "a pressure ≥ 0 on the region's top (Pa)",
-                ))
+            ("surcharge", Some(x)) if x >= 0.0 => {
+                surcharge = x;
+                continue;
             }
-            _ => {
-                let m = "unknown key of a geostatic initial stress (`k0`, `surcharge`)";
-                return Err(entry_error(i, &format!("{KEY}.{k}"), m));
-            }
-        }
+            ("k0", _) => format!("`k0`: the earth pressure coefficient at rest K0 ≥ 0, got {v}"),
+            ("surcharge", _) => format!("`surcharge`: a pressure ≥ 0 on the region's top (Pa), got {v}"),
+            _ => format!("unknown key `{k}` of a geostatic initial stress (`k0`, `surcharge`)"),
+        };
+        return Err(entry_error(i, KEY, m));
     }
     Ok(InitialStress::Geostatic { k0, surcharge })
 }
@@ -109,7 +109,7 @@ pub fn per_cell(
     let d = m.dim;
     let g = gravity[..d].iter().map(|x| x * x).sum::<f64>().sqrt();
     if !(g > 0.0) {
-        return Err("a geostatic initial stress needs gravity (the scene's `gravity` is zero)".into());
+        return Err(NO_GRAVITY.into());
     }
     let up: Vec<f64> = gravity[..d].iter().map(|x| -x / g).collect();
     let height = |x: &[f64]| x.iter().zip(&up).map(|(a, b)| a * b).sum::<f64>();
@@ -130,6 +130,11 @@ pub fn per_cell(
             }
             t
         })
-        .collect();
+        .collect::<Vec<_>>();
+    if out.iter().flatten().flatten().any(|x| x.is_infinite()) {
+        return Err(format!(
+            "the geostatic stress (K0 = {k0}, surcharge {q} Pa) is too large to hold in numbers"
+        ));
+    }
     Ok(out)
 }

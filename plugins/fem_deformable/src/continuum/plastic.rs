@@ -144,6 +144,7 @@ impl Plastic {
     /// f_p = −Σ_e α_e A_e Bᵀ σ0 balances the tractions σ0 n on the sides (a uniform
     /// σ0) or the region's weight (a geostatic one) at u = 0.
     pub fn prestress(&mut self, sigma0: &[[[f64; 3]; 3]]) {
+        debug_assert_eq!(sigma0.len(), self.sigma.len(), "one σ0 a cell");
         for (e, s0) in sigma0.iter().enumerate().take(self.sigma.len()) {
             let e0 = self.compliance(s0);
             self.eps_p[e] = std::array::from_fn(|a| std::array::from_fn(|b| -e0[a][b]));

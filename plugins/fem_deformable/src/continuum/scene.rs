@@ -147,7 +147,7 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
         let band = band_of(i, e, N)?;
         let coupling = coupling_of(i, e)?;
         let dp = plastic_of(i, e)?;
-        let sigma0 = super::initial::of(i, e, N)?;
+        let sigma0 = super::initial::of(i, e, N, &w.gravity.as_ref()[..N])?;
         let drives = super::sides::sides_of(i, e, "drive", N)?;
         let from = match e.get("drive_from") {
             None => 0.0,
