@@ -32,6 +32,23 @@ band = {{ normal = [0.0, 1.0], continuum = 10.0, discrete = 11.0 }}
     )
 }
 
+/// The scene `text` run 100 steps, and its region's largest displacement.
+fn run_still(text: &str) -> (Run, f64) {
+    let mut r = Run::new(text);
+    for _ in 0..100 {
+        r.step();
+    }
+    let u = r.cont().bodies[0].u.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    (r, u)
+}
+
+/// The load error of the block scene with `extra`.
+fn refused(extra: &str) -> nscdd::error::InputError {
+    Scene::<nscdd::dim::D2>::load_str(&block_scene(extra), "t.toml", &registry())
+        .err()
+        .expect("refused")
+}
+
 fn largest_horizontal(c: &Continuum2) -> f64 {
     c.bodies[0].u.iter().step_by(2).fold(0.0f64, |m, x| m.max(x.abs()))
 }
@@ -215,16 +232,10 @@ fn a_side_loaded_then_driven() {
 fn an_initial_stress_balances_the_sides_loads() {
     let loads = "load = { left = [1e4, 0.0], right = [-1e4, 0.0], top = [0.0, -1e4], bottom = [0.0, 1e4] }";
     let run = |extra: &str| {
-        let text = format!(
+        run_still(&format!(
             "gravity = [0.0, 0.0]\n{}",
             block_scene(&format!("{loads}\n{extra}")).replace("fix = [\"bottom\"]\n", "")
-        );
-        let mut r = Run::new(&text);
-        for _ in 0..100 {
-            r.step();
-        }
-        let u = r.cont().bodies[0].u.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        (r, u)
+        ))
     };
     let (_, free) = run("");
     let (_, held) = run("initial_stress = [-1e4, -1e4, 0.0]");
@@ -235,14 +246,9 @@ fn an_initial_stress_balances_the_sides_loads() {
     assert!(held < 1e-12 && held_dp < 1e-12, "{held:e} {held_dp:e}");
     assert_eq!(dp.cont().plastic[0].as_ref().unwrap().yielding, 0);
     // refused where it cannot apply
-    let bad = |extra: &str| {
-        Scene::<nscdd::dim::D2>::load_str(&block_scene(extra), "t.toml", &registry())
-            .err()
-            .expect("refused")
-    };
-    assert_eq!(bad("initial_stress = [1.0, 2.0]").key, "continuum[0].initial_stress");
+    assert_eq!(refused("initial_stress = [1.0, 2.0]").key, "continuum[0].initial_stress");
     assert_eq!(
-        bad("initial_stress = [-1.0, -1.0, 0.0]\nplane = \"stress\"").key,
+        refused("initial_stress = [-1.0, -1.0, 0.0]\nplane = \"stress\"").key,
         "continuum[0].initial_stress"
     );
 }
@@ -256,14 +262,7 @@ fn an_initial_stress_balances_the_sides_loads() {
 #[test]
 fn a_geostatic_initial_stress_holds_a_ground_under_its_weight() {
     let sides = "drive = { left = [0.0, \"free\"], right = [0.0, \"free\"] }";
-    let run = |extra: &str| {
-        let mut r = Run::new(&block_scene(&format!("{sides}\nload = {{ top = [0.0, -5000.0] }}\n{extra}")));
-        for _ in 0..100 {
-            r.step();
-        }
-        let u = r.cont().bodies[0].u.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        (r, u)
-    };
+    let run = |extra: &str| run_still(&block_scene(&format!("{sides}\nload = {{ top = [0.0, -5000.0] }}\n{extra}")));
     let (_, free) = run("");
     let (_, held) = run("initial_stress = { surcharge = 5000.0 }");
     let (dp, held_dp) = run("initial_stress = { surcharge = 5000.0, k0 = 0.6 }\nplastic = { friction = 30.0, dilatancy = 4.0 }");
@@ -278,18 +277,13 @@ fn a_geostatic_initial_stress_holds_a_ground_under_its_weight() {
     assert!(held < 1e-12 && held_dp < 1e-12, "{held:e} {held_dp:e}");
     assert!(wrong > 0.3 * free, "{wrong:e}");
     assert_eq!(dp.cont().plastic[0].as_ref().unwrap().yielding, 0);
-    let bad = |extra: &str| {
-        Scene::<nscdd::dim::D2>::load_str(&block_scene(extra), "t.toml", &registry())
-            .err()
-            .expect("refused")
-    };
     for (text, needle) in [
         ("initial_stress = { k0 = -1.0 }", "`k0`"),
         ("initial_stress = { surcharge = -1.0 }", "`surcharge`"),
         ("initial_stress = { depth = 1.0 }", "`depth`"),
         ("initial_stress = { k0 = 1e308, surcharge = 1e308 }", "too large"),
     ] {
-        let e = bad(text);
+        let e = refused(text);
         assert_eq!(e.key, "continuum[0].initial_stress", "{text}");
         assert!(e.message.contains(needle) && e.line.is_some(), "{text}: {e:?}");
     }
@@ -335,6 +329,5 @@ fn free_components_of_a_drive_make_rollers() {
     assert!((rolled - poisson).abs() < 0.02 * poisson, "{rolled:e} vs {poisson:e}");
     assert_eq!(r_rolled[0], 0.0);
     assert!(r_rolled[1] > 0.0);
-    let bad = Scene::<nscdd::dim::D2>::load_str(&block_scene("drive = { top = [\"free\", \"free\"] }"), "t.toml", &registry());
-    assert_eq!(bad.err().expect("refused").key, "continuum[0].drive");
+    assert_eq!(refused("drive = { top = [\"free\", \"free\"] }").key, "continuum[0].drive");
 }
