@@ -57,18 +57,28 @@ fn continuum_scenes_restart_bitwise_and_thread_independently() {
 #[cfg(feature = "mpi")]
 mod mpi_common;
 
-/// On 2 and 4 ranks, by model and by geometry: final.json is one process's.
+/// On 2 and 4 ranks, by model and by geometry: final.json is one process's. By
+/// geometry each rank holds only its part of the grains (its halo and the tied
+/// grains, `Attached::held_everywhere`), and a state written by 2 ranks restarts on
+/// 4 and in one process to the same end.
 #[cfg(feature = "mpi")]
 #[test]
 fn continuum_scenes_on_ranks_give_the_one_process_result() {
     use mpi_common::*;
     let dir = scratch("continuum_ranks");
-    for dec in ["[decomposition]\nby_model = true\nnx = 2", "[decomposition]\nnx = 2\nny = 2"] {
+    for (dec, part) in [
+        ("[decomposition]\nby_model = true\nnx = 2", false),
+        ("[decomposition]\nnx = 2\nny = 2", true),
+    ] {
         let scene = write(&dir, "footing.toml", &footing(20, "", dec));
         let one = dir.join("one");
         let o = nscdd(&args(&scene, &one, &[]));
         assert!(o.status.success(), "{}", text(&o.stderr));
         let reference = final_json(&one);
+        let bodies = serde_json::from_str::<serde_json::Value>(&reference).unwrap()["bodies"]
+            .as_array()
+            .unwrap()
+            .len() as u64;
         for n in [2, 4] {
             let out = dir.join(format!("ranks{n}"));
             let o = mpirun(&[(n, args(&scene, &out, &[]))]);
@@ -77,6 +87,25 @@ fn continuum_scenes_on_ranks_give_the_one_process_result() {
                 final_json(&out) == reference,
                 "{dec:?}, {n} ranks: final.json differs from one process"
             );
+            // by model every rank holds every body; by geometry its part
+            let held = per_rank_count(&out, "bodies_held_max");
+            assert!(
+                held.iter().all(|&h| (h < bodies) == part),
+                "{dec:?}, {n} ranks: {held:?} of {bodies} bodies"
+            );
+        }
+        if part {
+            let first = write(&dir, "first.toml", &footing(10, "", dec));
+            let half = dir.join("half");
+            ok(&mpirun(&[(2, args(&first, &half, &[]))]), "10 steps on 2 ranks");
+            let state = half.join("final.json");
+            let restart = ["--restart", state.to_str().unwrap()];
+            let on4 = dir.join("restart4");
+            ok(&mpirun(&[(4, args(&scene, &on4, &restart))]), "the restart on 4 ranks");
+            assert!(final_json(&on4) == reference, "a restart on 4 ranks ends elsewhere");
+            let on1 = dir.join("restart1");
+            ok(&nscdd(&args(&scene, &on1, &restart)), "the restart in one process");
+            assert!(final_json(&on1) == reference, "a restart in one process ends elsewhere");
         }
     }
 }

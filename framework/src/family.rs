@@ -170,6 +170,14 @@ pub fn local_problem<D: Dim>(w: &World<D>, families: &[Box<dyn SceneFamily<D>>])
     Ok(crate::fc::problem_of(w, &shares))
 }
 
+/// The world bodies the families read or touch, for MPI ranks
+/// ([`Attached::held_everywhere`]: every rank steps them); `None` if a family may
+/// touch any world body (its scene then holds every body on every rank).
+pub fn held_everywhere<D: Dim>(families: &[Box<dyn SceneFamily<D>>]) -> Option<Vec<u32>> {
+    let fams: Vec<&dyn Attached<Rigid<D>>> = families.iter().map(|f| &**f as &dyn Attached<Rigid<D>>).collect();
+    crate::dd::attach::held_everywhere(&fams)
+}
+
 /// The families' states, by section, for `final.json` and checkpoints.
 pub fn states<D: Dim>(families: &[Box<dyn SceneFamily<D>>]) -> serde_json::Map<String, serde_json::Value> {
     families.iter().map(|f| (f.section().to_string(), f.save_state())).collect()

@@ -120,6 +120,29 @@ pub trait Attached<F: Family> {
     /// (‖F(r)‖², ‖q‖²) of its contacts for the natural-map residual, from the written-back
     /// state and the world's velocities.
     fn residual_parts(&self, w: &F::World) -> (f64, f64);
+    /// On MPI ranks with bodies held per rank ([`super::local`], [`super::owned`]):
+    /// every world body the family reads or its contacts touch, for the whole run
+    /// (ascending global ids), which every rank then holds and steps as it does a
+    /// fixed or driven body (bitwise the same state wherever it is held), so that
+    /// the family, held whole on every rank, builds the same contacts everywhere.
+    /// It reads a world body through its slot ([`Family::held_slot`]). `None` (the
+    /// default): the family may touch any world body, and its scenes run on ranks
+    /// with every body and contact held on every rank.
+    fn held_everywhere(&self) -> Option<Vec<u32>> {
+        None
+    }
+}
+
+/// The world bodies that `fams` read or touch ([`Attached::held_everywhere`]),
+/// ascending and once each; `None` if a family may touch any world body.
+pub fn held_everywhere<F: Family>(fams: &[&dyn Attached<F>]) -> Option<Vec<u32>> {
+    let mut all = Vec::new();
+    for f in fams {
+        all.extend(f.held_everywhere()?);
+    }
+    all.sort_unstable();
+    all.dedup();
+    Some(all)
 }
 
 /// The parts of one subdomain, with the family index of each.

@@ -373,7 +373,11 @@ impl<D: Family> super::NscddOf<D> {
         let s = &self.settings;
         let c = D::contacts(w);
         let nc = D::len(c);
-        let (lo, hi) = Grid::bounds((0..nc).map(|a| D::point(c, a)));
+        // the attached families' contact points (every rank's, the same) counted
+        // once, by rank 0; `total`: the world's contacts
+        let fam: &[[f64; 3]] = if rs.cluster.rank() == 0 { &self.fam_points } else { &[] };
+        let points = || (0..nc).map(|a| D::point(c, a)).chain(fam.iter().copied());
+        let (lo, hi) = Grid::bounds(points());
         let mine: Vec<f64> = lo.iter().chain(&hi).copied().chain([nc as f64]).collect();
         let (_, all) = rs.all_gather_any(&mine);
         let (mut glo, mut ghi, mut total) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3], 0usize);
@@ -387,14 +391,14 @@ impl<D: Family> super::NscddOf<D> {
         let grid = if self.balanced_grid {
             // every rank's histograms of its contact points, added (integers: exact)
             let add = |mine: Vec<f64>| rs.all_sum(&mine);
-            Grid::balanced(glo, ghi, [s.nx, s.ny, s.nz], || (0..nc).map(|a| D::point(c, a)), add)
+            Grid::balanced(glo, ghi, [s.nx, s.ny, s.nz], points, add)
         } else {
             Grid::from_bounds(glo, ghi, s.nx, s.ny, s.nz)
         };
         let ns = grid.len();
         let mut loads = vec![0f64; ns];
-        for a in 0..nc {
-            loads[grid.cell_of(D::point(c, a)) as usize] += 1.0;
+        for p in points() {
+            loads[grid.cell_of(p) as usize] += 1.0;
         }
         let sum: Vec<usize> = rs.all_sum(&loads).into_iter().map(|x| x as usize).collect();
         let new = super::rank_balance::balanced_ranks(&sum, rs.cluster.size());

@@ -70,6 +70,8 @@ mod reactions;
 mod report;
 pub mod schemes;
 mod shells;
+mod stage;
+pub use stage::Stage;
 mod state;
 pub use first_part::LoadedPart;
 pub use state::{NscddState, RestartPart};
@@ -90,9 +92,9 @@ pub use schemes::Scheme;
 pub use subdomain::{Subdomain, Subdomain2, Subdomain3, SubdomainSolver};
 pub use transport::{InProcess, Transport, TransportStats};
 
-use crate::engine::{ContactStage, Diverged};
+use crate::engine::Diverged;
 use crate::norms::{Norms, Sums, VANISHING};
-use crate::solver::SolveReport;
+
 use gluing::GluePartial;
 use schemes::GlueBuffers;
 
@@ -158,7 +160,14 @@ pub struct NscddOf<D: Family> {
     pub by_model: bool,
     /// Subdomain of each attached family's contact (this step).
     fam_owner: Vec<Vec<u32>>,
+    /// The attached families' contact points (this step), one range per family.
     fam_points: Vec<[f64; 3]>,
+    fam_ranges: Vec<std::ops::Range<usize>>,
+    /// Whether the steps may hold bodies and contacts per rank ([`local`],
+    /// [`owned`]): rigid bodies alone, or attached families that name the world
+    /// bodies they touch, not by model. Decided at the first step (or
+    /// [`Self::start_ranks`]).
+    held_ok: Option<bool>,
     /// The report of the step in progress.
     pending: DdStepReport,
     /// Owner of each contact of the last step, by key (sorted).
@@ -206,6 +215,8 @@ impl<D: Family> NscddOf<D> {
             by_model: false,
             fam_owner: Vec::new(),
             fam_points: Vec::new(),
+            fam_ranges: Vec::new(),
+            held_ok: None,
             pending: DdStepReport::default(),
             kept: Vec::new(),
             grid_empty: false,
@@ -266,8 +277,34 @@ impl<D: Family> NscddOf<D> {
         self.loaded = Some(part);
     }
 
-    pub fn start_ranks(&mut self, w: &mut D::World, families: bool) {
-        self.start_held(w, !families && !self.by_model);
+    /// `shared`: the world bodies the scene's body families touch
+    /// ([`attach::held_everywhere`]; empty without families).
+    pub fn start_ranks(&mut self, w: &mut D::World, shared: Option<Vec<u32>>) {
+        let ok = self.decide_held(|| shared);
+        self.start_held(w, ok);
+    }
+
+    /// [`Self::held_ok`], decided once: `shared` gives the attached families'
+    /// world bodies (every rank steps them, [`owned`]).
+    fn decide_held(&mut self, shared: impl FnOnce() -> Option<Vec<u32>>) -> bool {
+        if let Some(ok) = self.held_ok {
+            return ok;
+        }
+        let ok = match shared() {
+            Some(ids) if !self.by_model => {
+                self.local.owned.set_shared(ids);
+                true
+            }
+            _ => false,
+        };
+        self.held_ok = Some(ok);
+        ok
+    }
+
+    /// Whether this scene's steps may hold bodies and contacts per rank (before it
+    /// is decided: rigid bodies alone, `no_families`, not by model).
+    fn held_scene(&self, no_families: bool) -> bool {
+        self.held_ok.unwrap_or(no_families && !self.by_model)
     }
 
     /// Re-partitions every `k` steps (see [`Nscdd::repartition_every`]).
@@ -282,14 +319,7 @@ impl<D: Family> NscddOf<D> {
         let s = &self.settings;
         let c = D::contacts(w);
         let nc = D::len(c);
-        // the attached families' contact points, one range per family
-        self.fam_points.clear();
-        let mut ranges = Vec::with_capacity(fams.len());
-        for f in fams {
-            let a = self.fam_points.len();
-            f.points(&mut self.fam_points);
-            ranges.push(a..self.fam_points.len());
-        }
+        let ranges = std::mem::take(&mut self.fam_ranges);
         let repart = self.repartitions();
         let (grid, owner) = match &self.grid {
             Some(g) if !repart => (g.clone(), partition::kept_owners::<D>(c, g, &self.kept)),
@@ -308,12 +338,13 @@ impl<D: Family> NscddOf<D> {
         let models = if self.by_model { 1 + fams.len() } else { 1 };
         let ns = grid.len() * models;
         self.fam_owner.resize_with(fams.len(), Vec::new);
-        for (f, r) in ranges.into_iter().enumerate() {
+        for (f, r) in ranges.iter().enumerate() {
             let base = if self.by_model { (f + 1) * grid.len() } else { 0 } as u32;
             let o = &mut self.fam_owner[f];
             o.clear();
-            o.extend(self.fam_points[r].iter().map(|&p| base + grid.cell_of(p)));
+            o.extend(self.fam_points[r.clone()].iter().map(|&p| base + grid.cell_of(p)));
         }
+        self.fam_ranges = ranges;
         // limited shells ([`shells`]): on a repartition step, the kept F_Γ routed
         let mut start = self.start_shells(w, repart);
         // the last step's copies, for the migrations (routed with limited shells)
@@ -333,20 +364,25 @@ impl<D: Family> NscddOf<D> {
             fams,
             owner: &self.fam_owner,
         };
-        let local = &self.local;
+        let (local, families) = (&self.local, !fams.is_empty());
         let mut shells = |subs: &mut [Subdomain<D>]| {
             let rs = self.ranks.as_mut().expect("ranks");
             match start.as_ref().and_then(|(asked, _)| shells::near_of::<D>(local, w, asked)) {
-                Some(near) => rs.fill_shells_near(subs, &near),
+                Some(near) => rs.fill_shells_near(subs, &near, families),
                 None => rs.fill_shells(subs),
             }
         };
         let shells = self.local.now.then_some(&mut shells as &mut dyn FnMut(&mut [Subdomain<D>]));
         self.last = partition::decompose_owned::<D>(w, &self.v_free, grid, owner, ns, &self.store, build.as_deref(), &fo, shells);
         // contacts held per rank: the other ranks' F_Γ are not kept up to date here
+        // (the copies' starting velocities hold F_Γ and the warm starts, families'
+        // parts included: made once, after it, `Subdomain::init_velocities`)
         if let (true, Some(rs)) = (self.local.now, self.ranks.as_mut()) {
+            rs.fresh_f_gamma(&mut self.last, &self.store);
             let slot = |g: u32| D::held_slot(w, g as usize);
-            rs.fresh_f_gamma(&mut self.last, &self.store, (&self.v_free, &slot));
+            for s in self.last.subs.iter_mut().filter(|s| rs.is_own(s.id)) {
+                s.init_velocities(&self.v_free, &slot);
+            }
         }
         rep.repartitioned = repart;
         if let Some((before, routed)) = before {
@@ -370,7 +406,11 @@ impl<D: Family> NscddOf<D> {
     /// parts and receives the others' packed results, [`LocalPart::pack`]).
     pub fn step_families(&mut self, w: &mut D::World, fams: &mut [&mut dyn Attached<D>]) -> Result<DdStepReport, Diverged> {
         self.pending = DdStepReport::default();
-        self.start_held(w, fams.is_empty() && !self.by_model);
+        let ok = self.decide_held(|| {
+            let fams: Vec<&dyn Attached<D>> = fams.iter().map(|f| &**f as &dyn Attached<D>).collect();
+            attach::held_everywhere(&fams)
+        });
+        self.start_held(w, ok);
         let base = D::step_with(w, &mut Stage { dd: self, fams });
         self.after_step();
         let base = base?;
@@ -379,6 +419,19 @@ impl<D: Family> NscddOf<D> {
         rep.contacts = base.contacts;
         rep.times = base.times;
         Ok(rep)
+    }
+
+    /// The attached families' contact points of the step, one range per family
+    /// (after their [`Attached::build`]: the partition's, and a distributed
+    /// repartition's, input).
+    fn family_points(&mut self, fams: &[&mut dyn Attached<D>]) {
+        self.fam_points.clear();
+        self.fam_ranges.clear();
+        for f in fams {
+            let a = self.fam_points.len();
+            f.points(&mut self.fam_points);
+            self.fam_ranges.push(a..self.fam_points.len());
+        }
     }
 
     /// The NSCDD iteration on `self.last`, then the write-back into `w`.
@@ -487,111 +540,4 @@ impl<D: Family> NscddOf<D> {
 /// One NSCDD step of `w` with a solver state (F_Γ kept in `state` between steps).
 pub fn step(w: &mut crate::world::World2, state: &mut Nscdd) -> Result<DdStepReport, Diverged> {
     state.step(w)
-}
-
-/// NSCDD with the step's attached families, as the contact-solve stage of the
-/// world's `step_with`.
-pub struct Stage<'a, 'f, D: Family> {
-    dd: &'a mut NscddOf<D>,
-    fams: &'a mut [&'f mut dyn Attached<D>],
-}
-
-/// NSCDD as the contact-solve stage of the world's `step_with`: it keeps V_free
-/// (the families' after theirs), builds the families' contacts and splits all
-/// contacts (timed with the Delassus stage), and runs the NSCDD iteration.
-impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
-    fn before_detection(&mut self, w: &mut D::World) {
-        let eligible = self.fams.is_empty() && !self.dd.by_model;
-        self.dd.before_detection(w, eligible);
-    }
-    fn after_detection(&mut self, w: &mut D::World) {
-        self.dd.after_detection(w);
-    }
-    fn after_free_velocity(&mut self, w: &D::World) {
-        D::velocities(w, &mut self.dd.v_free);
-        for f in self.fams.iter_mut() {
-            f.after_free_velocity(w);
-        }
-    }
-    fn prepare(&mut self, w: &mut D::World) {
-        for f in self.fams.iter_mut() {
-            f.build(w);
-        }
-        self.dd.repartition_local(w);
-        let mut rep = std::mem::take(&mut self.dd.pending);
-        self.dd.partition(w, self.fams, &mut rep);
-        self.dd.pending = rep;
-    }
-    fn solve(&mut self, w: &mut D::World) -> SolveReport {
-        let mut rep = std::mem::take(&mut self.dd.pending);
-        NscddOf::solve(self.dd, w, self.fams, &mut rep);
-        let s = rep.solve;
-        self.dd.pending = rep;
-        s
-    }
-    /// (the world's slots; NSCDD's global ids inside)
-    fn after_integrate(&mut self, w: &mut D::World, moved: Result<(), usize>) -> Result<(), usize> {
-        let moved = moved.map_err(|k| D::global(w, k));
-        self.dd.after_integrate(w, moved).map_err(|g| D::held_slot(w, g))
-    }
-    /// The counts outputs read ([`census`]), on the moved bodies (collective).
-    fn after_update(&mut self, w: &mut D::World) {
-        if self.dd.last.subs.is_empty() || self.dd.pending.census.is_some() {
-            return;
-        }
-        // rigid bodies: the sums over bodies per cell (the cells are the subdomains)
-        let sums = (self.fams.is_empty() && !self.dd.by_model)
-            .then_some(self.dd.grid.as_ref())
-            .flatten()
-            .map(|grid| census::BodySums { grid });
-        let census = census::census(&self.dd.last, w, self.dd.ranks.as_mut(), sums);
-        let imbalance = census.imbalance(self.dd.last.subs.len());
-        self.dd.pending.imbalance = imbalance;
-        // (the next step's repartition is already decided: its state was shared)
-        let (repartitioned, steps, next) = (self.dd.pending.repartitioned, self.dd.steps, self.dd.repartitions());
-        let factor = self.dd.rebalance.filter(|_| !next);
-        self.dd.balance.observe(imbalance, repartitioned, steps, factor);
-        self.dd.pending.subdomains = census.subdomains;
-        self.dd.pending.census = Some(census);
-    }
-    /// Per subdomain, in subdomain order ([`reactions`]); the attached families'
-    /// contacts are the world's business (their reactions stay the engine's sum).
-    fn reactions(&mut self, w: &mut D::World) -> bool {
-        if !self.fams.is_empty() || self.dd.last.subs.is_empty() {
-            return false;
-        }
-        let observed = D::observed(w);
-        reactions::set(&self.dd.last, w, self.dd.ranks.as_mut(), &observed);
-        true
-    }
-}
-
-/// NSCDD without attached families as a contact stage (`world.step_with(&mut dd)`),
-/// for one process: on MPI ranks step with [`NscddOf::step`], which also reduces each
-/// world to its rank's part and keeps the rank state between steps.
-impl<D: Family> ContactStage<D::World> for NscddOf<D> {
-    fn before_detection(&mut self, w: &mut D::World) {
-        Stage { dd: self, fams: &mut [] }.before_detection(w);
-    }
-    fn after_detection(&mut self, w: &mut D::World) {
-        Stage { dd: self, fams: &mut [] }.after_detection(w);
-    }
-    fn after_free_velocity(&mut self, w: &D::World) {
-        Stage { dd: self, fams: &mut [] }.after_free_velocity(w);
-    }
-    fn prepare(&mut self, w: &mut D::World) {
-        Stage { dd: self, fams: &mut [] }.prepare(w);
-    }
-    fn solve(&mut self, w: &mut D::World) -> SolveReport {
-        Stage { dd: self, fams: &mut [] }.solve(w)
-    }
-    fn reactions(&mut self, w: &mut D::World) -> bool {
-        Stage { dd: self, fams: &mut [] }.reactions(w)
-    }
-    fn after_update(&mut self, w: &mut D::World) {
-        Stage { dd: self, fams: &mut [] }.after_update(w);
-    }
-    fn after_integrate(&mut self, w: &mut D::World, moved: Result<(), usize>) -> Result<(), usize> {
-        Stage { dd: self, fams: &mut [] }.after_integrate(w, moved)
-    }
 }

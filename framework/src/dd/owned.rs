@@ -9,7 +9,8 @@
 //! halo(r)    the bodies whose box, grown by the alert distance, meets r's cells:
 //!            every body r's detection can pair (the region's own test)
 //! active(r)  halo(r) ∪ the bodies of r's contacts ∪ the fixed, driven, named
-//!            and unbounded bodies (stepped by every rank)
+//!            and unbounded bodies and those the attached body families touch
+//!            (stepped by every rank)
 //! ```
 //!
 //! A rank steps its active bodies exactly as one process does: their V⁺ is the
@@ -47,8 +48,12 @@ pub(super) struct Owned {
     pub cells: Option<CellIndex>,
     /// The active bodies this rank owned at the start of the step.
     mine: Vec<u32>,
-    /// Bodies stepped by every rank (fixed, driven, unbounded), by id.
+    /// Bodies stepped by every rank (fixed, driven, unbounded, and those of
+    /// `shared`), by id.
     everywhere: Vec<bool>,
+    /// The world bodies the attached families read or touch
+    /// ([`super::Attached::held_everywhere`]; ascending): stepped by every rank.
+    shared: Vec<u32>,
     /// The next step's bodies, by the world's slot (a buffer).
     keep: Vec<bool>,
 }
@@ -91,8 +96,10 @@ impl Owned {
         if self.everywhere.len() != nb {
             // and the observed bodies (named or driven: the history reads them on rank 0)
             self.everywhere = (0..nb).map(|g| D::everywhere(w, g)).collect();
-            for g in D::observed(w) {
-                self.everywhere[g as usize] = true;
+            for g in D::observed(w).into_iter().chain(self.shared.iter().copied()) {
+                if let Some(e) = self.everywhere.get_mut(g as usize) {
+                    *e = true;
+                }
             }
         }
         self.own_bodies::<D>(w, rs, grid);
@@ -111,6 +118,13 @@ impl Owned {
         };
         let mut boxes = Vec::new();
         self.next_active::<D>(w, &mine, &[], &mut boxes);
+    }
+
+    /// The attached families' world bodies (module docs: stepped by every rank),
+    /// before the first step.
+    pub(super) fn set_shared(&mut self, shared: Vec<u32>) {
+        self.shared = shared;
+        self.everywhere.clear();
     }
 
     /// The bodies stepped by every rank, by id (set by [`Owned::start`]).

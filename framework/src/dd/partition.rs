@@ -173,7 +173,10 @@ pub struct FamilyOwners<'a, 'f, D: Family> {
 /// subdomain's contacts.
 /// With `build`, only the subdomains it marks get their copies' M̂_E⁻¹, W_αα and
 /// starting velocities (the others are swept by another process: their structure
-/// alone is kept, for the exchange of results; no attached family then).
+/// alone is kept, for the exchange of results; a family's parts too, which receive
+/// its results). With `shells` (contacts held per rank) the caller makes the
+/// starting velocities, once the fresh bodies' F_Γ are known
+/// ([`super::RankState::fresh_f_gamma`]).
 #[allow(clippy::too_many_arguments)]
 pub fn decompose_owned<D: Family>(
     w: &D::World,
@@ -189,6 +192,7 @@ pub fn decompose_owned<D: Family>(
 ) -> Decomposition<D> {
     let built = |s: u32| build.is_none_or(|b| b[s as usize]);
     let (mut subs, mut copy_of) = split_contacts::<D>(w, &owner, ns);
+    let shelled = shells.is_some();
     if let Some(fill) = shells {
         // contacts held per rank: the other ranks' subdomains get their bodies only
         fill(&mut subs);
@@ -231,8 +235,9 @@ pub fn decompose_owned<D: Family>(
         entity_interface(&mut iface, &mut subs, &*fam.fams[f], ec);
     }
     link_chains(&mut subs, &iface);
+    // (with shells, the caller's, once the fresh bodies' F_Γ are known)
     let slot = |g: u32| D::held_slot(w, g as usize);
-    for sub in subs.iter_mut().filter(|s| built(s.id)) {
+    for sub in subs.iter_mut().filter(|s| built(s.id) && !shelled) {
         sub.init_velocities(v_free, &slot);
     }
     Decomposition {
@@ -305,6 +310,11 @@ fn split_families<D: Family>(
                 stamp[k] = s;
                 local[k] = sub.body_global.len() as u32;
                 sub.body_global.push(g);
+                // (a limited shell: the copy's local id on the subdomain's rank)
+                if let Some(n) = sub.shell_len.as_mut() {
+                    sub.shell_local.push(*n);
+                    *n += 1;
+                }
                 copy_of.push((g, s, local[k]));
             }
             local[k]

@@ -19,15 +19,10 @@ use super::ranks::RankState;
 
 impl RankState {
     /// Sets the starting F_Γ of this rank's copies of the fresh interface bodies
-    /// from every copy's kept F_Γ, asked of its subdomain's rank (module docs), and
-    /// the starting velocities of the subdomains holding them again. Collective.
-    /// (`v_free` by slot, `slot` the slot of a global id)
-    pub(super) fn fresh_f_gamma<D: Family>(
-        &mut self,
-        d: &mut Decomposition<D>,
-        store: &FGammaStore<D::V>,
-        (v_free, slot): (&[D::V], &dyn Fn(u32) -> usize),
-    ) {
+    /// from every copy's kept F_Γ, asked of its subdomain's rank (module docs); the
+    /// caller then makes the own subdomains' starting velocities (once: a family's
+    /// part moves its own copies in its warm start). Collective.
+    pub(super) fn fresh_f_gamma<D: Family>(&mut self, d: &mut Decomposition<D>, store: &FGammaStore<D::V>) {
         let iface = &d.iface;
         let mut bodies = Vec::new();
         // (subdomain, body) of the other ranks' copies asked: each one's kept F_Γ,
@@ -51,7 +46,6 @@ impl RankState {
         // the same order
         let mut answers = got.chunks_exact(ndof);
         let iface = &d.iface;
-        let mut touched = Vec::new();
         for ib in bodies {
             let g = iface.body[ib];
             let mut f: Vec<D::V> = iface
@@ -73,15 +67,8 @@ impl RankState {
                 let s = iface.sub[k];
                 if self.is_own(s) {
                     d.subs[s as usize].f_gamma[iface.slot[k] as usize] = f[j];
-                    touched.push(s);
                 }
             }
-        }
-        // the copies' starting velocities hold F_Γ (`Subdomain::init_velocities`)
-        touched.sort_unstable();
-        touched.dedup();
-        for s in touched {
-            d.subs[s as usize].init_velocities(v_free, slot);
         }
     }
 }

@@ -50,5 +50,36 @@ impl RankState {
             answered.push((s, l));
         }
         self.answered = Some(answered);
+        self.share_parts(d);
+    }
+
+    /// The attached families' parts of the other ranks' subdomains: their packed
+    /// results ([`super::LocalPart::pack`]) from each subdomain's rank to every rank
+    /// (one all-gather): a family, held whole on every rank, writes back every part.
+    /// Nothing without parts (the same on every rank: they hold the same families).
+    /// Collective.
+    fn share_parts<D: Family>(&mut self, d: &mut Decomposition<D>) {
+        if d.subs.iter().all(|s| s.parts.0.is_empty()) {
+            return;
+        }
+        let me = self.cluster.rank();
+        let len = |s: &super::Subdomain<D>| s.parts.0.iter().map(|(_, p)| p.packed_len()).sum::<usize>();
+        self.send.clear();
+        for s in d.subs.iter().filter(|s| self.rank_of[s.id as usize] == me) {
+            for (_, p) in &s.parts.0 {
+                p.pack(&mut self.send);
+            }
+        }
+        let at = self.counts_by(d.subs.len(), |k| len(&d.subs[k]));
+        self.reduced(self.send.len());
+        self.cluster.all_gather(&self.send, &self.counts, &mut self.all);
+        for s in d.subs.iter_mut().filter(|s| self.rank_of[s.id as usize] != me) {
+            let mut pos = at[s.id as usize];
+            for (_, p) in s.parts.0.iter_mut() {
+                let n = p.packed_len();
+                p.unpack(&self.all[pos..pos + n]);
+                pos += n;
+            }
+        }
     }
 }

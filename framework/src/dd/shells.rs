@@ -124,8 +124,11 @@ impl RankState {
     }
 
     /// The other ranks' subdomains limited to the bodies this rank may need, from
-    /// their ranks point to point (module docs). Collective.
-    pub(super) fn fill_shells_near<D: Family>(&mut self, subs: &mut [Subdomain<D>], near: &Near) {
+    /// their ranks point to point (module docs); with `families` (attached body
+    /// families, which copy their bodies into every subdomain after this), each
+    /// shell's number of bodies on its rank too ([`Subdomain::shell_len`]).
+    /// Collective.
+    pub(super) fn fill_shells_near<D: Family>(&mut self, subs: &mut [Subdomain<D>], near: &Near, families: bool) {
         // each own subdomain's bodies (subdomain, local id, body) to the ranks that may need them
         let own: Vec<&Subdomain<D>> = subs.iter().filter(|s| self.is_own(s.id)).collect();
         let (got, _) = self.route(own.into_iter(), near, false, |s, l, g, o| {
@@ -143,6 +146,12 @@ impl RankState {
         }
         self.totals.shell_bodies += got.iter().map(|m| m.len() as u64 / 3).sum::<u64>();
         self.totals.limited_shells += 1;
+        if families {
+            let lens = self.per_subdomain(subs.len(), 1, |s, out| out.push(subs[s].body_global.len() as f64));
+            for (sub, &n) in subs.iter_mut().zip(&lens) {
+                sub.shell_len = (!self.is_own(sub.id)).then_some(n as u32);
+            }
+        }
     }
 
     /// Each copy of `subs` (this rank's subdomains) to the ranks that may need its

@@ -109,7 +109,7 @@ impl<D: Dim> Runner<D> {
             start,
         };
         if let Some(n) = r.dd.as_mut() {
-            n.start_ranks(&mut scene.world, !scene.families.is_empty());
+            n.start_ranks(&mut scene.world, crate::family::held_everywhere(&scene.families));
         }
         r.write_frame(scene).map_err(io(here, "the first output frame"))?;
         Ok(r)

@@ -13,7 +13,7 @@
 use super::ties::{self, TieSet};
 use crate::body::FeBody;
 use crate::nodes::{fill_set, NodeSet};
-use nscdd::dd::{Attached, EntityInfo, LocalPart, Rigid};
+use nscdd::dd::{Attached, EntityInfo, Family, LocalPart, Rigid};
 use nscdd::dim::Dim;
 use nscdd::norms::Sums;
 use nscdd::world::World;
@@ -108,8 +108,9 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
         self.grain_begin.clear();
         self.grain_free.clear();
         for &g in &self.ties.grain {
-            self.grain_begin.push(ties::grain_velocity::<D, N>(&begin[g as usize]));
-            self.grain_free.push(ties::grain_velocity::<D, N>(&w.bodies.vel[g as usize]));
+            let k = slot(w, g);
+            self.grain_begin.push(ties::grain_velocity::<D, N>(&begin[k]));
+            self.grain_free.push(ties::grain_velocity::<D, N>(&w.bodies.vel[k]));
         }
         Ok(())
     }
@@ -135,7 +136,7 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
             // Σ c x, Σ c v⁻, Σ c v_free over the grains; minus Σ b (x, V⁻, V_free) over the nodes
             let (mut x, mut gap, mut ub, mut uf) = ([0.0; N], [0.0; N], [0.0; N], [0.0; N]);
             for i in t.grains(a) {
-                let p = w.bodies.pos[t.grain[i] as usize];
+                let p = w.bodies.pos[slot(w, t.grain[i])];
                 for d in 0..N {
                     x[d] += t.c[i] * p.as_ref()[d];
                     ub[d] += t.c[i] * self.grain_begin[i][d];
@@ -303,6 +304,22 @@ impl<D: Dim, const N: usize> Attached<Rigid<D>> for Continuum<D, N> {
         self.finish_velocities();
     }
     fn residual_parts(&self, w: &World<D>) -> (f64, f64) {
-        ties::residual_parts::<D, N>(&self.ties, &self.sets, &w.bodies.vel)
+        ties::residual_parts::<D, N>(&self.ties, &self.sets, (&w.bodies.vel, |g| slot(w, g)))
     }
+    /// The tied grains (every rank holds and steps them; the family reads no other
+    /// world body).
+    fn held_everywhere(&self) -> Option<Vec<u32>> {
+        let mut g = self.ties.grain.clone();
+        g.extend(self.band.iter().map(|b| b.0));
+        g.sort_unstable();
+        g.dedup();
+        Some(g)
+    }
+}
+
+/// The world's slot of grain `g` (a global id; on MPI ranks the world holds a part,
+/// every tied grain among it: [`Attached::held_everywhere`]).
+#[inline]
+fn slot<D: Dim>(w: &World<D>, g: u32) -> usize {
+    Rigid::<D>::held_slot(w, g as usize)
 }

@@ -136,12 +136,18 @@ pub fn grain_velocity<D: Dim, const N: usize>(v: &D::Twist) -> [f64; N] {
     std::array::from_fn(|c| v.as_ref()[c])
 }
 
-/// u_a = Σ c_ai v_i − Σ b_al V_l from the current velocities.
+/// u_a = Σ c_ai v_i − Σ b_al V_l from the current velocities; grain i's at
+/// `vel[at(i's id)]`.
 #[inline(always)]
-pub fn tie_velocity<D: Dim, const N: usize>(t: &TieSet<N>, a: usize, vel: &[D::Twist], set: &NodeSet<N>) -> [f64; N] {
+pub fn tie_velocity<D: Dim, const N: usize>(
+    t: &TieSet<N>,
+    a: usize,
+    (vel, at): (&[D::Twist], impl Fn(u32) -> usize),
+    set: &NodeSet<N>,
+) -> [f64; N] {
     let mut u = [0.0; N];
     for i in t.grains(a) {
-        let v = vel[t.grain[i] as usize].as_ref();
+        let v = vel[at(t.grain[i])].as_ref();
         for c in 0..N {
             u[c] += t.c[i] * v[c];
         }
@@ -269,7 +275,7 @@ pub fn sweep<D: Dim, const N: usize>(
 ) {
     for a in 0..t.len() {
         let set = &mut sets[t.body[a] as usize];
-        let u = tie_velocity::<D, N>(t, a, vel, set);
+        let u = tie_velocity::<D, N>(t, a, (vel, |g| g as usize), set);
         let du: [f64; N] = std::array::from_fn(|c| u[c] - t.target[a][c]);
         let r = t.r[a];
         let step = mul(&t.inv_w[a], &du);
@@ -336,11 +342,15 @@ fn make_columns<const N: usize>(t: &mut TieSet<N>, sets: &[NodeSet<N>]) {
 }
 
 /// (‖F(λ)‖², ‖q‖²) of the ties for the natural-map residual: the bilateral law's
-/// natural map is u − ū itself, q = u_free − ū.
-pub fn residual_parts<D: Dim, const N: usize>(t: &TieSet<N>, sets: &[NodeSet<N>], vel: &[D::Twist]) -> (f64, f64) {
+/// natural map is u − ū itself, q = u_free − ū. Grain g's velocity at `vel[at(g)]`.
+pub fn residual_parts<D: Dim, const N: usize>(
+    t: &TieSet<N>,
+    sets: &[NodeSet<N>],
+    (vel, at): (&[D::Twist], impl Fn(u32) -> usize + Copy),
+) -> (f64, f64) {
     let (mut f2, mut q2) = (0.0, 0.0);
     for a in 0..t.len() {
-        let u = tie_velocity::<D, N>(t, a, vel, &sets[t.body[a] as usize]);
+        let u = tie_velocity::<D, N>(t, a, (vel, at), &sets[t.body[a] as usize]);
         for c in 0..N {
             let (f, q) = (u[c] - t.target[a][c], t.u_free[a][c] - t.target[a][c]);
             f2 += f * f;
