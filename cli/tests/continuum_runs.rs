@@ -60,7 +60,8 @@ mod mpi_common;
 /// On 2 and 4 ranks, by model and by geometry: final.json is one process's. By
 /// geometry each rank holds only its part of the grains (its halo and the tied
 /// grains, `Attached::held_everywhere`), and a state written by 2 ranks restarts on
-/// 4 and in one process to the same end.
+/// 4 and in one process to the same end; with compliant grains too (the band's
+/// stiffness shares).
 #[cfg(feature = "mpi")]
 #[test]
 fn continuum_scenes_on_ranks_give_the_one_process_result() {
@@ -108,6 +109,21 @@ fn continuum_scenes_on_ranks_give_the_one_process_result() {
             assert!(final_json(&on1) == reference, "a restart in one process ends elsewhere");
         }
     }
+    // compliant grains: the band's share 1 − α of a contact's stiffness looks up its
+    // grains by id, on a rank's world holding a part as in one process
+    let grains = "materials = [\"grain\", \"grain\"]\nfriction = 0.5";
+    let text = footing(20, "", "[decomposition]\nnx = 2\nny = 2");
+    assert!(text.contains(grains), "the footing example's grain law changed");
+    let compliant = "materials = [\"grain\", \"grain\"]\nlaw = \"compliant\"\nstiffness = 1e6\ndamping = 50.0\nfriction = 0.5";
+    let scene = write(&dir, "compliant.toml", &text.replace(grains, compliant));
+    let one = dir.join("compliant1");
+    ok(&nscdd(&args(&scene, &one, &[])), "compliant grains in one process");
+    let two = dir.join("compliant2");
+    ok(&mpirun(&[(2, args(&scene, &two, &[]))]), "compliant grains on 2 ranks");
+    assert!(
+        final_json(&two) == final_json(&one),
+        "compliant grains: 2 ranks differ from one process"
+    );
 }
 
 /// Two copies of a continuum scene's state that differ only in the region's state

@@ -214,7 +214,8 @@ pub(super) fn region<D: Family>(
 }
 
 impl<D: Family> super::NscddOf<D> {
-    /// Before a step on ranks (rigid bodies, contacts held per rank) while no
+    /// Before a step on ranks (contacts held per rank: rigid bodies, or families
+    /// naming the world bodies they touch, [`super::NscddOf::held_ok`]) while no
     /// step has reduced the world (it holds every body, or its part as the scene
     /// was loaded, [`crate::scene::part`]): each world reduced to its rank's part
     /// ([`super::owned`]), on a fresh run's first step ([`Self::start_fresh`]) and
@@ -307,7 +308,8 @@ impl<D: Family> super::NscddOf<D> {
         self.grid.is_none() || self.grid_empty || steps.is_multiple_of(k) || self.balance.due == Some(steps)
     }
 
-    /// Before detection: on ranks, with `eligible` (rigid bodies only), the exchange
+    /// Before detection: on ranks, with `eligible` (the scene may hold its contacts
+    /// per rank, [`super::NscddOf::held_ok`]), the exchange
     /// of the last step's contacts and this step's region (see the module docs).
     pub(super) fn before_detection(&mut self, w: &mut D::World, eligible: bool) {
         let repart = self.repartitions();
@@ -315,8 +317,9 @@ impl<D: Family> super::NscddOf<D> {
             self.local.now = false;
             return;
         };
-        // (ranks of the subdomains not known: a scene with body families, or a
-        // restart that could not start per rank; that step runs on the whole sample)
+        // (not eligible: families that may touch any body, or by model; ranks of the
+        // subdomains not known: a restart that could not start per rank; that step
+        // runs on the whole sample)
         if !(eligible && self.local_contacts) || rs.rank_of.len() != grid.len() {
             self.local.now = false;
             rs.local = false;

@@ -264,12 +264,6 @@ impl<D: Family> NscddOf<D> {
         self.local.skip_view = skip;
     }
 
-    /// Before a run's first frame: on ranks, each world reduced to its rank's part
-    /// when the first step will run per rank ([`Self::start_held`], which the first
-    /// step calls otherwise), a fresh run's or a restart's, so that the first frame
-    /// too is written in pieces by the bodies' owners instead of whole by rank 0.
-    /// `families`: whether body families are attached (their scenes step every
-    /// body on every rank).
     /// A fresh scene whose world holds this rank's part since loading
     /// ([`crate::scene::part`]): the first step starts from the provisional grid
     /// and ranks the loader computed, as it would compute them from the whole world.
@@ -277,8 +271,13 @@ impl<D: Family> NscddOf<D> {
         self.loaded = Some(part);
     }
 
+    /// Before a run's first frame: on ranks, each world reduced to its rank's part
+    /// when the first step will run per rank ([`Self::start_held`], which the first
+    /// step calls otherwise), a fresh run's or a restart's, so that the first frame
+    /// too is written in pieces by the bodies' owners instead of whole by rank 0.
     /// `shared`: the world bodies the scene's body families touch
-    /// ([`attach::held_everywhere`]; empty without families).
+    /// ([`attach::held_everywhere`]; empty without families; `None`: a family may
+    /// touch any body, and every rank steps every body).
     pub fn start_ranks(&mut self, w: &mut D::World, shared: Option<Vec<u32>>) {
         let ok = self.decide_held(|| shared);
         self.start_held(w, ok);

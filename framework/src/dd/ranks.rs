@@ -29,7 +29,9 @@
 //! and every reduction runs in subdomain order, a run gives bitwise the results of
 //! the same decomposition run in one process, whatever the number of ranks.
 //!
-//! Between repartitions, for rigid bodies, each rank holds only its subdomains'
+//! Between repartitions, for rigid bodies (and attached families that name the
+//! world bodies they touch, [`super::Attached::held_everywhere`]: every rank steps
+//! those), each rank holds only its subdomains'
 //! contacts ([`super::local`]): it detects and builds those alone, the other ranks'
 //! subdomains are shells (the bodies near it, [`super::shells`]), and the end of
 //! the step carries only the copy velocities a rank asked for, point to point
@@ -398,7 +400,8 @@ impl RankState {
     /// Every subdomain's impulses, copy velocities and F_Γ from its rank to all; with
     /// `requests` (contacts held per rank, no repartition next or limited shells,
     /// [`super::shells`]), only the copy velocities of the bodies this rank steps
-    /// (`Some(None)`: all of them; [`RankState::share_requested`]).
+    /// (`Some(None)`: all of them; [`RankState::share_requested`], which also
+    /// all-gathers the attached families' packed parts).
     fn share_results<D: Family>(&mut self, d: &mut Decomposition<D>, requests: Option<Option<&[u32]>>) {
         if let (Some(active), true) = (requests, self.local) {
             return self.share_requested(d, active);

@@ -56,7 +56,9 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
         if self.dd.last.subs.is_empty() || self.dd.pending.census.is_some() {
             return;
         }
-        // rigid bodies: the sums over bodies per cell (the cells are the subdomains)
+        // contacts held per rank possible (rigid bodies, or families naming the world
+        // bodies they touch; not by model): the sums over bodies per cell (the cells
+        // are the subdomains)
         let sums = self
             .dd
             .held_scene(self.fams.is_empty())

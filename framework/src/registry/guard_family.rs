@@ -47,6 +47,9 @@ impl<D: Dim> SceneFamily<D> for GuardedFamily<D> {
         // the stage's calls go through this guard too (below)
         has.then_some(self as &mut dyn ContactStage<World<D>>)
     }
+    fn share_world(&mut self, w: &mut World<D>) {
+        self.guard.call(|| self.inner.share_world(w))
+    }
     fn update(&mut self, w: &World<D>) -> Result<(), Diverged> {
         self.guard.call(|| self.inner.update(w))
     }
@@ -140,6 +143,9 @@ impl<D: Dim> Attached<Rigid<D>> for GuardedFamily<D> {
     }
     fn residual_parts(&self, w: &World<D>) -> (f64, f64) {
         self.guard.call(|| self.inner.residual_parts(w))
+    }
+    fn held_everywhere(&self) -> Option<Vec<u32>> {
+        self.guard.call(|| self.inner.held_everywhere())
     }
 }
 

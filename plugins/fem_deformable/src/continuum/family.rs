@@ -306,8 +306,8 @@ impl<D: Dim, const N: usize> Attached<Rigid<D>> for Continuum<D, N> {
     fn residual_parts(&self, w: &World<D>) -> (f64, f64) {
         ties::residual_parts::<D, N>(&self.ties, &self.sets, (&w.bodies.vel, |g| slot(w, g)))
     }
-    /// The tied grains (every rank holds and steps them; the family reads no other
-    /// world body).
+    /// The tied grains, which it reads, and the band's grains, whose mass it shares
+    /// (every rank holds and steps them; the family reads no other world body).
     fn held_everywhere(&self) -> Option<Vec<u32>> {
         let mut g = self.ties.grain.clone();
         g.extend(self.band.iter().map(|b| b.0));
