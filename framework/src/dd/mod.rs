@@ -94,7 +94,6 @@ pub use transport::{InProcess, Transport, TransportStats};
 
 use crate::engine::Diverged;
 use crate::norms::{Norms, Sums, VANISHING};
-
 use gluing::GluePartial;
 use schemes::GlueBuffers;
 
