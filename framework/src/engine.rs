@@ -344,7 +344,7 @@ pub(crate) fn build_from_raw<D: Dim>(w: &mut World<D>) {
     s.laws.run(&w.laws, &step, &mut c.target, &mut c.joint);
     c.compliant = s.laws.compliance(&w.laws, &step, &mut c.compliance);
     if c.compliant && !w.contact_shares.is_empty() {
-        share_compliance(&w.contact_shares, c, (&w.ids, &mut s.share_pairs), &mut s.share);
+        share_compliance(&w.contact_shares, c, &mut s.share);
     }
     if c.compliant {
         let blocks = s.w.iter().zip(&c.target).zip(&c.compliance);
@@ -359,25 +359,13 @@ pub(crate) fn build_from_raw<D: Dim>(w: &mut World<D>) {
 
 /// Each compliant contact's c divided by its weight in the world's `shares` (a
 /// weight below 10⁻¹² counts as 10⁻¹²: the contact all but vanishes). The shares
-/// see the contacts' bodies by global id (`pairs`: scratch, when the world holds a
-/// part of the scene and its slots are not the ids).
-fn share_compliance<D: Dim>(
-    shares: &[crate::world::ContactShare<D>],
-    c: &mut Contacts<D>,
-    (ids, pairs): (&crate::model::BodyIds, &mut Vec<[u32; 2]>),
-    weight: &mut Vec<f64>,
-) {
+/// see the contacts by key (their bodies' global ids: a world holding a part of the
+/// scene numbers its bodies by slot).
+fn share_compliance<D: Dim>(shares: &[crate::world::ContactShare<D>], c: &mut Contacts<D>, weight: &mut Vec<f64>) {
     weight.clear();
     weight.resize(c.len(), 1.0);
-    let bodies: &[[u32; 2]] = if ids.is_identity() {
-        &c.bodies
-    } else {
-        pairs.clear();
-        pairs.extend(c.bodies.iter().map(|&[i, j]| [ids.global(i), ids.global(j)]));
-        pairs
-    };
     for share in shares {
-        share(bodies, &c.point, weight);
+        share(&c.key, &c.point, weight);
     }
     for (c, w) in c.compliance.iter_mut().zip(weight.iter()) {
         if *c > 0.0 && *w < 1.0 {

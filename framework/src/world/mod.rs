@@ -94,9 +94,9 @@ pub struct World<D: Dim> {
 }
 
 /// A share of the contacts' stiffness ([`World::contact_shares`]): multiplies
-/// `weight[a]` by the world's share of contact a between `bodies[a]` (global ids)
-/// at `point[a]`; one call per step for all the contacts.
-pub type ContactShare<D> = Arc<dyn Fn(&[[u32; 2]], &[<D as Dim>::Point], &mut [f64]) + Send + Sync>;
+/// `weight[a]` by the world's share of contact a of key `keys[a]` (its bodies'
+/// global ids) at `point[a]`; one call per step for all the contacts.
+pub type ContactShare<D> = Arc<dyn Fn(&[crate::model::ContactKey], &[<D as Dim>::Point], &mut [f64]) + Send + Sync>;
 
 /// The 2D world.
 pub type World2 = World<D2>;
@@ -117,8 +117,6 @@ pub(crate) struct Scratch<D: Dim> {
     pub w: Vec<D::W>,
     /// The contacts' weights of [`World::contact_shares`].
     pub share: Vec<f64>,
-    /// The contacts' bodies by global id, for the shares (a world holding a part).
-    pub share_pairs: Vec<[u32; 2]>,
     /// Detection restricted to this part of space (a rank's subdomains).
     pub region: Option<crate::detect::Region>,
     /// Last step's contacts held by other processes that this one may meet again
@@ -144,7 +142,6 @@ impl<D: Dim> Default for Scratch<D> {
             laws: LawBatches::default(),
             w: vec![],
             share: vec![],
-            share_pairs: vec![],
             region: None,
             extra_prev: vec![],
             active: None,

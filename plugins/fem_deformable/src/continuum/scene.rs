@@ -461,10 +461,10 @@ impl<D: Dim, const N: usize> SceneFamily<D> for Continuum<D, N> {
             region[g as usize] = r;
         }
         let bands = self.bands.clone();
-        w.contact_shares.push(std::sync::Arc::new(move |bodies, points, weight| {
-            for ((b, p), wt) in bodies.iter().zip(points).zip(weight.iter_mut()) {
+        w.contact_shares.push(std::sync::Arc::new(move |keys, points, weight| {
+            for ((k, p), wt) in keys.iter().zip(points).zip(weight.iter_mut()) {
                 let of = |i: u32| region.get(i as usize).copied().unwrap_or(u32::MAX);
-                let r = of(b[0]).min(of(b[1]));
+                let r = of(k.i).min(of(k.j));
                 if r != u32::MAX {
                     *wt *= 1.0 - bands[r as usize].alpha(&p.as_ref()[..N]);
                 }
