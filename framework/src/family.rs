@@ -171,11 +171,11 @@ pub fn local_problem<D: Dim>(w: &World<D>, families: &[Box<dyn SceneFamily<D>>])
 }
 
 /// The world bodies the families read or touch, for MPI ranks
-/// ([`Attached::held_everywhere`]: every rank steps them); `None` if a family may
+/// ([`crate::dd::attach::touched`]: every rank steps them); `None` if a family may
 /// touch any world body (its scene then holds every body on every rank).
-pub fn held_everywhere<D: Dim>(families: &[Box<dyn SceneFamily<D>>]) -> Option<Vec<u32>> {
+pub fn touched<D: Dim>(w: &World<D>, families: &[Box<dyn SceneFamily<D>>]) -> Option<crate::dd::attach::Touched> {
     let fams: Vec<&dyn Attached<Rigid<D>>> = families.iter().map(|f| &**f as &dyn Attached<Rigid<D>>).collect();
-    crate::dd::attach::held_everywhere(&fams)
+    crate::dd::attach::touched(w, &fams)
 }
 
 /// The families' states, by section, for `final.json` and checkpoints.

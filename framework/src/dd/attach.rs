@@ -131,6 +131,15 @@ pub trait Attached<F: Family> {
     fn held_everywhere(&self) -> Option<Vec<u32>> {
         None
     }
+    /// With bodies held per rank, besides [`Self::held_everywhere`] (which must then
+    /// be `Some`, maybe empty): boxes `[lo, hi]` (z = 0 in 2D) holding every point at
+    /// which the family's next detection may touch a world body, appended to `out`.
+    /// Every world body whose box, grown by the alert distance, meets one of them is
+    /// held and stepped by every rank for the next step, as [`Self::held_everywhere`]'s
+    /// are. Called before the first step and after each step's [`Self::write_back`]
+    /// (the family's positions not yet updated: the boxes must cover that update),
+    /// the same boxes on every rank. The default: none.
+    fn reach(&self, _w: &F::World, _out: &mut Vec<[[f64; 3]; 2]>) {}
 }
 
 /// The world bodies that `fams` read or touch ([`Attached::held_everywhere`]),
@@ -143,6 +152,32 @@ pub fn held_everywhere<F: Family>(fams: &[&dyn Attached<F>]) -> Option<Vec<u32>>
     all.sort_unstable();
     all.dedup();
     Some(all)
+}
+
+/// The world bodies attached families touch on MPI ranks with bodies held per rank:
+/// those every rank holds and steps ([`Attached::held_everywhere`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Touched {
+    /// Named bodies (ascending, once each).
+    pub ids: Vec<u32>,
+    /// The families' [`Attached::reach`] boxes: the bodies near them.
+    pub reach: Vec<[[f64; 3]; 2]>,
+}
+
+/// What `fams` touch ([`Touched`]); `None` if a family may touch any world body.
+pub fn touched<F: Family>(w: &F::World, fams: &[&dyn Attached<F>]) -> Option<Touched> {
+    let ids = held_everywhere(fams)?;
+    let mut reach = Vec::new();
+    reach_of(w, fams, &mut reach);
+    Some(Touched { ids, reach })
+}
+
+/// The boxes of `fams`' [`Attached::reach`], into `out` (cleared first).
+pub fn reach_of<F: Family>(w: &F::World, fams: &[&dyn Attached<F>], out: &mut Vec<[[f64; 3]; 2]>) {
+    out.clear();
+    for f in fams {
+        f.reach(w, out);
+    }
 }
 
 /// The parts of one subdomain, with the family index of each.

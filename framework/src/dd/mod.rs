@@ -274,23 +274,24 @@ impl<D: Family> NscddOf<D> {
     /// when the first step will run per rank ([`Self::start_held`], which the first
     /// step calls otherwise), a fresh run's or a restart's, so that the first frame
     /// too is written in pieces by the bodies' owners instead of whole by rank 0.
-    /// `shared`: the world bodies the scene's body families touch
-    /// ([`attach::held_everywhere`]; empty without families; `None`: a family may
-    /// touch any body, and every rank steps every body).
-    pub fn start_ranks(&mut self, w: &mut D::World, shared: Option<Vec<u32>>) {
-        let ok = self.decide_held(|| shared);
+    /// `touched`: the world bodies the scene's body families touch
+    /// ([`attach::touched`]; none without families; `None`: a family may touch any
+    /// body, and every rank steps every body).
+    pub fn start_ranks(&mut self, w: &mut D::World, touched: Option<attach::Touched>) {
+        let ok = self.decide_held(|| touched);
         self.start_held(w, ok);
     }
 
-    /// [`Self::held_ok`], decided once: `shared` gives the attached families'
+    /// [`Self::held_ok`], decided once: `touched` gives the attached families'
     /// world bodies (every rank steps them, [`owned`]).
-    fn decide_held(&mut self, shared: impl FnOnce() -> Option<Vec<u32>>) -> bool {
+    fn decide_held(&mut self, touched: impl FnOnce() -> Option<attach::Touched>) -> bool {
         if let Some(ok) = self.held_ok {
             return ok;
         }
-        let ok = match shared() {
-            Some(ids) if !self.by_model => {
-                self.local.owned.set_shared(ids);
+        let ok = match touched() {
+            Some(t) if !self.by_model => {
+                self.local.owned.set_shared(t.ids);
+                self.local.owned.set_reach(t.reach);
                 true
             }
             _ => false,
@@ -406,7 +407,7 @@ impl<D: Family> NscddOf<D> {
         self.pending = DdStepReport::default();
         let ok = self.decide_held(|| {
             let fams: Vec<&dyn Attached<D>> = fams.iter().map(|f| &**f as &dyn Attached<D>).collect();
-            attach::held_everywhere(&fams)
+            attach::touched(w, &fams)
         });
         self.start_held(w, ok);
         let base = D::step_with(w, &mut Stage { dd: self, fams });

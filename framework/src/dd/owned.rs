@@ -11,6 +11,8 @@
 //! active(r)  halo(r) ∪ the bodies of r's contacts ∪ the fixed, driven, named
 //!            and unbounded bodies and those the attached body families touch
 //!            (stepped by every rank)
+//! reach      the attached families' reach boxes (`Attached::reach`, the same on
+//!            every rank): a body whose grown box meets one is in every halo
 //! ```
 //!
 //! A rank steps its active bodies exactly as one process does: their V⁺ is the
@@ -56,6 +58,10 @@ pub(super) struct Owned {
     shared: Vec<u32>,
     /// The next step's bodies, by the world's slot (a buffer).
     keep: Vec<bool>,
+    /// The families' reach with which the bodies now held were chosen, and the one
+    /// for the next step ([`Owned::set_reach`]).
+    reach: Region,
+    reach_next: Vec<[[f64; 3]; 2]>,
 }
 
 /// The box `b` grown by `alert` ([`Region::grown_box`], the detection's own).
@@ -85,6 +91,25 @@ fn entered(
     });
     out.sort_unstable();
     out.dedup();
+}
+
+/// The region of `boxes`.
+fn region(boxes: Vec<[[f64; 3]; 2]>) -> Region {
+    Region { boxes, pairs: Vec::new() }
+}
+
+/// Whether a body's box `new`, grown by `alert`, meets the families' reach `after`
+/// and its box `old` did not meet the reach `before` (every rank then lacks it).
+fn entered_reach(n: usize, (old, before): (&[[f64; 3]; 2], &Region), (new, after): (&[[f64; 3]; 2], &Region), alert: f64) -> bool {
+    if after.boxes.is_empty() {
+        return false;
+    }
+    let (lo, hi) = grown(n, new, alert);
+    if !after.meets(n, &lo, &hi) {
+        return false;
+    }
+    let (lo, hi) = grown(n, old, alert);
+    !before.meets(n, &lo, &hi)
 }
 
 impl Owned {
@@ -125,6 +150,12 @@ impl Owned {
     pub(super) fn set_shared(&mut self, shared: Vec<u32>) {
         self.shared = shared;
         self.everywhere.clear();
+    }
+
+    /// The attached families' reach boxes for the next step (module docs): before
+    /// the first step and after each step's write-back.
+    pub(super) fn set_reach(&mut self, boxes: Vec<[[f64; 3]; 2]>) {
+        self.reach_next = boxes;
     }
 
     /// The bodies stepped by every rank, by id (set by [`Owned::start`]).
@@ -227,6 +258,11 @@ impl Owned {
                 entered(D::SPACE, (old, cells), (new, cells), alert, me as u32, (&mut was, &mut to));
                 full_next || !to.is_empty()
             };
+            let reach = (&self.reach, region(self.reach_next.clone()));
+            let mut entering = |g: u32| {
+                let k = D::held_slot(w, g as usize);
+                entering(g) || entered_reach(D::SPACE, (&boxes[k], reach.0), (&now[k], &reach.1), alert)
+            };
             let send: Vec<u32> = self.mine.iter().copied().filter(|&g| entering(g)).collect();
             exchange::<D>(w, rs, &send, moved.err())
         };
@@ -272,10 +308,11 @@ impl Owned {
         });
         D::set_active(w, candidates);
         D::body_boxes(w, boxes);
+        self.reach = region(std::mem::take(&mut self.reach_next));
         crate::step::each_body(nb, D::stepped(w), |g| {
             let k = D::held_slot(w, g);
             let (lo, hi) = grown(D::SPACE, &boxes[k], alert);
-            keep[k] |= self.everywhere[g] || mine.meets(D::SPACE, &lo, &hi);
+            keep[k] |= self.everywhere[g] || mine.meets(D::SPACE, &lo, &hi) || self.reach.meets(D::SPACE, &lo, &hi);
         });
         let mut active: Vec<u32> = (0..keep.len()).filter(|&k| keep[k]).map(|k| D::global(w, k) as u32).collect();
         if !unheld.is_empty() {

@@ -49,6 +49,13 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
     /// (the world's slots; NSCDD's global ids inside)
     fn after_integrate(&mut self, w: &mut D::World, moved: Result<(), usize>) -> Result<(), usize> {
         let moved = moved.map_err(|k| D::global(w, k));
+        if self.dd.local.now && !self.fams.is_empty() {
+            // the families' reach for the next step (their positions not yet updated)
+            let fams: Vec<&dyn Attached<D>> = self.fams.iter().map(|f| &**f as &dyn Attached<D>).collect();
+            let mut reach = Vec::new();
+            super::attach::reach_of(w, &fams, &mut reach);
+            self.dd.local.owned.set_reach(reach);
+        }
         self.dd.after_integrate(w, moved).map_err(|g| D::held_slot(w, g))
     }
     /// The counts outputs read ([`census`]), on the moved bodies (collective).

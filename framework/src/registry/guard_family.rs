@@ -147,6 +147,9 @@ impl<D: Dim> Attached<Rigid<D>> for GuardedFamily<D> {
     fn held_everywhere(&self) -> Option<Vec<u32>> {
         self.guard.call(|| self.inner.held_everywhere())
     }
+    fn reach(&self, w: &World<D>, out: &mut Vec<[[f64; 3]; 2]>) {
+        self.guard.call(|| self.inner.reach(w, out))
+    }
 }
 
 struct GuardedPart<F: Family> {

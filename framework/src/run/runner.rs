@@ -109,7 +109,8 @@ impl<D: Dim> Runner<D> {
             start,
         };
         if let Some(n) = r.dd.as_mut() {
-            n.start_ranks(&mut scene.world, crate::family::held_everywhere(&scene.families));
+            let touched = crate::family::touched(&scene.world, &scene.families);
+            n.start_ranks(&mut scene.world, touched);
         }
         r.write_frame(scene).map_err(io(here, "the first output frame"))?;
         Ok(r)

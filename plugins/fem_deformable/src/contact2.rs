@@ -28,7 +28,8 @@ pub type NodeSet = crate::nodes::NodeSet<2>;
 /// The antagonist of a contact.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Anta {
-    /// A rigid body of the world and the lever arms (d × n, d × t).
+    /// A rigid body of the world by its global id (on MPI ranks the world's slots
+    /// are not the ids) and the lever arms (d × n, d × t).
     Rigid {
         body: u32,
         arm: [f64; 2],
@@ -101,8 +102,15 @@ pub struct RawFe {
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum RawAnta {
+    /// A rigid body by the world's slot (the detection's step only).
     Rigid(u32),
-    Segment { body: u32, seg: u32, a: u32, b: u32, xi: f64 },
+    Segment {
+        body: u32,
+        seg: u32,
+        a: u32,
+        b: u32,
+        xi: f64,
+    },
 }
 
 /// Finds node contacts of every deformable body with the rigid bodies of `w`

@@ -38,7 +38,8 @@ pub type Basis = [[f64; 3]; 3];
 /// The antagonist of a 3D contact.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Anta3 {
-    /// A rigid body of the world and the lever arm d = p − x_j.
+    /// A rigid body of the world by its global id (on MPI ranks the world's slots
+    /// are not the ids) and the lever arm d = p − x_j.
     Rigid {
         body: u32,
         d: [f64; 3],
@@ -128,6 +129,7 @@ pub enum RawCand3 {
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum RawAnta3 {
+    /// A rigid body by the world's slot (the detection's step only).
     Rigid(u32),
     /// A boundary triangle of a deformable body: its index, corners, weights.
     Face {

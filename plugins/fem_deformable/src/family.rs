@@ -258,3 +258,42 @@ scene_family!(Deformables3, D3, crate::problem::share3);
 pub fn of<D: Dim, S: 'static>(families: &[Box<dyn SceneFamily<D>>]) -> Option<&S> {
     families.iter().find_map(|f| f.as_any().downcast_ref::<S>())
 }
+
+/// The world's slot of rigid body `g` (a global id; on MPI ranks the world holds a
+/// part, every body a family touches among it: [`nscdd::dd::Attached::held_everywhere`]
+/// and [`nscdd::dd::Attached::reach`]).
+#[inline]
+pub(crate) fn slot<D: Dim>(w: &World<D>, g: u32) -> usize {
+    <nscdd::dd::Rigid<D> as nscdd::dd::Family>::held_slot(w, g as usize)
+}
+
+/// The boxes in which the deformable bodies' next detection may touch a world body
+/// ([`nscdd::dd::Attached::reach`], after a step's write-back): each body's box of
+/// its boundary nodes now (the detections' test, [`crate::contact2::detect`],
+/// [`crate::contact3::detect`]), grown by what the position update may move a node
+/// (h max(|v⁻|, |v⁺|) in each direction) and by 1 % of the alert distance (two
+/// tests of the same boxes may round differently).
+pub(crate) fn reach(bodies: &[FeBody], h: f64, alert: f64, out: &mut Vec<[[f64; 3]; 2]>) {
+    for b in bodies {
+        let d = b.dim();
+        let (mut lo, mut hi) = ([0.0; 3], [0.0; 3]);
+        lo[..d].fill(f64::INFINITY);
+        hi[..d].fill(f64::NEG_INFINITY);
+        let mut moves = 0.0f64;
+        for &k in &b.mesh.boundary {
+            let p = b.position(k as usize);
+            for c in 0..d {
+                lo[c] = lo[c].min(p[c]);
+                hi[c] = hi[c].max(p[c]);
+                let i = d * k as usize + c;
+                moves = moves.max(b.v_begin[i].abs()).max(b.v[i].abs());
+            }
+        }
+        let grow = h * moves + 0.01 * alert;
+        for c in 0..d {
+            lo[c] -= grow;
+            hi[c] += grow;
+        }
+        out.push([lo, hi]);
+    }
+}

@@ -163,7 +163,14 @@ impl Attached<Rigid2> for Deformables2 {
         }
     }
     fn residual_parts(&self, w: &World2) -> (f64, f64) {
-        Deformables2::residual_parts(self, &w.bodies.vel)
+        Deformables2::residual_parts(self, &w.bodies.vel, |g| crate::family::slot(w, g))
+    }
+    /// None by id: the world bodies near the deformable bodies ([`Self::reach`]).
+    fn held_everywhere(&self) -> Option<Vec<u32>> {
+        Some(Vec::new())
+    }
+    fn reach(&self, w: &World2, out: &mut Vec<[[f64; 3]; 2]>) {
+        crate::family::reach(&self.bodies, w.time.h, self.alert, out);
     }
 }
 

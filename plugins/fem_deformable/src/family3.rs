@@ -172,6 +172,13 @@ impl Attached<Rigid3> for Deformables3 {
         }
     }
     fn residual_parts(&self, w: &World3) -> (f64, f64) {
-        Deformables3::residual_parts(self, &w.bodies.vel)
+        Deformables3::residual_parts(self, &w.bodies.vel, |g| crate::family::slot(w, g))
+    }
+    /// None by id: the world bodies near the deformable bodies ([`Self::reach`]).
+    fn held_everywhere(&self) -> Option<Vec<u32>> {
+        Some(Vec::new())
+    }
+    fn reach(&self, w: &World3, out: &mut Vec<[[f64; 3]; 2]>) {
+        crate::family::reach(&self.bodies, w.time.h, self.alert, out);
     }
 }

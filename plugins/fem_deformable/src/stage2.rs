@@ -193,12 +193,14 @@ impl Deformables2 {
                 for q in 0..3 {
                     wb[q] += wr[q];
                 }
+                // (the body's global id: slots change on MPI ranks)
+                let g = w.ids.global(j);
                 (
-                    Anta::Rigid { body: j, arm },
+                    Anta::Rigid { body: g, arm },
                     rigid_local(n, arm, v_begin[ju]),
                     rigid_local(n, arm, free_of(&self.rigid_free, j)),
                     w.bodies.material[ju],
-                    j,
+                    g,
                     0,
                 )
             }
@@ -231,18 +233,26 @@ impl Deformables2 {
         }
     }
 
-    /// Warm start: the kept impulses applied to the node sets and rigid bodies.
+    /// Warm start: the kept impulses applied to the node sets and rigid bodies (by
+    /// their slots: on MPI ranks the world holds a part).
     fn warm_start(&mut self, w: &mut World2) {
         let c = &self.contacts;
         for a in 0..c.len() {
             let r = c.r[a];
             if r != [0.0, 0.0] {
+                let anta = match c.anta[a] {
+                    Anta::Rigid { body, arm } => Anta::Rigid {
+                        body: crate::family::slot(w, body) as u32,
+                        arm,
+                    },
+                    side => side,
+                };
                 apply(
                     &mut self.sets,
                     &mut w.bodies.vel,
                     &w.bodies.inv_mass,
                     c.cand[a],
-                    c.anta[a],
+                    anta,
                     c.frame[a],
                     r,
                 );
@@ -272,17 +282,25 @@ impl Deformables2 {
     /// rigid contacts and the deformable ones, from the current velocities.
     pub fn residual(&self, w: &World2) -> f64 {
         let (f1, q1) = nlgs::residual_parts(&w.contacts, &w.bodies.vel);
-        let (f2, q2) = self.residual_parts(&w.bodies.vel);
+        let (f2, q2) = self.residual_parts(&w.bodies.vel, |g| crate::family::slot(w, g));
         nlgs::residual_of(f1 + f2, q1 + q2)
     }
 
     /// (‖F(r)‖², ‖q‖²) of the deformable contacts (natural map, as the rigid ones).
-    pub fn residual_parts(&self, vel: &[[f64; 3]]) -> (f64, f64) {
+    /// `at(g)`: the index in `vel` of the rigid body of global id g.
+    pub fn residual_parts(&self, vel: &[[f64; 3]], at: impl Fn(u32) -> usize) -> (f64, f64) {
         let c = &self.contacts;
         let (mut f2, mut q2) = (0.0, 0.0);
         for a in 0..c.len() {
             let t = c.target[a];
-            let mut u = local_velocity(&self.sets, vel, c.cand[a], c.anta[a], c.frame[a]);
+            let anta = match c.anta[a] {
+                Anta::Rigid { body, arm } => Anta::Rigid {
+                    body: at(body) as u32,
+                    arm,
+                },
+                side => side,
+            };
+            let mut u = local_velocity(&self.sets, vel, c.cand[a], anta, c.frame[a]);
             u[0] -= t.u_target;
             f2 += natural_map_sq(&c.r[a], &u, t.mu);
             let q = [c.u_free[a][0] - t.u_target, c.u_free[a][1]];

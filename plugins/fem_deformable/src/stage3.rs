@@ -193,12 +193,14 @@ impl Deformables3 {
                 for q in 0..6 {
                     wb[q] += wr[q];
                 }
+                // (the body's global id: slots change on MPI ranks)
+                let g = w.ids.global(j);
                 (
-                    Anta3::Rigid { body: j, d },
+                    Anta3::Rigid { body: g, d },
                     rigid_local(&basis, d, &v_begin[ju]),
                     rigid_local(&basis, d, &free_of(&self.rigid_free, j)),
                     w.bodies.material[ju],
-                    j,
+                    g,
                     0,
                 )
             }
@@ -235,14 +237,22 @@ impl Deformables3 {
         }
     }
 
-    /// Warm start: the kept impulses applied to the node sets and rigid bodies.
+    /// Warm start: the kept impulses applied to the node sets and rigid bodies (by
+    /// their slots: on MPI ranks the world holds a part).
     fn warm_start(&mut self, w: &mut World3) {
         let c = &self.contacts;
-        let inv: RigidInv<'_> = &w.bodies.inv_mass;
         for a in 0..c.len() {
             let r = c.r[a];
             if r != [0.0; 3] {
-                apply(&mut self.sets, &mut w.bodies.vel, inv, c.cand[a], c.anta[a], &c.frame[a], r);
+                let anta = match c.anta[a] {
+                    Anta3::Rigid { body, d } => Anta3::Rigid {
+                        body: crate::family::slot(w, body) as u32,
+                        d,
+                    },
+                    side => side,
+                };
+                let inv: RigidInv<'_> = &w.bodies.inv_mass;
+                apply(&mut self.sets, &mut w.bodies.vel, inv, c.cand[a], anta, &c.frame[a], r);
             }
         }
     }
@@ -269,17 +279,22 @@ impl Deformables3 {
     /// deformable contacts).
     pub fn residual(&self, w: &World3) -> f64 {
         let (f1, q1) = nlgs::residual_parts(&w.contacts, &w.bodies.vel);
-        let (f2, q2) = self.residual_parts(&w.bodies.vel);
+        let (f2, q2) = self.residual_parts(&w.bodies.vel, |g| crate::family::slot(w, g));
         nlgs::residual_of(f1 + f2, q1 + q2)
     }
 
     /// (‖F(r)‖², ‖q‖²) of the deformable contacts.
-    pub fn residual_parts(&self, vel: &[[f64; 6]]) -> (f64, f64) {
+    /// `at(g)`: the index in `vel` of the rigid body of global id g.
+    pub fn residual_parts(&self, vel: &[[f64; 6]], at: impl Fn(u32) -> usize) -> (f64, f64) {
         let c = &self.contacts;
         let (mut f2, mut q2) = (0.0, 0.0);
         for a in 0..c.len() {
             let t = c.target[a];
-            let mut u = local_velocity(&self.sets, vel, c.cand[a], c.anta[a], &c.frame[a]);
+            let anta = match c.anta[a] {
+                Anta3::Rigid { body, d } => Anta3::Rigid { body: at(body) as u32, d },
+                side => side,
+            };
+            let mut u = local_velocity(&self.sets, vel, c.cand[a], anta, &c.frame[a]);
             u[0] -= t.u_target;
             f2 += natural_map_sq(&c.r[a], &u, t.mu);
             let q = [c.u_free[a][0] - t.u_target, c.u_free[a][1], c.u_free[a][2]];

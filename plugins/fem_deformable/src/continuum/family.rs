@@ -12,8 +12,9 @@
 
 use super::ties::{self, TieSet};
 use crate::body::FeBody;
+use crate::family::slot;
 use crate::nodes::{fill_set, NodeSet};
-use nscdd::dd::{Attached, EntityInfo, Family, LocalPart, Rigid};
+use nscdd::dd::{Attached, EntityInfo, LocalPart, Rigid};
 use nscdd::dim::Dim;
 use nscdd::norms::Sums;
 use nscdd::world::World;
@@ -315,11 +316,4 @@ impl<D: Dim, const N: usize> Attached<Rigid<D>> for Continuum<D, N> {
         g.dedup();
         Some(g)
     }
-}
-
-/// The world's slot of grain `g` (a global id; on MPI ranks the world holds a part,
-/// every tied grain among it: [`Attached::held_everywhere`]).
-#[inline]
-fn slot<D: Dim>(w: &World<D>, g: u32) -> usize {
-    Rigid::<D>::held_slot(w, g as usize)
 }

@@ -1,0 +1,84 @@
+//! Deformable (finite-element) bodies on MPI ranks decomposed by geometry: each
+//! rank holds only its part of the rigid bodies (its halo and the bodies near the
+//! deformable ones, `Attached::reach`, which every rank steps), and the ranks give
+//! the one-process `final.json`, in 2D and 3D, and across a restart on another rank
+//! count. (Decomposed by model, every rank holds every body: `mpi.rs`.)
+#![cfg(all(feature = "fem", feature = "mpi"))]
+
+mod mpi_common;
+use mpi_common::*;
+
+/// The example `name` with `steps` steps, no VTK, decomposed by geometry (`dec`
+/// instead of `by_model`), its grains' `origin` replaced by `lowered`: the lowest
+/// layer within the alert distance of the foundation from the first step.
+fn scene(name: &str, (steps, dec): (u32, &str), (origin, lowered): (&str, &str)) -> String {
+    let src = std::fs::read_to_string(format!("{}/../examples/scenes/{name}.toml", env!("CARGO_MANIFEST_DIR"))).unwrap();
+    let by_model = src.find("by_model = true\n").expect("a by-model decomposition");
+    let end = src[by_model..].find("\n\n").map_or(src.len(), |e| by_model + e);
+    let duration = src.find("duration = ").expect("a duration");
+    let line_end = duration + src[duration..].find('\n').unwrap();
+    assert!(src.contains(origin), "{name}: the grains' origin changed");
+    let s = format!("{}{dec}{}", &src[..by_model], &src[end..]);
+    let s = s.replace(&src[duration..line_end], &format!("steps = {steps}"));
+    s.replace("[output]\n", "[output]\nvtk = false\n").replace(origin, lowered)
+}
+
+/// The number of bodies and of deformable contacts in a `final.json`.
+fn counts(fin: &str) -> (u64, usize) {
+    let v: serde_json::Value = serde_json::from_str(fin).expect("final.json");
+    let bodies = v["bodies"].as_array().expect("bodies").len() as u64;
+    let fe = v["families"]["deformable"]["contacts"].as_array().map_or(0, Vec::len);
+    (bodies, fe)
+}
+
+/// Runs `scene` (`steps` steps) in one process and on each of `ranks`: the same
+/// `final.json`, each rank holding fewer bodies than the scene. Returns the
+/// one-process `final.json`.
+fn same_on_ranks(dir: &std::path::Path, tag: &str, (scene, steps): (&std::path::Path, u64), ranks: &[u32]) -> String {
+    let one = dir.join(format!("{tag}_one"));
+    ok(&nscdd(&args(scene, &one, &[])), &format!("{tag} in one process"));
+    let reference = final_json(&one);
+    let (bodies, fe) = counts(&reference);
+    assert!(fe > 0, "{tag}: no deformable contact at the end");
+    for &n in ranks {
+        let out = dir.join(format!("{tag}_ranks{n}"));
+        ok(&mpirun(&[(n, args(scene, &out, &[]))]), &format!("{tag} on {n} ranks"));
+        assert!(
+            final_json(&out) == reference,
+            "{tag}, {n} ranks: final.json differs from one process"
+        );
+        // (summed over the steps: a fresh run's first step holds the provisional
+        // grid's halo and the real one's, on small samples nearly every body)
+        let held = per_rank_count(&out, "bodies_held");
+        assert!(
+            held.iter().all(|&h| h < steps * bodies),
+            "{tag}, {n} ranks: {held:?} bodies held over {steps} steps of {bodies} bodies"
+        );
+    }
+    reference
+}
+
+#[test]
+fn deformable_scenes_by_geometry_hold_bodies_per_rank() {
+    let dir = scratch("fe_held");
+    let lattice = ("origin = [0.2, 0.62]", "origin = [0.2, 0.56]");
+    let dec = "nx = 4";
+    let s2 = write(&dir, "foundation.toml", &scene("foundation", (40, dec), lattice));
+    let reference = same_on_ranks(&dir, "2d", (&s2, 40), &[2, 4]);
+    // a state written by 2 ranks restarts on 4 ranks and in one process
+    let first = write(&dir, "first.toml", &scene("foundation", (20, dec), lattice));
+    let half = dir.join("half");
+    ok(&mpirun(&[(2, args(&first, &half, &[]))]), "20 steps on 2 ranks");
+    let state = half.join("final.json");
+    let restart = ["--restart", state.to_str().unwrap()];
+    let on4 = dir.join("restart4");
+    ok(&mpirun(&[(4, args(&s2, &on4, &restart))]), "the restart on 4 ranks");
+    assert!(final_json(&on4) == reference, "a restart on 4 ranks ends elsewhere");
+    let on1 = dir.join("restart1");
+    ok(&nscdd(&args(&s2, &on1, &restart)), "the restart in one process");
+    assert!(final_json(&on1) == reference, "a restart in one process ends elsewhere");
+    // 3D: spheres on a deformable block
+    let lattice = ("origin = [0.2, 0.2, 0.42]", "origin = [0.2, 0.2, 0.36]");
+    let s3 = write(&dir, "foundation3d.toml", &scene("foundation3d", (15, "nx = 2"), lattice));
+    same_on_ranks(&dir, "3d", (&s3, 15), &[2]);
+}
