@@ -2,7 +2,8 @@
 //! rank holds only its part of the rigid bodies (its halo and the bodies near the
 //! deformable ones, `Attached::reach`, which every rank steps), and the ranks give
 //! the one-process `final.json`, in 2D and 3D, and across a restart on another rank
-//! count. (Decomposed by model, every rank holds every body: `mpi.rs`.)
+//! count; by model too, with at least as many grid cells as ranks (with more ranks,
+//! every rank holds every body: `mpi.rs`).
 #![cfg(all(feature = "fem", feature = "mpi"))]
 
 mod mpi_common;
@@ -77,6 +78,14 @@ fn deformable_scenes_by_geometry_hold_bodies_per_rank() {
     let on1 = dir.join("restart1");
     ok(&nscdd(&args(&s2, &on1, &restart)), "the restart in one process");
     assert!(final_json(&on1) == reference, "a restart in one process ends elsewhere");
+    // by model (the block's contacts in subdomains of their own, each on its cell's
+    // rank): held per rank too with as many cells as ranks
+    let sm = write(
+        &dir,
+        "by_model.toml",
+        &scene("foundation", (40, "by_model = true\nnx = 2"), lattice),
+    );
+    same_on_ranks(&dir, "by_model", (&sm, 40), &[2]);
     // 3D: spheres on a deformable block
     let lattice = ("origin = [0.2, 0.2, 0.42]", "origin = [0.2, 0.2, 0.36]");
     let s3 = write(&dir, "foundation3d.toml", &scene("foundation3d", (15, "nx = 2"), lattice));

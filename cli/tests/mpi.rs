@@ -407,12 +407,13 @@ fn an_unwritable_output_stops_every_rank() {
 /// A body that diverges: every rank stops at that step (exit code 1), rank 0 names
 /// the step and the body and keeps the history written so far.
 
-/// A scene with deformable bodies by model (2 × 1 cells, 4 subdomains) on 2 and 4
-/// ranks: final.json bitwise that of one process (the deformable bodies' state
-/// included; the families' parts travel as their packed impulses), and the 3D
-/// foundation (2 × 2 cells by model) on 2 ranks, and the whole 2D foundation (its
-/// state's kept contacts merged on rank 0 alone); without a decomposition, refused by
-/// every rank with exit 2.
+/// A scene with deformable bodies by model (2 × 1 cells, 4 subdomains) on 2 ranks
+/// (each its part of the disks, `cli/tests/deformable_ranks.rs`) and 4 (every rank
+/// every disk: more ranks than cells): final.json bitwise that of one process (the
+/// deformable bodies' state included; the families' parts travel as their packed
+/// impulses), and the 3D foundation (2 × 2 cells by model) on 2 ranks, and the
+/// whole 2D foundation on 4 ranks (its state's kept contacts merged on rank 0
+/// alone); without a decomposition, refused by every rank with exit 2.
 #[cfg(feature = "fem")]
 #[test]
 fn deformable_scenes_on_ranks_give_the_one_process_result() {
@@ -455,22 +456,23 @@ fn deformable_scenes_on_ranks_give_the_one_process_result() {
         final_json(&out) == final_json(&one3),
         "3D on 2 ranks: final.json differs from one process"
     );
-    // the whole foundation (disks resting on the blocks: kept contacts, every rank
-    // holding every contact): rank 0 merges the kept contacts alone, also in many
-    // rounds (a merge it skipped once hung every rank)
+    // the whole foundation (disks resting on the blocks: kept contacts) on more
+    // ranks than cells (by model: every rank holding every contact): rank 0 merges
+    // the kept contacts alone, also in many rounds (a merge it skipped once hung
+    // every rank)
     let whole = dir.join("whole.toml");
     std::fs::write(&whole, src.replace("[output]\n", "[output]\nvtk = false\n")).unwrap();
     let one = dir.join("whole_one");
     assert!(nscdd(&args(&whole, &one, &[])).status.success());
-    let out = dir.join("whole_ranks2");
-    let mut c = mpirun_command(&[(2, args(&whole, &out, &[]))]);
+    let out = dir.join("whole_ranks4");
+    let mut c = mpirun_command(&[(4, args(&whole, &out, &[]))]);
     c.env("NSCDD_MERGE_RECORDS", "3");
     let o = run_limited(c);
-    assert!(o.status.success(), "the whole foundation on 2 ranks: {}", text(&o.stderr));
+    assert!(o.status.success(), "the whole foundation on 4 ranks: {}", text(&o.stderr));
     let fin = final_json(&out);
     assert!(
         fin == final_json(&one),
-        "the whole foundation on 2 ranks: final.json differs from one process"
+        "the whole foundation on 4 ranks: final.json differs from one process"
     );
     let v: serde_json::Value = serde_json::from_str(&fin).expect("final.json");
     assert!(

@@ -162,6 +162,8 @@ pub struct Touched {
     pub ids: Vec<u32>,
     /// The families' [`Attached::reach`] boxes: the bodies near them.
     pub reach: Vec<[[f64; 3]; 2]>,
+    /// The number of families (their subdomains by model).
+    pub families: usize,
 }
 
 /// What `fams` touch ([`Touched`]); `None` if a family may touch any world body.
@@ -169,7 +171,11 @@ pub fn touched<F: Family>(w: &F::World, fams: &[&dyn Attached<F>]) -> Option<Tou
     let ids = held_everywhere(fams)?;
     let mut reach = Vec::new();
     reach_of(w, fams, &mut reach);
-    Some(Touched { ids, reach })
+    Some(Touched {
+        ids,
+        reach,
+        families: fams.len(),
+    })
 }
 
 /// The boxes of `fams`' [`Attached::reach`], into `out` (cleared first).

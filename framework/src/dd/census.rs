@@ -79,6 +79,26 @@ impl BodySums<'_> {
     }
 }
 
+/// [`BodySums`] by subdomain: the first subdomains are the grid's cells (by model,
+/// the families' come next, with no bodies of their own: zeros).
+struct CellValues(Option<Vec<[f64; SUMS]>>);
+
+impl CellValues {
+    /// Values a subdomain adds.
+    fn k(&self) -> usize {
+        if self.0.is_some() {
+            SUMS
+        } else {
+            0
+        }
+    }
+    fn add(&self, s: usize, v: &mut Vec<f64>) {
+        if let Some(c) = &self.0 {
+            v.extend_from_slice(c.get(s).unwrap_or(&[0.0; SUMS]));
+        }
+    }
+}
+
 /// Each subdomain's loaded contacts per local body, and its loaded grain–grain contacts.
 fn loaded<D: Family>(w: &D::World, d: &Decomposition<D>, s: usize) -> (Vec<u32>, u64) {
     let sub = &d.subs[s];
@@ -123,10 +143,9 @@ pub(super) fn census<D: Family>(d: &Decomposition<D>, w: &D::World, mut ranks: O
         ..Default::default()
     };
     let bulk = D::bulk_box(w);
-    // the subdomains are the grid's cells (rigid bodies only)
-    let cells = sums.filter(|b| b.grid.len() == ns).map(|b| b.per_cell(w, d, bulk, &own));
-    let k = if cells.is_some() { SUMS } else { 0 };
-    let add_cell = |s: usize, v: &mut Vec<f64>| v.extend_from_slice(cells.as_ref().map_or(&[][..], |c| &c[s][..]));
+    let sums = sums.filter(|b| ns.is_multiple_of(b.grid.len()));
+    let cells = CellValues(sums.map(|b| b.per_cell(w, d, bulk, &own)));
+    let (k, add_cell) = (cells.k(), |s: usize, v: &mut Vec<f64>| cells.add(s, v));
     if !D::wants_coordination(w) {
         let n = |s: usize, v: &mut Vec<f64>| {
             v.push(D::len(&d.subs[s].contacts) as f64);

@@ -62,6 +62,9 @@ pub(super) struct Local {
     pub limited: bool,
     /// The bodies this rank steps ([`super::owned`]).
     pub owned: super::owned::Owned,
+    /// Subdomains per grid cell (0 or 1; by model, 1 + the attached families: a
+    /// family's subdomain of a cell is solved by the cell's rank, [`per_model`]).
+    pub models: usize,
     /// On a repartition step: this rank's contacts of the last step (their
     /// [`Family::prev_record`]s), for the ranks whose new cells they may meet.
     own_prev: Option<Vec<f64>>,
@@ -184,6 +187,24 @@ impl Local {
     }
 }
 
+/// The ranks of the subdomains from those of the grid's cells (`cells`): by model,
+/// each family's subdomain of a cell on the cell's rank (`models` subdomains a cell,
+/// [`Local::models`]).
+pub(super) fn per_model(mut cells: Vec<u32>, models: usize) -> Vec<u32> {
+    let n = cells.len();
+    for _ in 1..models {
+        cells.extend_from_within(..n);
+    }
+    cells
+}
+
+impl Local {
+    /// The subdomains of `grid` with contacts held per rank.
+    pub(super) fn subdomains(&self, grid: &Grid) -> usize {
+        grid.len() * self.models.max(1)
+    }
+}
+
 /// The region a rank detects in: its cells, and the pairs of its kept contacts
 /// that the cells would miss (their grown boxes' intersection has left them).
 pub(super) fn region<D: Family>(
@@ -260,7 +281,7 @@ impl<D: Family> super::NscddOf<D> {
         };
         debug_assert_eq!(part.cells, cells, "the loader's grid is the decomposition's");
         let grid = part.grid();
-        rs.rank_of = part.rank_of;
+        rs.rank_of = per_model(part.rank_of, self.local.models);
         rs.totals.loaded_bodies = D::held(w).map_or_else(|| D::n_bodies(w), <[u32]>::len) as u64;
         self.local.owned.start_held::<D>(w, rs, &grid);
         self.grid = Some(grid);
@@ -280,12 +301,13 @@ impl<D: Family> super::NscddOf<D> {
         let (Some(rs), Some(grid)) = (self.ranks.as_mut(), self.grid.as_ref()) else {
             return;
         };
-        if rs.rank_of.len() == grid.len() || self.grid_empty || self.local.held {
+        if rs.rank_of.len() == self.local.subdomains(grid) || self.grid_empty || self.local.held {
             return;
         }
         // (the saved subdomains lie in the grid: `NscddOf::load_state` checks)
         let kept_owners: Vec<u32> = self.kept.iter().map(|e| e.1).collect();
         rs.assign(&kept_owners, grid.len(), true);
+        rs.rank_of = per_model(std::mem::take(&mut rs.rank_of), self.local.models);
         rs.totals.restart_contacts = D::len(D::contacts(w)) as u64;
         rs.totals.loaded_bodies = D::held(w).map_or_else(|| D::n_bodies(w), <[u32]>::len) as u64;
         let owner = super::owner::kept_owners::<D>(D::contacts(w), grid, &self.kept);
@@ -317,10 +339,11 @@ impl<D: Family> super::NscddOf<D> {
             self.local.now = false;
             return;
         };
-        // (not eligible: families that may touch any body, or by model; ranks of the
+        // (not eligible: families that may touch any body, or by model on more ranks
+        // than cells; ranks of the
         // subdomains not known: a restart that could not start per rank; that step
         // runs on the whole sample)
-        if !(eligible && self.local_contacts) || rs.rank_of.len() != grid.len() {
+        if !(eligible && self.local_contacts) || rs.rank_of.len() != self.local.subdomains(grid) {
             self.local.now = false;
             rs.local = false;
             D::set_region(w, None);
@@ -404,7 +427,7 @@ impl<D: Family> super::NscddOf<D> {
             loads[grid.cell_of(p) as usize] += 1.0;
         }
         let sum: Vec<usize> = rs.all_sum(&loads).into_iter().map(|x| x as usize).collect();
-        let new = super::rank_balance::balanced_ranks(&sum, rs.cluster.size());
+        let new = per_model(super::rank_balance::balanced_ranks(&sum, rs.cluster.size()), self.local.models);
         rs.old_rank_of = std::mem::replace(&mut rs.rank_of, new);
         if D::active(w).is_some() {
             let Local { owned, boxes, .. } = &mut self.local;
@@ -449,7 +472,7 @@ impl<D: Family> super::NscddOf<D> {
             return moved;
         };
         // a repartition brings the bodies of the new halos itself
-        let full_next = rs.rank_of.len() != grid.len();
+        let full_next = rs.rank_of.len() != self.local.subdomains(grid);
         let Local { owned, boxes, .. } = &mut self.local;
         owned.after_integrate::<D>(w, (rs, grid), (boxes, full_next), moved)
     }

@@ -164,8 +164,8 @@ pub struct NscddOf<D: Family> {
     fam_ranges: Vec<std::ops::Range<usize>>,
     /// Whether the steps may hold bodies and contacts per rank ([`local`],
     /// [`owned`]): rigid bodies alone, or attached families that name the world
-    /// bodies they touch, not by model. Decided at the first step (or
-    /// [`Self::start_ranks`]).
+    /// bodies they touch; by model, with at least as many grid cells as ranks.
+    /// Decided at the first step (or [`Self::start_ranks`]).
     held_ok: Option<bool>,
     /// The report of the step in progress.
     pending: DdStepReport,
@@ -288,8 +288,14 @@ impl<D: Family> NscddOf<D> {
         if let Some(ok) = self.held_ok {
             return ok;
         }
+        // by model, each family's subdomain of a cell goes with the cell: at least
+        // as many cells as ranks
+        let s = &self.settings;
+        let cells = s.nx as u64 * s.ny as u64 * s.nz.max(1) as u64;
+        let fit = !self.by_model || self.ranks.as_ref().is_none_or(|r| u64::from(r.cluster.size()) <= cells);
         let ok = match touched() {
-            Some(t) if !self.by_model => {
+            Some(t) if fit => {
+                self.local.models = if self.by_model { 1 + t.families } else { 1 };
                 self.local.owned.set_shared(t.ids);
                 self.local.owned.set_reach(t.reach);
                 true

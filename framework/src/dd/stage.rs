@@ -64,8 +64,8 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
             return;
         }
         // contacts held per rank possible (rigid bodies, or families naming the world
-        // bodies they touch; not by model): the sums over bodies per cell (the cells
-        // are the subdomains)
+        // bodies they touch): the sums over bodies per cell (the first subdomains are
+        // the cells)
         let sums = self
             .dd
             .held_scene(self.fams.is_empty())
