@@ -32,10 +32,25 @@ fn counts(fin: &str) -> (u64, usize) {
     (bodies, fe)
 }
 
-/// Runs `scene` (`steps` steps) in one process and on each of `ranks`: the same
-/// `final.json`, each rank holding fewer bodies than the scene. Returns the
-/// one-process `final.json`.
-fn same_on_ranks(dir: &std::path::Path, tag: &str, (scene, steps): (&std::path::Path, u64), ranks: &[u32]) -> String {
+/// Every column of `out`'s history.csv but the timings, row by row.
+fn physics(out: &std::path::Path) -> Vec<String> {
+    let h = std::fs::read_to_string(out.join("history.csv")).expect("history.csv");
+    let mut lines = h.lines();
+    let head: Vec<&str> = lines.next().expect("header").split(',').collect();
+    let keep: Vec<usize> = (0..head.len()).filter(|&k| !head[k].starts_with("t_")).collect();
+    lines
+        .map(|l| {
+            let v: Vec<&str> = l.split(',').collect();
+            keep.iter().map(|&k| v.get(k).copied().unwrap_or("")).collect::<Vec<_>>().join(",")
+        })
+        .collect()
+}
+
+/// Runs `scene` (`steps` steps, a grid of `cells` cells) in one process and on each
+/// of `ranks`: the same `final.json` and history (but its timings); each rank
+/// holding fewer bodies than the scene when there are at least as many cells as
+/// ranks. Returns the one-process `final.json`.
+fn same_on_ranks(dir: &std::path::Path, tag: &str, (scene, steps, cells): (&std::path::Path, u64, u32), ranks: &[u32]) -> String {
     let one = dir.join(format!("{tag}_one"));
     ok(&nscdd(&args(scene, &one, &[])), &format!("{tag} in one process"));
     let reference = final_json(&one);
@@ -48,11 +63,16 @@ fn same_on_ranks(dir: &std::path::Path, tag: &str, (scene, steps): (&std::path::
             final_json(&out) == reference,
             "{tag}, {n} ranks: final.json differs from one process"
         );
+        assert_eq!(
+            physics(&out),
+            physics(&one),
+            "{tag}, {n} ranks: the history differs from one process"
+        );
         // (summed over the steps: a fresh run's first step holds the provisional
         // grid's halo and the real one's, on small samples nearly every body)
         let held = per_rank_count(&out, "bodies_held");
         assert!(
-            held.iter().all(|&h| h < steps * bodies),
+            held.iter().all(|&h| (h < steps * bodies) == (n <= cells)),
             "{tag}, {n} ranks: {held:?} bodies held over {steps} steps of {bodies} bodies"
         );
     }
@@ -65,7 +85,7 @@ fn deformable_scenes_by_geometry_hold_bodies_per_rank() {
     let lattice = ("origin = [0.2, 0.62]", "origin = [0.2, 0.56]");
     let dec = "nx = 4";
     let s2 = write(&dir, "foundation.toml", &scene("foundation", (40, dec), lattice));
-    let reference = same_on_ranks(&dir, "2d", (&s2, 40), &[2, 4]);
+    let reference = same_on_ranks(&dir, "2d", (&s2, 40, 4), &[2, 4]);
     // a state written by 2 ranks restarts on 4 ranks and in one process
     let first = write(&dir, "first.toml", &scene("foundation", (20, dec), lattice));
     let half = dir.join("half");
@@ -79,15 +99,16 @@ fn deformable_scenes_by_geometry_hold_bodies_per_rank() {
     ok(&nscdd(&args(&s2, &on1, &restart)), "the restart in one process");
     assert!(final_json(&on1) == reference, "a restart in one process ends elsewhere");
     // by model (the block's contacts in subdomains of their own, each on its cell's
-    // rank): held per rank too with as many cells as ranks
+    // rank): held per rank too with as many cells as ranks; on more ranks every
+    // rank holds every body, and the outputs' sums are still added as in one process
     let sm = write(
         &dir,
         "by_model.toml",
         &scene("foundation", (40, "by_model = true\nnx = 2"), lattice),
     );
-    same_on_ranks(&dir, "by_model", (&sm, 40), &[2]);
+    same_on_ranks(&dir, "by_model", (&sm, 40, 2), &[2, 4]);
     // 3D: spheres on a deformable block
     let lattice = ("origin = [0.2, 0.2, 0.42]", "origin = [0.2, 0.2, 0.36]");
     let s3 = write(&dir, "foundation3d.toml", &scene("foundation3d", (15, "nx = 2"), lattice));
-    same_on_ranks(&dir, "3d", (&s3, 15), &[2]);
+    same_on_ranks(&dir, "3d", (&s3, 15, 2), &[2]);
 }

@@ -121,8 +121,9 @@ pub trait Attached<F: Family> {
     /// state and the world's velocities.
     fn residual_parts(&self, w: &F::World) -> (f64, f64);
     /// On MPI ranks with bodies held per rank ([`super::local`], [`super::owned`]):
-    /// every world body the family reads or its contacts touch, for the whole run
-    /// (ascending global ids), which every rank then holds and steps as it does a
+    /// world bodies the family reads or its contacts touch, for the whole run
+    /// (ascending global ids; those it may touch as it moves come from
+    /// [`Self::reach`]), which every rank then holds and steps as it does a
     /// fixed or driven body (bitwise the same state wherever it is held), so that
     /// the family, held whole on every rank, builds the same contacts everywhere.
     /// It reads a world body through its slot ([`Family::held_slot`]). `None` (the
@@ -136,7 +137,8 @@ pub trait Attached<F: Family> {
     /// which the family's next detection may touch a world body, appended to `out`.
     /// Every world body whose box, grown by the alert distance, meets one of them is
     /// held and stepped by every rank for the next step, as [`Self::held_everywhere`]'s
-    /// are. Called before the first step and after each step's [`Self::write_back`]
+    /// are. Called when the mode is decided (before the first step, also in one
+    /// process) and after each step's [`Self::write_back`] of a step held per rank
     /// (the family's positions not yet updated: the boxes must cover that update),
     /// the same boxes on every rank. The default: none.
     fn reach(&self, _w: &F::World, _out: &mut Vec<[[f64; 3]; 2]>) {}

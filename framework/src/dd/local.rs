@@ -62,8 +62,11 @@ pub(super) struct Local {
     pub limited: bool,
     /// The bodies this rank steps ([`super::owned`]).
     pub owned: super::owned::Owned,
-    /// Subdomains per grid cell (0 or 1; by model, 1 + the attached families: a
-    /// family's subdomain of a cell is solved by the cell's rank, [`per_model`]).
+    /// Subdomains per grid cell: 1 (0 before it is decided), by model 1 + the
+    /// attached families (a family's subdomain of a cell is solved by the cell's
+    /// rank, [`per_model`]; after a step on the whole sample, until the next
+    /// repartition, by the rank the balance of all subdomains gave it, which holds
+    /// every body the family touches too).
     pub models: usize,
     /// On a repartition step: this rank's contacts of the last step (their
     /// [`Family::prev_record`]s), for the ranks whose new cells they may meet.

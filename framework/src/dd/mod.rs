@@ -167,6 +167,11 @@ pub struct NscddOf<D: Family> {
     /// bodies they touch; by model, with at least as many grid cells as ranks.
     /// Decided at the first step (or [`Self::start_ranks`]).
     held_ok: Option<bool>,
+    /// Whether the outputs' sums (the observed bodies' reactions, the sums over
+    /// bodies) are added per subdomain ([`reactions`], [`census`]): the scenes that
+    /// may hold bodies per rank, whatever the number of ranks (by model on more
+    /// ranks than cells too), so that one process and any rank count add alike.
+    sums_per_sub: Option<bool>,
     /// The report of the step in progress.
     pending: DdStepReport,
     /// Owner of each contact of the last step, by key (sorted).
@@ -216,6 +221,7 @@ impl<D: Family> NscddOf<D> {
             fam_points: Vec::new(),
             fam_ranges: Vec::new(),
             held_ok: None,
+            sums_per_sub: None,
             pending: DdStepReport::default(),
             kept: Vec::new(),
             grid_empty: false,
@@ -293,7 +299,9 @@ impl<D: Family> NscddOf<D> {
         let s = &self.settings;
         let cells = s.nx as u64 * s.ny as u64 * s.nz.max(1) as u64;
         let fit = !self.by_model || self.ranks.as_ref().is_none_or(|r| u64::from(r.cluster.size()) <= cells);
-        let ok = match touched() {
+        let touched = touched();
+        self.sums_per_sub = Some(touched.is_some());
+        let ok = match touched {
             Some(t) if fit => {
                 self.local.models = if self.by_model { 1 + t.families } else { 1 };
                 self.local.owned.set_shared(t.ids);
@@ -310,6 +318,12 @@ impl<D: Family> NscddOf<D> {
     /// is decided: rigid bodies alone, `no_families`, not by model).
     fn held_scene(&self, no_families: bool) -> bool {
         self.held_ok.unwrap_or(no_families && !self.by_model)
+    }
+
+    /// Whether the outputs' sums are added per subdomain ([`Self::sums_per_sub`];
+    /// before it is decided, as [`Self::held_scene`]).
+    fn sums_per_subdomain(&self, no_families: bool) -> bool {
+        self.sums_per_sub.unwrap_or(no_families && !self.by_model)
     }
 
     /// Re-partitions every `k` steps (see [`Nscdd::repartition_every`]).

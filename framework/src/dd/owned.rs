@@ -99,7 +99,8 @@ fn region(boxes: Vec<[[f64; 3]; 2]>) -> Region {
 }
 
 /// Whether a body's box `new`, grown by `alert`, meets the families' reach `after`
-/// and its box `old` did not meet the reach `before` (every rank then lacks it).
+/// and its box `old` did not meet the reach `before` (then only the ranks whose
+/// halo holds it have it: its owner sends it to every rank).
 fn entered_reach(n: usize, (old, before): (&[[f64; 3]; 2], &Region), (new, after): (&[[f64; 3]; 2], &Region), alert: f64) -> bool {
     if after.boxes.is_empty() {
         return false;

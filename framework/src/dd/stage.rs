@@ -68,7 +68,7 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
         // the cells)
         let sums = self
             .dd
-            .held_scene(self.fams.is_empty())
+            .sums_per_subdomain(self.fams.is_empty())
             .then_some(self.dd.grid.as_ref())
             .flatten()
             .map(|grid| census::BodySums { grid });
@@ -83,10 +83,11 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
         self.dd.pending.census = Some(census);
     }
     /// Per subdomain, in subdomain order ([`reactions`]): the rigid contacts'
-    /// (the attached families' contacts add none). With families that do not name
-    /// the world bodies they touch (every rank holds every contact), the engine's sum.
+    /// (the attached families' contacts add none), also when every rank steps every
+    /// body (by model on more ranks than cells: the same sums as one process). With
+    /// families that do not name the world bodies they touch, the engine's sum.
     fn reactions(&mut self, w: &mut D::World) -> bool {
-        if !self.dd.held_scene(self.fams.is_empty()) || self.dd.last.subs.is_empty() {
+        if !self.dd.sums_per_subdomain(self.fams.is_empty()) || self.dd.last.subs.is_empty() {
             return false;
         }
         let observed = D::observed(w);

@@ -243,18 +243,17 @@ impl<D: Family> NscddOf<D> {
         if s.grid_of != [self.settings.nx, self.settings.ny, self.settings.nz] || s.by_model != self.by_model {
             return Ok(false);
         }
-        // (rigid bodies only: by model the subdomains go on past the grid's cells)
-        if !self.by_model {
-            let cells = s.grid.as_ref().map_or(0, |g| g.len());
-            if s.grid.is_some() && cells != (self.settings.nx * self.settings.ny * self.settings.nz) as usize {
-                return Err(format!("grid: {cells} cells, the decomposition's {:?}", s.grid_of));
-            }
-            if let Some((k, e)) = s.kept.iter().enumerate().find(|(_, e)| e.1 as usize >= cells) {
-                return Err(format!("kept[{k}]: subdomain {} of a grid of {cells} cells", e.1));
-            }
-            if let Some((k, e)) = s.f_gamma.iter().enumerate().find(|(_, e)| e.1 as usize >= cells) {
-                return Err(format!("f_gamma[{k}]: subdomain {} of a grid of {cells} cells", e.1));
-            }
+        // (the kept contacts are the world's, in the grid's cells; by model the F_Γ's
+        // subdomains go on past the cells, the families')
+        let cells = s.grid.as_ref().map_or(0, |g| g.len());
+        if s.grid.is_some() && cells != (self.settings.nx * self.settings.ny * self.settings.nz) as usize {
+            return Err(format!("grid: {cells} cells, the decomposition's {:?}", s.grid_of));
+        }
+        if let Some((k, e)) = s.kept.iter().enumerate().find(|(_, e)| e.1 as usize >= cells) {
+            return Err(format!("kept[{k}]: subdomain {} of a grid of {cells} cells", e.1));
+        }
+        if let Some((k, e)) = s.f_gamma.iter().enumerate().find(|(_, e)| e.1 as usize >= cells && !self.by_model) {
+            return Err(format!("f_gamma[{k}]: subdomain {} of a grid of {cells} cells", e.1));
         }
         let dofs = D::V::default().as_ref().len();
         let mut entries = Vec::with_capacity(s.f_gamma.len());

@@ -368,7 +368,7 @@ pub(crate) fn scene_solver<D: Dim>(
 
 /// [`run`], as one rank of a multi-process run when `cluster` is given: every rank
 /// steps its part of the world (or the whole world: body families that may touch
-/// any body, by model) and sweeps its subdomains ([`crate::dd::ranks`]); rank 0
+/// any body, by model on more ranks than cells) and sweeps its subdomains ([`crate::dd::ranks`]); rank 0
 /// writes the outputs (the same files as one process, and `ranks.json`), except the
 /// VTK frames, of which every rank writes its piece (`.pvtp` by rank 0). A scene's
 /// body families ([`crate::family`]) step with the world, add their history columns

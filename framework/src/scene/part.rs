@@ -56,7 +56,7 @@ pub struct Survey {
 
 /// The survey of the scene at `path` (any dimension): a scene whose world holds no
 /// body, its [`Scene::survey`] set; `None` for a scene with body families (loaded
-/// whole: they step every body on every rank).
+/// whole on every rank; each rank then keeps its part, [`crate::dd::NscddOf::start_ranks`]).
 pub fn survey_any(path: &std::path::Path, registry: &Registry) -> Result<Option<AnyScene>, InputError> {
     let (text, file) = super::read_file(path)?;
     Ok(match super::dimension_of(&text) {

@@ -29,7 +29,8 @@ pub type NodeSet = crate::nodes::NodeSet<2>;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Anta {
     /// A rigid body of the world by its global id (on MPI ranks the world's slots
-    /// are not the ids) and the lever arms (d × n, d × t).
+    /// are not the ids; in a subdomain's part, its local copy) and the lever arms
+    /// (d × n, d × t).
     Rigid {
         body: u32,
         arm: [f64; 2],

@@ -39,7 +39,8 @@ pub type Basis = [[f64; 3]; 3];
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Anta3 {
     /// A rigid body of the world by its global id (on MPI ranks the world's slots
-    /// are not the ids) and the lever arm d = p − x_j.
+    /// are not the ids; in a subdomain's part, its local copy) and the lever arm
+    /// d = p − x_j.
     Rigid {
         body: u32,
         d: [f64; 3],

@@ -271,8 +271,8 @@ pub(crate) fn slot<D: Dim>(w: &World<D>, g: u32) -> usize {
 /// ([`nscdd::dd::Attached::reach`], after a step's write-back): each body's box of
 /// its boundary nodes now (the detections' test, [`crate::contact2::detect`],
 /// [`crate::contact3::detect`]), grown by what the position update may move a node
-/// (h max(|v⁻|, |v⁺|) in each direction) and by 1 % of the alert distance (two
-/// tests of the same boxes may round differently).
+/// (h max(|v⁻|, |v⁺|) in each direction) and by 1 % of the alert distance and
+/// 1e-12 of its coordinates (two tests of the same boxes may round differently).
 pub(crate) fn reach(bodies: &[FeBody], h: f64, alert: f64, out: &mut Vec<[[f64; 3]; 2]>) {
     for b in bodies {
         let d = b.dim();
@@ -289,7 +289,8 @@ pub(crate) fn reach(bodies: &[FeBody], h: f64, alert: f64, out: &mut Vec<[[f64; 
                 moves = moves.max(b.v_begin[i].abs()).max(b.v[i].abs());
             }
         }
-        let grow = h * moves + 0.01 * alert;
+        let size = (0..d).map(|c| lo[c].abs().max(hi[c].abs())).fold(0.0, f64::max);
+        let grow = h * moves + 0.01 * alert + 1e-12 * size;
         for c in 0..d {
             lo[c] -= grow;
             hi[c] += grow;
