@@ -42,20 +42,6 @@ fn most_fe_contacts(out: &std::path::Path) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Every column of `out`'s history.csv but the timings, row by row.
-fn physics(out: &std::path::Path) -> Vec<String> {
-    let h = std::fs::read_to_string(out.join("history.csv")).expect("history.csv");
-    let mut lines = h.lines();
-    let head: Vec<&str> = lines.next().expect("header").split(',').collect();
-    let keep: Vec<usize> = (0..head.len()).filter(|&k| !head[k].starts_with("t_")).collect();
-    lines
-        .map(|l| {
-            let v: Vec<&str> = l.split(',').collect();
-            keep.iter().map(|&k| v.get(k).copied().unwrap_or("")).collect::<Vec<_>>().join(",")
-        })
-        .collect()
-}
-
 /// Runs `scene` (`steps` steps, a grid of `cells` cells) in one process and on each
 /// of `ranks`: the same `final.json` and history (but its timings); each rank
 /// holding fewer bodies than the scene when there are at least as many cells as
@@ -74,8 +60,8 @@ fn same_on_ranks(dir: &std::path::Path, tag: &str, (scene, steps, cells): (&std:
             "{tag}, {n} ranks: final.json differs from one process"
         );
         assert_eq!(
-            physics(&out),
-            physics(&one),
+            history_physics(&out),
+            history_physics(&one),
             "{tag}, {n} ranks: the history differs from one process"
         );
         // (summed over the steps: a fresh run's first step holds the provisional

@@ -188,6 +188,11 @@ impl Local {
         }
         to.finish(rs).concat()
     }
+
+    /// The subdomains of `grid` with contacts held per rank.
+    pub(super) fn subdomains(&self, grid: &Grid) -> usize {
+        grid.len() * self.models.max(1)
+    }
 }
 
 /// The ranks of the subdomains from those of the grid's cells (`cells`): by model,
@@ -199,13 +204,6 @@ pub(super) fn per_model(mut cells: Vec<u32>, models: usize) -> Vec<u32> {
         cells.extend_from_within(..n);
     }
     cells
-}
-
-impl Local {
-    /// The subdomains of `grid` with contacts held per rank.
-    pub(super) fn subdomains(&self, grid: &Grid) -> usize {
-        grid.len() * self.models.max(1)
-    }
 }
 
 /// The region a rank detects in: its cells, and the pairs of its kept contacts
@@ -343,9 +341,8 @@ impl<D: Family> super::NscddOf<D> {
             return;
         };
         // (not eligible: families that may touch any body, or by model on more ranks
-        // than cells; ranks of the
-        // subdomains not known: a restart that could not start per rank; that step
-        // runs on the whole sample)
+        // than cells; ranks of the subdomains not known: a restart that could not
+        // start per rank; that step runs on the whole sample)
         if !(eligible && self.local_contacts) || rs.rank_of.len() != self.local.subdomains(grid) {
             self.local.now = false;
             rs.local = false;

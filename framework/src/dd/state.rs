@@ -252,8 +252,10 @@ impl<D: Family> NscddOf<D> {
         if let Some((k, e)) = s.kept.iter().enumerate().find(|(_, e)| e.1 as usize >= cells) {
             return Err(format!("kept[{k}]: subdomain {} of a grid of {cells} cells", e.1));
         }
-        if let Some((k, e)) = s.f_gamma.iter().enumerate().find(|(_, e)| e.1 as usize >= cells && !self.by_model) {
-            return Err(format!("f_gamma[{k}]: subdomain {} of a grid of {cells} cells", e.1));
+        if !self.by_model {
+            if let Some((k, e)) = s.f_gamma.iter().enumerate().find(|(_, e)| e.1 as usize >= cells) {
+                return Err(format!("f_gamma[{k}]: subdomain {} of a grid of {cells} cells", e.1));
+            }
         }
         let dofs = D::V::default().as_ref().len();
         let mut entries = Vec::with_capacity(s.f_gamma.len());

@@ -41,6 +41,21 @@ pub enum Anta {
 /// The 2D contacts of deformable bodies of one step; the frame is the normal n.
 pub type FeContacts2 = FeContacts<FeSide, Anta, [f64; 2], Block2, 2>;
 
+impl Anta {
+    /// The antagonist with its rigid body's id mapped by `at` (a global id to the
+    /// world's slot).
+    #[inline]
+    pub fn rigid_at(self, at: impl Fn(u32) -> usize) -> Anta {
+        match self {
+            Anta::Rigid { body, arm } => Anta::Rigid {
+                body: at(body) as u32,
+                arm,
+            },
+            side => side,
+        }
+    }
+}
+
 impl NodeSet {
     /// Fᵀ (Σ_kl w_k w_l G_kl) F for a side, as [W_nn, W_nt, W_tt].
     pub fn delassus(&self, s: &FeSide, n: [f64; 2]) -> [f64; 3] {

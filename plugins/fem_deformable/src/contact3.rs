@@ -48,6 +48,18 @@ pub enum Anta3 {
     Fe(FeSide3),
 }
 
+impl Anta3 {
+    /// The antagonist with its rigid body's id mapped by `at` (a global id to the
+    /// world's slot).
+    #[inline]
+    pub fn rigid_at(self, at: impl Fn(u32) -> usize) -> Anta3 {
+        match self {
+            Anta3::Rigid { body, d } => Anta3::Rigid { body: at(body) as u32, d },
+            side => side,
+        }
+    }
+}
+
 /// The 3D contacts of deformable bodies of one step; the frame is the basis
 /// B = [n t1 t2].
 pub type FeContacts3 = FeContacts<FeSide3, Anta3, Basis, Block3, 3>;

@@ -240,13 +240,7 @@ impl Deformables2 {
         for a in 0..c.len() {
             let r = c.r[a];
             if r != [0.0, 0.0] {
-                let anta = match c.anta[a] {
-                    Anta::Rigid { body, arm } => Anta::Rigid {
-                        body: crate::family::slot(w, body) as u32,
-                        arm,
-                    },
-                    side => side,
-                };
+                let anta = c.anta[a].rigid_at(|g| crate::family::slot(w, g));
                 apply(
                     &mut self.sets,
                     &mut w.bodies.vel,
@@ -293,13 +287,7 @@ impl Deformables2 {
         let (mut f2, mut q2) = (0.0, 0.0);
         for a in 0..c.len() {
             let t = c.target[a];
-            let anta = match c.anta[a] {
-                Anta::Rigid { body, arm } => Anta::Rigid {
-                    body: at(body) as u32,
-                    arm,
-                },
-                side => side,
-            };
+            let anta = c.anta[a].rigid_at(&at);
             let mut u = local_velocity(&self.sets, vel, c.cand[a], anta, c.frame[a]);
             u[0] -= t.u_target;
             f2 += natural_map_sq(&c.r[a], &u, t.mu);

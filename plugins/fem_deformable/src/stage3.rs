@@ -244,13 +244,7 @@ impl Deformables3 {
         for a in 0..c.len() {
             let r = c.r[a];
             if r != [0.0; 3] {
-                let anta = match c.anta[a] {
-                    Anta3::Rigid { body, d } => Anta3::Rigid {
-                        body: crate::family::slot(w, body) as u32,
-                        d,
-                    },
-                    side => side,
-                };
+                let anta = c.anta[a].rigid_at(|g| crate::family::slot(w, g));
                 let inv: RigidInv<'_> = &w.bodies.inv_mass;
                 apply(&mut self.sets, &mut w.bodies.vel, inv, c.cand[a], anta, &c.frame[a], r);
             }
@@ -290,10 +284,7 @@ impl Deformables3 {
         let (mut f2, mut q2) = (0.0, 0.0);
         for a in 0..c.len() {
             let t = c.target[a];
-            let anta = match c.anta[a] {
-                Anta3::Rigid { body, d } => Anta3::Rigid { body: at(body) as u32, d },
-                side => side,
-            };
+            let anta = c.anta[a].rigid_at(&at);
             let mut u = local_velocity(&self.sets, vel, c.cand[a], anta, &c.frame[a]);
             u[0] -= t.u_target;
             f2 += natural_map_sq(&c.r[a], &u, t.mu);
