@@ -4,8 +4,8 @@
 
 Usage: continuum_footing.py OUT_DIR [--shallow] [--seeds 3,5,...] [--jobs N] [--tag T]
     [--young E] [--hardening PHI0 KAPPA_H PHI | --friction PHI] [--grain-share S]
-    [--coupling node|grain] [--geostatic Q] [--depth D --disc-footing Y --duration T]
-    [--plot]
+    [--coupling node|grain] [--geostatic Q] [--tolerance T]
+    [--depth D --disc-footing Y --duration T] [--plot]
 
 For each seed (default 3 and 5) writes OUT_DIR/{T,disc}_sSEED.toml (T: `hyb` unless
 `--tag`): the example (1300 grains in a 0.6 m layer over the continuum, 3.5 s) and its
@@ -24,7 +24,8 @@ scripts/biaxial_study.sh installs it in .venv-docs).
 1770), 2 s, 15 mm (plot docs/continuum_footing_shallow.png). The hybrid's
 foundation: `--young`, `--hardening` (initial friction angle, hardening strain,
 friction angle) or `--friction` (perfectly plastic), `--grain-share`,
-`--coupling` and `--geostatic` replace the example's. `--depth D`: the foundation D m deep (the
+`--coupling`, `--geostatic` and `--tolerance` (the solver's, for the hybrid only:
+the all-discrete references keep 1.666e-4) replace the example's. `--depth D`: the foundation D m deep (the
 example: 0.5) in both runs, the all-discrete footing at `--disc-footing` (0.615:
 its layer settles more), both run `--duration` s (3.5); the references are then
 named discD_fY_tT_sSEED; `--plot` then writes OUT_DIR/continuum_footing.png (also
@@ -135,9 +136,12 @@ def hybrid_variant(text):
     """The hybrid's foundation with the command line's law, if any: `--young E`,
     `--hardening PHI0 KAPPA_H PHI` or `--friction PHI` (perfectly plastic),
     `--grain-share S`, `--coupling node|grain`, `--geostatic Q` (the foundation
-    starts at its geostatic stress under a surcharge of Q Pa)."""
+    starts at its geostatic stress under a surcharge of Q Pa), `--tolerance T` (the
+    solver's tolerance, QM/16: the example's 1.666e-4)."""
     young, hard, phi, share = opt("--young"), opt("--hardening", 3), opt("--friction"), opt("--grain-share")
-    coupling, geostatic = opt("--coupling"), opt("--geostatic")
+    coupling, geostatic, tol = opt("--coupling"), opt("--geostatic"), opt("--tolerance")
+    if tol:
+        text = re.sub(r"(?m)^tolerance = .*$", f"tolerance = {float(tol):g}", text)
     if geostatic:
         text = re.sub(r"(?m)^(band = .*)$", rf"\1\ninitial_stress = {{ surcharge = {geostatic} }}", text, count=1)
     if coupling:
