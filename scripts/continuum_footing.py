@@ -4,7 +4,7 @@
 
 Usage: continuum_footing.py OUT_DIR [--shallow] [--seeds 3,5,...] [--jobs N] [--tag T]
     [--young E] [--hardening PHI0 KAPPA_H PHI | --friction PHI] [--grain-share S]
-    [--coupling node|grain] [--geostatic Q] [--tolerance T]
+    [--coupling node|grain] [--geostatic Q] [--tolerance T] [--disc-tolerance T]
     [--depth D --disc-footing Y --duration T] [--plot]
 
 For each seed (default 3 and 5) writes OUT_DIR/{T,disc}_sSEED.toml (T: `hyb` unless
@@ -17,19 +17,23 @@ every variant). Prints each one's time, sweeps, the footing force at 5, 10 and 1
 of penetration and its mean over 0–10, 10–30, 30–50 and 10–50 mm, and, with more
 than two seeds, the scatter: each discrete seed's RMS distance (smoothed force at
 every millimetre up to 50 mm) to the mean of the other seeds, each hybrid's to the
-mean of every discrete seed. `--plot`: docs/continuum_footing.png (needs matplotlib:
-scripts/biaxial_study.sh installs it in .venv-docs).
+mean of every discrete seed, and the probability that a hybrid lies farther than a
+discrete seed (Mann–Whitney's U / n1 n2: 0.5 when the two lists are alike).
+`--plot`: docs/continuum_footing.png (needs matplotlib: scripts/biaxial_study.sh
+installs it in .venv-docs).
 
 `--shallow`: the layout until 2026-11-26, a 0.3 m layer (650 grains; all-discrete
 1770), 2 s, 15 mm (plot docs/continuum_footing_shallow.png). The hybrid's
 foundation: `--young`, `--hardening` (initial friction angle, hardening strain,
 friction angle) or `--friction` (perfectly plastic), `--grain-share`,
 `--coupling`, `--geostatic` and `--tolerance` (the solver's, for the hybrid only:
-the all-discrete references keep 1.666e-4) replace the example's. `--depth D`: the foundation D m deep (the
-example: 0.5) in both runs, the all-discrete footing at `--disc-footing` (0.615:
-its layer settles more), both run `--duration` s (3.5); the references are then
-named discD_fY_tT_sSEED; `--plot` then writes OUT_DIR/continuum_footing.png (also
-with `--geostatic`).
+the all-discrete references keep 1.666e-4) replace the example's;
+`--disc-tolerance T` runs the all-discrete references at T (their names then end
+in _tolT). `--depth D`: the foundation D m deep (the example: 0.5) in both runs,
+the all-discrete footing at `--disc-footing` (0.615: its layer settles more), both
+run `--duration` s (3.5); the references are then named discD_fY_tT_sSEED;
+`--plot` then writes OUT_DIR/continuum_footing.png (also with `--geostatic` or
+either tolerance).
 """
 import csv
 import os
@@ -221,6 +225,9 @@ def main():
         disc_name = f"disc{depth}_f{float(opt('--disc-footing', default='0.615')):g}_t{float(opt('--duration', default='3.5')):g}"
     else:
         disc_name = "disc"
+    disc_tol = opt("--disc-tolerance")
+    if disc_tol:
+        disc_name += f"_tol{float(disc_tol):g}"
     os.makedirs(out, exist_ok=True)
     src = shallow(open(os.path.join(ROOT, "examples/scenes/footing.toml")).read())
     env = dict(os.environ, NSCDD_PYTHON_ENV=os.environ.get("NSCDD_PYTHON_ENV", os.path.join(ROOT, "venv")))
@@ -238,6 +245,8 @@ def main():
             dest = os.path.join(out, name)
             path = os.path.join(out, name + ".toml")
             text = re.sub(r"(?m)^seed = 3$", f"seed = {seed}", text)
+            if disc_tol and kind != tag:
+                text = re.sub(r"(?m)^tolerance = .*$", f"tolerance = {float(disc_tol):g}", text)
             same = lambda t: [x for x in t.splitlines() if not x.startswith("#")]
             if os.path.exists(os.path.join(dest, "history.csv")) and os.path.exists(path) and same(open(path).read()) == same(text):
                 continue  # run once: the all-discrete reference serves every variant
@@ -271,6 +280,12 @@ def main():
         d = [rms(hyb[s], m) for s in seeds if hyb[s]]
         if d:
             print(f"RMS over 1-{top} mm, each {tag} to the discrete mean: {min(d):.0f}-{max(d):.0f}, mean {sum(d) / len(d):.0f} N/m")
+            print(f"  each discrete seed: {', '.join(f'{s}: {x:.0f}' for s, x in zip(ds, loo))}")
+            print(f"  each {tag}: {', '.join(f'{s}: {rms(hyb[s], m):.0f}' for s in seeds if hyb[s])}")
+            # Mann–Whitney's U over both lists, as the probability that a hybrid lies
+            # farther than a discrete seed (0.5: the same distribution)
+            u = sum((x > y) + 0.5 * (x == y) for x in d for y in loo) / (len(d) * len(loo))
+            print(f"  P(a {tag} lies farther than a discrete seed) = {u:.2f} (Mann-Whitney U / n1 n2; 0.5: as far)")
             hm = mean_curve([c for c in hyb.values() if c])
             print(f"mean {tag} curve to the discrete mean: {rms(hm, m):.0f} N/m; mean force {sum(hm) / len(hm):.0f} against {sum(m) / len(m):.0f} N/m")
     if "--plot" not in sys.argv:
@@ -299,7 +314,7 @@ def main():
     ax.legend()
     fig.tight_layout()
     # (the example's own layouts in docs/, a variant's with its runs)
-    variant = depth or opt("--geostatic")
+    variant = depth or opt("--geostatic") or opt("--tolerance") or disc_tol
     png = os.path.join(out, "continuum_footing.png") if variant else os.path.join(ROOT, "docs/continuum_footing.png" if deep else "docs/continuum_footing_shallow.png")
     fig.savefig(png, dpi=110)
 
