@@ -77,22 +77,6 @@ fn balance(out: &Path) -> Vec<(u64, bool, f64)> {
         .collect()
 }
 
-/// The history without its timings.
-fn untimed(out: &Path) -> Vec<String> {
-    let h = std::fs::read_to_string(out.join("history.csv")).unwrap();
-    let head: Vec<String> = h.lines().next().unwrap().split(',').map(String::from).collect();
-    h.lines()
-        .map(|l| {
-            l.split(',')
-                .zip(&head)
-                .filter(|(_, c)| !c.starts_with("t_"))
-                .map(|(v, _)| v)
-                .collect::<Vec<_>>()
-                .join(",")
-        })
-        .collect()
-}
-
 #[test]
 fn a_balanced_grid_splits_the_contacts_evenly() {
     let dir = scratch("balanced_grid");
@@ -125,7 +109,7 @@ fn a_balanced_grid_splits_the_contacts_evenly() {
         std::fs::read_to_string(two.join("final.json")).unwrap() == fin,
         "2 threads: final.json differs"
     );
-    assert_eq!(untimed(&two), untimed(&bal));
+    assert_eq!(history_physics(&two), history_physics(&bal));
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -7,6 +7,7 @@
 //! every rank holds every body: `mpi.rs`).
 #![cfg(all(feature = "fem", feature = "mpi"))]
 
+mod common;
 mod mpi_common;
 use mpi_common::*;
 
@@ -60,8 +61,8 @@ fn same_on_ranks(dir: &std::path::Path, tag: &str, (scene, steps, cells): (&std:
             "{tag}, {n} ranks: final.json differs from one process"
         );
         assert_eq!(
-            history_physics(&out),
-            history_physics(&one),
+            common::history_physics(&out),
+            common::history_physics(&one),
             "{tag}, {n} ranks: the history differs from one process"
         );
         // (summed over the steps: a fresh run's first step holds the provisional

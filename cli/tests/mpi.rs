@@ -10,6 +10,7 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
+mod common;
 mod mpi_common;
 use mpi_common::*;
 
@@ -82,7 +83,7 @@ fn same_as_threads(scene: &Path, dir: &Path, subdomains: &str, scheme: &str, ran
             let head: Vec<&str> = h.lines().next().expect("header").split(',').collect();
             assert!(!named || head.contains(&"floor_fy"), "{head:?}");
         }
-        assert_eq!(history_physics(&out), history_physics(&one), "history on {n} ranks");
+        assert_eq!(common::history_physics(&out), common::history_physics(&one), "history on {n} ranks");
         assert!(out.join("ranks.json").exists(), "ranks.json on {n} ranks");
     }
 }

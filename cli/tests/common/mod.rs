@@ -67,6 +67,23 @@ pub fn run_scene(dir: &Path, name: &str, scene: &str, flags: &[&str]) -> PathBuf
     out
 }
 
+/// Every column of `out`'s history.csv but the timings (`t_*`), the header and
+/// each row.
+pub fn history_physics(out: &Path) -> Vec<String> {
+    let h = std::fs::read_to_string(out.join("history.csv")).expect("history.csv");
+    let head: Vec<&str> = h.lines().next().expect("header").split(',').collect();
+    h.lines()
+        .map(|l| {
+            l.split(',')
+                .zip(&head)
+                .filter(|(_, c)| !c.starts_with("t_"))
+                .map(|(v, _)| v)
+                .collect::<Vec<_>>()
+                .join(",")
+        })
+        .collect()
+}
+
 pub fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()
 }

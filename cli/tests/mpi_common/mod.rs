@@ -160,20 +160,6 @@ pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 }
 
 /// final.json, with its NSCDD solver state (gathered from every rank on rank 0).
-/// Every column of `out`'s history.csv but the timings (`t_*`), row by row.
-pub fn history_physics(out: &Path) -> Vec<String> {
-    let h = std::fs::read_to_string(out.join("history.csv")).expect("history.csv");
-    let mut lines = h.lines();
-    let head: Vec<&str> = lines.next().expect("header").split(',').collect();
-    let keep: Vec<usize> = (0..head.len()).filter(|&k| !head[k].starts_with("t_")).collect();
-    lines
-        .map(|l| {
-            let v: Vec<&str> = l.split(',').collect();
-            keep.iter().map(|&k| v.get(k).copied().unwrap_or("")).collect::<Vec<_>>().join(",")
-        })
-        .collect()
-}
-
 pub fn final_json(out: &Path) -> String {
     std::fs::read_to_string(out.join("final.json")).unwrap_or_else(|e| panic!("{}: {e}", out.display()))
 }
