@@ -4,8 +4,8 @@
 
 Usage: continuum_footing.py OUT_DIR [--shallow] [--seeds 3,5,...] [--jobs N] [--tag T]
     [--young E] [--hardening PHI0 KAPPA_H PHI | --friction PHI] [--grain-share S]
-    [--coupling node|grain] [--geostatic Q] [--tolerance T] [--disc-tolerance T]
-    [--depth D --disc-footing Y --duration T] [--plot]
+    [--coupling node|grain] [--geostatic Q | --stress-free] [--tolerance T] [--disc-tolerance T]
+    [--depth D --disc-footing Y --duration T] [--extend T] [--plot]
 
 For each seed (default 3 and 5) writes OUT_DIR/{T,disc}_sSEED.toml (T: `hyb` unless
 `--tag`): the example (1300 grains in a 0.6 m layer over the continuum, 3.5 s) and its
@@ -19,6 +19,11 @@ than two seeds, the scatter: each discrete seed's RMS distance (smoothed force a
 every millimetre up to 50 mm) to the mean of the other seeds, each hybrid's to the
 mean of every discrete seed, and the probability that a hybrid lies farther than a
 discrete seed (Mann–Whitney's U / n1 n2: 0.5 when the two lists are alike).
+`--extend T`: runs short of 50 mm by their end are continued (a restart from
+their final.json) to T s, so that no seed drops out of the comparison: the seeds
+touched last are those whose footing comes down into a hollow of the deposit's
+surface, embedded in the grains beside it and so the strongest (docs/CONTINUUM.md,
+"The layer at rest and the seeds left out").
 `--plot`: docs/continuum_footing.png (needs matplotlib: scripts/biaxial_study.sh
 installs it in .venv-docs).
 
@@ -26,7 +31,8 @@ installs it in .venv-docs).
 1770), 2 s, 15 mm (plot docs/continuum_footing_shallow.png). The hybrid's
 foundation: `--young`, `--hardening` (initial friction angle, hardening strain,
 friction angle) or `--friction` (perfectly plastic), `--grain-share`,
-`--coupling`, `--geostatic` and `--tolerance` (the solver's, for the hybrid only:
+`--coupling`, `--geostatic` (or `--stress-free`: the runs before 2026-11-27, tags
+`hyb` and `hybt3`) and `--tolerance` (the solver's, for the hybrid only:
 the all-discrete references keep 1.666e-4) replace the example's;
 `--disc-tolerance T` runs the all-discrete references at T (their names then end
 in _tolT). `--depth D`: the foundation D m deep (the example: 0.5) in both runs,
@@ -120,6 +126,9 @@ def mean_force(p, r, lo, hi):
 
 def curve(d):
     r = list(csv.DictReader(open(os.path.join(d, "history.csv"))))
+    if os.path.exists(os.path.join(d + "_ext", "history.csv")):  # continued (`--extend`)
+        last = int(r[-1]["step"])
+        r += [x for x in csv.DictReader(open(os.path.join(d + "_ext", "history.csv"))) if int(x["step"]) > last]
     fy = [float(x["footing_fy"]) for x in r]
     y = [float(x["footing_y"]) for x in r]
     first = next((i for i, f in enumerate(fy) if f > 1), len(r))  # never touched: empty
@@ -140,12 +149,15 @@ def hybrid_variant(text):
     """The hybrid's foundation with the command line's law, if any: `--young E`,
     `--hardening PHI0 KAPPA_H PHI` or `--friction PHI` (perfectly plastic),
     `--grain-share S`, `--coupling node|grain`, `--geostatic Q` (the foundation
-    starts at its geostatic stress under a surcharge of Q Pa), `--tolerance T` (the
-    solver's tolerance, QM/16: the example's 1.666e-4)."""
+    starts at its geostatic stress under a surcharge of Q Pa; the example's: 1e4),
+    `--stress-free` (it starts stress-free, as the example did until 2026-11-27),
+    `--tolerance T` (the solver's tolerance, QM/16: the example's 1.666e-4)."""
     young, hard, phi, share = opt("--young"), opt("--hardening", 3), opt("--friction"), opt("--grain-share")
     coupling, geostatic, tol = opt("--coupling"), opt("--geostatic"), opt("--tolerance")
     if tol:
         text = re.sub(r"(?m)^tolerance = .*$", f"tolerance = {float(tol):g}", text)
+    if geostatic or "--stress-free" in sys.argv:
+        text = re.sub(r"(?m)^initial_stress = .*\n?", "", text)
     if geostatic:
         text = re.sub(r"(?m)^(band = .*)$", rf"\1\ninitial_stress = {{ surcharge = {geostatic} }}", text, count=1)
     if coupling:
@@ -183,8 +195,15 @@ def mean_curve(cs):
     return [sum(v) / len(v) for v in zip(*cs)]
 
 
+def mean_se(v):
+    """The mean of `v` and its standard error."""
+    m = sum(v) / len(v)
+    return m, (sum((x - m) ** 2 for x in v) / (len(v) - 1) / len(v)) ** 0.5 if len(v) > 1 else 0.0
+
+
 def run_all(jobs, todo, env):
-    """Runs `todo` ([(name, path, out)]), `jobs` at a time; returns {name: wall}."""
+    """Runs `todo` ([(name, path, out, extra arguments)]), `jobs` at a time; returns
+    {name: wall}."""
     walls, running = {}, []
     nscdd = os.path.join(ROOT, "target/release/nscdd")
 
@@ -200,11 +219,34 @@ def run_all(jobs, todo, env):
             else:
                 time.sleep(0.2)
 
-    for name, path, dest in todo:
+    for name, path, dest, extra in todo:
         reap(jobs - 1)
-        running.append((name, subprocess.Popen([nscdd, "run", path, "--out", dest, "--quiet"], env=env), time.time()))
+        running.append((name, subprocess.Popen([nscdd, "run", path, "--out", dest, "--quiet", *extra], env=env), time.time()))
     reap(0)
     return walls
+
+
+def extend(out, names, top, until, jobs, env):
+    """`--extend T`: each run whose footing is not `top` mm deep by its end is
+    continued from its final.json to T s (OUT_DIR/NAME_ext, its own scene file with
+    that duration; a restart continues bitwise as the longer run would), and its
+    curve reads both histories. Without it the seeds touched last (the footing
+    embedded in a hollow of the surface: the strongest) drop out of the comparison
+    over 1–`top` mm."""
+    todo = []
+    for name in names:
+        d = os.path.join(out, name)
+        p, f, r = curve(d)
+        if (p and p[-1] >= top) or float(r[-1]["time"]) >= until - 1e-9:
+            continue
+        text = re.sub(r"(?m)^duration = .*$", f"duration = {until:g}", open(d + ".toml").read())
+        path = d + "_ext.toml"
+        if os.path.exists(os.path.join(d + "_ext", "history.csv")) and os.path.exists(path) and open(path).read() == text:
+            continue
+        open(path, "w").write(text)
+        todo.append((name + "_ext", path, d + "_ext", ["--restart", os.path.join(d, "final.json")]))
+    for name, wall in run_all(jobs, todo, env).items():
+        print(f"{name}: continued to {until:g} s in {wall:.1f} s")
 
 
 def main():
@@ -230,6 +272,8 @@ def main():
         disc_name += f"_tol{float(disc_tol):g}"
     os.makedirs(out, exist_ok=True)
     src = shallow(open(os.path.join(ROOT, "examples/scenes/footing.toml")).read())
+    if not deep:  # (that layout started its foundation stress-free)
+        src = re.sub(r"(?m)^initial_stress = .*\n?", "", src)
     env = dict(os.environ, NSCDD_PYTHON_ENV=os.environ.get("NSCDD_PYTHON_ENV", os.path.join(ROOT, "venv")))
     todo, names = [], []
     for seed in seeds:
@@ -251,9 +295,11 @@ def main():
             if os.path.exists(os.path.join(dest, "history.csv")) and os.path.exists(path) and same(open(path).read()) == same(text):
                 continue  # run once: the all-discrete reference serves every variant
             open(path, "w").write(text)
-            todo.append((name, path, dest))
+            todo.append((name, path, dest, []))
     walls = run_all(jobs, todo, env)
     curves, top = {}, 50 if deep else 15
+    if opt("--extend"):
+        extend(out, names, top, float(opt("--extend")), jobs, env)
     for name in names:
         p, f, r = curve(os.path.join(out, name))
         curves[name] = (p, f)
@@ -288,6 +334,14 @@ def main():
             print(f"  P(a {tag} lies farther than a discrete seed) = {u:.2f} (Mann-Whitney U / n1 n2; 0.5: as far)")
             hm = mean_curve([c for c in hyb.values() if c])
             print(f"mean {tag} curve to the discrete mean: {rms(hm, m):.0f} N/m; mean force {sum(hm) / len(hm):.0f} against {sum(m) / len(m):.0f} N/m")
+            # each seed's mean force over 1..top mm: the ratio of the two means and
+            # its standard error (the seeds independent; first-order propagation)
+            fh = [sum(c) / len(c) for c in hyb.values() if c]
+            fd = [sum(disc[s]) / len(disc[s]) for s in ds]
+            (mh, eh), (md, ed) = mean_se(fh), mean_se(fd)
+            ratio = mh / md
+            print(f"mean force over 1-{top} mm, each seed's: {tag} {mh:.0f} +- {eh:.0f} ({len(fh)} seeds), discrete {md:.0f} +- {ed:.0f} ({len(fd)}); "
+                  f"ratio {ratio:.2f} +- {ratio * ((eh / mh) ** 2 + (ed / md) ** 2) ** 0.5:.2f} (standard errors)")
     if "--plot" not in sys.argv:
         return
     try:
@@ -314,7 +368,7 @@ def main():
     ax.legend()
     fig.tight_layout()
     # (the example's own layouts in docs/, a variant's with its runs)
-    variant = depth or opt("--geostatic") or opt("--tolerance") or disc_tol
+    variant = depth or opt("--geostatic") or "--stress-free" in sys.argv or opt("--tolerance") or disc_tol
     png = os.path.join(out, "continuum_footing.png") if variant else os.path.join(ROOT, "docs/continuum_footing.png" if deep else "docs/continuum_footing_shallow.png")
     fig.savefig(png, dpi=110)
 
