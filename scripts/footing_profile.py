@@ -40,7 +40,9 @@ def arrays(path):
 def lateral_ratio(path, base):
     """σxx/σyy of the grains 0.05–0.45 m below `base` within |x − 0.5| < WIDE, from a
     contacts frame: Σ f_n l_x²/|l| over Σ f_n l_y²/|l| (l the branch between the two
-    centres; the normal part of the fabric stress, walls' contacts left out)."""
+    centres, 0.016–0.024 m for two grains; a wall's contact line runs from a grain's
+    centre to the contact point, at most 0.012 m: left out; the normal part of the
+    fabric stress)."""
     a = arrays(path)
     pts, fn = a["Points"], a["f_n"]
     sxx = syy = 0.0
@@ -48,7 +50,7 @@ def lateral_ratio(path, base):
         x1, y1, x2, y2 = pts[6 * k], pts[6 * k + 1], pts[6 * k + 3], pts[6 * k + 4]
         lx, ly = x2 - x1, y2 - y1
         length = (lx * lx + ly * ly) ** 0.5
-        if abs((x1 + x2) / 2 - 0.5) < WIDE and 0.05 < base - (y1 + y2) / 2 < 0.45 and 0 < length < 0.03:
+        if abs((x1 + x2) / 2 - 0.5) < WIDE and 0.05 < base - (y1 + y2) / 2 < 0.45 and 0.014 < length < 0.03:
             sxx += fn[k] * lx * lx / length
             syy += fn[k] * ly * ly / length
     return sxx / syy
