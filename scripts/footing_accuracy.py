@@ -4,7 +4,7 @@
 same tolerance is not the same accuracy").
 
 Usage: footing_accuracy.py OUT_DIR [--seed S] [--from STEP] [--states K] [--every N]
-    [--tolerances 1e-3,5e-4,...] [--reference TOL] [--jobs 2] [--scenes hybrid|all-discrete]
+    [--tolerances 1e-3,5e-4,...] [--reference TOL] [--jobs 2] [--scenes A,B,...]
 
 For each of the two scenes of `continuum_footing.py` (seed S, default 3): runs it to
 step STEP (default 2600, under the footing), then K times (default 10): from the
@@ -14,9 +14,11 @@ reference tolerance (default 1e-6, at most 200 000 sweeps); then N steps (defaul
 reference's: the footing force |F − F_ref| (N/m) and the RMS of |v − v_ref| over the
 grains above the band (y > 0.1 m, the region both scenes have). Prints, per
 tolerance, the mean sweeps, NLGS seconds, errors and natural-map residual over the
-K states. The two scenes run side by side with `--jobs 2` (the default); `--scenes`
-studies only the one named (the hybrid after a change of the example's foundation:
-the all-discrete scene has none).
+K states, and the median RMS velocity of the grains above the band in the
+reference steps (the scale of the errors). The scenes run side by side with
+`--jobs 2` (the default); `--scenes` names those to study, of `hybrid` (the
+example), `hybrid-stress-free` (its foundation started stress-free, as until
+2026-11-27) and `all-discrete` (default: `hybrid,all-discrete`).
 """
 import csv
 import json
@@ -61,13 +63,14 @@ def verr(v, ref):
 
 def study(kind, base, out, start, states, every, tols, reference, env):
     """Rows (tolerance, sweeps, t_nlgs, force error, velocity error, residual), one
-    per state and tolerance."""
+    per state and tolerance, and the median RMS velocity of the reference steps."""
     run(out, f"{kind}_start", scene(base, start, 1.666e-4, 3000), None, env)
-    state, step, rows = os.path.join(out, f"{kind}_start", "final.json"), start, []
+    state, step, rows, scale = os.path.join(out, f"{kind}_start", "final.json"), start, [], []
     for _ in range(states):
         one = lambda tol, cap: run(out, f"{kind}_one", scene(base, step + 1, tol, cap), state, env)
         r, dest = one(reference, 200000)
         f_ref, v_ref = float(r[0]["footing_fy"]), velocities(dest)
+        scale.append(verr(v_ref, {i: (0.0, 0.0) for i in v_ref}))
         for tol in tols:
             r, dest = one(tol, 3000)
             x = r[0]
@@ -76,7 +79,7 @@ def study(kind, base, out, start, states, every, tols, reference, env):
         state = os.path.join(out, f"{kind}_state{step + every}.json")
         os.replace(os.path.join(out, f"{kind}_chain", "final.json"), state)
         step += every
-    return rows
+    return rows, st.median(scale)
 
 
 def main():
@@ -91,17 +94,20 @@ def main():
     src = cf.shallow(open(os.path.join(cf.ROOT, "examples/scenes/footing.toml")).read())
     scenes = {
         "hybrid": cf.deepen(src, False),
+        "hybrid-stress-free": re.sub(r"(?m)^initial_stress = .*\n?", "", cf.deepen(src, False)),
         "all-discrete": cf.deepen(cf.discrete(src), True),
     }
-    only = cf.opt("--scenes")
-    scenes = {k: re.sub(r"(?m)^seed = 3$", f"seed = {seed}", t) for k, t in scenes.items() if only in (None, k)}
+    only = cf.opt("--scenes", default="hybrid,all-discrete").split(",")
+    if any(k not in scenes for k in only):
+        sys.exit(f"--scenes: of {', '.join(scenes)}")
+    scenes = {k: re.sub(r"(?m)^seed = 3$", f"seed = {seed}", scenes[k]) for k in only}
     with ThreadPoolExecutor(jobs) as pool:
         got = {k: pool.submit(study, k, t, out, start, states, every, tols, reference, env) for k, t in scenes.items()}
         got = {k: f.result() for k, f in got.items()}
     print(f"seed {seed}, {states} states from step {start} every {every}; reference tolerance {reference:g}")
     print("| scene | tolerance | sweeps | NLGS (ms) | force error, median / mean (N/m) | velocity error, median / mean (mm/s) | natural-map residual, median |")
     print("|---|---|---|---|---|---|---|")
-    for k, rows in got.items():
+    for k, (rows, scale) in got.items():
         for tol in tols:
             r = [x for x in rows if x[0] == tol]
             f, v = [x[3] for x in r], [x[4] * 1000 for x in r]
@@ -109,6 +115,8 @@ def main():
                 f"| {k} | {tol:g} | {st.mean(x[1] for x in r):.0f} | {1000 * st.mean(x[2] for x in r):.1f} | "
                 f"{st.median(f):.0f} / {st.mean(f):.0f} | {st.median(v):.3f} / {st.mean(v):.3f} | {st.median(x[5] for x in r):.1e} |"
             )
+    for k, (rows, scale) in got.items():
+        print(f"{k}: RMS velocity of the grains above the band in the reference steps, median {1000 * scale:.1f} mm/s")
 
 
 if __name__ == "__main__":
