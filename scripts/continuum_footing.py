@@ -145,6 +145,12 @@ def opt(name, n=1, default=None):
     return v if n > 1 else v[0]
 
 
+def stress_free(text):
+    """The scene with its foundation started stress-free (its `initial_stress` line
+    removed; the example until 2026-11-27)."""
+    return re.sub(r"(?m)^initial_stress = .*\n?", "", text)
+
+
 def hybrid_variant(text):
     """The hybrid's foundation with the command line's law, if any: `--young E`,
     `--hardening PHI0 KAPPA_H PHI` or `--friction PHI` (perfectly plastic),
@@ -157,7 +163,7 @@ def hybrid_variant(text):
     if tol:
         text = re.sub(r"(?m)^tolerance = .*$", f"tolerance = {float(tol):g}", text)
     if geostatic or "--stress-free" in sys.argv:
-        text = re.sub(r"(?m)^initial_stress = .*\n?", "", text)
+        text = stress_free(text)
     if geostatic:
         text = re.sub(r"(?m)^(band = .*)$", rf"\1\ninitial_stress = {{ surcharge = {geostatic} }}", text, count=1)
     if coupling:
@@ -273,7 +279,7 @@ def main():
     os.makedirs(out, exist_ok=True)
     src = shallow(open(os.path.join(ROOT, "examples/scenes/footing.toml")).read())
     if not deep:  # (that layout started its foundation stress-free)
-        src = re.sub(r"(?m)^initial_stress = .*\n?", "", src)
+        src = stress_free(src)
     env = dict(os.environ, NSCDD_PYTHON_ENV=os.environ.get("NSCDD_PYTHON_ENV", os.path.join(ROOT, "venv")))
     todo, names = [], []
     for seed in seeds:

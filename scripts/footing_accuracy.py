@@ -94,7 +94,7 @@ def main():
     src = cf.shallow(open(os.path.join(cf.ROOT, "examples/scenes/footing.toml")).read())
     scenes = {
         "hybrid": cf.deepen(src, False),
-        "hybrid-stress-free": re.sub(r"(?m)^initial_stress = .*\n?", "", cf.deepen(src, False)),
+        "hybrid-stress-free": cf.stress_free(cf.deepen(src, False)),
         "all-discrete": cf.deepen(cf.discrete(src), True),
     }
     only = cf.opt("--scenes", default="hybrid,all-discrete").split(",")

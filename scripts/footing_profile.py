@@ -23,6 +23,9 @@ import re
 import struct
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from continuum_footing import mean_se  # noqa: E402
+
 HALF, WIDE, EVERY, BIN = 0.1, 0.4, 50, 0.1
 
 
@@ -110,9 +113,7 @@ def main():
             mean = {k: sum(p[j][k] for p in ps if k in p[j]) / sum(1 for p in ps if k in p[j]) for k in keys}
             print(f"mean of {len(ps)} {g} ({what}, by depth below the footing's base): "
                   + "  ".join(f"{k * BIN:.1f}-{(k + 1) * BIN:.1f}: {v:.3g}" for k, v in sorted(mean.items())))
-        k0 = [p[2] for p in ps]
-        m = sum(k0) / len(k0)
-        se = (sum((x - m) ** 2 for x in k0) / max(1, len(k0) - 1) / len(k0)) ** 0.5
+        m, se = mean_se([p[2] for p in ps])
         print(f"mean of {len(ps)} {g}: σxx/σyy of the layer at rest (the frame before first contact, 0.05-0.45 m below the base) {m:.3f} +- {se:.3f}")
 
 
