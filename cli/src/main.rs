@@ -345,7 +345,7 @@ pub(crate) fn load_any(
 
 /// [`load_any`] on MPI ranks: the scene's survey ([`nscdd::scene::part`]; each rank
 /// builds its part once the decomposition flags apply), or the whole scene for one
-/// with body families.
+/// with a body family that gives no load boxes.
 fn survey_any(scene: &std::path::Path, reg: &nscdd::registry::Registry) -> Result<nscdd::scene::AnyScene, nscdd::error::InputError> {
     match nscdd::scene::part::survey_any(scene, reg).map_err(fem_hint)? {
         Some(s) => Ok(s),

@@ -27,7 +27,8 @@ pub fn run<D: nscdd::scene::schema::SceneDim>(
 ) -> ExitCode {
     // a family's body (a deformable one) may be copied into any number of subdomains
     let movable = match (s.families.is_empty(), &s.survey) {
-        (true, Some(sv)) => sv.movable,
+        (true, Some(sv)) if !sv.families => sv.movable,
+        (true, Some(_)) => usize::MAX,
         (true, None) => (0..s.world.bodies.len()).filter(|&b| s.world.bodies.movable(b)).count(),
         (false, _) => usize::MAX,
     };
@@ -58,8 +59,14 @@ pub fn run<D: nscdd::scene::schema::SceneDim>(
                 let contacts: Option<nscdd::output::Pull> = if in_part.is_some() { Some(&mut none) } else { None };
                 nscdd::output::write_final_json(out, w, families.as_ref(), dd_state.as_ref(), (contacts, None))
             };
-            // (a part: the saved NSCDD state, which chose each rank's bodies and contacts)
-            let nscdd_only = |out: &mut dyn std::io::Write| serde_json::to_writer(out, dd_state).map_err(std::io::Error::from);
+            // (a part: the saved NSCDD state, which chose each rank's bodies and
+            // contacts; the families, loaded against each rank's part: their states
+            // and descriptions, which count the world bodies they took)
+            let nscdd_only = |out: &mut dyn std::io::Write| {
+                serde_json::to_writer(&mut *out, dd_state)?;
+                serde_json::to_writer(&mut *out, &families)?;
+                s.families.iter().try_for_each(|f| out.write_all(f.describe().as_bytes()))
+            };
             match s.survey.as_ref().filter(|_| s.world.ids.held().is_some()) {
                 // a part: the survey's digest of every body instead of the world's
                 Some(sv) => crate::ranks::digest(scene, nscdd_only, (&s.decomposition, &w.time, &w.solver, sv.digest)),

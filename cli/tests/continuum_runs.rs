@@ -96,6 +96,14 @@ fn continuum_scenes_on_ranks_give_the_one_process_result() {
                 held.iter().all(|&h| (h < bodies) == (n <= cells)),
                 "{dec:?}, {n} ranks: {held:?} of {bodies} bodies"
             );
+            // and it loaded only its part (`FamilyKind::load_boxes`: the region's
+            // mesh box, its band grains held by every rank; more ranks than cells:
+            // loaded whole, none counted)
+            let loaded = per_rank_count(&out, "loaded_bodies");
+            assert!(
+                n > cells || loaded.iter().all(|&l| l > 0 && l < bodies),
+                "{dec:?}, {n} ranks: {loaded:?} of {bodies} bodies loaded"
+            );
         }
         if geometry {
             let first = write(&dir, "first.toml", &footing(10, "", dec));

@@ -72,6 +72,13 @@ fn same_on_ranks(dir: &std::path::Path, tag: &str, (scene, steps, cells): (&std:
             held.iter().all(|&h| (h < steps * bodies) == (n <= cells)),
             "{tag}, {n} ranks: {held:?} bodies held over {steps} steps of {bodies} bodies"
         );
+        // loaded in part (`FamilyKind::load_boxes`): no rank built every body (more
+        // ranks than cells: loaded whole, every rank steps every body, none counted)
+        let loaded = per_rank_count(&out, "loaded_bodies");
+        assert!(
+            n > cells || loaded.iter().all(|&l| l > 0 && l < bodies),
+            "{tag}, {n} ranks: {loaded:?} bodies loaded of {bodies}"
+        );
     }
     reference
 }

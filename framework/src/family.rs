@@ -63,6 +63,19 @@ pub struct EntryError {
 /// Builds a family from the entries of its scene section.
 pub trait FamilyKind<D: Dim>: Send + Sync {
     fn load(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D>) -> Result<Box<dyn SceneFamily<D>>, EntryError>;
+    /// On MPI ranks, before any world body is built (`cx.world` holds none): boxes
+    /// `[lo, hi]` (z = 0 in 2D) holding every point at which [`Self::load`] reads
+    /// a world body and at which the loaded family's first
+    /// [`Attached::held_everywhere`] and [`Attached::reach`] may name one. Each rank
+    /// then builds only its part of the world ([`crate::scene::part`]): its halo and
+    /// every body whose box, grown by the alert distance, meets one of these, and
+    /// the family is loaded against that part; its load must then find world
+    /// bodies by slot ([`crate::model::BodyIds`]). `None` (the default): the scene
+    /// is loaded whole on every rank, each rank keeping its part before the first
+    /// step.
+    fn load_boxes(&self, _entries: &[toml::Table], _cx: &FamilyContext<'_, D>) -> Result<Option<Vec<[[f64; 3]; 2]>>, EntryError> {
+        Ok(None)
+    }
 }
 
 /// A body family of a loaded scene (module docs). Beside the subdomain interface

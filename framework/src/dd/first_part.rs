@@ -67,6 +67,13 @@ impl Halo {
         Halo { mine, space, alert }
     }
 
+    /// The boxes `boxes` instead of a rank's cells (a body family's
+    /// [`crate::family::FamilyKind::load_boxes`]: every rank holds the bodies near them).
+    pub fn around(boxes: Vec<[[f64; 3]; 2]>, space: usize, alert: f64) -> Halo {
+        let mine = Region { boxes, pairs: Vec::new() };
+        Halo { mine, space, alert }
+    }
+
     /// Whether the box `b` (min, max; the first `space` coordinates) grown by the
     /// alert distance meets this rank's cells.
     pub fn meets(&self, b: &[[f64; 3]; 2]) -> bool {

@@ -236,48 +236,96 @@ impl<D: SceneDim> Scene<D> {
         };
         dimension_is::<D>(&cx, &sf)?;
         let sections = std::mem::take(&mut sf.sections);
-        for name in sections.keys() {
-            if registry.family::<D>(name).is_none() {
-                let installed = registry.family_sections::<D>();
-                let installed = if installed.is_empty() {
-                    "none".to_string()
-                } else {
-                    installed.join(", ")
-                };
-                let msg = format!(
-                    "unknown key `{name}`: not a key of {} scene files nor the section of an installed body family (installed: {installed}; a plugin may provide it)",
-                    D::NAME
-                );
-                return Err(cx.err(&[k(name)], msg));
-            }
-        }
+        check_sections::<D>(&cx, &sections, registry)?;
         let mut scene = load::load_parsed(&cx, sf, registry)?;
-        let dir = std::path::Path::new(file)
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .unwrap_or(std::path::Path::new("."));
-        for (name, value) in sections {
-            let kind = registry.family::<D>(&name).expect("checked above");
-            let entries = family_entries(&cx, &name, value)?;
-            let fcx = crate::family::FamilyContext {
-                world: &scene.world,
-                dir,
-                max_memory: registry.max_memory(),
-            };
-            let fam = kind.load(&entries, &fcx).map_err(|e| {
-                let mut path = vec![k(&name)];
-                path.extend(e.index.map(Seg::Index));
-                if !e.key.is_empty() {
-                    path.push(k(&e.key));
-                }
-                cx.err(&path, e.message)
-            })?;
-            let mut fam = fam;
-            fam.share_world(&mut scene.world);
-            scene.families.push(fam);
-        }
+        scene.add_families(&cx, sections, registry)?;
         Ok(scene)
     }
+
+    /// Builds the body families of `sections` (checked by [`check_sections`]) on
+    /// the world's rigid bodies (all of them, or a rank's part: [`part`]).
+    fn add_families(&mut self, cx: &Ctx, sections: Sections, registry: &Registry) -> Result<(), InputError> {
+        for (name, value) in sections {
+            let kind = registry.family::<D>(&name).expect("checked by check_sections");
+            let entries = family_entries(cx, &name, value)?;
+            let fcx = crate::family::FamilyContext {
+                world: &self.world,
+                dir: scene_dir(cx.file),
+                max_memory: registry.max_memory(),
+            };
+            let mut fam = kind.load(&entries, &fcx).map_err(|e| entry_error(cx, &name, e))?;
+            fam.share_world(&mut self.world);
+            self.families.push(fam);
+        }
+        Ok(())
+    }
+}
+
+/// The body families' sections of a scene file, by name.
+type Sections = std::collections::BTreeMap<String, toml::Value>;
+
+/// The folder of the scene file `file` (where the files an entry names are found).
+fn scene_dir(file: &str) -> &std::path::Path {
+    std::path::Path::new(file)
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."))
+}
+
+/// A family's bad entry, as the loader's error (file, line, key).
+fn entry_error(cx: &Ctx, name: &str, e: crate::family::EntryError) -> InputError {
+    let mut path = vec![k(name)];
+    path.extend(e.index.map(Seg::Index));
+    if !e.key.is_empty() {
+        path.push(k(&e.key));
+    }
+    cx.err(&path, e.message)
+}
+
+/// Every section is an installed family's.
+fn check_sections<D: SceneDim>(cx: &Ctx, sections: &Sections, registry: &Registry) -> Result<(), InputError> {
+    for name in sections.keys() {
+        if registry.family::<D>(name).is_none() {
+            let installed = registry.family_sections::<D>();
+            let installed = if installed.is_empty() {
+                "none".to_string()
+            } else {
+                installed.join(", ")
+            };
+            let msg = format!(
+                "unknown key `{name}`: not a key of {} scene files nor the section of an installed body family (installed: {installed}; a plugin may provide it)",
+                D::NAME
+            );
+            return Err(cx.err(&[k(name)], msg));
+        }
+    }
+    Ok(())
+}
+
+/// The families' [`crate::family::FamilyKind::load_boxes`] of `sections` on the
+/// surveyed world (no body built); `None` if one family has none (the scene is then
+/// loaded whole on every rank).
+fn family_boxes<D: SceneDim>(
+    cx: &Ctx,
+    scene: &Scene<D>,
+    sections: &Sections,
+    registry: &Registry,
+) -> Result<Option<Vec<[[f64; 3]; 2]>>, InputError> {
+    let mut all = Vec::new();
+    for (name, value) in sections {
+        let kind = registry.family::<D>(name).expect("checked by check_sections");
+        let entries = family_entries(cx, name, value.clone())?;
+        let fcx = crate::family::FamilyContext {
+            world: &scene.world,
+            dir: scene_dir(cx.file),
+            max_memory: registry.max_memory(),
+        };
+        match kind.load_boxes(&entries, &fcx).map_err(|e| entry_error(cx, name, e))? {
+            Some(b) => all.extend(b),
+            None => return Ok(None),
+        }
+    }
+    Ok(Some(all))
 }
 
 /// The `[[name]]` entries of a body family's section.

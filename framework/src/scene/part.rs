@@ -23,14 +23,22 @@
 //!    steps, those of the contacts it keeps: [`super::restart_scan`]); the rank
 //!    builds only those, and the restart writes their saved state and its contacts.
 //!
-//! Scenes with body families, by-model subdomains or no decomposition, and restarts
-//! from a state of another decomposition, are loaded whole, as before. The ranks
-//! agree on the survey's digest of every body (and, restarted, on every saved
+//! 5. **Body families** ([`crate::family::FamilyKind::load_boxes`]): the survey asks
+//!    each family, before any body is built, for boxes holding every world body its
+//!    load reads and its first step may name (a continuum region's mesh box, a
+//!    deformable body's reach); every rank also holds the bodies near them, and the
+//!    families are loaded against the rank's part. A family without such boxes, or
+//!    a restart of a scene with families, loads the scene whole, as before (each
+//!    rank keeps its part before the first step).
+//!
+//! Scenes with no decomposition, and restarts from a state of another
+//! decomposition, are loaded whole, as before. The ranks agree on the survey's
+//! digest of every body and of the families' boxes (and, restarted, on every saved
 //! body's and contact's).
 
 use super::builder::Part;
 use super::schema::{BodySpec, SceneDim, SceneFile};
-use super::{AnyScene, Ctx, Scene, Scene3};
+use super::{AnyScene, Ctx, Scene, Scene3, Sections};
 use crate::dim::{D2, D3};
 use crate::error::InputError;
 use crate::registry::Registry;
@@ -48,6 +56,10 @@ pub struct Survey {
     everywhere: Vec<u32>,
     /// Every body's shape, by global id (a restart's boxes at the saved poses).
     shapes: Vec<crate::model::ShapeRef>,
+    /// The body families' load boxes ([`crate::family::FamilyKind::load_boxes`]).
+    boxes: Vec<[[f64; 3]; 2]>,
+    /// The scene has body families (then loaded against each rank's part).
+    pub families: bool,
     /// The movable bodies (the decomposition flags' check).
     pub movable: usize,
     /// A digest of every body's columns and of the bodies every rank holds.
@@ -55,8 +67,9 @@ pub struct Survey {
 }
 
 /// The survey of the scene at `path` (any dimension): a scene whose world holds no
-/// body, its [`Scene::survey`] set; `None` for a scene with body families (loaded
-/// whole on every rank; each rank then keeps its part, [`crate::dd::NscddOf::start_ranks`]).
+/// body, its [`Scene::survey`] set; `None` for a scene with a body family that
+/// gives no load boxes (loaded whole on every rank; each rank then keeps its part,
+/// [`crate::dd::NscddOf::start_ranks`]).
 pub fn survey_any(path: &std::path::Path, registry: &Registry) -> Result<Option<AnyScene>, InputError> {
     let (text, file) = super::read_file(path)?;
     Ok(match super::dimension_of(&text) {
@@ -65,25 +78,30 @@ pub fn survey_any(path: &std::path::Path, registry: &Registry) -> Result<Option<
     })
 }
 
-/// Loads `text` with `part` (every body's columns kept, those it accepts held);
-/// `None` for a scene with body families.
-fn load_with<D: SceneDim>(text: &str, file: &str, registry: &Registry, part: Part) -> Result<Option<(Scene<D>, Part)>, InputError> {
-    let sf: SceneFile<BodySpec<D>> = super::parse(text, file)?;
+/// Loads `text`'s rigid bodies with `part` (every body's columns kept, those it
+/// accepts held), and its families' sections (checked, not loaded).
+fn load_with<D: SceneDim>(text: &str, file: &str, registry: &Registry, part: Part) -> Result<(Scene<D>, Part, Sections), InputError> {
+    let mut sf: SceneFile<BodySpec<D>> = super::parse(text, file)?;
     let cx = Ctx {
         text,
         file,
         families: !sf.sections.is_empty(),
     };
     super::dimension_is::<D>(&cx, &sf)?;
-    if cx.families {
-        return Ok(None);
-    }
+    let sections = std::mem::take(&mut sf.sections);
+    super::check_sections::<D>(&cx, &sections, registry)?;
     let (scene, part) = super::load::load_parsed_part(&cx, sf, registry, Some(part))?;
-    Ok(Some((scene, part.expect("the part given"))))
+    Ok((scene, part.expect("the part given"), sections))
 }
 
 fn survey<D: SceneDim>(text: &str, file: &str, registry: &Registry) -> Result<Option<Scene<D>>, InputError> {
-    let Some((mut scene, mut p)) = load_with::<D>(text, file, registry, Part::new(Box::new(|_, _| false), 0.0))? else {
+    let (mut scene, mut p, sections) = load_with::<D>(text, file, registry, Part::new(Box::new(|_, _| false), 0.0))?;
+    let cx = Ctx {
+        text,
+        file,
+        families: !sections.is_empty(),
+    };
+    let Some(boxes) = super::family_boxes(&cx, &scene, &sections, registry)? else {
         return Ok(None);
     };
     let driven = &p.driven;
@@ -102,6 +120,7 @@ fn survey<D: SceneDim>(text: &str, file: &str, registry: &Registry) -> Result<Op
         h.write_u8(u8::from(p.movable[g]));
     }
     everywhere.iter().for_each(|&g| h.write_u32(g));
+    boxes.iter().flatten().flatten().for_each(|x| h.write_u64(x.to_bits()));
     // the movable bodies' centres, in place (not a second N-sized list)
     let mut centres = std::mem::take(&mut p.centre);
     let mut g = 0;
@@ -116,6 +135,8 @@ fn survey<D: SceneDim>(text: &str, file: &str, registry: &Registry) -> Result<Op
         centres,
         everywhere,
         shapes: std::mem::take(&mut p.shape),
+        boxes,
+        families: cx.families,
         digest: h.finish(),
     });
     Ok(Some(scene))
@@ -130,26 +151,36 @@ pub fn load_on<D: SceneDim>(s: &mut Scene<D>, registry: &Registry, (ranks, me): 
     let Some(sv) = s.survey.take() else { return Ok(false) };
     let decomposition = s.decomposition.take();
     // (a grid of fewer cells than ranks is refused when the run starts)
+    // (by model, each family's subdomain of a cell goes with the cell)
     let first = decomposition
         .as_ref()
-        .filter(|c| ranks > 1 && !c.by_model && c.dd.nx as u64 * c.dd.ny as u64 * c.dd.nz as u64 >= u64::from(ranks))
+        .filter(|c| ranks > 1 && c.dd.nx as u64 * c.dd.ny as u64 * c.dd.nz as u64 >= u64::from(ranks))
         .and_then(|c| crate::dd::first_part::provisional(&sv.centres, [c.dd.nx, c.dd.ny, c.dd.nz], ranks));
     let Some(first) = first else {
         load_whole(s, registry, &sv, decomposition)?;
         return Ok(false);
     };
     // (a margin on the alert distance: a body kept in excess leaves at the first step)
-    let halo = crate::dd::first_part::Halo::new(&first, me, D::N, s.world.alert * 1.01);
+    let alert = s.world.alert * 1.01;
+    let halo = crate::dd::first_part::Halo::new(&first, me, D::N, alert);
+    let near = crate::dd::first_part::Halo::around(sv.boxes.clone(), D::N, alert);
     let everywhere = sv.everywhere.clone();
-    let keep = move |g: u32, b: &[[f64; 3]; 2]| everywhere.binary_search(&g).is_ok() || halo.meets(b);
+    let keep = move |g: u32, b: &[[f64; 3]; 2]| everywhere.binary_search(&g).is_ok() || halo.meets(b) || near.meets(b);
     let share = 1.0 / f64::from(ranks);
-    let (scene, _) = load_with::<D>(&sv.text, &sv.file, registry, Part::new(Box::new(keep), share))?.expect("surveyed without families");
+    let (scene, _, sections) = load_with::<D>(&sv.text, &sv.file, registry, Part::new(Box::new(keep), share))?;
     *s = scene;
+    let cx = Ctx {
+        text: &sv.text,
+        file: &sv.file,
+        families: sv.families,
+    };
+    s.add_families(&cx, sections, registry)?;
     s.decomposition = decomposition;
     s.part = Some(first);
     s.survey = Some(Survey {
         file: sv.file,
         movable: sv.movable,
+        families: sv.families,
         digest: sv.digest,
         ..Default::default()
     });
@@ -191,6 +222,12 @@ pub fn restart_on<D: SceneDim>(
     let Some(sv) = s.survey.take() else {
         return super::restart_scene_on(s, path, on);
     };
+    if sv.families {
+        // (a family's bodies at the saved state are not known before it is loaded)
+        let decomposition = s.decomposition.take();
+        load_whole(s, registry, &sv, decomposition)?;
+        return super::restart_scene_on(s, path, on);
+    }
     let mut rp = super::restart::rank_part_of(path, s, on);
     let scanned = rp.as_mut().and_then(|rp| {
         // (a margin on the alert distance: a body kept in excess leaves at the first step)
@@ -211,7 +248,7 @@ pub fn restart_on<D: SceneDim>(
     let keep = scanned.keep;
     let keep = move |g: u32, _: &[[f64; 3]; 2]| keep[g as usize];
     let share = 1.0 / f64::from(ranks);
-    let (scene, _) = load_with::<D>(&sv.text, &sv.file, registry, Part::new(Box::new(keep), share))?.expect("surveyed without families");
+    let (scene, ..) = load_with::<D>(&sv.text, &sv.file, registry, Part::new(Box::new(keep), share))?;
     *s = scene;
     s.decomposition = decomposition;
     let contacts = super::restart::restart_scene_with(s, path, rp)?;

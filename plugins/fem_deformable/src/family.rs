@@ -42,6 +42,9 @@ impl FamilyKind<D2> for DeformableKind {
         crate::scene::refuse_compliant(&bodies, cx.world)?;
         Ok(Box::new(Deformables2::new(bodies, cx.world.alert)))
     }
+    fn load_boxes(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D2>) -> Result<Option<Vec<[[f64; 3]; 2]>>, EntryError> {
+        load_boxes(entries, cx, 2).map(Some)
+    }
 }
 
 impl FamilyKind<D3> for DeformableKind {
@@ -58,6 +61,28 @@ impl FamilyKind<D3> for DeformableKind {
         crate::scene::refuse_compliant(&bodies, cx.world)?;
         Ok(Box::new(Deformables3::new(bodies, cx.world.alert)))
     }
+    fn load_boxes(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D3>) -> Result<Option<Vec<[[f64; 3]; 2]>>, EntryError> {
+        load_boxes(entries, cx, 3).map(Some)
+    }
+}
+
+/// The bodies' boxes before they are built ([`FamilyKind::load_boxes`]): each
+/// mesh's box grown by what its first step may move it (h |V₀|) and by 2 % of the
+/// alert distance, which hold the first [`reach`] (the family reads no world body
+/// at load and names none by id).
+fn load_boxes<D: Dim>(entries: &[toml::Table], cx: &FamilyContext<'_, D>, dim: usize) -> Result<Vec<[[f64; 3]; 2]>, EntryError> {
+    let mut out = Vec::new();
+    for (i, e) in entries.iter().enumerate() {
+        let spec = crate::scene::spec_of(i, e)?;
+        let [mut lo, mut hi] = crate::scene::mesh_box(&spec.mesh, dim, cx.dir).map_err(|(k, m)| crate::scene::entry_error(i, k, m))?;
+        let v = spec.velocity.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let grow = cx.world.time.h * v + 0.02 * cx.world.alert;
+        for k in 0..dim {
+            (lo[k], hi[k]) = (lo[k] - grow, hi[k] + grow);
+        }
+        out.push([lo, hi]);
+    }
+    Ok(out)
 }
 
 #[derive(Serialize, Deserialize)]

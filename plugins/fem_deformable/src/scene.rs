@@ -326,6 +326,42 @@ pub fn build_scaled(
     Ok(body)
 }
 
+/// A box `[lo, hi]` (z = 0 in 2D) holding every node of a spec's mesh, before
+/// the mesh is made (a file's is read) and with a margin of 1e-9 of its size: what
+/// the families give as [`nscdd::family::FamilyKind::load_boxes`]. Errors name
+/// the key.
+pub fn mesh_box(mesh: &MeshSpec, dim: usize, dir: &Path) -> Result<[[f64; 3]; 2], (&'static str, String)> {
+    let (mut lo, mut hi) = ([0.0; 3], [0.0; 3]);
+    match mesh {
+        MeshSpec::Rectangle { origin, size, .. } if dim == 2 => {
+            lo[..2].copy_from_slice(origin);
+            (0..2).for_each(|k| hi[k] = origin[k] + size[k]);
+        }
+        MeshSpec::Box { origin, size, .. } if dim == 3 => {
+            lo = *origin;
+            (0..3).for_each(|k| hi[k] = origin[k] + size[k]);
+        }
+        MeshSpec::Disk { centre, radius, .. } if dim == 2 => {
+            (0..2).for_each(|k| (lo[k], hi[k]) = (centre[k] - radius, centre[k] + radius));
+        }
+        _ => {
+            let raw = raw_mesh(mesh, dim, dir, &mut |_| Ok(()))?;
+            lo[..dim].fill(f64::INFINITY);
+            hi[..dim].fill(f64::NEG_INFINITY);
+            for p in raw.points.chunks_exact(dim) {
+                for k in 0..dim {
+                    (lo[k], hi[k]) = (lo[k].min(p[k]), hi[k].max(p[k]));
+                }
+            }
+        }
+    }
+    let size = (0..dim).map(|k| lo[k].abs().max(hi[k].abs())).fold(0.0, f64::max);
+    for k in 0..dim {
+        (lo[k], hi[k]) = (lo[k] - 1e-9 * size, hi[k] + 1e-9 * size);
+    }
+    Ok([lo, hi])
+}
+
 /// The mesh of a spec, made by Python (checked against the memory limit first); a
 /// file's, read.
 fn raw_mesh(

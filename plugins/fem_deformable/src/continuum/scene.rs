@@ -25,12 +25,34 @@ impl FamilyKind<D2> for ContinuumKind {
     fn load(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D2>) -> Result<Box<dyn SceneFamily<D2>>, EntryError> {
         Ok(Box::new(load::<D2, 2>(entries, cx)?))
     }
+    fn load_boxes(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D2>) -> Result<Option<Vec<[[f64; 3]; 2]>>, EntryError> {
+        load_boxes(entries, cx.dir, 2).map(Some)
+    }
 }
 
 impl FamilyKind<D3> for ContinuumKind {
     fn load(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D3>) -> Result<Box<dyn SceneFamily<D3>>, EntryError> {
         Ok(Box::new(load::<D3, 3>(entries, cx)?))
     }
+    fn load_boxes(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D3>) -> Result<Option<Vec<[[f64; 3]; 2]>>, EntryError> {
+        load_boxes(entries, cx.dir, 3).map(Some)
+    }
+}
+
+/// The keys of a `[[continuum]]` entry beside a deformable body's.
+const CONTINUUM_KEYS: [&str; 7] = ["band", "coupling", "plastic", "drive", "drive_from", "load", "initial_stress"];
+
+/// The regions' mesh boxes ([`FamilyKind::load_boxes`]): the load ties the grains
+/// lying in a region's mesh, and the family touches no other world body.
+fn load_boxes(entries: &[toml::Table], dir: &Path, dim: usize) -> Result<Vec<[[f64; 3]; 2]>, EntryError> {
+    let mut out = Vec::new();
+    for (i, e) in entries.iter().enumerate() {
+        let mut rest = e.clone();
+        CONTINUUM_KEYS.iter().for_each(|k| drop(rest.remove(*k)));
+        let spec = crate::scene::spec_of(i, &rest)?;
+        out.push(crate::scene::mesh_box(&spec.mesh, dim, dir).map_err(|(k, m)| entry_error(i, k, m))?);
+    }
+    Ok(out)
 }
 
 /// How the band's grains are tied ([`super::ties`]).
@@ -159,9 +181,7 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
         };
         let loads = super::sides::sides_of(i, e, "load", N)?;
         let mut rest = e.clone();
-        for k in ["band", "coupling", "plastic", "drive", "drive_from", "load", "initial_stress"] {
-            rest.remove(k);
-        }
+        CONTINUUM_KEYS.iter().for_each(|k| drop(rest.remove(*k)));
         let spec = crate::scene::spec_of(i, &rest)?;
         let mut memory = |nodes: f64| {
             let bytes = crate::scene::mesh_bytes(N, nodes);
@@ -191,11 +211,14 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
         };
         plastic.push(plastic_state(&b, dp, sigma0, &alpha).map_err(|(k, m)| at(k, m))?);
         let mut grains: Vec<BandGrain> = Vec::new();
-        for g in 0..w.bodies.len() {
-            if tied[g] || !Rigid::<D>::is_grain(w, g) || !w.bodies.movable(g) {
+        // (by slot: on MPI ranks the world may hold a part, every body near the
+        // regions among it, [`FamilyKind::load_boxes`])
+        for k in 0..w.bodies.len() {
+            let g = w.ids.global(k as u32) as usize;
+            if tied[k] || !Rigid::<D>::is_grain(w, g) || !w.bodies.movable(k) {
                 continue;
             }
-            let x = &w.bodies.pos[g].as_ref()[..N];
+            let x = &w.bodies.pos[k].as_ref()[..N];
             let alpha = band.alpha(x);
             if alpha <= 0.0 {
                 continue;
@@ -204,11 +227,11 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
             if alpha >= 1.0 {
                 return Err(at("band", format!("body {g} (a grain) lies in the continuum part of the region, beyond the band: grains belong to the discrete part and the band")));
             }
-            tied[g] = true;
+            tied[k] = true;
             grains.push((g as u32, cell, xi, 1.0 - alpha));
         }
         let body = bodies.len() as u32;
-        let mass = |g: u32, wp: f64| wp * w.bodies.mass[g as usize];
+        let mass = |g: u32, wp: f64| wp * w.bodies.mass[crate::family::slot(w, g)];
         push_ties(&mut ties, body, &b.mesh, &grains, coupling, &mass);
         band_all.extend(grains.iter().map(|x| (x.0, x.3)));
         band_region.extend(grains.iter().map(|x| (x.0, bodies.len() as u32)));
@@ -451,12 +474,13 @@ impl<D: Dim, const N: usize> SceneFamily<D> for Continuum<D, N> {
     }
     fn share_world(&mut self, w: &mut World<D>) {
         for &(g, wp) in &self.band {
-            w.bodies.mass[g as usize] *= wp;
-            w.bodies.refresh_inverse(g as usize);
+            let k = crate::family::slot(w, g);
+            w.bodies.mass[k] *= wp;
+            w.bodies.refresh_inverse(k);
         }
         // the contacts of a band grain keep the share 1 − α(x) of their stiffness
-        // at their point (compliant laws: docs/CONTINUUM.md, energy)
-        let mut region = vec![u32::MAX; w.bodies.len()];
+        // at their point (compliant laws: docs/CONTINUUM.md, energy), by global id
+        let mut region = vec![u32::MAX; w.ids.n_global(w.bodies.len())];
         for &(g, r) in &self.band_region {
             region[g as usize] = r;
         }
