@@ -114,6 +114,12 @@ fn continuum_scenes_on_ranks_give_the_one_process_result() {
             let on4 = dir.join("restart4");
             ok(&mpirun(&[(4, args(&scene, &on4, &restart))]), "the restart on 4 ranks");
             assert!(final_json(&on4) == reference, "a restart on 4 ranks ends elsewhere");
+            // loaded in part (the region's mesh box, the saved state's halos)
+            let loaded = per_rank_count(&on4, "loaded_bodies");
+            assert!(
+                loaded.iter().all(|&l| l > 0 && l < bodies),
+                "the restart on 4 ranks: {loaded:?} of {bodies} bodies loaded"
+            );
             let on1 = dir.join("restart1");
             ok(&nscdd(&args(&scene, &on1, &restart)), "the restart in one process");
             assert!(final_json(&on1) == reference, "a restart in one process ends elsewhere");

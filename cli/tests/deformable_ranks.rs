@@ -83,6 +83,16 @@ fn same_on_ranks(dir: &std::path::Path, tag: &str, (scene, steps, cells): (&std:
     reference
 }
 
+/// A restart on `n` ranks (one cell each) loaded its part: no rank built every body.
+fn restarted_in_part(out: &std::path::Path, reference: &str, n: usize) {
+    let loaded = per_rank_count(out, "loaded_bodies");
+    let all = bodies(reference);
+    assert!(
+        loaded.len() == n && loaded.iter().all(|&l| l > 0 && l < all),
+        "{loaded:?} bodies loaded of {all}"
+    );
+}
+
 #[test]
 fn deformable_scenes_by_geometry_hold_bodies_per_rank() {
     let dir = scratch("fe_held");
@@ -99,6 +109,7 @@ fn deformable_scenes_by_geometry_hold_bodies_per_rank() {
     let on4 = dir.join("restart4");
     ok(&mpirun(&[(4, args(&s2, &on4, &restart))]), "the restart on 4 ranks");
     assert!(final_json(&on4) == reference, "a restart on 4 ranks ends elsewhere");
+    restarted_in_part(&on4, &reference, 4);
     let on1 = dir.join("restart1");
     ok(&nscdd(&args(&s2, &on1, &restart)), "the restart in one process");
     assert!(final_json(&on1) == reference, "a restart in one process ends elsewhere");
@@ -114,7 +125,18 @@ fn deformable_scenes_by_geometry_hold_bodies_per_rank() {
     // a free block thrown onto a layer of disks, bouncing off: the disks enter the
     // block's reach as it comes down (sent to every rank) and leave it as it goes
     let drop = write(&dir, "drop.toml", DROP);
-    same_on_ranks(&dir, "drop", (&drop, 90, 4), &[2, 4]);
+    let reference = same_on_ranks(&dir, "drop", (&drop, 90, 4), &[2, 4]);
+    // restarted on 4 ranks from a state of 2 written as the block touches the disks
+    // (step 50): each rank builds the bodies near the block's reach at that state
+    // (`FamilyKind::load_boxes` given the saved state), not every body
+    let first = write(&dir, "drop50.toml", &DROP.replace("steps = 90", "steps = 50"));
+    let half = dir.join("drop_half");
+    ok(&mpirun(&[(2, args(&first, &half, &[]))]), "the drop's 50 steps on 2 ranks");
+    let state = half.join("final.json");
+    let on4 = dir.join("drop_restart4");
+    ok(&mpirun(&[(4, args(&drop, &on4, &["--restart", state.to_str().unwrap()]))]), "the drop restarted on 4 ranks");
+    assert!(final_json(&on4) == reference, "the drop restarted on 4 ranks ends elsewhere");
+    restarted_in_part(&on4, &reference, 4);
     // 3D: spheres on a deformable block
     let lattice = ("origin = [0.2, 0.2, 0.42]", "origin = [0.2, 0.2, 0.36]");
     let s3 = write(&dir, "foundation3d.toml", &scene("foundation3d", (15, "nx = 2"), lattice));

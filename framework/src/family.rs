@@ -70,10 +70,18 @@ pub trait FamilyKind<D: Dim>: Send + Sync {
     /// then builds only its part of the world ([`crate::scene::part`]): its halo and
     /// every body whose box, grown by the alert distance, meets one of these, and
     /// the family is loaded against that part; its load must then find world
-    /// bodies by slot ([`crate::model::BodyIds`]). `None` (the default): the scene
-    /// is loaded whole on every rank, each rank keeping its part before the first
-    /// step.
-    fn load_boxes(&self, _entries: &[toml::Table], _cx: &FamilyContext<'_, D>) -> Result<Option<Vec<[[f64; 3]; 2]>>, EntryError> {
+    /// bodies by slot ([`crate::model::BodyIds`]). On a restart, `saved` is the
+    /// family's saved state ([`SceneFamily::save_state`]) and the boxes must also
+    /// hold its first step's reach at that state (a state it cannot read: `None`,
+    /// the restart then loads whole and reports the error). `None` (the default):
+    /// the scene is loaded whole on every rank, each rank keeping its part before
+    /// the first step.
+    fn load_boxes(
+        &self,
+        _entries: &[toml::Table],
+        _cx: &FamilyContext<'_, D>,
+        _saved: Option<&serde_json::Value>,
+    ) -> Result<Option<Vec<[[f64; 3]; 2]>>, EntryError> {
         Ok(None)
     }
 }

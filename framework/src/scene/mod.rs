@@ -303,13 +303,15 @@ fn check_sections<D: SceneDim>(cx: &Ctx, sections: &Sections, registry: &Registr
 }
 
 /// The families' [`crate::family::FamilyKind::load_boxes`] of `sections` on the
-/// surveyed world (no body built); `None` if one family has none (the scene is then
-/// loaded whole on every rank).
+/// surveyed world (no body built), with a restart's `saved` families' states (by
+/// section); `None` if one family has none (the scene is then loaded whole on
+/// every rank).
 fn family_boxes<D: SceneDim>(
     cx: &Ctx,
     scene: &Scene<D>,
     sections: &Sections,
     registry: &Registry,
+    saved: Option<&serde_json::Map<String, serde_json::Value>>,
 ) -> Result<Option<Vec<[[f64; 3]; 2]>>, InputError> {
     let mut all = Vec::new();
     for (name, value) in sections {
@@ -320,7 +322,8 @@ fn family_boxes<D: SceneDim>(
             dir: scene_dir(cx.file),
             max_memory: registry.max_memory(),
         };
-        match kind.load_boxes(&entries, &fcx).map_err(|e| entry_error(cx, name, e))? {
+        let state = saved.and_then(|m| m.get(name));
+        match kind.load_boxes(&entries, &fcx, state).map_err(|e| entry_error(cx, name, e))? {
             Some(b) => all.extend(b),
             None => return Ok(None),
         }

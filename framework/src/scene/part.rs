@@ -56,7 +56,9 @@ pub struct Survey {
     everywhere: Vec<u32>,
     /// Every body's shape, by global id (a restart's boxes at the saved poses).
     shapes: Vec<crate::model::ShapeRef>,
-    /// The body families' load boxes ([`crate::family::FamilyKind::load_boxes`]).
+    /// The body families' sections and load boxes
+    /// ([`crate::family::FamilyKind::load_boxes`]).
+    sections: Sections,
     boxes: Vec<[[f64; 3]; 2]>,
     /// The scene has body families (then loaded against each rank's part).
     pub families: bool,
@@ -101,7 +103,7 @@ fn survey<D: SceneDim>(text: &str, file: &str, registry: &Registry) -> Result<Op
         file,
         families: !sections.is_empty(),
     };
-    let Some(boxes) = super::family_boxes(&cx, &scene, &sections, registry)? else {
+    let Some(boxes) = super::family_boxes(&cx, &scene, &sections, registry, None)? else {
         return Ok(None);
     };
     let driven = &p.driven;
@@ -136,6 +138,7 @@ fn survey<D: SceneDim>(text: &str, file: &str, registry: &Registry) -> Result<Op
         everywhere,
         shapes: std::mem::take(&mut p.shape),
         boxes,
+        sections,
         families: cx.families,
         digest: h.finish(),
     });
@@ -206,12 +209,16 @@ fn load_whole<D: SceneDim>(
 /// surveyed scene is loaded in part too: a first pass over the state marks the
 /// bodies of the rank's first step ([`super::restart_scan`]: its halo of the
 /// saved grid at the saved poses, those every rank steps, those of its kept
-/// contacts), the rank builds only those, and the restart writes the saved state
-/// of its bodies. The ranks then agree on the survey's digest, every saved body's
-/// and every contact's. Otherwise the scene is loaded whole, as before. (The
-/// scene's own overlap check, of the initial positions the state replaces, runs
-/// on the bodies each rank holds, chosen at the saved positions: an overlap of
-/// the initial positions may go unreported, where one process refuses it.)
+/// contacts), the rank builds only those and the bodies near its body families'
+/// boxes (their load's, and their first step's at the saved state:
+/// [`crate::family::FamilyKind::load_boxes`] given the state's `families`), the
+/// families load against that part, and the restart writes the saved state of its
+/// bodies and the families'. The ranks then agree on the survey's digest, every
+/// saved body's and every contact's. Otherwise the scene is loaded whole, as
+/// before. (The scene's own overlap check, of the initial positions the state
+/// replaces, runs on the bodies each rank holds, chosen at the saved positions: an
+/// overlap of the initial positions may go unreported, where one process refuses
+/// it.)
 pub fn restart_on<D: SceneDim>(
     s: &mut Scene<D>,
     registry: &Registry,
@@ -222,14 +229,14 @@ pub fn restart_on<D: SceneDim>(
     let Some(sv) = s.survey.take() else {
         return super::restart_scene_on(s, path, on);
     };
-    if sv.families {
-        // (a family's bodies at the saved state are not known before it is loaded)
-        let decomposition = s.decomposition.take();
-        load_whole(s, registry, &sv, decomposition)?;
-        return super::restart_scene_on(s, path, on);
-    }
     let mut rp = super::restart::rank_part_of(path, s, on);
-    let scanned = rp.as_mut().and_then(|rp| {
+    // (by model, or from another decomposition's state: whole; the rank's part
+    // is then kept before the first step)
+    let boxes = match rp.is_some() && sv.families {
+        true => saved_boxes(s, registry, &sv, path)?,
+        false => Some(sv.boxes.clone()),
+    };
+    let scanned = rp.as_mut().filter(|_| boxes.is_some()).and_then(|rp| {
         // (a margin on the alert distance: a body kept in excess leaves at the first step)
         let halo = rp.halo(D::N, s.world.alert * 1.01);
         let scene = super::restart_scan::ScanInput {
@@ -241,15 +248,25 @@ pub fn restart_on<D: SceneDim>(
         super::restart_scan::scan::<D>(path, &scene, rp)
     });
     let decomposition = s.decomposition.take();
-    let Some(scanned) = scanned else {
+    let (Some(scanned), Some(boxes)) = (scanned, boxes) else {
         load_whole(s, registry, &sv, decomposition)?;
-        return super::restart::restart_scene_with(s, path, rp);
+        return match sv.families && rp.is_none() {
+            true => super::restart_scene_on(s, path, on),
+            false => super::restart::restart_scene_with(s, path, rp),
+        };
     };
     let keep = scanned.keep;
-    let keep = move |g: u32, _: &[[f64; 3]; 2]| keep[g as usize];
+    let near = crate::dd::first_part::Halo::around(boxes, D::N, s.world.alert * 1.01);
+    let keep = move |g: u32, b: &[[f64; 3]; 2]| keep[g as usize] || near.meets(b);
     let share = 1.0 / f64::from(ranks);
-    let (scene, ..) = load_with::<D>(&sv.text, &sv.file, registry, Part::new(Box::new(keep), share))?;
+    let (scene, _, sections) = load_with::<D>(&sv.text, &sv.file, registry, Part::new(Box::new(keep), share))?;
     *s = scene;
+    let cx = Ctx {
+        text: &sv.text,
+        file: &sv.file,
+        families: sv.families,
+    };
+    s.add_families(&cx, sections, registry)?;
     s.decomposition = decomposition;
     let contacts = super::restart::restart_scene_with(s, path, rp)?;
     let mut h = std::collections::hash_map::DefaultHasher::new();
@@ -259,10 +276,30 @@ pub fn restart_on<D: SceneDim>(
     s.survey = Some(Survey {
         file: sv.file,
         movable: sv.movable,
+        families: sv.families,
         digest: h.finish(),
         ..Default::default()
     });
     Ok(contacts)
+}
+
+/// The families' boxes of a restart in part: their load's (the survey's) and their
+/// first step's at the saved state (the state's `families` given to
+/// [`crate::family::FamilyKind::load_boxes`]); `None` when the state has no
+/// readable `families` or a family gives no boxes (the restart is then whole, and
+/// reports what is wrong).
+fn saved_boxes<D: SceneDim>(s: &Scene<D>, registry: &Registry, sv: &Survey, path: &std::path::Path) -> Result<Option<Vec<[[f64; 3]; 2]>>, InputError> {
+    let Some(saved) = super::restart::families_of(path) else { return Ok(None) };
+    let cx = Ctx {
+        text: &sv.text,
+        file: &sv.file,
+        families: true,
+    };
+    let Some(mut boxes) = super::family_boxes(&cx, s, &sv.sections, registry, Some(&saved))? else {
+        return Ok(None);
+    };
+    boxes.extend_from_slice(&sv.boxes);
+    Ok(Some(boxes))
 }
 
 /// [`load_on`] for a scene of either dimension.

@@ -218,16 +218,37 @@ pub(super) fn restart_scene_with<D: Dim>(
 }
 
 /// The `nscdd` part of the saved state at `path` alone (`None` when absent or
-/// unreadable: the whole reading then reports what is wrong). A `final.json` or
-/// checkpoint is pretty-printed, so its top-level keys are the lines starting with
-/// two spaces and a quote: the file is scanned for the `nscdd` key (the last one,
-/// whose value the streaming reader keeps) and only its value parsed (18 MB of a
-/// 137 MB state: the bodies and contacts are not parsed twice); another layout is
-/// parsed whole, the rest skipped (a key given twice: no part).
+/// unreadable: the whole reading then reports what is wrong), read by [`top_key`].
 fn nscdd_of(path: &Path) -> Option<crate::dd::NscddState> {
+    #[derive(serde::Deserialize)]
+    struct Only {
+        #[serde(default)]
+        nscdd: Option<crate::dd::NscddState>,
+    }
+    top_key(path, b"\n  \"nscdd\": ", |o: Only| o.nscdd)
+}
+
+/// The `families` part of the saved state at `path` alone (the body families'
+/// states by section; `None` when absent or unreadable), read by [`top_key`].
+pub(super) fn families_of(path: &Path) -> Option<serde_json::Map<String, serde_json::Value>> {
+    #[derive(serde::Deserialize)]
+    struct Only {
+        #[serde(default)]
+        families: Option<serde_json::Map<String, serde_json::Value>>,
+    }
+    top_key(path, b"\n  \"families\": ", |o: Only| o.families)
+}
+
+/// One top-level value of the saved state at `path`, `key` its line's start
+/// (`\n  "name": `). A `final.json` or checkpoint is pretty-printed, so its
+/// top-level keys are the lines starting with two spaces and a quote: the file is
+/// scanned for the key (the last one, whose value the streaming reader keeps) and
+/// only its value parsed (18 MB of a 137 MB state for `nscdd`: the bodies and
+/// contacts are not parsed twice); another layout is parsed whole as `O`, the rest
+/// skipped, and `pick` takes the value (a key given twice: none).
+fn top_key<T: serde::de::DeserializeOwned, O: serde::de::DeserializeOwned>(path: &Path, key: &[u8], pick: impl Fn(O) -> Option<T>) -> Option<T> {
     use serde::Deserialize;
     use std::io::{Read, Seek};
-    const KEY: &[u8] = b"\n  \"nscdd\": ";
     let mut f = std::fs::File::open(path).ok()?;
     let mut buf = vec![0u8; 1 << 20];
     let (mut kept, mut start, mut pretty, mut last) = (0usize, 0u64, None, None);
@@ -236,14 +257,14 @@ fn nscdd_of(path: &Path) -> Option<crate::dd::NscddState> {
         let len = kept + n;
         let pretty = *pretty.get_or_insert_with(|| buf[..len].starts_with(b"{\n  \""));
         // the last occurrence, as the streaming reader keeps the last value
-        if let Some(i) = memchr::memmem::rfind(&buf[..len], KEY) {
-            last = Some(start + (i + KEY.len()) as u64);
+        if let Some(i) = memchr::memmem::rfind(&buf[..len], key) {
+            last = Some(start + (i + key.len()) as u64);
         }
         if n == 0 || !pretty {
             break;
         }
         // the last bytes may begin the key
-        let carry = (KEY.len() - 1).min(len);
+        let carry = (key.len() - 1).min(len);
         buf.copy_within(len - carry..len, 0);
         start += (len - carry) as u64;
         kept = carry;
@@ -251,19 +272,13 @@ fn nscdd_of(path: &Path) -> Option<crate::dd::NscddState> {
     if let Some(at) = last {
         f.seek(std::io::SeekFrom::Start(at)).ok()?;
         let mut de = serde_json::Deserializer::from_reader(std::io::BufReader::with_capacity(1 << 16, f));
-        return Option::<crate::dd::NscddState>::deserialize(&mut de).ok().flatten();
+        return Option::<T>::deserialize(&mut de).ok().flatten();
     }
     if pretty.unwrap_or(false) {
         return None;
     }
-    #[derive(serde::Deserialize)]
-    struct Only {
-        #[serde(default)]
-        nscdd: Option<crate::dd::NscddState>,
-    }
     f.seek(std::io::SeekFrom::Start(0)).ok()?;
-    let only: Only = serde_json::from_reader(std::io::BufReader::with_capacity(1 << 16, f)).ok()?;
-    only.nscdd
+    pick(serde_json::from_reader(std::io::BufReader::with_capacity(1 << 16, f)).ok()?)
 }
 
 /// [`restart`] from the text of a saved state; `file` names it in messages.

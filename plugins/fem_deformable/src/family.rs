@@ -42,8 +42,13 @@ impl FamilyKind<D2> for DeformableKind {
         crate::scene::refuse_compliant(&bodies, cx.world)?;
         Ok(Box::new(Deformables2::new(bodies, cx.world.alert)))
     }
-    fn load_boxes(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D2>) -> Result<Option<Vec<[[f64; 3]; 2]>>, EntryError> {
-        load_boxes(entries, cx, 2).map(Some)
+    fn load_boxes(
+        &self,
+        entries: &[toml::Table],
+        cx: &FamilyContext<'_, D2>,
+        saved: Option<&serde_json::Value>,
+    ) -> Result<Option<Vec<[[f64; 3]; 2]>>, EntryError> {
+        load_boxes(entries, cx, 2, saved)
     }
 }
 
@@ -61,28 +66,49 @@ impl FamilyKind<D3> for DeformableKind {
         crate::scene::refuse_compliant(&bodies, cx.world)?;
         Ok(Box::new(Deformables3::new(bodies, cx.world.alert)))
     }
-    fn load_boxes(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D3>) -> Result<Option<Vec<[[f64; 3]; 2]>>, EntryError> {
-        load_boxes(entries, cx, 3).map(Some)
+    fn load_boxes(
+        &self,
+        entries: &[toml::Table],
+        cx: &FamilyContext<'_, D3>,
+        saved: Option<&serde_json::Value>,
+    ) -> Result<Option<Vec<[[f64; 3]; 2]>>, EntryError> {
+        load_boxes(entries, cx, 3, saved)
     }
 }
 
 /// The bodies' boxes before they are built ([`FamilyKind::load_boxes`]): each
-/// mesh's box grown by what its first step may move it (h |V₀|) and by 2 % of the
-/// alert distance, which hold the first [`reach`] (the family reads no world body
-/// at load and names none by id).
-fn load_boxes<D: Dim>(entries: &[toml::Table], cx: &FamilyContext<'_, D>, dim: usize) -> Result<Vec<[[f64; 3]; 2]>, EntryError> {
+/// mesh's box grown by what its first step may move it (h |V|, V the initial or
+/// the `saved` velocity) and by 2 % of the alert distance, which hold the first
+/// [`reach`] (the family reads no world body at load and names none by id);
+/// restarted, grown by the saved displacement too. `None`: a saved state that is
+/// not this scene's (the restart reports it).
+fn load_boxes<D: Dim>(
+    entries: &[toml::Table],
+    cx: &FamilyContext<'_, D>,
+    dim: usize,
+    saved: Option<&serde_json::Value>,
+) -> Result<Option<Vec<[[f64; 3]; 2]>>, EntryError> {
+    let saved = match saved.map(State::deserialize) {
+        None => None,
+        Some(Ok(s)) if s.bodies.len() == entries.len() => Some(s.bodies),
+        Some(_) => return Ok(None),
+    };
+    let most = |x: &[f64]| x.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let mut out = Vec::new();
     for (i, e) in entries.iter().enumerate() {
         let spec = crate::scene::spec_of(i, e)?;
         let [mut lo, mut hi] = crate::scene::mesh_box(&spec.mesh, dim, cx.dir).map_err(|(k, m)| crate::scene::entry_error(i, k, m))?;
-        let v = spec.velocity.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        let grow = cx.world.time.h * v + 0.02 * cx.world.alert;
+        let (u, v) = saved.as_ref().map_or((0.0, 0.0), |b| (most(&b[i].displacement), most(&b[i].velocity)));
+        let grow = u + cx.world.time.h * most(&spec.velocity).max(v) + 0.02 * cx.world.alert;
+        if !grow.is_finite() {
+            return Ok(None);
+        }
         for k in 0..dim {
             (lo[k], hi[k]) = (lo[k] - grow, hi[k] + grow);
         }
         out.push([lo, hi]);
     }
-    Ok(out)
+    Ok(Some(out))
 }
 
 #[derive(Serialize, Deserialize)]

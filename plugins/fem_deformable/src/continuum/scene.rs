@@ -25,7 +25,12 @@ impl FamilyKind<D2> for ContinuumKind {
     fn load(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D2>) -> Result<Box<dyn SceneFamily<D2>>, EntryError> {
         Ok(Box::new(load::<D2, 2>(entries, cx)?))
     }
-    fn load_boxes(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D2>) -> Result<Option<Vec<[[f64; 3]; 2]>>, EntryError> {
+    fn load_boxes(
+        &self,
+        entries: &[toml::Table],
+        cx: &FamilyContext<'_, D2>,
+        _: Option<&serde_json::Value>,
+    ) -> Result<Option<Vec<[[f64; 3]; 2]>>, EntryError> {
         load_boxes(entries, cx.dir, 2).map(Some)
     }
 }
@@ -34,7 +39,12 @@ impl FamilyKind<D3> for ContinuumKind {
     fn load(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D3>) -> Result<Box<dyn SceneFamily<D3>>, EntryError> {
         Ok(Box::new(load::<D3, 3>(entries, cx)?))
     }
-    fn load_boxes(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D3>) -> Result<Option<Vec<[[f64; 3]; 2]>>, EntryError> {
+    fn load_boxes(
+        &self,
+        entries: &[toml::Table],
+        cx: &FamilyContext<'_, D3>,
+        _: Option<&serde_json::Value>,
+    ) -> Result<Option<Vec<[[f64; 3]; 2]>>, EntryError> {
         load_boxes(entries, cx.dir, 3).map(Some)
     }
 }
@@ -43,7 +53,8 @@ impl FamilyKind<D3> for ContinuumKind {
 const CONTINUUM_KEYS: [&str; 7] = ["band", "coupling", "plastic", "drive", "drive_from", "load", "initial_stress"];
 
 /// The regions' mesh boxes ([`FamilyKind::load_boxes`]): the load ties the grains
-/// lying in a region's mesh, and the family touches no other world body.
+/// lying in a region's mesh, and the family touches no other world body (restarted
+/// too: it names the grains tied at the load, and a region has no contacts).
 fn load_boxes(entries: &[toml::Table], dir: &Path, dim: usize) -> Result<Vec<[[f64; 3]; 2]>, EntryError> {
     let mut out = Vec::new();
     for (i, e) in entries.iter().enumerate() {
