@@ -27,9 +27,10 @@
 //!    each family, before any body is built, for boxes holding every world body its
 //!    load reads and its first step may name (a continuum region's mesh box, a
 //!    deformable body's reach); every rank also holds the bodies near them, and the
-//!    families are loaded against the rank's part. A family without such boxes, or
-//!    a restart of a scene with families, loads the scene whole, as before (each
-//!    rank keeps its part before the first step).
+//!    families are loaded against the rank's part; restarted, the boxes also hold
+//!    the families' first step at the saved state (the state's `families` read
+//!    alone). A family without such boxes, or a restart decomposed by model, loads
+//!    the scene whole, as before (each rank keeps its part before the first step).
 //!
 //! Scenes with no decomposition, and restarts from a state of another
 //! decomposition, are loaded whole, as before. The ranks agree on the survey's
