@@ -134,7 +134,10 @@ fn deformable_scenes_by_geometry_hold_bodies_per_rank() {
     ok(&mpirun(&[(2, args(&first, &half, &[]))]), "the drop's 50 steps on 2 ranks");
     let state = half.join("final.json");
     let on4 = dir.join("drop_restart4");
-    ok(&mpirun(&[(4, args(&drop, &on4, &["--restart", state.to_str().unwrap()]))]), "the drop restarted on 4 ranks");
+    ok(
+        &mpirun(&[(4, args(&drop, &on4, &["--restart", state.to_str().unwrap()]))]),
+        "the drop restarted on 4 ranks",
+    );
     assert!(final_json(&on4) == reference, "the drop restarted on 4 ranks ends elsewhere");
     restarted_in_part(&on4, &reference, 4);
     // 3D: spheres on a deformable block

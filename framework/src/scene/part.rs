@@ -289,8 +289,15 @@ pub fn restart_on<D: SceneDim>(
 /// [`crate::family::FamilyKind::load_boxes`]); `None` when the state has no
 /// readable `families` or a family gives no boxes (the restart is then whole, and
 /// reports what is wrong).
-fn saved_boxes<D: SceneDim>(s: &Scene<D>, registry: &Registry, sv: &Survey, path: &std::path::Path) -> Result<Option<Vec<[[f64; 3]; 2]>>, InputError> {
-    let Some(saved) = super::restart::families_of(path) else { return Ok(None) };
+fn saved_boxes<D: SceneDim>(
+    s: &Scene<D>,
+    registry: &Registry,
+    sv: &Survey,
+    path: &std::path::Path,
+) -> Result<Option<Vec<[[f64; 3]; 2]>>, InputError> {
+    let Some(saved) = super::restart::families_of(path) else {
+        return Ok(None);
+    };
     let cx = Ctx {
         text: &sv.text,
         file: &sv.file,

@@ -246,7 +246,11 @@ pub(super) fn families_of(path: &Path) -> Option<serde_json::Map<String, serde_j
 /// only its value parsed (18 MB of a 137 MB state for `nscdd`: the bodies and
 /// contacts are not parsed twice); another layout is parsed whole as `O`, the rest
 /// skipped, and `pick` takes the value (a key given twice: none).
-fn top_key<T: serde::de::DeserializeOwned, O: serde::de::DeserializeOwned>(path: &Path, key: &[u8], pick: impl Fn(O) -> Option<T>) -> Option<T> {
+fn top_key<T: serde::de::DeserializeOwned, O: serde::de::DeserializeOwned>(
+    path: &Path,
+    key: &[u8],
+    pick: impl Fn(O) -> Option<T>,
+) -> Option<T> {
     use serde::Deserialize;
     use std::io::{Read, Seek};
     let mut f = std::fs::File::open(path).ok()?;

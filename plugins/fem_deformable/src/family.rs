@@ -98,7 +98,9 @@ fn load_boxes<D: Dim>(
     for (i, e) in entries.iter().enumerate() {
         let spec = crate::scene::spec_of(i, e)?;
         let [mut lo, mut hi] = crate::scene::mesh_box(&spec.mesh, dim, cx.dir).map_err(|(k, m)| crate::scene::entry_error(i, k, m))?;
-        let (u, v) = saved.as_ref().map_or((0.0, 0.0), |b| (most(&b[i].displacement), most(&b[i].velocity)));
+        let (u, v) = saved
+            .as_ref()
+            .map_or((0.0, 0.0), |b| (most(&b[i].displacement), most(&b[i].velocity)));
         let grow = u + cx.world.time.h * most(&spec.velocity).max(v) + 0.02 * cx.world.alert;
         if !grow.is_finite() {
             return Ok(None);
