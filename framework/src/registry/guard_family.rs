@@ -28,6 +28,14 @@ impl<D: Dim> FamilyKind<D> for GuardedFamilyKind<D> {
             guard: self.guard.clone(),
         }))
     }
+    fn load_boxes(
+        &self,
+        entries: &[toml::Table],
+        cx: &FamilyContext<'_, D>,
+        saved: Option<&serde_json::Value>,
+    ) -> Result<Option<Vec<[[f64; 3]; 2]>>, EntryError> {
+        self.guard.call(|| self.inner.load_boxes(entries, cx, saved))
+    }
 }
 
 struct GuardedFamily<D: Dim> {
