@@ -179,6 +179,7 @@ pub fn load_on<D: SceneDim>(s: &mut Scene<D>, registry: &Registry, (ranks, me): 
         families: sv.families,
     };
     s.add_families(&cx, sections, registry)?;
+    check_family_part(s, &sv.boxes, &sv.file)?;
     s.decomposition = decomposition;
     s.part = Some(first);
     s.survey = Some(Survey {
@@ -257,7 +258,7 @@ pub fn restart_on<D: SceneDim>(
         };
     };
     let keep = scanned.keep;
-    let near = crate::dd::first_part::Halo::around(boxes, D::N, s.world.alert * 1.01);
+    let near = crate::dd::first_part::Halo::around(boxes.clone(), D::N, s.world.alert * 1.01);
     let keep = move |g: u32, b: &[[f64; 3]; 2]| keep[g as usize] || near.meets(b);
     let share = 1.0 / f64::from(ranks);
     let (scene, _, sections) = load_with::<D>(&sv.text, &sv.file, registry, Part::new(Box::new(keep), share))?;
@@ -270,6 +271,7 @@ pub fn restart_on<D: SceneDim>(
     s.add_families(&cx, sections, registry)?;
     s.decomposition = decomposition;
     let contacts = super::restart::restart_scene_with(s, path, rp)?;
+    check_family_part(s, &boxes, &sv.file)?;
     let mut h = std::collections::hash_map::DefaultHasher::new();
     let w = &s.world;
     let state = [sv.digest, scanned.digest, contacts.unwrap_or(0), w.step, w.t.to_bits()];
@@ -310,10 +312,58 @@ fn saved_boxes<D: SceneDim>(
     Ok(Some(boxes))
 }
 
+/// Once a rank's families are loaded against its part (and restarted): every world
+/// body they name is held, and their first reach lies within their load `boxes`.
+/// Otherwise a family's [`crate::family::FamilyKind::load_boxes`] are wrong (its
+/// plugin's error), reported here rather than as a body missing at a later step.
+fn check_family_part<D: SceneDim>(s: &Scene<D>, boxes: &[[[f64; 3]; 2]], file: &str) -> Result<(), InputError> {
+    let Some(t) = crate::family::touched(&s.world, &s.families) else {
+        return Ok(());
+    };
+    let err = |what: String| {
+        InputError {
+        file: file.to_string(),
+        line: None,
+        key: s.families.iter().map(|f| f.section()).collect::<Vec<_>>().join(", "),
+        message: format!(
+            "{what}: the body families' load boxes (`FamilyKind::load_boxes`) do not hold it, so the scene cannot load in part on MPI ranks; this is the family plugin's error"
+        ),
+    }
+    };
+    if let Some(g) = t.ids.iter().find(|&&g| s.world.ids.slot(g).is_none()) {
+        return Err(err(format!("a family names world body {g}, which this rank did not build")));
+    }
+    if let Some(b) = t.reach.iter().find(|b| !covered(b, boxes, D::N)) {
+        return Err(err(format!("a family's first reach {b:?} lies outside its load boxes")));
+    }
+    Ok(())
+}
+
+/// Whether the box `b` lies inside one of `boxes` (the first `n` coordinates).
+fn covered(b: &[[f64; 3]; 2], boxes: &[[[f64; 3]; 2]], n: usize) -> bool {
+    boxes.iter().any(|c| (0..n).all(|k| c[0][k] <= b[0][k] && b[1][k] <= c[1][k]))
+}
+
 /// [`load_on`] for a scene of either dimension.
 pub fn load_any_on(s: &mut AnyScene, registry: &Registry, on: (u32, u32)) -> Result<bool, InputError> {
     match s {
         AnyScene::D2(x) => load_on::<D2>(x, registry, on),
         AnyScene::D3(x) => load_on::<D3>(x as &mut Scene3, registry, on),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn a_reach_box_is_covered_by_a_load_box_that_holds_it() {
+        let load = [[[0.0, 0.0, 0.0], [1.0, 1.0, 0.0]], [[2.0, 0.0, 0.0], [3.0, 1.0, 0.0]]];
+        let inside = [[0.1, 0.2, 0.0], [0.9, 1.0, 0.0]];
+        let across = [[0.5, 0.2, 0.0], [2.5, 0.8, 0.0]];
+        let below = [[2.1, -0.1, 0.0], [2.9, 0.5, 0.0]];
+        assert!(super::covered(&inside, &load, 2));
+        assert!(!super::covered(&across, &load, 2), "two boxes together do not hold it");
+        assert!(!super::covered(&below, &load, 2));
+        // (2D: z is not compared)
+        assert!(super::covered(&[[0.1, 0.2, 5.0], [0.9, 1.0, 6.0]], &load, 2));
     }
 }
