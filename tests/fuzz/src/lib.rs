@@ -152,6 +152,30 @@ pub fn deformable(data: &[u8]) {
     }
 }
 
+/// A scene loaded in part as each of 2 MPI ranks would (`nscdd::scene::part`): its
+/// survey, then the rank's part, for ranks 0 and 1 (with the `fem` feature,
+/// deformable bodies and continuum regions too: their load boxes).
+pub fn part(data: &[u8]) {
+    let Ok(t) = std::str::from_utf8(data) else { return };
+    let dir = std::env::temp_dir().join(format!("nscdd-fuzz-part-{}", std::process::id()));
+    let path = dir.join("fuzz.toml");
+    if std::fs::create_dir_all(&dir).and_then(|()| std::fs::write(&path, t)).is_err() {
+        return;
+    }
+    #[allow(unused_mut)]
+    let mut r = registry();
+    #[cfg(feature = "fem")]
+    {
+        r.add_plugin(&nscdd_fem_deformable::FemPlugin);
+        r.set_max_memory(MAX_FE_MEMORY);
+    }
+    for me in 0..2 {
+        if let Ok(Some(mut s)) = nscdd::scene::part::survey_any(&path, &r) {
+            let _ = nscdd::scene::part::load_any_on(&mut s, &r, (2, me));
+        }
+    }
+}
+
 /// Two steps of a scene with its families (as the run loop makes its solver).
 #[cfg(feature = "fem")]
 fn step_twice<D: nscdd::dim::Dim>(s: &mut Scene<D>) {
@@ -179,6 +203,7 @@ pub fn targets() -> Vec<(&'static str, fn(&[u8]))> {
         ("restart", restart),
         ("fc_json", fc_json),
         ("solve_fc", solve_fc),
+        ("part", part),
     ];
     #[cfg(feature = "fem")]
     t.push(("deformable", deformable));
