@@ -252,7 +252,8 @@ pub fn restart_on<D: SceneDim>(
     let decomposition = s.decomposition.take();
     let (Some(scanned), Some(boxes)) = (scanned, boxes) else {
         load_whole(s, registry, &sv, decomposition)?;
-        return match sv.families && rp.is_none() {
+        // (a whole scene with families reads every contact, as before)
+        return match sv.families {
             true => super::restart_scene_on(s, path, on),
             false => super::restart::restart_scene_with(s, path, rp),
         };
@@ -320,15 +321,13 @@ fn check_family_part<D: SceneDim>(s: &Scene<D>, boxes: &[[[f64; 3]; 2]], file: &
     let Some(t) = crate::family::touched(&s.world, &s.families) else {
         return Ok(());
     };
-    let err = |what: String| {
-        InputError {
+    let key = s.families.iter().map(|f| f.section()).collect::<Vec<_>>().join(", ");
+    let why = "the body families' load boxes (`FamilyKind::load_boxes`) do not hold it, so the scene cannot load in part on MPI ranks; this is the family plugin's error";
+    let err = |what: String| InputError {
         file: file.to_string(),
         line: None,
-        key: s.families.iter().map(|f| f.section()).collect::<Vec<_>>().join(", "),
-        message: format!(
-            "{what}: the body families' load boxes (`FamilyKind::load_boxes`) do not hold it, so the scene cannot load in part on MPI ranks; this is the family plugin's error"
-        ),
-    }
+        key: key.clone(),
+        message: format!("{what}: {why}"),
     };
     if let Some(g) = t.ids.iter().find(|&&g| s.world.ids.slot(g).is_none()) {
         return Err(err(format!("a family names world body {g}, which this rank did not build")));
