@@ -170,15 +170,7 @@ pub fn load_on<D: SceneDim>(s: &mut Scene<D>, registry: &Registry, (ranks, me): 
     let near = crate::dd::first_part::Halo::around(sv.boxes.clone(), D::N, alert);
     let everywhere = sv.everywhere.clone();
     let keep = move |g: u32, b: &[[f64; 3]; 2]| everywhere.binary_search(&g).is_ok() || halo.meets(b) || near.meets(b);
-    let share = 1.0 / f64::from(ranks);
-    let (scene, _, sections) = load_with::<D>(&sv.text, &sv.file, registry, Part::new(Box::new(keep), share))?;
-    *s = scene;
-    let cx = Ctx {
-        text: &sv.text,
-        file: &sv.file,
-        families: sv.families,
-    };
-    s.add_families(&cx, sections, registry)?;
+    load_part(s, registry, &sv, Part::new(Box::new(keep), 1.0 / f64::from(ranks)))?;
     check_family_part(s, &sv.boxes, &sv.file)?;
     s.decomposition = decomposition;
     s.part = Some(first);
@@ -190,6 +182,19 @@ pub fn load_on<D: SceneDim>(s: &mut Scene<D>, registry: &Registry, (ranks, me): 
         ..Default::default()
     });
     Ok(true)
+}
+
+/// The surveyed scene loaded as `part` keeps it (a rank's part), its families
+/// loaded against that part.
+fn load_part<D: SceneDim>(s: &mut Scene<D>, registry: &Registry, sv: &Survey, part: Part) -> Result<(), InputError> {
+    let (scene, _, sections) = load_with::<D>(&sv.text, &sv.file, registry, part)?;
+    *s = scene;
+    let cx = Ctx {
+        text: &sv.text,
+        file: &sv.file,
+        families: sv.families,
+    };
+    s.add_families(&cx, sections, registry)
 }
 
 /// The surveyed scene loaded whole (as [`super::load_any`] loads it), with the
@@ -261,15 +266,7 @@ pub fn restart_on<D: SceneDim>(
     let keep = scanned.keep;
     let near = crate::dd::first_part::Halo::around(boxes.clone(), D::N, s.world.alert * 1.01);
     let keep = move |g: u32, b: &[[f64; 3]; 2]| keep[g as usize] || near.meets(b);
-    let share = 1.0 / f64::from(ranks);
-    let (scene, _, sections) = load_with::<D>(&sv.text, &sv.file, registry, Part::new(Box::new(keep), share))?;
-    *s = scene;
-    let cx = Ctx {
-        text: &sv.text,
-        file: &sv.file,
-        families: sv.families,
-    };
-    s.add_families(&cx, sections, registry)?;
+    load_part(s, registry, &sv, Part::new(Box::new(keep), 1.0 / f64::from(ranks)))?;
     s.decomposition = decomposition;
     let contacts = super::restart::restart_scene_with(s, path, rp)?;
     check_family_part(s, &boxes, &sv.file)?;
