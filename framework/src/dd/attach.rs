@@ -42,6 +42,7 @@
 //! [`LocalPart::sweep`] visits all its contacts in the family's own code.
 
 use super::family::Family;
+pub use super::rank_view::RankView;
 use super::subdomain::SubdomainSolver;
 use crate::norms::Sums;
 use std::any::Any;
@@ -142,6 +143,30 @@ pub trait Attached<F: Family> {
     /// (the family's positions not yet updated: the boxes must cover that update),
     /// the same boxes on every rank. The default: none.
     fn reach(&self, _w: &F::World, _out: &mut Vec<[[f64; 3]; 2]>) {}
+    /// Each step, before [`Self::after_free_velocity`]: where the step's contacts
+    /// will be solved ([`RankView`]; `None`: on any rank, or in one process; the
+    /// same on every rank). A family that then does on this rank only the work of
+    /// the contacts solved here (and of its bodies without contact, shared among the
+    /// ranks) returns true: after its [`Self::write_back`] the step exchanges the
+    /// results ([`Self::pack_stepped`], [`Self::unpack_stepped`]), before
+    /// [`Self::residual_parts`]. It still builds every contact and part, the same on
+    /// every rank (their order and packed results are those of one process); the
+    /// parts of other ranks' subdomains are never prepared nor swept here. The
+    /// default: false (the family is stepped whole on every rank).
+    fn set_ranks(&mut self, _view: Option<RankView>) -> bool {
+        false
+    }
+    /// After [`Self::write_back`] of a step [`Self::set_ranks`] returned true for:
+    /// the results computed here that the other ranks need (any length), appended
+    /// to `out`.
+    fn pack_stepped(&self, _out: &mut Vec<f64>) {}
+    /// Every rank's [`Self::pack_stepped`], in rank order: after it the family's
+    /// state is the same on every rank.
+    fn unpack_stepped(&mut self, _all: &[f64]) {}
+    /// (its bodies stepped here, its bodies) in a step stepped in part (`ranks.json`).
+    fn stepped_bodies(&self) -> Option<(usize, usize)> {
+        None
+    }
 }
 
 /// The world bodies that `fams` read or touch ([`Attached::held_everywhere`]),
@@ -205,8 +230,8 @@ impl<F: Family> std::fmt::Debug for Parts<F> {
 pub(super) fn write_back_families<D: Family>(
     d: &super::partition::Decomposition<D>,
     w: &mut D::World,
-    fams: &mut [&mut dyn Attached<D>],
-    ranks: Option<&mut super::ranks::RankState>,
+    (fams, stepped): (&mut [&mut dyn Attached<D>], &[bool]),
+    mut ranks: Option<&mut super::ranks::RankState>,
 ) -> f64 {
     // each subdomain's sums, by the rank that holds it, added in subdomain order
     let sums = |s: usize, out: &mut Vec<f64>| {
@@ -214,7 +239,7 @@ pub(super) fn write_back_families<D: Family>(
         out.extend([a, b]);
     };
     let ns = d.subs.len();
-    let per_sub = super::rank_reduce::per_subdomain(ranks, ns, 2, sums);
+    let per_sub = super::rank_reduce::per_subdomain(ranks.as_deref_mut(), ns, 2, sums);
     let (mut f2, mut q2) = (0.0, 0.0);
     for x in per_sub.chunks_exact(2) {
         (f2, q2) = (f2 + x[0], q2 + x[1]);
@@ -227,6 +252,7 @@ pub(super) fn write_back_families<D: Family>(
             .collect();
         fam.write_back(w, &parts);
     }
+    super::rank_view::share_stepped(fams, stepped, ranks);
     for fam in fams.iter() {
         let (a, b) = fam.residual_parts(w);
         (f2, q2) = (f2 + a, q2 + b);

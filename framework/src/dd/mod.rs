@@ -65,6 +65,7 @@ pub mod rank_merge;
 mod rank_reduce;
 mod rank_share;
 mod rank_totals;
+mod rank_view;
 pub mod ranks;
 mod reactions;
 mod report;
@@ -80,7 +81,7 @@ pub mod team;
 pub mod transport;
 
 use crate::model::ContactKey;
-pub use attach::{Attached, EntityInfo, LocalPart};
+pub use attach::{Attached, EntityInfo, LocalPart, RankView};
 pub use census::Census;
 pub use cluster::{Cluster, Solo};
 pub use config::{Balance, DdConfig};
@@ -162,6 +163,9 @@ pub struct NscddOf<D: Family> {
     /// The attached families' contact points (this step), one range per family.
     fam_points: Vec<[f64; 3]>,
     fam_ranges: Vec<std::ops::Range<usize>>,
+    /// Which attached families are stepped in part on this rank this step
+    /// ([`Attached::set_ranks`]).
+    fam_stepped: Vec<bool>,
     /// Whether the steps may hold bodies and contacts per rank ([`local`],
     /// [`owned`]): rigid bodies alone, or attached families that name the world
     /// bodies they touch; by model, with at least as many grid cells as ranks.
@@ -220,6 +224,7 @@ impl<D: Family> NscddOf<D> {
             fam_owner: Vec::new(),
             fam_points: Vec::new(),
             fam_ranges: Vec::new(),
+            fam_stepped: Vec::new(),
             held_ok: None,
             sums_per_sub: None,
             pending: DdStepReport::default(),
@@ -482,6 +487,7 @@ impl<D: Family> NscddOf<D> {
             for fam in fams.iter_mut() {
                 fam.write_back(w, &[]);
             }
+            rank_view::share_stepped(fams, &self.fam_stepped, self.ranks.as_mut());
             return;
         }
         let per = set.sweeps_per_gluing.max(1);
@@ -548,7 +554,7 @@ impl<D: Family> NscddOf<D> {
             None => attach::write_back(d, w),
         }
         self.store.keep(&d.subs);
-        rep.solve.residual = attach::write_back_families(d, w, fams, self.ranks.as_mut());
+        rep.solve.residual = attach::write_back_families(d, w, (fams, &self.fam_stepped), self.ranks.as_mut());
         self.local.body_sub.clear();
         if let (true, false, Some(rs)) = (self.local.now, self.local.skip_view, self.ranks.as_mut()) {
             self.local.body_sub = shells::body_subdomains(rs, d, D::n_bodies(w));

@@ -18,9 +18,11 @@ use super::ranks::RankState;
 /// the state read in part, [`super::RestartPart`], gives each contact to one rank);
 /// the bodies its world held before the first step of a fresh run or after a
 /// restart (`loaded_bodies`: a scene loaded in part, [`crate::scene::part`], gives
-/// each rank its halo).
+/// each rank its halo); the attached families' bodies it stepped and their bodies,
+/// summed over the steps stepped in part (`family_bodies_stepped`,
+/// `family_bodies`, [`super::Attached::set_ranks`]).
 pub fn totals_json(st: &mut RankState) -> String {
-    const H: usize = 23;
+    const H: usize = 25;
     let p = st.cluster.size() as usize;
     let t = &st.totals;
     let (wait_wall, wait_cpu) = st.cluster.waited();
@@ -49,6 +51,8 @@ pub fn totals_json(st: &mut RankState) -> String {
         t.bodies_held_max as f64,
         t.restart_contacts as f64,
         t.loaded_bodies as f64,
+        t.family_bodies_stepped as f64,
+        t.family_bodies as f64,
         t.peers.len() as f64,
     ];
     mine.extend(t.peers.iter().map(|&x| x as f64));
@@ -86,6 +90,8 @@ pub fn totals_json(st: &mut RankState) -> String {
                 "bodies_held_max": x[19] as u64,
                 "restart_contacts": x[20] as u64,
                 "loaded_bodies": x[21] as u64,
+                "family_bodies_stepped": x[22] as u64,
+                "family_bodies": x[23] as u64,
                 "peers": peers,
                 "last_subdomains": subs,
             })

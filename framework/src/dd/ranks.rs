@@ -97,6 +97,10 @@ pub struct RankTotals {
     /// the steps, and the steps whose shells were limited ([`super::shells`]).
     pub shell_bodies: u64,
     pub limited_shells: u64,
+    /// The attached families' bodies this rank stepped, and their bodies, summed
+    /// over the steps stepped in part ([`super::Attached::set_ranks`]).
+    pub family_bodies_stepped: u64,
+    pub family_bodies: u64,
 }
 
 /// The multi-process state of an NSCDD solver.

@@ -25,7 +25,10 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
     }
     fn after_free_velocity(&mut self, w: &D::World) {
         D::velocities(w, &mut self.dd.v_free);
-        for f in self.fams.iter_mut() {
+        let views = self.dd.rank_views(self.fams.len());
+        self.dd.fam_stepped.clear();
+        for (f, view) in self.fams.iter_mut().zip(views) {
+            self.dd.fam_stepped.push(f.set_ranks(view));
             f.after_free_velocity(w);
         }
     }

@@ -5,7 +5,7 @@
 //! so that a family still downcasts its parts and itself.
 
 use super::guard::Guard;
-use crate::dd::attach::{EntityInfo, LocalPart};
+use crate::dd::attach::{EntityInfo, LocalPart, RankView};
 use crate::dd::{Attached, Family, Rigid};
 use crate::dim::Dim;
 use crate::engine::{ContactStage, Diverged};
@@ -157,6 +157,18 @@ impl<D: Dim> Attached<Rigid<D>> for GuardedFamily<D> {
     }
     fn reach(&self, w: &World<D>, out: &mut Vec<[[f64; 3]; 2]>) {
         self.guard.call(|| self.inner.reach(w, out))
+    }
+    fn set_ranks(&mut self, view: Option<RankView>) -> bool {
+        self.guard.call(|| self.inner.set_ranks(view))
+    }
+    fn pack_stepped(&self, out: &mut Vec<f64>) {
+        self.guard.call(|| self.inner.pack_stepped(out))
+    }
+    fn unpack_stepped(&mut self, all: &[f64]) {
+        self.guard.call(|| self.inner.unpack_stepped(all))
+    }
+    fn stepped_bodies(&self) -> Option<(usize, usize)> {
+        self.guard.call(|| self.inner.stepped_bodies())
     }
 }
 

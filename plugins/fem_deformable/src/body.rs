@@ -319,6 +319,19 @@ impl FeBody {
         }
     }
 
+    /// Whether an impulse along `n` at the point Σ_q w_q x_q (nodes `nodes`) moves
+    /// the body: some node with w_q ≠ 0 has a free degree of freedom c with
+    /// n_c ≠ 0. Then the point's block of M̂⁻¹ along n is positive (M̂ restricted to
+    /// the free degrees of freedom is positive definite; the columns are 0 on the
+    /// fixed ones): a test of W_αα > 0 without the columns.
+    pub fn mobile(&self, nodes: &[u32], w: &[f64], n: &[f64]) -> bool {
+        let d = self.dim();
+        nodes
+            .iter()
+            .zip(w)
+            .any(|(&k, &wq)| wq != 0.0 && (0..d).any(|c| n[c] != 0.0 && !self.fixed[d * k as usize + c]))
+    }
+
     /// Keeps the cached columns of `keep` only (memory bound between steps).
     pub fn retain_columns(&mut self, keep: &[u32]) {
         self.columns.retain(|k, _| keep.binary_search(k).is_ok());

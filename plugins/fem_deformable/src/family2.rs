@@ -15,7 +15,7 @@
 
 use crate::contact2::*;
 use crate::stage2::{self, Deformables2};
-use nscdd::dd::{Attached, EntityInfo, LocalPart, Rigid2};
+use nscdd::dd::{Attached, EntityInfo, LocalPart, RankView, Rigid2};
 use nscdd::dim::coulomb2 as coulomb;
 use nscdd::dim::d2::Block2;
 use nscdd::engine::ContactStage;
@@ -87,13 +87,13 @@ impl LocalPart<Rigid2> for FePart2 {
         }
     }
     fn pack(&self, out: &mut Vec<f64>) {
-        self.contacts.pack_r(out);
+        self.contacts.pack_results(out);
     }
     fn packed_len(&self) -> usize {
-        2 * self.contacts.len()
+        FeContacts2::RESULTS * self.contacts.len()
     }
     fn unpack(&mut self, values: &[f64]) {
-        self.contacts.unpack_r(values);
+        self.contacts.unpack_results(values);
     }
     fn as_any(&self) -> &dyn Any {
         self
@@ -150,17 +150,12 @@ impl Attached<Rigid2> for Deformables2 {
         for (_, p) in parts {
             let Some(p) = p.as_any().downcast_ref::<FePart2>() else { continue };
             for (l, &g) in p.global.iter().enumerate() {
-                self.contacts.r[g as usize] = p.contacts.r[l];
+                self.contacts.results_from(g as usize, &p.contacts, l);
             }
         }
         self.finish_velocities();
         // the one-domain sets hold V⁺ at the contact nodes (for the residual)
-        for (bi, set) in self.sets.iter_mut().enumerate() {
-            let b = &self.bodies[bi];
-            for (kk, &nd) in set.nodes.iter().enumerate() {
-                set.v[kk] = [b.v[2 * nd as usize], b.v[2 * nd as usize + 1]];
-            }
-        }
+        crate::nodes::sets_at_velocities(&self.bodies, &mut self.sets);
     }
     fn residual_parts(&self, w: &World2) -> (f64, f64) {
         Deformables2::residual_parts(self, &w.bodies.vel, |g| crate::family::slot(w, g))
@@ -171,6 +166,20 @@ impl Attached<Rigid2> for Deformables2 {
     }
     fn reach(&self, w: &World2, out: &mut Vec<[[f64; 3]; 2]>) {
         crate::family::reach(&self.bodies, w.time.h, self.alert, out);
+    }
+    /// The bodies of the contacts solved here ([`crate::stepped`]).
+    fn set_ranks(&mut self, view: Option<RankView>) -> bool {
+        self.stepped.set(view)
+    }
+    fn pack_stepped(&self, out: &mut Vec<f64>) {
+        self.stepped.pack(&self.bodies, out);
+    }
+    fn unpack_stepped(&mut self, all: &[f64]) {
+        self.stepped.unpack(&mut self.bodies, all);
+        crate::nodes::sets_at_velocities(&self.bodies, &mut self.sets);
+    }
+    fn stepped_bodies(&self) -> Option<(usize, usize)> {
+        self.stepped.counts()
     }
 }
 

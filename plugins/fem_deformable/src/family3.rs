@@ -5,7 +5,7 @@
 use crate::contact3::*;
 use crate::family2::split_by;
 use crate::stage3::{self, Deformables3};
-use nscdd::dd::{Attached, EntityInfo, LocalPart, Rigid3};
+use nscdd::dd::{Attached, EntityInfo, LocalPart, RankView, Rigid3};
 use nscdd::dim::coulomb3 as coulomb;
 use nscdd::dim::d3::{Block3, InvMass3};
 use nscdd::engine::ContactStage;
@@ -95,13 +95,13 @@ impl LocalPart<Rigid3> for FePart3 {
         }
     }
     fn pack(&self, out: &mut Vec<f64>) {
-        self.contacts.pack_r(out);
+        self.contacts.pack_results(out);
     }
     fn packed_len(&self) -> usize {
-        3 * self.contacts.len()
+        FeContacts3::RESULTS * self.contacts.len()
     }
     fn unpack(&mut self, values: &[f64]) {
-        self.contacts.unpack_r(values);
+        self.contacts.unpack_results(values);
     }
     fn as_any(&self) -> &dyn Any {
         self
@@ -158,18 +158,12 @@ impl Attached<Rigid3> for Deformables3 {
         for (_, p) in parts {
             let Some(p) = p.as_any().downcast_ref::<FePart3>() else { continue };
             for (l, &g) in p.global.iter().enumerate() {
-                self.contacts.r[g as usize] = p.contacts.r[l];
+                self.contacts.results_from(g as usize, &p.contacts, l);
             }
         }
         self.finish_velocities();
         // the one-domain sets hold V⁺ at the contact nodes (for the residual)
-        for (bi, set) in self.sets.iter_mut().enumerate() {
-            let b = &self.bodies[bi];
-            for (kk, &nd) in set.nodes.iter().enumerate() {
-                let i = 3 * nd as usize;
-                set.v[kk] = [b.v[i], b.v[i + 1], b.v[i + 2]];
-            }
-        }
+        crate::nodes::sets_at_velocities(&self.bodies, &mut self.sets);
     }
     fn residual_parts(&self, w: &World3) -> (f64, f64) {
         Deformables3::residual_parts(self, &w.bodies.vel, |g| crate::family::slot(w, g))
@@ -180,5 +174,19 @@ impl Attached<Rigid3> for Deformables3 {
     }
     fn reach(&self, w: &World3, out: &mut Vec<[[f64; 3]; 2]>) {
         crate::family::reach(&self.bodies, w.time.h, self.alert, out);
+    }
+    /// The bodies of the contacts solved here ([`crate::stepped`]).
+    fn set_ranks(&mut self, view: Option<RankView>) -> bool {
+        self.stepped.set(view)
+    }
+    fn pack_stepped(&self, out: &mut Vec<f64>) {
+        self.stepped.pack(&self.bodies, out);
+    }
+    fn unpack_stepped(&mut self, all: &[f64]) {
+        self.stepped.unpack(&mut self.bodies, all);
+        crate::nodes::sets_at_velocities(&self.bodies, &mut self.sets);
+    }
+    fn stepped_bodies(&self) -> Option<(usize, usize)> {
+        self.stepped.counts()
     }
 }

@@ -20,6 +20,7 @@ pub mod python;
 pub mod scene;
 pub mod stage2;
 pub mod stage3;
+pub mod stepped;
 
 use nscdd::dim::{D2, D3};
 use nscdd::registry::{Plugin, Registry};

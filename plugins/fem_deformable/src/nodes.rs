@@ -163,25 +163,59 @@ pub fn fill_set<const D: usize>(set: &mut NodeSet<D>, body: &mut FeBody, nodes: 
     }
 }
 
-/// V⁺ = V_free + M̂⁻¹ Σ_α H_α r_α for every body: the impulses are (candidate
-/// side, deformable antagonist side if any, global impulse P on the candidate);
-/// one solve per body touched.
+/// A node set of a body this rank does not step ([`crate::stepped`]): its nodes,
+/// with zero velocities and G (never swept here).
+pub fn fill_nodes<const D: usize>(set: &mut NodeSet<D>, nodes: &[u32]) {
+    set.nodes.clear();
+    set.nodes.extend_from_slice(nodes);
+    set.v.clear();
+    set.v.resize(nodes.len(), [0.0; D]);
+    set.g.clear();
+    set.g.resize(D * D * nodes.len() * nodes.len(), 0.0);
+}
+
+/// The node sets of a step's contact nodes (`nodes` per body, sorted, unique): G
+/// and the free velocities of the bodies `stepped` (`None`: all), the nodes alone
+/// of the others.
+pub fn fill_sets<const D: usize>(bodies: &mut [FeBody], sets: &mut [NodeSet<D>], nodes: &[Vec<u32>], stepped: Option<&[bool]>) {
+    for (bi, ns) in nodes.iter().enumerate() {
+        let body = &mut bodies[bi];
+        body.retain_columns(ns);
+        if stepped.is_none_or(|m| m[bi]) {
+            fill_set(&mut sets[bi], body, ns, 1.0);
+        } else {
+            fill_nodes(&mut sets[bi], ns);
+        }
+    }
+}
+
+/// V⁺ = V_free + M̂⁻¹ Σ_α H_α r_α for every body `stepped` (`None`: all): the
+/// impulses are (candidate side, deformable antagonist side if any, global
+/// impulse P on the candidate); one solve per body touched.
 pub fn velocities_after<const D: usize>(
     bodies: &mut [FeBody],
     sets: &[NodeSet<D>],
     impulses: impl Iterator<Item = (FeSide<D>, Option<FeSide<D>>, [f64; D])>,
+    stepped: Option<&[bool]>,
 ) {
+    let steps = |b: usize| stepped.is_none_or(|m| m[b]);
     let mut f: Vec<Vec<f64>> = vec![Vec::new(); bodies.len()];
     for (cand, anta, p) in impulses {
         for (s, sign) in std::iter::once((cand, 1.0)).chain(anta.map(|s| (s, -1.0))) {
             let b = s.body as usize;
+            if !steps(b) {
+                continue;
+            }
             if f[b].is_empty() {
                 f[b] = vec![0.0; bodies[b].n_dofs()];
             }
             sets[b].add_side_force(&s, p, sign, &mut f[b]);
         }
     }
-    for (b, mut dv) in bodies.iter_mut().zip(f) {
+    for (bi, (b, mut dv)) in bodies.iter_mut().zip(f).enumerate() {
+        if !steps(bi) {
+            continue;
+        }
         let mut v = b.v_free.clone();
         if !dv.is_empty() {
             b.solve_in_place(&mut dv);
@@ -190,6 +224,16 @@ pub fn velocities_after<const D: usize>(
             }
         }
         b.v = v;
+    }
+}
+
+/// Every node set's velocities from its body's V (after the step: V⁺ at the
+/// contact nodes, for the residual).
+pub fn sets_at_velocities<const D: usize>(bodies: &[FeBody], sets: &mut [NodeSet<D>]) {
+    for (b, set) in bodies.iter().zip(sets.iter_mut()) {
+        for (v, &nd) in set.v.iter_mut().zip(&set.nodes) {
+            *v = std::array::from_fn(|c| b.v[D * nd as usize + c]);
+        }
     }
 }
 
@@ -232,15 +276,32 @@ impl<C, A, F, B, const D: usize> Default for FeContacts<C, A, F, B, D> {
 }
 
 impl<C, A, F: Copy, B: Copy, const D: usize> FeContacts<C, A, F, B, D> {
-    /// The impulses, flat (a part's results between MPI ranks).
-    pub fn pack_r(&self, out: &mut Vec<f64>) {
-        out.extend(self.r.iter().flatten());
-    }
-    /// Impulses [`Self::pack_r`]ed by another rank.
-    pub fn unpack_r(&mut self, v: &[f64]) {
-        for (r, x) in self.r.iter_mut().zip(v.chunks_exact(D)) {
-            r.copy_from_slice(x);
+    /// Values per contact of [`Self::pack_results`].
+    pub const RESULTS: usize = 2 * D + 2;
+    /// A part's results between MPI ranks, flat: per contact its impulse, and its
+    /// u_free and target (computed by the rank solving it only, when the bodies
+    /// are stepped per rank: [`crate::stepped`]).
+    pub fn pack_results(&self, out: &mut Vec<f64>) {
+        for a in 0..self.r.len() {
+            out.extend_from_slice(&self.r[a]);
+            out.extend_from_slice(&self.u_free[a]);
+            out.extend([self.target[a].u_target, self.target[a].mu]);
         }
+    }
+    /// Results [`Self::pack_results`]ed by another rank.
+    pub fn unpack_results(&mut self, v: &[f64]) {
+        for (a, x) in v.chunks_exact(Self::RESULTS).enumerate().take(self.r.len()) {
+            self.r[a].copy_from_slice(&x[..D]);
+            self.u_free[a].copy_from_slice(&x[D..2 * D]);
+            self.target[a].u_target = x[2 * D];
+            self.target[a].mu = x[2 * D + 1];
+        }
+    }
+    /// Contact `a`'s results from contact `l` of `part` (a part's write-back).
+    pub fn results_from(&mut self, a: usize, part: &Self, l: usize) {
+        self.r[a] = part.r[l];
+        self.u_free[a] = part.u_free[l];
+        self.target[a] = part.target[l];
     }
     pub fn len(&self) -> usize {
         self.cand.len()

@@ -24,8 +24,9 @@ use nscdd::world::World2;
 use std::time::Instant;
 
 /// An antagonist side: the side, its local velocities at the beginning of the step
-/// and free, its material, its key and its feature.
-type AntaSide = (Anta, [f64; 2], [f64; 2], u16, u32, u32);
+/// and free, its material, its key and its feature, and whether an impulse along
+/// the normal moves it.
+type AntaSide = (Anta, [f64; 2], [f64; 2], u16, u32, u32, bool);
 
 /// Seconds per stage of the deformable part of the last step (the benchmark's
 /// split).
@@ -63,6 +64,8 @@ pub struct Deformables2 {
     rigid_free: Vec<(u32, [f64; 3])>,
     /// The VTK frames written, (t, frame) ([`crate::family`]).
     pub frames: Vec<(f64, u32)>,
+    /// The bodies this MPI rank steps ([`crate::stepped`]).
+    pub stepped: crate::stepped::Stepped,
 }
 
 impl Deformables2 {
@@ -76,11 +79,22 @@ impl Deformables2 {
         }
     }
 
-    /// Free velocities (factoring M̂ first if h or θ changed) and detection.
+    /// Detection, then the free velocities (factoring M̂ first if h or θ changed)
+    /// of the bodies this rank steps ([`crate::stepped`]).
     pub fn begin_step(&mut self, w: &World2) -> Result<(), String> {
-        self.times = free_velocities(&mut self.bodies, w.time.h, w.time.theta)?;
         let t = Instant::now();
         detect(w, &self.bodies, self.alert, &mut self.raw);
+        let sides = self.raw.iter().map(|rc| {
+            let anta = match rc.anta {
+                RawAnta::Segment { body, .. } => Some(body),
+                RawAnta::Rigid(_) => None,
+            };
+            ([rc.point[0], rc.point[1], 0.0], rc.body, anta)
+        });
+        self.stepped.decide(self.bodies.len(), sides);
+        let detect = t.elapsed().as_secs_f64();
+        self.times = free_velocities(&mut self.bodies, w.time.h, w.time.theta, self.stepped.mask())?;
+        let t = Instant::now();
         self.rigid_free.clear();
         for rc in &self.raw {
             if let RawAnta::Rigid(j) = rc.anta {
@@ -89,7 +103,7 @@ impl Deformables2 {
         }
         self.rigid_free.sort_unstable_by_key(|x| x.0);
         self.rigid_free.dedup_by_key(|x| x.0);
-        self.times.detect = t.elapsed().as_secs_f64();
+        self.times.detect = detect + t.elapsed().as_secs_f64();
         Ok(())
     }
 
@@ -122,8 +136,9 @@ impl Deformables2 {
             let vb_i = local(n, [body.v_begin[2 * rc.node as usize], body.v_begin[2 * rc.node as usize + 1]]);
             let vf_i = local(n, set.v[k as usize]);
             let mut wb = set.delassus(&cand, n);
-            let (anta, ub_j, uf_j, mat_j, key_j, feature) = self.antagonist(w, rc, n, &v_begin, &mut wb);
-            if !(wb[0] > 0.0) {
+            let (anta, ub_j, uf_j, mat_j, key_j, feature, moves) = self.antagonist(w, rc, n, &v_begin, &mut wb);
+            // W_αα > 0, known on every rank (the columns only where the body is stepped)
+            if !(moves || body.mobile(&[rc.node], &[1.0], &n)) {
                 continue;
             }
             let Some(law) = w.law(body.material, mat_j) else { continue };
@@ -169,14 +184,11 @@ impl Deformables2 {
                 nodes[body as usize].extend([a, b]);
             }
         }
-        for (bi, ns) in nodes.iter_mut().enumerate() {
+        for ns in nodes.iter_mut() {
             ns.sort_unstable();
             ns.dedup();
-            let body = &mut self.bodies[bi];
-            body.retain_columns(ns);
-            let set = &mut self.sets[bi];
-            fill_set(set, body, ns, 1.0);
         }
+        crate::nodes::fill_sets(&mut self.bodies, &mut self.sets, &nodes, self.stepped.mask());
     }
 
     /// The antagonist side of a raw contact: the side, its local velocities at the
@@ -193,6 +205,7 @@ impl Deformables2 {
                 for q in 0..3 {
                     wb[q] += wr[q];
                 }
+                let moves = wr[0] > 0.0;
                 // (the body's global id: slots change on MPI ranks)
                 let g = w.ids.global(j);
                 (
@@ -202,6 +215,7 @@ impl Deformables2 {
                     w.bodies.material[ju],
                     g,
                     0,
+                    moves,
                 )
             }
             RawAnta::Segment { body: ob, seg, a, b, xi } => {
@@ -228,6 +242,7 @@ impl Deformables2 {
                     other.material,
                     1 << 31 | ob,
                     seg,
+                    other.mobile(&[a, b], &[1.0 - xi, xi], &n),
                 )
             }
         }
@@ -264,7 +279,7 @@ impl Deformables2 {
             };
             (c.cand[a], anta, global(c.frame[a], c.r[a]))
         });
-        crate::nodes::velocities_after(&mut self.bodies, &self.sets, impulses);
+        crate::nodes::velocities_after(&mut self.bodies, &self.sets, impulses, self.stepped.mask());
     }
 
     /// u⁺ = u⁻ + h((1 − θ)V⁻ + θV⁺) ([`update_bodies`]).
@@ -298,16 +313,21 @@ impl Deformables2 {
     }
 }
 
-/// Factors M̂ of every body if h or θ changed, then its free velocity; the
-/// times of both stages.
-pub fn free_velocities(bodies: &mut [FeBody], h: f64, theta: f64) -> Result<FeTimes, String> {
+/// Factors M̂ of every body if h or θ changed, then the free velocity of those
+/// `stepped` (`None`: all; the others keep V⁻ only); the times of both stages.
+pub fn free_velocities(bodies: &mut [FeBody], h: f64, theta: f64, stepped: Option<&[bool]>) -> Result<FeTimes, String> {
     let t0 = Instant::now();
     for b in bodies.iter_mut() {
         b.factorize(h, theta)?;
     }
     let t1 = Instant::now();
-    for b in bodies.iter_mut() {
-        b.free_velocity(h, theta);
+    for (bi, b) in bodies.iter_mut().enumerate() {
+        if stepped.is_none_or(|m| m[bi]) {
+            b.free_velocity(h, theta);
+        } else {
+            // (V⁻ kept; V_free is not needed here: [`crate::stepped`])
+            b.v_begin.clone_from(&b.v);
+        }
     }
     Ok(FeTimes {
         factor: (t1 - t0).as_secs_f64(),

@@ -9,7 +9,6 @@
 
 use crate::body::FeBody;
 use crate::contact3::*;
-use crate::nodes::fill_set;
 use crate::stage2::{free_velocities, law_output, node_target, update_bodies, FeTimes};
 use nscdd::dim::coulomb3 as coulomb;
 use nscdd::dim::d3::{tangents, Block3};
@@ -27,8 +26,9 @@ fn vb3(b: &FeBody, k: u32) -> [f64; 3] {
 }
 
 /// An antagonist side: the side, its local velocities at the beginning of the step
-/// and free, its material, its key and its feature.
-type AntaSide3 = (Anta3, [f64; 3], [f64; 3], u16, u32, u32);
+/// and free, its material, its key and its feature, and whether an impulse along
+/// the normal moves it.
+type AntaSide3 = (Anta3, [f64; 3], [f64; 3], u16, u32, u32, bool);
 
 /// The deformable bodies of a 3D scene and their contacts.
 #[derive(Default)]
@@ -47,6 +47,8 @@ pub struct Deformables3 {
     rigid_free: Vec<(u32, [f64; 6])>,
     /// The VTK frames written, (t, frame) ([`crate::family`]).
     pub frames: Vec<(f64, u32)>,
+    /// The bodies this MPI rank steps ([`crate::stepped`]).
+    pub stepped: crate::stepped::Stepped,
 }
 
 /// The rigid bodies' M̂⁻¹ as the sweep reads them.
@@ -63,11 +65,22 @@ impl Deformables3 {
         }
     }
 
-    /// Free velocities (factoring M̂ first if h or θ changed) and detection.
+    /// Detection, then the free velocities (factoring M̂ first if h or θ changed)
+    /// of the bodies this rank steps ([`crate::stepped`]).
     pub fn begin_step(&mut self, w: &World3) -> Result<(), String> {
-        self.times = free_velocities(&mut self.bodies, w.time.h, w.time.theta)?;
         let t = Instant::now();
         detect(w, &self.bodies, self.alert, &mut self.raw);
+        let sides = self.raw.iter().map(|rc| {
+            let anta = match rc.anta {
+                RawAnta3::Face { body, .. } => Some(body),
+                RawAnta3::Rigid(_) => None,
+            };
+            (rc.point, rc.body, anta)
+        });
+        self.stepped.decide(self.bodies.len(), sides);
+        let detect = t.elapsed().as_secs_f64();
+        self.times = free_velocities(&mut self.bodies, w.time.h, w.time.theta, self.stepped.mask())?;
+        let t = Instant::now();
         self.rigid_free.clear();
         for rc in &self.raw {
             if let RawAnta3::Rigid(j) = rc.anta {
@@ -76,7 +89,7 @@ impl Deformables3 {
         }
         self.rigid_free.sort_unstable_by_key(|x| x.0);
         self.rigid_free.dedup_by_key(|x| x.0);
-        self.times.detect = t.elapsed().as_secs_f64();
+        self.times.detect = detect + t.elapsed().as_secs_f64();
         Ok(())
     }
 
@@ -98,10 +111,15 @@ impl Deformables3 {
             let bi = rc.body as usize;
             let set = &self.sets[bi];
             let body = &self.bodies[bi];
-            let (cand, vbi, cand_key) = match rc.cand {
+            let (cand, vbi, cand_key, cand_moves) = match rc.cand {
                 RawCand3::Node(node) => {
                     let k = set.nodes.binary_search(&node).unwrap() as u32;
-                    (FeSide3::node(rc.body, k), vb3(body, node), node)
+                    (
+                        FeSide3::node(rc.body, k),
+                        vb3(body, node),
+                        node,
+                        body.mobile(&[node], &[1.0], &rc.n),
+                    )
                 }
                 RawCand3::Face { face, nodes: f, w: wts } => {
                     let k = f.map(|x| set.nodes.binary_search(&x).unwrap() as u32);
@@ -112,7 +130,8 @@ impl Deformables3 {
                             v[c] += wts[q] * vn[c];
                         }
                     }
-                    (FeSide3 { body: rc.body, k, w: wts }, v, 1 << 31 | face)
+                    let moves = body.mobile(&f, &wts, &rc.n);
+                    (FeSide3 { body: rc.body, k, w: wts }, v, 1 << 31 | face, moves)
                 }
             };
             let (t1, t2) = tangents(rc.n);
@@ -120,8 +139,9 @@ impl Deformables3 {
             let ub_i = local(&basis, vbi);
             let uf_i = local(&basis, set.side_velocity(&cand));
             let mut wb = project(&basis, &set.side_block(&cand));
-            let (anta, ub_j, uf_j, mat_j, key_j, feature) = self.antagonist(w, rc, &basis, &v_begin, &mut wb);
-            if !(wb[0] > 0.0) {
+            let (anta, ub_j, uf_j, mat_j, key_j, feature, moves) = self.antagonist(w, rc, &basis, &v_begin, &mut wb);
+            // W_αα > 0, known on every rank (the columns only where the body is stepped)
+            if !(moves || cand_moves) {
                 continue;
             }
             let Some(law) = w.law(body.material, mat_j) else { continue };
@@ -170,13 +190,11 @@ impl Deformables3 {
                 nodes[body as usize].extend(f);
             }
         }
-        for (bi, ns) in nodes.iter_mut().enumerate() {
+        for ns in nodes.iter_mut() {
             ns.sort_unstable();
             ns.dedup();
-            let body = &mut self.bodies[bi];
-            body.retain_columns(ns);
-            fill_set(&mut self.sets[bi], body, ns, 1.0);
         }
+        crate::nodes::fill_sets(&mut self.bodies, &mut self.sets, &nodes, self.stepped.mask());
     }
 
     /// The antagonist side of a raw contact: the side, its local velocities at the
@@ -193,6 +211,7 @@ impl Deformables3 {
                 for q in 0..6 {
                     wb[q] += wr[q];
                 }
+                let moves = wr[0] > 0.0;
                 // (the body's global id: slots change on MPI ranks)
                 let g = w.ids.global(j);
                 (
@@ -202,6 +221,7 @@ impl Deformables3 {
                     w.bodies.material[ju],
                     g,
                     0,
+                    moves,
                 )
             }
             RawAnta3::Face {
@@ -232,6 +252,7 @@ impl Deformables3 {
                     other.material,
                     1 << 31 | ob,
                     face,
+                    other.mobile(&f, &wts, &rc.n),
                 )
             }
         }
@@ -261,7 +282,7 @@ impl Deformables3 {
             };
             (c.cand[a], anta, global(&c.frame[a], c.r[a]))
         });
-        crate::nodes::velocities_after(&mut self.bodies, &self.sets, impulses);
+        crate::nodes::velocities_after(&mut self.bodies, &self.sets, impulses, self.stepped.mask());
     }
 
     /// u⁺ = u⁻ + h((1 − θ)V⁻ + θV⁺).
