@@ -1,0 +1,223 @@
+//! Deformable bodies stepped per rank (docs/SCALING.md, "Deformable bodies stepped
+//! per rank"): between repartitions each rank computes the free velocity, the
+//! columns of M̂⁻¹ and V⁺ only of the deformable bodies whose contacts its
+//! subdomains solve (`Attached::set_ranks`), and the ranks exchange the V⁺ they
+//! computed; the results are the one-process files, in 2D and 3D, by geometry and
+//! by model, and across a restart on another rank count.
+#![cfg(all(feature = "fem", feature = "mpi"))]
+
+mod common;
+mod mpi_common;
+use mpi_common::*;
+
+/// Runs `scene` in one process and on each of `ranks`: the same `final.json` and
+/// history (but its timings), every rank stepping some deformable bodies and the
+/// ranks fewer together than every rank all of them (`family_bodies_stepped`
+/// against `family_bodies` in `ranks.json`, over the steps between repartitions). Returns the one-process
+/// `final.json`.
+fn stepped_on_ranks(dir: &std::path::Path, tag: &str, scene: &std::path::Path, ranks: &[u32]) -> String {
+    let one = dir.join(format!("{tag}_one"));
+    ok(&nscdd(&args(scene, &one, &[])), &format!("{tag} in one process"));
+    let reference = final_json(&one);
+    for &n in ranks {
+        let out = dir.join(format!("{tag}_ranks{n}"));
+        ok(&mpirun(&[(n, args(scene, &out, &[]))]), &format!("{tag} on {n} ranks"));
+        assert!(final_json(&out) == reference, "{tag}, {n} ranks: final.json differs from one process");
+        assert_eq!(
+            common::history_physics(&out),
+            common::history_physics(&one),
+            "{tag}, {n} ranks: the history differs from one process"
+        );
+        let stepped = per_rank_count(&out, "family_bodies_stepped");
+        let all = per_rank_count(&out, "family_bodies");
+        let replicated = all.iter().sum::<u64>();
+        assert!(
+            stepped.iter().zip(&all).all(|(&s, &a)| s > 0 && s <= a) && stepped.iter().sum::<u64>() < replicated,
+            "{tag}, {n} ranks: deformable bodies stepped {stepped:?} of {all:?}"
+        );
+    }
+    reference
+}
+
+#[test]
+fn deformable_bodies_are_stepped_per_rank() {
+    let dir = scratch("fe_stepped");
+    let s2 = write(&dir, "blocks.toml", BLOCKS);
+    let reference = stepped_on_ranks(&dir, "2d", &s2, &[2, 4]);
+    // a state written by 2 ranks between repartitions restarts on 4 ranks
+    let first = write(&dir, "first.toml", &BLOCKS.replace("steps = 60", "steps = 33"));
+    let half = dir.join("half");
+    ok(&mpirun(&[(2, args(&first, &half, &[]))]), "33 steps on 2 ranks");
+    let state = half.join("final.json");
+    let on4 = dir.join("restart4");
+    ok(&mpirun(&[(4, args(&s2, &on4, &["--restart", state.to_str().unwrap()]))]), "the restart on 4 ranks");
+    assert!(final_json(&on4) == reference, "a restart on 4 ranks ends elsewhere");
+    // by model: the blocks' contacts in subdomains of their own, on their cells' ranks
+    let sm = write(&dir, "by_model.toml", &BLOCKS.replace("nx = 4\n", "by_model = true\nnx = 4\n"));
+    stepped_on_ranks(&dir, "by_model", &sm, &[2]);
+    let s3 = write(&dir, "blocks3d.toml", BLOCKS3D);
+    stepped_on_ranks(&dir, "3d", &s3, &[2]);
+}
+
+/// Four deformable blocks on a floor (the first two 2 mm apart: node–segment
+/// contacts between them), two layers of disks resting on them, 4 cells,
+/// re-partitioned every 5 steps.
+const BLOCKS: &str = r#"
+[time]
+step = 1e-3
+theta = 0.5
+steps = 60
+
+[solver]
+tolerance = 1e-5
+max_sweeps = 20000
+
+[detection]
+alert = 0.005
+
+[output]
+every = 30
+vtk = false
+
+[decomposition]
+nx = 4
+repartition_every = 5
+
+[[materials]]
+name = "soil"
+density = 2000.0
+
+[[materials]]
+name = "stone"
+density = 2500.0
+
+[[laws]]
+materials = ["soil", "stone"]
+friction = 0.5
+
+[[laws]]
+materials = ["stone", "stone"]
+friction = 0.3
+
+[[laws]]
+materials = ["soil", "soil"]
+friction = 0.4
+
+[[bodies]]
+name = "floor"
+shape = "wall"
+material = "stone"
+position = [0.5, -0.01]
+length = 1.2
+thickness = 0.02
+fixed = true
+
+[[generate]]
+kind = "square_lattice"
+material = "stone"
+radius = 0.02
+origin = [0.05, 0.123]
+nx = 22
+ny = 2
+spacing = 0.042
+
+[[deformable]]
+name = "a"
+material = "soil"
+young = 2e6
+poisson = 0.3
+mesh = { rectangle = { origin = [0.02, 0.001], size = [0.2, 0.1], cells = [8, 4] } }
+
+[[deformable]]
+name = "b"
+material = "soil"
+young = 2e6
+poisson = 0.3
+mesh = { rectangle = { origin = [0.222, 0.001], size = [0.2, 0.1], cells = [8, 4] } }
+
+[[deformable]]
+name = "c"
+material = "soil"
+young = 2e6
+poisson = 0.3
+mesh = { rectangle = { origin = [0.5, 0.001], size = [0.2, 0.1], cells = [8, 4] } }
+
+[[deformable]]
+name = "d"
+material = "soil"
+young = 2e6
+poisson = 0.3
+mesh = { rectangle = { origin = [0.76, 0.001], size = [0.2, 0.1], cells = [8, 4] } }
+"#;
+
+/// Two deformable boxes 5 mm apart under a layer of spheres, 2 cells,
+/// re-partitioned every 4 steps.
+const BLOCKS3D: &str = r#"
+dimension = 3
+
+[time]
+step = 1e-3
+theta = 0.5
+steps = 30
+
+[solver]
+tolerance = 1e-5
+max_sweeps = 20000
+
+[detection]
+alert = 0.01
+
+[output]
+every = 30
+vtk = false
+
+[decomposition]
+nx = 2
+repartition_every = 4
+
+[[materials]]
+name = "soil"
+density = 2000.0
+
+[[materials]]
+name = "stone"
+density = 2500.0
+
+[[laws]]
+materials = ["soil", "stone"]
+friction = 0.5
+
+[[laws]]
+materials = ["stone", "stone"]
+friction = 0.3
+
+[[laws]]
+materials = ["soil", "soil"]
+friction = 0.4
+
+[[generate]]
+kind = "sphere_lattice"
+material = "stone"
+radius = 0.05
+origin = [0.1, 0.1, 0.355]
+nx = 8
+ny = 3
+nz = 1
+spacing = 0.12
+
+[[deformable]]
+name = "left"
+material = "soil"
+young = 5e6
+poisson = 0.3
+fix = ["bottom"]
+mesh = { box = { origin = [0.0, 0.0, 0.0], size = [0.45, 0.35, 0.3], cells = [5, 4, 3] } }
+
+[[deformable]]
+name = "right"
+material = "soil"
+young = 5e6
+poisson = 0.3
+fix = ["bottom"]
+mesh = { box = { origin = [0.455, 0.0, 0.0], size = [0.45, 0.35, 0.3], cells = [5, 4, 3] } }
+"#;
