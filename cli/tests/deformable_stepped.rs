@@ -22,7 +22,10 @@ fn stepped_on_ranks(dir: &std::path::Path, tag: &str, scene: &std::path::Path, r
     for &n in ranks {
         let out = dir.join(format!("{tag}_ranks{n}"));
         ok(&mpirun(&[(n, args(scene, &out, &[]))]), &format!("{tag} on {n} ranks"));
-        assert!(final_json(&out) == reference, "{tag}, {n} ranks: final.json differs from one process");
+        assert!(
+            final_json(&out) == reference,
+            "{tag}, {n} ranks: final.json differs from one process"
+        );
         assert_eq!(
             common::history_physics(&out),
             common::history_physics(&one),
@@ -50,7 +53,10 @@ fn deformable_bodies_are_stepped_per_rank() {
     ok(&mpirun(&[(2, args(&first, &half, &[]))]), "33 steps on 2 ranks");
     let state = half.join("final.json");
     let on4 = dir.join("restart4");
-    ok(&mpirun(&[(4, args(&s2, &on4, &["--restart", state.to_str().unwrap()]))]), "the restart on 4 ranks");
+    ok(
+        &mpirun(&[(4, args(&s2, &on4, &["--restart", state.to_str().unwrap()]))]),
+        "the restart on 4 ranks",
+    );
     assert!(final_json(&on4) == reference, "a restart on 4 ranks ends elsewhere");
     // by model: the blocks' contacts in subdomains of their own, on their cells' ranks
     let sm = write(&dir, "by_model.toml", &BLOCKS.replace("nx = 4\n", "by_model = true\nnx = 4\n"));

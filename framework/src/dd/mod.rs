@@ -483,11 +483,7 @@ impl<D: Family> NscddOf<D> {
         if total == 0 {
             rep.solve.converged = true;
             self.store.keep(&d.subs);
-            // no contact anywhere: the families' V⁺ is their V_free
-            for fam in fams.iter_mut() {
-                fam.write_back(w, &[]);
-            }
-            rank_view::share_stepped(fams, &self.fam_stepped, self.ranks.as_mut());
+            rank_view::write_back_alone(w, fams, &self.fam_stepped, self.ranks.as_mut());
             return;
         }
         let per = set.sweeps_per_gluing.max(1);

@@ -75,3 +75,12 @@ pub(super) fn share_stepped<D: Family>(fams: &mut [&mut dyn Attached<D>], on: &[
         }
     }
 }
+
+/// No contact on any rank: the families' V⁺ is their V_free (each family stepped
+/// in part then shares it, [`share_stepped`]).
+pub(super) fn write_back_alone<D: Family>(w: &mut D::World, fams: &mut [&mut dyn Attached<D>], on: &[bool], ranks: Option<&mut RankState>) {
+    for fam in fams.iter_mut() {
+        fam.write_back(w, &[]);
+    }
+    share_stepped(fams, on, ranks);
+}
