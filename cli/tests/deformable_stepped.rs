@@ -3,7 +3,8 @@
 //! columns of M̂⁻¹ and V⁺ only of the deformable bodies whose contacts its
 //! subdomains solve (`Attached::set_ranks`), and the ranks exchange the V⁺ they
 //! computed; the results are the one-process files, in 2D and 3D, by geometry and
-//! by model, and across a restart on another rank count.
+//! by model, with threads inside the ranks, and across a restart on another rank
+//! count.
 #![cfg(all(feature = "fem", feature = "mpi"))]
 
 mod common;
@@ -47,6 +48,10 @@ fn deformable_bodies_are_stepped_per_rank() {
     let dir = scratch("fe_stepped");
     let s2 = write(&dir, "blocks.toml", BLOCKS);
     let reference = stepped_on_ranks(&dir, "2d", &s2, &[2, 4]);
+    // threads inside the ranks: the same file
+    let hybrid = dir.join("hybrid");
+    ok(&mpirun(&[(2, args(&s2, &hybrid, &["--threads", "2"]))]), "2 ranks of 2 threads");
+    assert!(final_json(&hybrid) == reference, "2 ranks of 2 threads end elsewhere");
     // a state written by 2 ranks between repartitions restarts on 4 ranks
     let first = write(&dir, "first.toml", &BLOCKS.replace("steps = 60", "steps = 33"));
     let half = dir.join("half");
