@@ -1,8 +1,8 @@
 //! Deformable bodies stepped per rank (docs/SCALING.md, "Deformable bodies stepped
-//! per rank"): between repartitions each rank computes the free velocity, the
-//! columns of M̂⁻¹ and V⁺ only of the deformable bodies whose contacts its
-//! subdomains solve (`Attached::set_ranks`), and the ranks exchange the V⁺ they
-//! computed; the results are the one-process files, in 2D and 3D, by geometry and
+//! per rank"): at every step, repartitions included, each rank computes the free
+//! velocity, the columns of M̂⁻¹ and V⁺ only of the deformable bodies whose
+//! contacts its subdomains solve (`Attached::solved_on`), and the ranks exchange
+//! the V⁺ they computed; the results are the one-process files, in 2D and 3D, by geometry and
 //! by model, with threads inside the ranks, and across a restart on another rank
 //! count.
 #![cfg(all(feature = "fem", feature = "mpi"))]
@@ -14,9 +14,10 @@ use mpi_common::*;
 /// Runs `scene` in one process and on each of `ranks`: the same `final.json` and
 /// history (but its timings), every rank stepping some deformable bodies and the
 /// ranks fewer together than every rank all of them (`family_bodies_stepped`
-/// against `family_bodies` in `ranks.json`, over the steps between repartitions). Returns the one-process
+/// against `family_bodies` in `ranks.json`: `body_steps`, every step stepped in
+/// part). Returns the one-process
 /// `final.json`.
-fn stepped_on_ranks(dir: &std::path::Path, tag: &str, scene: &std::path::Path, ranks: &[u32]) -> String {
+fn stepped_on_ranks(dir: &std::path::Path, tag: &str, (scene, body_steps): (&std::path::Path, u64), ranks: &[u32]) -> String {
     let one = dir.join(format!("{tag}_one"));
     ok(&nscdd(&args(scene, &one, &[])), &format!("{tag} in one process"));
     let reference = final_json(&one);
@@ -36,7 +37,7 @@ fn stepped_on_ranks(dir: &std::path::Path, tag: &str, scene: &std::path::Path, r
         let all = per_rank_count(&out, "family_bodies");
         let replicated = all.iter().sum::<u64>();
         assert!(
-            stepped.iter().zip(&all).all(|(&s, &a)| s > 0 && s <= a) && stepped.iter().sum::<u64>() < replicated,
+            stepped.iter().zip(&all).all(|(&s, &a)| s > 0 && s <= a && a == body_steps) && stepped.iter().sum::<u64>() < replicated,
             "{tag}, {n} ranks: deformable bodies stepped {stepped:?} of {all:?}"
         );
     }
@@ -47,12 +48,13 @@ fn stepped_on_ranks(dir: &std::path::Path, tag: &str, scene: &std::path::Path, r
 fn deformable_bodies_are_stepped_per_rank() {
     let dir = scratch("fe_stepped");
     let s2 = write(&dir, "blocks.toml", BLOCKS);
-    let reference = stepped_on_ranks(&dir, "2d", &s2, &[2, 4]);
+    let reference = stepped_on_ranks(&dir, "2d", (&s2, 4 * 60), &[2, 4]);
     // threads inside the ranks: the same file
     let hybrid = dir.join("hybrid");
     ok(&mpirun(&[(2, args(&s2, &hybrid, &["--threads", "2"]))]), "2 ranks of 2 threads");
     assert!(final_json(&hybrid) == reference, "2 ranks of 2 threads end elsewhere");
-    // a state written by 2 ranks between repartitions restarts on 4 ranks
+    // a state written by 2 ranks between repartitions restarts on 4 ranks (and
+    // at a repartition, step 35)
     let first = write(&dir, "first.toml", &BLOCKS.replace("steps = 60", "steps = 33"));
     let half = dir.join("half");
     ok(&mpirun(&[(2, args(&first, &half, &[]))]), "33 steps on 2 ranks");
@@ -63,11 +65,21 @@ fn deformable_bodies_are_stepped_per_rank() {
         "the restart on 4 ranks",
     );
     assert!(final_json(&on4) == reference, "a restart on 4 ranks ends elsewhere");
+    let first = write(&dir, "first35.toml", &BLOCKS.replace("steps = 60", "steps = 35"));
+    let half = dir.join("half35");
+    ok(&mpirun(&[(2, args(&first, &half, &[]))]), "35 steps on 2 ranks");
+    let state = half.join("final.json");
+    let on3 = dir.join("restart3");
+    ok(
+        &mpirun(&[(3, args(&s2, &on3, &["--restart", state.to_str().unwrap()]))]),
+        "the restart on 3 ranks",
+    );
+    assert!(final_json(&on3) == reference, "a restart on 3 ranks ends elsewhere");
     // by model: the blocks' contacts in subdomains of their own, on their cells' ranks
     let sm = write(&dir, "by_model.toml", &BLOCKS.replace("nx = 4\n", "by_model = true\nnx = 4\n"));
-    stepped_on_ranks(&dir, "by_model", &sm, &[2]);
+    stepped_on_ranks(&dir, "by_model", (&sm, 4 * 60), &[2]);
     let s3 = write(&dir, "blocks3d.toml", BLOCKS3D);
-    stepped_on_ranks(&dir, "3d", &s3, &[2]);
+    stepped_on_ranks(&dir, "3d", (&s3, 2 * 30), &[2]);
 }
 
 /// Four deformable blocks on a floor (the first two 2 mm apart: node–segment

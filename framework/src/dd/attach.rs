@@ -42,7 +42,7 @@
 //! [`LocalPart::sweep`] visits all its contacts in the family's own code.
 
 use super::family::Family;
-pub use super::rank_view::RankView;
+pub use super::rank_solved::SolvedOn;
 use super::subdomain::SubdomainSolver;
 use crate::norms::Sums;
 use std::any::Any;
@@ -143,20 +143,23 @@ pub trait Attached<F: Family> {
     /// (the family's positions not yet updated: the boxes must cover that update),
     /// the same boxes on every rank. The default: none.
     fn reach(&self, _w: &F::World, _out: &mut Vec<[[f64; 3]; 2]>) {}
-    /// Each step, before [`Self::after_free_velocity`]: where the step's contacts
-    /// will be solved ([`RankView`]; `None`: on any rank, or in one process; the
-    /// same on every rank). A family that then does on this rank only the work of
-    /// the contacts solved here (and of its bodies without contact, shared among the
-    /// ranks) returns true: after its [`Self::write_back`] the step exchanges the
-    /// results ([`Self::pack_stepped`], [`Self::unpack_stepped`]), before
-    /// [`Self::residual_parts`]. It still builds every contact and part, the same on
-    /// every rank (their order and packed results are those of one process); the
-    /// parts of other ranks' subdomains are never prepared nor swept here. The
-    /// default: false (the family is stepped whole on every rank).
-    fn set_ranks(&mut self, _view: Option<RankView>) -> bool {
+    /// Each step of the NSCDD stage, after the partition and before [`Self::split`]:
+    /// where its contacts ([`Self::points`] order) are solved ([`SolvedOn`]; `None`
+    /// in one process, where all are solved). A family may leave to this call the
+    /// numbers only a solved contact needs (its bodies' free velocities, W_αα,
+    /// u_free): its contact list and points must not depend on them. A family that
+    /// then does on this rank only the work of the contacts solved here (and of its
+    /// bodies without contact, shared among the ranks) returns true: after its
+    /// [`Self::write_back`] the step exchanges the results ([`Self::pack_stepped`],
+    /// [`Self::unpack_stepped`]), before [`Self::residual_parts`]. It still builds
+    /// every contact and part, the same on every rank (their order and packed
+    /// results are those of one process); the parts of other ranks' subdomains are
+    /// never prepared nor swept here. The default: false (the family is stepped
+    /// whole on every rank).
+    fn solved_on(&mut self, _w: &F::World, _on: Option<&SolvedOn<'_>>) -> bool {
         false
     }
-    /// After [`Self::write_back`] of a step [`Self::set_ranks`] returned true for:
+    /// After [`Self::write_back`] of a step [`Self::solved_on`] returned true for:
     /// the results computed here that the other ranks need (any length), appended
     /// to `out`.
     fn pack_stepped(&self, _out: &mut Vec<f64>) {}
@@ -252,7 +255,7 @@ pub(super) fn write_back_families<D: Family>(
             .collect();
         fam.write_back(w, &parts);
     }
-    super::rank_view::share_stepped(fams, stepped, ranks);
+    super::rank_solved::share_stepped(fams, stepped, ranks);
     for fam in fams.iter() {
         let (a, b) = fam.residual_parts(w);
         (f2, q2) = (f2 + a, q2 + b);

@@ -64,8 +64,8 @@ mod rank_link;
 pub mod rank_merge;
 mod rank_reduce;
 mod rank_share;
+mod rank_solved;
 mod rank_totals;
-mod rank_view;
 pub mod ranks;
 mod reactions;
 mod report;
@@ -81,7 +81,7 @@ pub mod team;
 pub mod transport;
 
 use crate::model::ContactKey;
-pub use attach::{Attached, EntityInfo, LocalPart, RankView};
+pub use attach::{Attached, EntityInfo, LocalPart, SolvedOn};
 pub use census::Census;
 pub use cluster::{Cluster, Solo};
 pub use config::{Balance, DdConfig};
@@ -164,7 +164,7 @@ pub struct NscddOf<D: Family> {
     fam_points: Vec<[f64; 3]>,
     fam_ranges: Vec<std::ops::Range<usize>>,
     /// Which attached families are stepped in part on this rank this step
-    /// ([`Attached::set_ranks`]).
+    /// ([`Attached::solved_on`]).
     fam_stepped: Vec<bool>,
     /// Whether the steps may hold bodies and contacts per rank ([`local`],
     /// [`owned`]): rigid bodies alone, or attached families that name the world
@@ -339,7 +339,7 @@ impl<D: Family> NscddOf<D> {
 
     /// This step's decomposition of `w.contacts`: a new grid every
     /// `repartition_every` steps, else the kept owners.
-    fn partition(&mut self, w: &D::World, fams: &[&mut dyn Attached<D>], rep: &mut DdStepReport) {
+    fn partition(&mut self, w: &D::World, fams: &mut [&mut dyn Attached<D>], rep: &mut DdStepReport) {
         let s = &self.settings;
         let c = D::contacts(w);
         let nc = D::len(c);
@@ -384,8 +384,9 @@ impl<D: Family> NscddOf<D> {
         // several processes: each builds only the subdomains of its rank (chosen by
         // the distributed repartition when contacts are held per rank)
         let build = self.ranks.as_mut().map(|rs| rs.assign(&owner, ns, repart && !self.local.now));
+        rank_solved::solved_on(w, fams, (&self.fam_owner, self.ranks.as_ref()), &mut self.fam_stepped);
         let fo = FamilyOwners {
-            fams,
+            fams: &*fams,
             owner: &self.fam_owner,
         };
         let (local, families) = (&self.local, !fams.is_empty());
@@ -483,7 +484,7 @@ impl<D: Family> NscddOf<D> {
         if total == 0 {
             rep.solve.converged = true;
             self.store.keep(&d.subs);
-            rank_view::write_back_alone(w, fams, &self.fam_stepped, self.ranks.as_mut());
+            rank_solved::write_back_alone(w, fams, &self.fam_stepped, self.ranks.as_mut());
             return;
         }
         let per = set.sweeps_per_gluing.max(1);

@@ -20,7 +20,7 @@ use super::ranks::RankState;
 /// restart (`loaded_bodies`: a scene loaded in part, [`crate::scene::part`], gives
 /// each rank its halo); the attached families' bodies it stepped and their bodies,
 /// summed over the steps stepped in part (`family_bodies_stepped`,
-/// `family_bodies`, [`super::Attached::set_ranks`]).
+/// `family_bodies`, [`super::Attached::solved_on`]).
 pub fn totals_json(st: &mut RankState) -> String {
     const H: usize = 25;
     let p = st.cluster.size() as usize;

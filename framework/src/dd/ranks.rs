@@ -98,7 +98,7 @@ pub struct RankTotals {
     pub shell_bodies: u64,
     pub limited_shells: u64,
     /// The attached families' bodies this rank stepped, and their bodies, summed
-    /// over the steps stepped in part ([`super::Attached::set_ranks`]).
+    /// over the steps stepped in part ([`super::Attached::solved_on`]).
     pub family_bodies_stepped: u64,
     pub family_bodies: u64,
 }

@@ -25,10 +25,7 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
     }
     fn after_free_velocity(&mut self, w: &D::World) {
         D::velocities(w, &mut self.dd.v_free);
-        let views = self.dd.rank_views(self.fams.len());
-        self.dd.fam_stepped.clear();
-        for (f, view) in self.fams.iter_mut().zip(views) {
-            self.dd.fam_stepped.push(f.set_ranks(view));
+        for f in self.fams.iter_mut() {
             f.after_free_velocity(w);
         }
     }

@@ -5,7 +5,7 @@
 //! so that a family still downcasts its parts and itself.
 
 use super::guard::Guard;
-use crate::dd::attach::{EntityInfo, LocalPart, RankView};
+use crate::dd::attach::{EntityInfo, LocalPart, SolvedOn};
 use crate::dd::{Attached, Family, Rigid};
 use crate::dim::Dim;
 use crate::engine::{ContactStage, Diverged};
@@ -158,8 +158,8 @@ impl<D: Dim> Attached<Rigid<D>> for GuardedFamily<D> {
     fn reach(&self, w: &World<D>, out: &mut Vec<[[f64; 3]; 2]>) {
         self.guard.call(|| self.inner.reach(w, out))
     }
-    fn set_ranks(&mut self, view: Option<RankView>) -> bool {
-        self.guard.call(|| self.inner.set_ranks(view))
+    fn solved_on(&mut self, w: &World<D>, on: Option<&SolvedOn<'_>>) -> bool {
+        self.guard.call(|| self.inner.solved_on(w, on))
     }
     fn pack_stepped(&self, out: &mut Vec<f64>) {
         self.guard.call(|| self.inner.pack_stepped(out))

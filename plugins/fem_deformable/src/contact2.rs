@@ -118,7 +118,8 @@ pub struct RawFe {
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum RawAnta {
-    /// A rigid body by the world's slot (the detection's step only).
+    /// A rigid body: its slot in the world from `detect`, its global id once the
+    /// family keeps the raw contacts (`detect_step`: slots move on MPI ranks).
     Rigid(u32),
     Segment {
         body: u32,

@@ -142,7 +142,8 @@ pub enum RawCand3 {
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum RawAnta3 {
-    /// A rigid body by the world's slot (the detection's step only).
+    /// A rigid body: its slot in the world from `detect`, its global id once the
+    /// family keeps the raw contacts (`detect_step`: slots move on MPI ranks).
     Rigid(u32),
     /// A boundary triangle of a deformable body: its index, corners, weights.
     Face {

@@ -15,10 +15,9 @@
 
 use crate::contact2::*;
 use crate::stage2::{self, Deformables2};
-use nscdd::dd::{Attached, EntityInfo, LocalPart, RankView, Rigid2};
+use nscdd::dd::{Attached, EntityInfo, LocalPart, Rigid2, SolvedOn};
 use nscdd::dim::coulomb2 as coulomb;
 use nscdd::dim::d2::Block2;
-use nscdd::engine::ContactStage;
 use nscdd::norms::Sums;
 use nscdd::world::World2;
 use std::any::Any;
@@ -101,11 +100,34 @@ impl LocalPart<Rigid2> for FePart2 {
 }
 
 impl Attached<Rigid2> for Deformables2 {
+    /// Detection only: the free velocities come after the partition
+    /// ([`Self::solved_on`]).
     fn after_free_velocity(&mut self, w: &World2) {
-        ContactStage::after_free_velocity(self, w);
+        self.detect_step(w);
     }
+    /// The contact list and points, no body stepped yet (no solve).
     fn build(&mut self, w: &mut World2) {
-        Deformables2::build(self, w);
+        self.stepped.hold(self.bodies.len());
+        self.build_contacts(w);
+    }
+    /// The bodies of the contacts solved here ([`crate::stepped`]): their free
+    /// velocities, and the contacts built again with their numbers.
+    fn solved_on(&mut self, w: &World2, on: Option<&SolvedOn<'_>>) -> bool {
+        let c = &self.contacts;
+        let sides = (0..c.len()).map(|a| {
+            let anta = match c.anta[a] {
+                Anta::Fe(s) => Some(s.body),
+                Anta::Rigid { .. } => None,
+            };
+            (c.cand[a].body, anta)
+        });
+        let part = self.stepped.decide(self.bodies.len(), on, sides);
+        // (M̂ is factored at load time for the scene's h and θ: nothing can fail here)
+        if let Err(e) = self.free_step(w) {
+            self.error = Some(e);
+        }
+        self.build_contacts(w);
+        part
     }
     fn points(&self, out: &mut Vec<[f64; 3]>) {
         out.extend(self.contacts.point.iter().map(|p| [p[0], p[1], 0.0]));
@@ -166,10 +188,6 @@ impl Attached<Rigid2> for Deformables2 {
     }
     fn reach(&self, w: &World2, out: &mut Vec<[[f64; 3]; 2]>) {
         crate::family::reach(&self.bodies, w.time.h, self.alert, out);
-    }
-    /// The bodies of the contacts solved here ([`crate::stepped`]).
-    fn set_ranks(&mut self, view: Option<RankView>) -> bool {
-        self.stepped.set(view)
     }
     fn pack_stepped(&self, out: &mut Vec<f64>) {
         self.stepped.pack(&self.bodies, out);

@@ -5,10 +5,9 @@
 use crate::contact3::*;
 use crate::family2::split_by;
 use crate::stage3::{self, Deformables3};
-use nscdd::dd::{Attached, EntityInfo, LocalPart, RankView, Rigid3};
+use nscdd::dd::{Attached, EntityInfo, LocalPart, Rigid3, SolvedOn};
 use nscdd::dim::coulomb3 as coulomb;
 use nscdd::dim::d3::{Block3, InvMass3};
-use nscdd::engine::ContactStage;
 use nscdd::norms::Sums;
 use nscdd::world::World3;
 use std::any::Any;
@@ -109,11 +108,34 @@ impl LocalPart<Rigid3> for FePart3 {
 }
 
 impl Attached<Rigid3> for Deformables3 {
+    /// Detection only: the free velocities come after the partition
+    /// ([`Self::solved_on`]).
     fn after_free_velocity(&mut self, w: &World3) {
-        ContactStage::after_free_velocity(self, w);
+        self.detect_step(w);
     }
+    /// The contact list and points, no body stepped yet (no solve).
     fn build(&mut self, w: &mut World3) {
-        Deformables3::build(self, w);
+        self.stepped.hold(self.bodies.len());
+        self.build_contacts(w);
+    }
+    /// The bodies of the contacts solved here ([`crate::stepped`]): their free
+    /// velocities, and the contacts built again with their numbers.
+    fn solved_on(&mut self, w: &World3, on: Option<&SolvedOn<'_>>) -> bool {
+        let c = &self.contacts;
+        let sides = (0..c.len()).map(|a| {
+            let anta = match c.anta[a] {
+                Anta3::Fe(s) => Some(s.body),
+                Anta3::Rigid { .. } => None,
+            };
+            (c.cand[a].body, anta)
+        });
+        let part = self.stepped.decide(self.bodies.len(), on, sides);
+        // (M̂ is factored at load time for the scene's h and θ: nothing can fail here)
+        if let Err(e) = self.free_step(w) {
+            self.error = Some(e);
+        }
+        self.build_contacts(w);
+        part
     }
     fn points(&self, out: &mut Vec<[f64; 3]>) {
         out.extend_from_slice(&self.contacts.point);
@@ -174,10 +196,6 @@ impl Attached<Rigid3> for Deformables3 {
     }
     fn reach(&self, w: &World3, out: &mut Vec<[[f64; 3]; 2]>) {
         crate::family::reach(&self.bodies, w.time.h, self.alert, out);
-    }
-    /// The bodies of the contacts solved here ([`crate::stepped`]).
-    fn set_ranks(&mut self, view: Option<RankView>) -> bool {
-        self.stepped.set(view)
     }
     fn pack_stepped(&self, out: &mut Vec<f64>) {
         self.stepped.pack(&self.bodies, out);

@@ -79,37 +79,52 @@ impl Deformables2 {
         }
     }
 
-    /// Detection, then the free velocities (factoring M̂ first if h or θ changed)
-    /// of the bodies this rank steps ([`crate::stepped`]).
+    /// Detection and the free velocities (factoring M̂ first if h or θ changed):
+    /// the one-domain stage.
     pub fn begin_step(&mut self, w: &World2) -> Result<(), String> {
+        self.detect_step(w);
+        self.free_step(w)
+    }
+
+    /// Detection, and the V_free of the rigid antagonists.
+    pub fn detect_step(&mut self, w: &World2) {
         let t = Instant::now();
         detect(w, &self.bodies, self.alert, &mut self.raw);
-        let sides = self.raw.iter().map(|rc| {
-            let anta = match rc.anta {
-                RawAnta::Segment { body, .. } => Some(body),
-                RawAnta::Rigid(_) => None,
-            };
-            ([rc.point[0], rc.point[1], 0.0], rc.body, anta)
-        });
-        self.stepped.decide(self.bodies.len(), sides);
-        let detect = t.elapsed().as_secs_f64();
-        self.times = free_velocities(&mut self.bodies, w.time.h, w.time.theta, self.stepped.mask())?;
-        let t = Instant::now();
+        // the rigid antagonists by global id: on MPI ranks a repartition moves
+        // bodies between the world's slots before the contacts are built again
+        // ([`crate::stepped`])
         self.rigid_free.clear();
-        for rc in &self.raw {
-            if let RawAnta::Rigid(j) = rc.anta {
-                self.rigid_free.push((j, w.bodies.vel[j as usize]));
+        for rc in &mut self.raw {
+            if let RawAnta::Rigid(j) = &mut rc.anta {
+                let g = w.ids.global(*j);
+                self.rigid_free.push((g, w.bodies.vel[*j as usize]));
+                *j = g;
             }
         }
         self.rigid_free.sort_unstable_by_key(|x| x.0);
         self.rigid_free.dedup_by_key(|x| x.0);
-        self.times.detect = detect + t.elapsed().as_secs_f64();
+        self.times.detect = t.elapsed().as_secs_f64();
+    }
+
+    /// The free velocities of the bodies this rank steps ([`crate::stepped`]).
+    pub fn free_step(&mut self, w: &World2) -> Result<(), String> {
+        let detect = self.times.detect;
+        self.times = free_velocities(&mut self.bodies, w.time.h, w.time.theta, self.stepped.mask())?;
+        self.times.detect = detect;
         Ok(())
     }
 
     /// Builds the node sets, their G blocks and the contacts (frames, W_αα, ū, warm
     /// start), from the raw contacts of [`Self::begin_step`].
     pub fn build(&mut self, w: &mut World2) {
+        self.build_contacts(w);
+        self.warm_start(w);
+    }
+
+    /// [`Self::build`] but the warm start: the contact list (the same whatever
+    /// bodies this rank steps) and, for the bodies it steps ([`crate::stepped`]),
+    /// G, W_αα, u_free and the targets.
+    pub fn build_contacts(&mut self, w: &World2) {
         let t0 = Instant::now();
         let solves0: u64 = self.bodies.iter().map(|b| b.solves).sum();
         self.fill_sets();
@@ -168,7 +183,6 @@ impl Deformables2 {
             c.key.push(key);
         }
         self.contacts = c;
-        self.warm_start(w);
         let solves1: u64 = self.bodies.iter().map(|b| b.solves).sum();
         self.times.solves = solves1.saturating_sub(solves0);
         self.times.columns = (t1 - t0).as_secs_f64();
@@ -196,8 +210,8 @@ impl Deformables2 {
     /// share of W_αα to `wb`.
     fn antagonist(&self, w: &World2, rc: &RawFe, n: [f64; 2], v_begin: &[[f64; 3]], wb: &mut [f64; 3]) -> AntaSide {
         match rc.anta {
-            RawAnta::Rigid(j) => {
-                let ju = j as usize;
+            RawAnta::Rigid(g) => {
+                let ju = crate::family::slot(w, g);
                 let t = [-n[1], n[0]];
                 let dd = [rc.point[0] - w.bodies.pos[ju][0], rc.point[1] - w.bodies.pos[ju][1]];
                 let arm = [dd[0] * n[1] - dd[1] * n[0], dd[0] * t[1] - dd[1] * t[0]];
@@ -206,12 +220,10 @@ impl Deformables2 {
                     wb[q] += wr[q];
                 }
                 let moves = wr[0] > 0.0;
-                // (the body's global id: slots change on MPI ranks)
-                let g = w.ids.global(j);
                 (
                     Anta::Rigid { body: g, arm },
                     rigid_local(n, arm, v_begin[ju]),
-                    rigid_local(n, arm, free_of(&self.rigid_free, j)),
+                    rigid_local(n, arm, free_of(&self.rigid_free, g)),
                     w.bodies.material[ju],
                     g,
                     0,

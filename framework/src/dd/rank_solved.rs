@@ -1,0 +1,75 @@
+//! An attached family stepped in part on each rank (docs/SCALING.md, "Deformable
+//! bodies stepped per rank"): after each step's partition the framework tells the
+//! families where each of their contacts is solved ([`SolvedOn`], given to
+//! [`Attached::solved_on`]), before they split their contacts into parts. A family
+//! that uses it does the work of its contacts' bodies on the ranks solving them
+//! only, and after its [`Attached::write_back`] the ranks exchange what each
+//! computed ([`Attached::pack_stepped`], one all-gather), so that its state is the
+//! same on every rank again before its residual, outputs and position update.
+
+use super::attach::Attached;
+use super::family::Family;
+use super::ranks::RankState;
+
+/// Where this step's contacts of one attached family are solved.
+pub struct SolvedOn<'a> {
+    /// This rank and the number of ranks.
+    pub rank: u32,
+    pub ranks: u32,
+    /// The rank solving contact `a` (the family's [`Attached::points`] order).
+    pub rank_of: &'a dyn Fn(usize) -> u32,
+}
+
+/// After the families' write-back: each family stepped in part (`on`) packs what
+/// it computed, every rank receives every rank's pack (one all-gather per family;
+/// collective: `on` is the same on every rank).
+pub(super) fn share_stepped<D: Family>(fams: &mut [&mut dyn Attached<D>], on: &[bool], mut ranks: Option<&mut RankState>) {
+    for (fam, _) in fams.iter_mut().zip(on).filter(|x| *x.1) {
+        let Some(rs) = ranks.as_deref_mut() else { return };
+        let mut mine = Vec::new();
+        fam.pack_stepped(&mut mine);
+        let (_, all) = rs.all_gather_any(&mine);
+        fam.unpack_stepped(&all);
+        if let Some((here, n)) = fam.stepped_bodies() {
+            rs.totals.family_bodies_stepped += here as u64;
+            rs.totals.family_bodies += n as u64;
+        }
+    }
+}
+
+/// No contact on any rank: the families' V⁺ is their V_free (each family stepped
+/// in part then shares it, [`share_stepped`]).
+pub(super) fn write_back_alone<D: Family>(w: &mut D::World, fams: &mut [&mut dyn Attached<D>], on: &[bool], ranks: Option<&mut RankState>) {
+    for fam in fams.iter_mut() {
+        fam.write_back(w, &[]);
+    }
+    share_stepped(fams, on, ranks);
+}
+
+/// After the partition (`owner`: each family's contacts' subdomains; the ranks'
+/// `rank_of` decided): each family told where its contacts are solved
+/// ([`Attached::solved_on`]), `stepped` whether it is stepped in part.
+pub(super) fn solved_on<D: Family>(
+    w: &D::World,
+    fams: &mut [&mut dyn Attached<D>],
+    (owner, ranks): (&[Vec<u32>], Option<&RankState>),
+    stepped: &mut Vec<bool>,
+) {
+    stepped.clear();
+    for (f, fam) in fams.iter_mut().enumerate() {
+        let s = match ranks {
+            Some(rs) => {
+                let o = &owner[f];
+                let rank_of = |a: usize| rs.rank_of[o[a] as usize];
+                let on = SolvedOn {
+                    rank: rs.cluster.rank(),
+                    ranks: rs.cluster.size(),
+                    rank_of: &rank_of,
+                };
+                fam.solved_on(w, Some(&on))
+            }
+            None => fam.solved_on(w, None),
+        };
+        stepped.push(s);
+    }
+}
