@@ -14,13 +14,16 @@ of the run). With more ranks than cores the ranks share the cores: the wall time
 grows with P / cores and time sharing blurs the wall split between own work and
 waits; the compute CPU per rank is what weak scaling keeps constant.
 
-Usage: python3 scripts/weak_scaling.py [--ranks 1,2,4,8] [--steps 200] [--out DIR]
-Needs the program built with `--features nscdd-cli/mpi` and OpenMPI.
+Usage: python3 scripts/weak_scaling.py [--ranks 1,2,4,8] [--steps 200] [--out DIR] [--settle-only]
+Needs the program built with `--features nscdd-cli/mpi` and OpenMPI. `--settle-only`
+writes the settled states alone (to carry them to another machine); the environment's
+NSCDD and TIME name the program and GNU time if they are not at their usual paths.
 """
 import argparse, json, os, re, subprocess, sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BIN = os.path.join(ROOT, "target", "release", "nscdd")
+BIN = os.environ.get("NSCDD", os.path.join(ROOT, "target", "release", "nscdd"))
+TIME = os.environ.get("TIME", "/usr/bin/time")
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
            OMPI_MCA_btl_vader_single_copy_mechanism="none")
 
@@ -50,6 +53,7 @@ def main():
     ap.add_argument("--ranks", default="1,2,4,8")
     ap.add_argument("--steps", type=int, default=200)
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "weak"))
+    ap.add_argument("--settle-only", action="store_true")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     for p in [int(x) for x in a.ranks.split(",")]:
@@ -60,10 +64,12 @@ def main():
         state = os.path.join(d, "settle", "final.json")
         if not os.path.exists(state):
             run([BIN, "run", settle, "--out", os.path.join(d, "settle"), "--quiet", "--subdomains", f"{p}x1"])
+        if a.settle_only:
+            continue
         timed = os.path.join(d, "timed.toml")
         open(timed, "w").write(scene(p, 1500 + a.steps))
         out = os.path.join(d, "run")
-        err = run(["mpirun", "-n", str(p), "--oversubscribe", "--bind-to", "none", "/usr/bin/time", "-f", "cpu %U %S",
+        err = run(["mpirun", "-n", str(p), "--oversubscribe", "--bind-to", "none", TIME, "-f", "cpu %U %S",
                    BIN, "run", timed, "--restart", state, "--out", out, "--quiet", "--subdomains", f"{p}x1"])
         wall = float(re.search(r"sweeps, ([0-9.]+) s", err).group(1))
         cpu = [float(u) + float(s) for u, s in re.findall(r"cpu ([0-9.]+) ([0-9.]+)", err)]
