@@ -352,19 +352,39 @@ impl FeBody {
 
     /// ½ VᵀMV.
     pub fn kinetic_energy(&self) -> f64 {
-        let mut mv = vec![0.0; self.n_dofs()];
-        self.mul_add(1.0, 0.0, &self.v, &mut mv);
-        0.5 * dot(&self.v, &mv)
+        self.energies(&self.u, &self.v)[0]
     }
     /// ½ uᵀKu.
     pub fn elastic_energy(&self) -> f64 {
-        let mut ku = vec![0.0; self.n_dofs()];
-        self.mul_add(0.0, 1.0, &self.u, &mut ku);
-        0.5 * dot(&self.u, &ku)
+        self.energies(&self.u, &self.v)[1]
     }
     /// −u·F_ext (the potential of the constant external loads, gravity).
     pub fn load_potential(&self) -> f64 {
         -dot(&self.u, &self.f_ext)
+    }
+    /// Component i of u⁺ = u⁻ + h((1 − θ)V⁻ + θV⁺) (V⁻ = `v_begin`, V⁺ = `v`).
+    #[inline]
+    pub fn u_next(&self, i: usize, h: f64, theta: f64) -> f64 {
+        self.u[i] + h * ((1.0 - theta) * self.v_begin[i] + theta * self.v[i])
+    }
+    /// [½ vᵀMv, ½ uᵀKu, −u·F_ext] at displacements `u` and velocities `v`, in one
+    /// pass over the pattern of M and K (stored whole: column c's sums times x_c),
+    /// without allocation.
+    pub fn energies(&self, u: &[f64], v: &[f64]) -> [f64; 3] {
+        let cp = self.pattern.col_ptr();
+        let ri = self.pattern.row_idx();
+        let (mut ke, mut se) = (0.0, 0.0);
+        for c in 0..self.n_dofs() {
+            let (mut mv, mut ku) = (0.0, 0.0);
+            for p in cp[c]..cp[c + 1] {
+                let r = ri[p];
+                mv += self.m_val[p] * v[r];
+                ku += self.k_val[p] * u[r];
+            }
+            ke += v[c] * mv;
+            se += u[c] * ku;
+        }
+        [0.5 * ke, 0.5 * se, -dot(u, &self.f_ext)]
     }
     /// Total mass (Σ of M's entries of one component).
     pub fn mass(&self) -> f64 {

@@ -210,11 +210,19 @@ fn load<C: Copy, A: Copy, F: Copy, B: Copy, const N: usize>(
     Ok(())
 }
 
-fn history_values(bodies: &[FeBody], contacts: usize, out: &mut Vec<f64>) {
+/// The contacts and the sums over the bodies of [`FeBody::energies`], added in body
+/// order; `known`: each body's, already computed by the rank stepping it
+/// ([`crate::stepped::Stepped::energies`]).
+fn history_values(bodies: &[FeBody], contacts: usize, known: Option<&[[f64; 3]]>, out: &mut Vec<f64>) {
+    let mut sum = [0.0; 3];
+    for (b, body) in bodies.iter().enumerate() {
+        let e = known.map_or_else(|| body.energies(&body.u, &body.v), |k| k[b]);
+        for (s, x) in sum.iter_mut().zip(e) {
+            *s += x;
+        }
+    }
     out.push(contacts as f64);
-    out.push(bodies.iter().map(|b| b.kinetic_energy()).sum());
-    out.push(bodies.iter().map(|b| b.elastic_energy()).sum());
-    out.push(bodies.iter().map(|b| b.load_potential()).sum());
+    out.extend(sum);
 }
 
 fn describe(bodies: &[FeBody]) -> String {
@@ -277,7 +285,7 @@ macro_rules! scene_family {
                 .to_vec()
             }
             fn history_values(&self, out: &mut Vec<f64>) {
-                history_values(&self.bodies, self.contacts.len(), out)
+                history_values(&self.bodies, self.contacts.len(), self.stepped.energies(), out)
             }
             fn write_frame(&mut self, dir: &Path, frame: u32, t: f64) -> std::io::Result<()> {
                 write_frame(&self.bodies, "deformable", &mut self.frames, dir, frame, t)
@@ -289,6 +297,7 @@ macro_rules! scene_family {
                 save(&self.bodies, &self.contacts)
             }
             fn load_state(&mut self, state: &serde_json::Value) -> Result<(), String> {
+                self.stepped = Default::default();
                 load(&mut self.bodies, &mut self.contacts, state)
             }
             fn local_problem(&self, w: &World<$dim>) -> Option<nscdd::fc::FamilyShare> {

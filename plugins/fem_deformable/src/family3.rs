@@ -129,7 +129,7 @@ impl Attached<Rigid3> for Deformables3 {
             };
             (c.cand[a].body, anta)
         });
-        let part = self.stepped.decide(self.bodies.len(), on, sides);
+        let part = self.stepped.decide(self.bodies.len(), on, sides, (w.time.h, w.time.theta));
         // (M̂ is factored at load time for the scene's h and θ: nothing can fail here)
         if let Err(e) = self.free_step(w) {
             self.error = Some(e);

@@ -104,9 +104,13 @@ impl<const D: usize> NodeSet<D> {
         self.cross_block(s, s)
     }
     /// Σ_kl w_k w'_l G_kl of two sides `a`, `b` of this body (global frame): their
-    /// coupling through M̂⁻¹ (`a = b`: [`Self::side_block`]).
+    /// coupling through M̂⁻¹ (`a = b`: [`Self::side_block`]); 0 for a set without G
+    /// (a body not stepped on this rank, [`fill_nodes`]).
     pub fn cross_block(&self, a: &FeSide<D>, b: &FeSide<D>) -> [[f64; D]; D] {
         let mut g = [[0.0; D]; D];
+        if self.g.is_empty() {
+            return g;
+        }
         for p in 0..D {
             for q in 0..D {
                 let ww = a.w[p] * b.w[q];
@@ -164,14 +168,14 @@ pub fn fill_set<const D: usize>(set: &mut NodeSet<D>, body: &mut FeBody, nodes: 
 }
 
 /// A node set of a body this rank does not step ([`crate::stepped`]): its nodes,
-/// with zero velocities and G (never swept here).
+/// with zero velocities and no G (never swept here; its blocks read as 0,
+/// [`NodeSet::cross_block`]).
 pub fn fill_nodes<const D: usize>(set: &mut NodeSet<D>, nodes: &[u32]) {
     set.nodes.clear();
     set.nodes.extend_from_slice(nodes);
     set.v.clear();
     set.v.resize(nodes.len(), [0.0; D]);
     set.g.clear();
-    set.g.resize(D * D * nodes.len() * nodes.len(), 0.0);
 }
 
 /// The node sets of a step's contact nodes (`nodes` per body, sorted, unique): G

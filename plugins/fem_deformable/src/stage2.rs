@@ -353,7 +353,7 @@ pub fn free_velocities(bodies: &mut [FeBody], h: f64, theta: f64, stepped: Optio
 pub fn update_bodies(bodies: &mut [FeBody], h: f64, theta: f64, step: u64) -> Result<(), Diverged> {
     for (bi, b) in bodies.iter_mut().enumerate() {
         for i in 0..b.u.len() {
-            b.u[i] += h * ((1.0 - theta) * b.v_begin[i] + theta * b.v[i]);
+            b.u[i] = b.u_next(i, h, theta);
         }
         if let Some(i) = (0..b.u.len()).find(|&i| !(b.u[i].is_finite() && b.v[i].is_finite())) {
             let d = b.dim();

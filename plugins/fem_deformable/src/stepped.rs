@@ -8,9 +8,11 @@
 //! `b mod P`. Every rank still detects every contact and builds every part
 //! (positions, V⁻ and the impulses are the same on every rank). After the
 //! write-back, the first rank stepping a body sends its V⁺ to every rank
-//! ([`Stepped::pack`], [`Stepped::unpack`]); the contacts' impulses, u_free and
-//! targets come with their parts' results, from the rank that solved them
-//! ([`crate::nodes::FeContacts::pack_results`]).
+//! ([`Stepped::pack`], [`Stepped::unpack`]) with the body's energies after the
+//! step (the history's columns, each body's computed once); the contacts'
+//! impulses, u_free and targets come with their parts' results, from the rank that
+//! solved them ([`crate::nodes::FeContacts::pack_results`]). A body not stepped
+//! here has no G (its contacts' W_αα and parts are never used here).
 
 use crate::body::FeBody;
 use nscdd::dd::SolvedOn;
@@ -26,6 +28,12 @@ pub struct Stepped {
     mine: Vec<bool>,
     /// Per body, in part: the rank whose V⁺ every rank takes.
     sender: Vec<u32>,
+    /// (h, θ) of the step in progress, in part.
+    ht: (f64, f64),
+    /// Per body, after the exchange of a step stepped in part: its energies after
+    /// the step ([`FeBody::energies`] at u⁺, V⁺), as its sender computed them.
+    energy: Vec<[f64; 3]>,
+    energy_known: bool,
 }
 
 impl Stepped {
@@ -34,6 +42,7 @@ impl Stepped {
     pub fn hold(&mut self, n: usize) {
         self.on = None;
         self.held = true;
+        self.energy_known = false;
         self.mine.clear();
         self.mine.resize(n, false);
     }
@@ -41,9 +50,17 @@ impl Stepped {
     /// After the partition ([`nscdd::dd::Attached::solved_on`]; `None`: every body
     /// here), from the contacts' bodies (candidate, deformable antagonist) in the
     /// family's order: a body is stepped by every rank solving one of its contacts.
-    /// Whether the family is stepped in part.
-    pub fn decide(&mut self, n: usize, on: Option<&SolvedOn<'_>>, contacts: impl Iterator<Item = (u32, Option<u32>)>) -> bool {
+    /// Whether the family is stepped in part. `ht`: the step's h and θ.
+    pub fn decide(
+        &mut self,
+        n: usize,
+        on: Option<&SolvedOn<'_>>,
+        contacts: impl Iterator<Item = (u32, Option<u32>)>,
+        ht: (f64, f64),
+    ) -> bool {
         self.held = false;
+        self.energy_known = false;
+        self.ht = ht;
         let Some(on) = on else {
             self.on = None;
             return false;
@@ -85,26 +102,46 @@ impl Stepped {
         self.on.map(|_| (self.mine.iter().filter(|&&x| x).count(), self.mine.len()))
     }
 
-    /// V⁺ of the bodies this rank sends: (body, its V⁺) each.
+    /// The bodies this rank sends: (body, its V⁺, its energies after the step) each,
+    /// the energies at u⁺ ([`FeBody::u_next`], the position update's arithmetic).
     pub fn pack(&self, bodies: &[FeBody], out: &mut Vec<f64>) {
         let Some((rank, _)) = self.on else { return };
+        let (h, theta) = self.ht;
+        let mut u_next = Vec::new();
         for (b, body) in bodies.iter().enumerate().filter(|(b, _)| self.sender[*b] == rank) {
             out.push(b as f64);
             out.extend_from_slice(&body.v);
+            u_next.clear();
+            u_next.extend((0..body.u.len()).map(|i| body.u_next(i, h, theta)));
+            out.extend(body.energies(&u_next, &body.v));
         }
     }
 
     /// Every rank's [`Self::pack`] (rank order): the V⁺ of the bodies not stepped
-    /// here.
-    pub fn unpack(&self, bodies: &mut [FeBody], all: &[f64]) {
+    /// here, every body's energies.
+    pub fn unpack(&mut self, bodies: &mut [FeBody], all: &[f64]) {
+        self.energy.clear();
+        self.energy.resize(bodies.len(), [f64::NAN; 3]);
         let mut i = 0;
         while let Some(&b) = all.get(i) {
             let Some(body) = bodies.get_mut(b as usize) else { return };
-            let Some(v) = all.get(i + 1..i + 1 + body.v.len()) else { return };
+            let n = body.v.len();
+            let (Some(v), Some(e)) = (all.get(i + 1..i + 1 + n), all.get(i + 1 + n..i + 4 + n)) else {
+                return;
+            };
             if !self.steps(b as usize) {
                 body.v.copy_from_slice(v);
             }
-            i += 1 + body.v.len();
+            self.energy[b as usize] = [e[0], e[1], e[2]];
+            i += 4 + n;
         }
+        self.energy_known = true;
+    }
+
+    /// Every body's energies after the step, as their senders computed them
+    /// ([`Self::pack`]); `None` unless the step in progress was stepped in part and
+    /// exchanged.
+    pub fn energies(&self) -> Option<&[[f64; 3]]> {
+        self.energy_known.then_some(&self.energy[..])
     }
 }
