@@ -77,6 +77,9 @@ pub struct FeBody {
     columns: HashMap<u32, Vec<f64>>,
     /// Column solves done since the last refactorization (a measure).
     pub solves: u64,
+    /// Counts the changes of M̂⁻¹ (refactorizations, fixed dofs): what was built
+    /// from its columns at another count is stale ([`crate::nodes::fill_set`]).
+    generation: u64,
     pub skfem_version: String,
 }
 
@@ -142,6 +145,7 @@ impl FeBody {
             f_plastic: Vec::new(),
             columns: HashMap::new(),
             solves: 0,
+            generation: 0,
             skfem_version,
         })
     }
@@ -195,6 +199,7 @@ impl FeBody {
         }
         self.factor = None;
         self.columns.clear();
+        self.generation += 1;
     }
 
     /// Factors M̂ = (1 + hθα) M + (h²θ² + hθβ) K if (h, θ) changed (the symbolic
@@ -228,6 +233,7 @@ impl FeBody {
         self.factor = Some(llt);
         self.factored_for = (h, theta);
         self.columns.clear();
+        self.generation += 1;
         self.solves = 0;
         Ok(true)
     }
@@ -335,6 +341,10 @@ impl FeBody {
     /// Keeps the cached columns of `keep` only (memory bound between steps).
     pub fn retain_columns(&mut self, keep: &[u32]) {
         self.columns.retain(|k, _| keep.binary_search(k).is_ok());
+    }
+    /// The count of M̂⁻¹'s changes (refactorizations, fixed dofs).
+    pub fn generation(&self) -> u64 {
+        self.generation
     }
     pub fn cached_columns(&self) -> usize {
         self.columns.len()

@@ -40,6 +40,8 @@ pub struct NodeSet<const D: usize> {
     pub nodes: Vec<u32>,
     pub v: Vec<[f64; D]>,
     pub g: Vec<f64>,
+    /// The body's [`FeBody::generation`] and the scale `g` was filled with.
+    g_of: (u64, f64),
 }
 
 impl<const D: usize> NodeSet<D> {
@@ -141,17 +143,24 @@ impl<const D: usize> NodeSet<D> {
 }
 
 /// Fills a node set: velocities from the free velocity, G from M̂⁻¹ columns
-/// (scaled by `scale`).
+/// (scaled by `scale`). G is kept when the set had the same nodes, built from the
+/// same M̂⁻¹ ([`FeBody::generation`]) and scale: it is then these very numbers (a
+/// body whose contact nodes stay put costs no G a step).
 pub fn fill_set<const D: usize>(set: &mut NodeSet<D>, body: &mut FeBody, nodes: &[u32], scale: f64) {
     debug_assert_eq!(body.dim(), D);
-    body.ensure_columns(nodes);
-    let n = nodes.len();
-    let nd = body.n_dofs();
-    set.nodes.clear();
-    set.nodes.extend_from_slice(nodes);
     set.v.clear();
     set.v
         .extend(nodes.iter().map(|&k| std::array::from_fn(|c| body.v_free[D * k as usize + c])));
+    let n = nodes.len();
+    let kept = set.nodes == nodes && set.g.len() == D * D * n * n && set.g_of == (body.generation(), scale);
+    if kept && n > 0 {
+        return;
+    }
+    body.ensure_columns(nodes);
+    let nd = body.n_dofs();
+    set.nodes.clear();
+    set.nodes.extend_from_slice(nodes);
+    set.g_of = (body.generation(), scale);
     set.g.clear();
     set.g.resize(D * D * n * n, 0.0);
     for (l, &nl) in nodes.iter().enumerate() {
@@ -168,14 +177,18 @@ pub fn fill_set<const D: usize>(set: &mut NodeSet<D>, body: &mut FeBody, nodes: 
 }
 
 /// A node set of a body this rank does not step ([`crate::stepped`]): its nodes,
-/// with zero velocities and no G (never swept here; its blocks read as 0,
-/// [`NodeSet::cross_block`]).
+/// with zero velocities; G is kept if the nodes are the same (for
+/// [`fill_set`], when the body is stepped again), else dropped (its blocks then
+/// read as 0, [`NodeSet::cross_block`]). Either way its contacts' W_αα are never
+/// used here: their parts are not prepared nor swept on this rank.
 pub fn fill_nodes<const D: usize>(set: &mut NodeSet<D>, nodes: &[u32]) {
-    set.nodes.clear();
-    set.nodes.extend_from_slice(nodes);
+    if set.nodes != nodes {
+        set.nodes.clear();
+        set.nodes.extend_from_slice(nodes);
+        set.g.clear();
+    }
     set.v.clear();
     set.v.resize(nodes.len(), [0.0; D]);
-    set.g.clear();
 }
 
 /// The node sets of a step's contact nodes (`nodes` per body, sorted, unique): G
