@@ -1,0 +1,55 @@
+//! A node set's G (the blocks of M̂⁻¹ among a body's contact nodes) is kept while
+//! its nodes and the body's M̂⁻¹ stay, and only then (`nodes::fill_set`).
+mod common;
+use common::*;
+use nscdd_fem_deformable::nodes::{fill_nodes, fill_set, NodeSet};
+
+const SCENE: &str = r#"
+[time]
+step = 1e-3
+steps = 1
+[[materials]]
+name = "soil"
+density = 2000.0
+[[deformable]]
+material = "soil"
+young = 1e7
+poisson = 0.3
+mesh = { rectangle = { origin = [0.0, 0.0], size = [0.4, 0.2], cells = [8, 4] } }
+"#;
+
+#[test]
+fn g_is_kept_while_the_nodes_and_the_factor_stay() {
+    let mut s = scene(SCENE);
+    let body = &mut s.fe.bodies[0];
+    let nodes = [0u32, 3, 7, 20];
+    let mut set = NodeSet::<2>::default();
+    fill_set(&mut set, body, &nodes, 1.0);
+    let g1 = set.g.clone();
+    assert!(g1.iter().any(|&x| x != 0.0));
+    // the same nodes and factor: kept (a sentinel shows it was not refilled)
+    set.g[0] = 42.0;
+    fill_set(&mut set, body, &nodes, 1.0);
+    assert_eq!(set.g[0], 42.0);
+    // another scale: refilled
+    fill_set(&mut set, body, &nodes, 2.0);
+    assert_eq!(set.g[0], 2.0 * g1[0]);
+    fill_set(&mut set, body, &nodes, 1.0);
+    assert_eq!(set.g, g1);
+    // another h: M̂ changes, G is filled from the new columns
+    assert!(body.factorize(2e-3, 0.5).unwrap());
+    fill_set(&mut set, body, &nodes, 1.0);
+    let mut fresh = NodeSet::<2>::default();
+    fill_set(&mut fresh, body, &nodes, 1.0);
+    assert_eq!(set.g, fresh.g);
+    assert_ne!(set.g, g1);
+    // a body not stepped here: G kept for the same nodes, dropped for others
+    fill_nodes(&mut set, &nodes);
+    assert_eq!(set.g, fresh.g);
+    assert!(set.v.iter().all(|v| *v == [0.0; 2]));
+    fill_nodes(&mut set, &nodes[..3]);
+    assert!(set.g.is_empty());
+    // and a set without G is filled again
+    fill_set(&mut set, body, &nodes, 1.0);
+    assert_eq!(set.g, fresh.g);
+}
