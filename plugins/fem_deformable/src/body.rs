@@ -338,6 +338,12 @@ impl FeBody {
             .any(|(&k, &wq)| wq != 0.0 && (0..d).any(|c| n[c] != 0.0 && !self.fixed[d * k as usize + c]))
     }
 
+    /// Drops every cached column and their memory (a body this MPI rank no longer
+    /// steps, [`crate::stepped`]).
+    pub fn release_columns(&mut self) {
+        self.columns = HashMap::new();
+    }
+
     /// Keeps the cached columns of `keep` only (memory bound between steps).
     pub fn retain_columns(&mut self, keep: &[u32]) {
         self.columns.retain(|k, _| keep.binary_search(k).is_ok());

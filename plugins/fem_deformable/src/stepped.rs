@@ -12,10 +12,17 @@
 //! step (the history's columns, each body's computed once); the contacts'
 //! impulses, u_free and targets come with their parts' results, from the rank that
 //! solved them ([`crate::nodes::FeContacts::pack_results`]). A body not stepped
-//! here has no G (its contacts' W_αα and parts are never used here).
+//! here keeps no new G (its contacts' W_αα and parts are never used here), and
+//! once it has gone [`RELEASE_AFTER`] steps unstepped here its columns of M̂⁻¹
+//! are dropped (memory per rank; stepped again, it solves them anew, the same
+//! numbers).
 
 use crate::body::FeBody;
 use nscdd::dd::SolvedOn;
+
+/// Steps a body goes unstepped on a rank before the rank drops its columns of M̂⁻¹
+/// (a body stepped on alternate steps keeps them).
+pub const RELEASE_AFTER: u32 = 10;
 
 /// Which bodies this rank steps in the step in progress (module docs).
 #[derive(Default)]
@@ -34,6 +41,10 @@ pub struct Stepped {
     /// the step ([`FeBody::energies`] at u⁺, V⁺), as its sender computed them.
     energy: Vec<[f64; 3]>,
     energy_known: bool,
+    /// Per body, in part: the steps since this rank last stepped it.
+    idle: Vec<u32>,
+    /// The bodies that have just reached [`RELEASE_AFTER`] idle steps.
+    release: Vec<u32>,
 }
 
 impl Stepped {
@@ -61,6 +72,7 @@ impl Stepped {
         self.held = false;
         self.energy_known = false;
         self.ht = ht;
+        self.release.clear();
         let Some(on) = on else {
             self.on = None;
             return false;
@@ -84,7 +96,21 @@ impl Stepped {
                 *m = *s == on.rank;
             }
         }
+        self.idle.resize(n, 0);
+        self.release.clear();
+        for (b, (i, &m)) in self.idle.iter_mut().zip(&self.mine).enumerate() {
+            *i = if m { 0 } else { i.saturating_add(1) };
+            if *i == RELEASE_AFTER {
+                self.release.push(b as u32);
+            }
+        }
         true
+    }
+
+    /// The bodies whose columns of M̂⁻¹ this rank may drop now (after
+    /// [`Self::decide`]: [`RELEASE_AFTER`] steps unstepped here).
+    pub fn to_release(&self) -> &[u32] {
+        &self.release
     }
 
     /// Which bodies this rank steps (`None`: all of them).

@@ -52,4 +52,14 @@ fn g_is_kept_while_the_nodes_and_the_factor_stay() {
     // and a set without G is filled again
     fill_set(&mut set, body, &nodes, 1.0);
     assert_eq!(set.g, fresh.g);
+    // columns dropped (a body a rank no longer steps) are solved again, the same
+    // numbers, when the nodes change
+    let more = [0u32, 3, 7, 20, 31];
+    let mut before = NodeSet::<2>::default();
+    fill_set(&mut before, body, &more, 1.0);
+    body.release_columns();
+    assert_eq!(body.cached_columns(), 0);
+    fill_set(&mut set, body, &more, 1.0);
+    assert_eq!(set.g, before.g);
+    assert_eq!(body.cached_columns(), more.len());
 }
