@@ -52,6 +52,17 @@ fn g_is_kept_while_the_nodes_and_the_factor_stay() {
     // and a set without G is filled again
     fill_set(&mut set, body, &nodes, 1.0);
     assert_eq!(set.g, fresh.g);
+    // some nodes changed: the old nodes' blocks copied, the new ones' read, the
+    // same numbers as a fresh fill
+    for next in [&[0u32, 7, 9, 20, 44][..], &[1, 2], &[0, 1, 2, 7, 9, 20, 44], &[]] {
+        fill_set(&mut set, body, next, 1.0);
+        let mut f = NodeSet::<2>::default();
+        fill_set(&mut f, body, next, 1.0);
+        assert_eq!(set.g, f.g, "{next:?}");
+        assert_eq!(set.nodes, next);
+    }
+    fill_set(&mut set, body, &nodes, 1.0);
+    assert_eq!(set.g, fresh.g);
     // columns dropped (a body a rank no longer steps) are solved again, the same
     // numbers, when the nodes change
     let more = [0u32, 3, 7, 20, 31];
