@@ -35,13 +35,36 @@ impl<const D: usize> FeSide<D> {
 /// Nodes of one body in contact, their current velocities and G
 /// (`g[(D k + c) · D n + D l + d]` = entry (c, d) of the block G_kl), scaled by the
 /// multiplicity of a copy when the body is shared by subdomains.
-#[derive(Clone, Debug, Default)]
+#[derive(Debug, Default)]
 pub struct NodeSet<const D: usize> {
     pub nodes: Vec<u32>,
     pub v: Vec<[f64; D]>,
     pub g: Vec<f64>,
-    /// The body's [`FeBody::generation`] and the scale `g` was filled with.
+    /// The nodes `g` holds the blocks of, and the body's [`FeBody::generation`] and
+    /// the scale it was filled with ([`fill_set`]).
+    g_nodes: Vec<u32>,
     g_of: (u64, f64),
+    /// Whether `g_nodes` are `nodes` (else `g` is kept for a later [`fill_set`]
+    /// only, and the blocks read as 0).
+    g_current: bool,
+    /// The last G's storage, reused by [`fill_set`].
+    spare: Vec<f64>,
+}
+
+impl<const D: usize> Clone for NodeSet<D> {
+    /// The nodes, velocities and current G (a part's copy).
+    fn clone(&self) -> Self {
+        let g = if self.g_current { self.g.clone() } else { Vec::new() };
+        NodeSet {
+            nodes: self.nodes.clone(),
+            v: self.v.clone(),
+            g_nodes: if self.g_current { self.g_nodes.clone() } else { Vec::new() },
+            g,
+            g_of: self.g_of,
+            g_current: self.g_current,
+            spare: Vec::new(),
+        }
+    }
 }
 
 impl<const D: usize> NodeSet<D> {
@@ -110,7 +133,7 @@ impl<const D: usize> NodeSet<D> {
     /// (a body not stepped on this rank, [`fill_nodes`]).
     pub fn cross_block(&self, a: &FeSide<D>, b: &FeSide<D>) -> [[f64; D]; D] {
         let mut g = [[0.0; D]; D];
-        if self.g.is_empty() {
+        if !self.g_current {
             return g;
         }
         for p in 0..D {
@@ -143,50 +166,87 @@ impl<const D: usize> NodeSet<D> {
 }
 
 /// Fills a node set: velocities from the free velocity, G from M̂⁻¹ columns
-/// (scaled by `scale`). G is kept when the set had the same nodes, built from the
-/// same M̂⁻¹ ([`FeBody::generation`]) and scale: it is then these very numbers (a
-/// body whose contact nodes stay put costs no G a step).
+/// (scaled by `scale`). The blocks between two nodes of the set's last G (built
+/// from the same M̂⁻¹, [`FeBody::generation`], and scale) are copied from it:
+/// they are these very numbers. Only the blocks of a new node are read from the
+/// columns (a read per entry, scattered over columns of the whole mesh), so a
+/// body whose contact nodes stay put costs no G a step.
 pub fn fill_set<const D: usize>(set: &mut NodeSet<D>, body: &mut FeBody, nodes: &[u32], scale: f64) {
     debug_assert_eq!(body.dim(), D);
     set.v.clear();
     set.v
         .extend(nodes.iter().map(|&k| std::array::from_fn(|c| body.v_free[D * k as usize + c])));
-    let n = nodes.len();
-    let kept = set.nodes == nodes && set.g.len() == D * D * n * n && set.g_of == (body.generation(), scale);
-    if kept && n > 0 {
+    if set.nodes != nodes {
+        set.nodes.clear();
+        set.nodes.extend_from_slice(nodes);
+    }
+    let (n, m) = (nodes.len(), set.g_nodes.len());
+    let valid = set.g_of == (body.generation(), scale) && set.g.len() == D * D * m * m;
+    set.g_current = true;
+    if valid && set.g_nodes == nodes {
         return;
     }
     body.ensure_columns(nodes);
     let nd = body.n_dofs();
-    set.nodes.clear();
-    set.nodes.extend_from_slice(nodes);
-    set.g_of = (body.generation(), scale);
+    // each node's index in the last G (u32::MAX: new, or nothing kept)
+    let was = if valid { old_index(&set.g_nodes, nodes) } else { vec![u32::MAX; n] };
+    std::mem::swap(&mut set.g, &mut set.spare);
+    let old = &set.spare;
     set.g.clear();
     set.g.resize(D * D * n * n, 0.0);
+    for (k, &ko) in was.iter().enumerate().filter(|x| *x.1 != u32::MAX) {
+        for c in 0..D {
+            let (row, row_old) = ((D * k + c) * D * n, (D * ko as usize + c) * D * m);
+            for (l, &lo) in was.iter().enumerate().filter(|x| *x.1 != u32::MAX) {
+                let (a, b) = (row + D * l, row_old + D * lo as usize);
+                set.g[a..a + D].copy_from_slice(&old[b..b + D]);
+            }
+        }
+    }
+    // G_kl (c, d) = scale · (column d of node l)[D n_k + c] where k or l is new
+    let fresh: Vec<usize> = (0..n).filter(|&k| was[k] == u32::MAX).collect();
+    let all: Vec<usize> = (0..n).collect();
     for (l, &nl) in nodes.iter().enumerate() {
         let col = body.column(nl);
+        let rows = if was[l] == u32::MAX { &all } else { &fresh };
         for d in 0..D {
             let cd = &col[d * nd..(d + 1) * nd];
-            for (k, &nk) in nodes.iter().enumerate() {
+            for &k in rows {
                 for c in 0..D {
-                    set.g[(D * k + c) * D * n + D * l + d] = scale * cd[D * nk as usize + c];
+                    set.g[(D * k + c) * D * n + D * l + d] = scale * cd[D * nodes[k] as usize + c];
                 }
             }
         }
     }
+    set.g_nodes.clear();
+    set.g_nodes.extend_from_slice(nodes);
+    set.g_of = (body.generation(), scale);
+}
+
+/// For each node of `new` (sorted), its index in `old` (sorted), or u32::MAX.
+fn old_index(old: &[u32], new: &[u32]) -> Vec<u32> {
+    let mut out = Vec::with_capacity(new.len());
+    let mut i = 0;
+    for &x in new {
+        while i < old.len() && old[i] < x {
+            i += 1;
+        }
+        out.push(if old.get(i) == Some(&x) { i as u32 } else { u32::MAX });
+    }
+    out
 }
 
 /// A node set of a body this rank does not step ([`crate::stepped`]): its nodes,
-/// with zero velocities; G is kept if the nodes are the same (for
-/// [`fill_set`], when the body is stepped again), else dropped (its blocks then
-/// read as 0, [`NodeSet::cross_block`]). Either way its contacts' W_αα are never
-/// used here: their parts are not prepared nor swept on this rank.
+/// with zero velocities; its G is kept for a later [`fill_set`] (when the body is
+/// stepped here again) but reads as 0 unless it holds these very nodes
+/// ([`NodeSet::cross_block`]). Either way its contacts' W_αα are never used here:
+/// their parts are not prepared nor swept on this rank.
 pub fn fill_nodes<const D: usize>(set: &mut NodeSet<D>, nodes: &[u32]) {
     if set.nodes != nodes {
         set.nodes.clear();
         set.nodes.extend_from_slice(nodes);
-        set.g.clear();
     }
+    set.g_current = set.g_nodes == set.nodes && !set.g.is_empty();
     set.v.clear();
     set.v.resize(nodes.len(), [0.0; D]);
 }

@@ -43,13 +43,17 @@ fn g_is_kept_while_the_nodes_and_the_factor_stay() {
     fill_set(&mut fresh, body, &nodes, 1.0);
     assert_eq!(set.g, fresh.g);
     assert_ne!(set.g, g1);
-    // a body not stepped here: G kept for the same nodes, dropped for others
+    // a body not stepped here: G current for the same nodes, kept aside (reading as
+    // 0, not copied into parts) for others
     fill_nodes(&mut set, &nodes);
     assert_eq!(set.g, fresh.g);
     assert!(set.v.iter().all(|v| *v == [0.0; 2]));
+    let side = nscdd_fem_deformable::nodes::FeSide::<2>::node(0, 0);
+    assert_ne!(set.side_block(&side), [[0.0; 2]; 2]);
     fill_nodes(&mut set, &nodes[..3]);
-    assert!(set.g.is_empty());
-    // and a set without G is filled again
+    assert_eq!(set.side_block(&side), [[0.0; 2]; 2]);
+    assert!(set.clone().g.is_empty());
+    // and stepped again, its G is that of a fresh fill
     fill_set(&mut set, body, &nodes, 1.0);
     assert_eq!(set.g, fresh.g);
     // some nodes changed: the old nodes' blocks copied, the new ones' read, the
