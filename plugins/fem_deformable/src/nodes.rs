@@ -129,8 +129,8 @@ impl<const D: usize> NodeSet<D> {
         self.cross_block(s, s)
     }
     /// Σ_kl w_k w'_l G_kl of two sides `a`, `b` of this body (global frame): their
-    /// coupling through M̂⁻¹ (`a = b`: [`Self::side_block`]); 0 for a set without G
-    /// (a body not stepped on this rank, [`fill_nodes`]).
+    /// coupling through M̂⁻¹ (`a = b`: [`Self::side_block`]); 0 unless the set's G
+    /// holds its current nodes (a body not stepped on this rank, [`fill_nodes`]).
     pub fn cross_block(&self, a: &FeSide<D>, b: &FeSide<D>) -> [[f64; D]; D] {
         let mut g = [[0.0; D]; D];
         if !self.g_current {

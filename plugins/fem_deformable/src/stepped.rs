@@ -12,7 +12,7 @@
 //! step (the history's columns, each body's computed once); the contacts'
 //! impulses, u_free and targets come with their parts' results, from the rank that
 //! solved them ([`crate::nodes::FeContacts::pack_results`]). A body not stepped
-//! here keeps no new G (its contacts' W_αα and parts are never used here), and
+//! here builds no G (its contacts' W_αα and parts are never used here), and
 //! once it has gone [`RELEASE_AFTER`] steps unstepped here its columns of M̂⁻¹
 //! are dropped (memory per rank; stepped again, it solves them anew, the same
 //! numbers).
