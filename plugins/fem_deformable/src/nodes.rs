@@ -47,8 +47,6 @@ pub struct NodeSet<const D: usize> {
     /// Whether `g_nodes` are `nodes` (else `g` is kept for a later [`fill_set`]
     /// only, and the blocks read as 0).
     g_current: bool,
-    /// The last G's storage, reused by [`fill_set`].
-    spare: Vec<f64>,
 }
 
 impl<const D: usize> Clone for NodeSet<D> {
@@ -62,12 +60,19 @@ impl<const D: usize> Clone for NodeSet<D> {
             g,
             g_of: self.g_of,
             g_current: self.g_current,
-            spare: Vec::new(),
         }
     }
 }
 
 impl<const D: usize> NodeSet<D> {
+    /// Drops G (a body this MPI rank no longer steps,
+    /// [`crate::stepped::RELEASE_AFTER`]); the next [`fill_set`] reads every block
+    /// from the columns.
+    pub fn release_g(&mut self) {
+        self.g = Vec::new();
+        self.g_nodes.clear();
+        self.g_current = false;
+    }
     pub fn len(&self) -> usize {
         self.nodes.len()
     }
@@ -190,9 +195,7 @@ pub fn fill_set<const D: usize>(set: &mut NodeSet<D>, body: &mut FeBody, nodes: 
     let nd = body.n_dofs();
     // each node's index in the last G (u32::MAX: new, or nothing kept)
     let was = if valid { old_index(&set.g_nodes, nodes) } else { vec![u32::MAX; n] };
-    std::mem::swap(&mut set.g, &mut set.spare);
-    let old = &set.spare;
-    set.g.clear();
+    let old = std::mem::take(&mut set.g);
     set.g.resize(D * D * n * n, 0.0);
     for (k, &ko) in was.iter().enumerate().filter(|x| *x.1 != u32::MAX) {
         for c in 0..D {

@@ -14,14 +14,14 @@
 //! solved them ([`crate::nodes::FeContacts::pack_results`]). A body not stepped
 //! here builds no G (its contacts' W_αα and parts are never used here), and
 //! once it has gone [`RELEASE_AFTER`] steps unstepped here its columns of M̂⁻¹
-//! are dropped (memory per rank; stepped again, it solves them anew, the same
-//! numbers).
+//! and its G are dropped (memory per rank; stepped again, it solves them anew,
+//! the same numbers).
 
 use crate::body::FeBody;
 use nscdd::dd::SolvedOn;
 
 /// Steps a body goes unstepped on a rank before the rank drops its columns of M̂⁻¹
-/// (a body stepped on alternate steps keeps them).
+/// and its G (a body stepped on alternate steps keeps them).
 pub const RELEASE_AFTER: u32 = 10;
 
 /// Which bodies this rank steps in the step in progress (module docs).

@@ -77,4 +77,10 @@ fn g_is_kept_while_the_nodes_and_the_factor_stay() {
     fill_set(&mut set, body, &more, 1.0);
     assert_eq!(set.g, before.g);
     assert_eq!(body.cached_columns(), more.len());
+    // and with its G dropped too
+    body.release_columns();
+    set.release_g();
+    assert_eq!(set.side_block(&side), [[0.0; 2]; 2]);
+    fill_set(&mut set, body, &nodes, 1.0);
+    assert_eq!(set.g, fresh.g);
 }
