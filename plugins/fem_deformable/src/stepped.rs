@@ -171,3 +171,43 @@ impl Stepped {
         self.energy_known.then_some(&self.energy[..])
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two bodies on 2 ranks: body 0's contact is solved on rank 1, body 1's on
+    /// rank 0; seen from rank 0.
+    fn decide(s: &mut Stepped, rank_of_0: u32) -> bool {
+        let rank_of = |a: usize| if a == 0 { rank_of_0 } else { 0 };
+        let on = SolvedOn {
+            rank: 0,
+            ranks: 2,
+            rank_of: &rank_of,
+        };
+        s.decide(2, Some(&on), [(0, None), (1, None)].into_iter(), (1e-3, 0.5))
+    }
+
+    #[test]
+    fn a_body_unstepped_here_is_released_once_after_release_after_steps() {
+        let mut s = Stepped::default();
+        for step in 1..=RELEASE_AFTER + 3 {
+            assert!(decide(&mut s, 1));
+            assert!(!s.steps(0) && s.steps(1));
+            let expect: &[u32] = if step == RELEASE_AFTER { &[0] } else { &[] };
+            assert_eq!(s.to_release(), expect, "step {step}");
+        }
+        // stepped here again: the count starts over
+        assert!(decide(&mut s, 0));
+        assert!(s.steps(0) && s.to_release().is_empty());
+        for _ in 1..RELEASE_AFTER {
+            decide(&mut s, 1);
+            assert!(s.to_release().is_empty());
+        }
+        decide(&mut s, 1);
+        assert_eq!(s.to_release(), &[0]);
+        // one process: nothing stepped in part, nothing released
+        assert!(!s.decide(2, None, std::iter::empty(), (1e-3, 0.5)));
+        assert!(s.to_release().is_empty() && s.energies().is_none());
+    }
+}
