@@ -97,7 +97,6 @@ impl Stepped {
             }
         }
         self.idle.resize(n, 0);
-        self.release.clear();
         for (b, (i, &m)) in self.idle.iter_mut().zip(&self.mine).enumerate() {
             *i = if m { 0 } else { i.saturating_add(1) };
             if *i == RELEASE_AFTER {
@@ -107,7 +106,7 @@ impl Stepped {
         true
     }
 
-    /// The bodies whose columns of M̂⁻¹ this rank may drop now (after
+    /// The bodies whose columns of M̂⁻¹ and G this rank may drop now (after
     /// [`Self::decide`]: [`RELEASE_AFTER`] steps unstepped here).
     pub fn to_release(&self) -> &[u32] {
         &self.release
