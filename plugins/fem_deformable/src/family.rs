@@ -321,6 +321,21 @@ pub fn of<D: Dim, S: 'static>(families: &[Box<dyn SceneFamily<D>>]) -> Option<&S
     families.iter().find_map(|f| f.as_any().downcast_ref::<S>())
 }
 
+/// The raw contacts' rigid antagonists (`slots`: the world's slots) renamed by
+/// global id, and their V_free by global id (sorted, once each) into `free`: on MPI
+/// ranks a repartition moves bodies between the world's slots before the contacts
+/// are built again ([`crate::stepped`]).
+pub(crate) fn rigid_by_global<'a, D: Dim>(w: &World<D>, slots: impl Iterator<Item = &'a mut u32>, free: &mut Vec<(u32, D::Twist)>) {
+    free.clear();
+    for j in slots {
+        let g = w.ids.global(*j);
+        free.push((g, w.bodies.vel[*j as usize]));
+        *j = g;
+    }
+    free.sort_unstable_by_key(|x| x.0);
+    free.dedup_by_key(|x| x.0);
+}
+
 /// The world's slot of rigid body `g` (a global id; on MPI ranks the world holds a
 /// part, every body a family touches among it: [`nscdd::dd::Attached::held_everywhere`]
 /// and [`nscdd::dd::Attached::reach`]).

@@ -122,10 +122,7 @@ impl Attached<Rigid2> for Deformables2 {
             (c.cand[a].body, anta)
         });
         let part = self.stepped.decide(self.bodies.len(), on, sides, (w.time.h, w.time.theta));
-        for &b in self.stepped.to_release() {
-            self.bodies[b as usize].release_columns();
-            self.sets[b as usize].release_g();
-        }
+        self.stepped.release(&mut self.bodies, &mut self.sets);
         // (M̂ is factored at load time for the scene's h and θ: nothing can fail here)
         if let Err(e) = self.free_step(w) {
             self.error = Some(e);

@@ -90,19 +90,11 @@ impl Deformables2 {
     pub fn detect_step(&mut self, w: &World2) {
         let t = Instant::now();
         detect(w, &self.bodies, self.alert, &mut self.raw);
-        // the rigid antagonists by global id: on MPI ranks a repartition moves
-        // bodies between the world's slots before the contacts are built again
-        // ([`crate::stepped`])
-        self.rigid_free.clear();
-        for rc in &mut self.raw {
-            if let RawAnta::Rigid(j) = &mut rc.anta {
-                let g = w.ids.global(*j);
-                self.rigid_free.push((g, w.bodies.vel[*j as usize]));
-                *j = g;
-            }
-        }
-        self.rigid_free.sort_unstable_by_key(|x| x.0);
-        self.rigid_free.dedup_by_key(|x| x.0);
+        let rigid = self.raw.iter_mut().filter_map(|rc| match &mut rc.anta {
+            RawAnta::Rigid(j) => Some(j),
+            _ => None,
+        });
+        crate::family::rigid_by_global(w, rigid, &mut self.rigid_free);
         self.times.detect = t.elapsed().as_secs_f64();
     }
 

@@ -18,6 +18,7 @@
 //! the same numbers).
 
 use crate::body::FeBody;
+use crate::nodes::NodeSet;
 use nscdd::dd::SolvedOn;
 
 /// Steps a body goes unstepped on a rank before the rank drops its columns of M̂⁻¹
@@ -110,6 +111,14 @@ impl Stepped {
     /// [`Self::decide`]: [`RELEASE_AFTER`] steps unstepped here).
     pub fn to_release(&self) -> &[u32] {
         &self.release
+    }
+
+    /// Drops the columns and G of [`Self::to_release`]'s bodies.
+    pub fn release<const D: usize>(&self, bodies: &mut [FeBody], sets: &mut [NodeSet<D>]) {
+        for &b in &self.release {
+            bodies[b as usize].release_columns();
+            sets[b as usize].release_g();
+        }
     }
 
     /// Which bodies this rank steps (`None`: all of them).
