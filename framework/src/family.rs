@@ -38,6 +38,11 @@ pub struct FamilyContext<'a, D: Dim> {
     /// The registry's memory limit (`--max-memory`; None: the machine's), for
     /// [`Self::check_memory`].
     pub max_memory: Option<f64>,
+    /// (this rank, ranks) when the scene is loaded for a run on several MPI ranks
+    /// (`None`: one process). A family may then hold less at load: what only the
+    /// ranks stepping one of its bodies need ([`Attached::solved_on`]) can be made
+    /// when a rank first steps it.
+    pub ranks: Option<(u32, u32)>,
 }
 
 impl<D: Dim> FamilyContext<'_, D> {

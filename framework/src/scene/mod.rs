@@ -94,6 +94,8 @@ pub(crate) struct Ctx<'a> {
     file: &'a str,
     /// The scene has sections of body families ([`crate::family`]).
     families: bool,
+    /// (this rank, ranks) of a run on several MPI ranks ([`crate::family::FamilyContext::ranks`]).
+    ranks: Option<(u32, u32)>,
 }
 
 impl Ctx<'_> {
@@ -198,6 +200,7 @@ pub fn load_plugins(text: &str, file: &str, mut load: impl FnMut(&std::path::Pat
         text,
         file,
         families: false,
+        ranks: None,
     };
     // a text that does not parse is reported by the scene's loader
     let Ok(t) = toml::from_str::<toml::Table>(text) else {
@@ -228,11 +231,18 @@ impl<D: SceneDim> Scene<D> {
     /// Loads a scene of dimension `D` from its text; `file` names it in messages
     /// (and its folder is where the files a body family's entries name are found).
     pub fn load_str(text: &str, file: &str, registry: &Registry) -> Result<Self, InputError> {
+        Self::load_str_on(text, file, registry, None)
+    }
+
+    /// [`Self::load_str`] for rank `on` = (this rank, ranks) of a run on several MPI
+    /// ranks ([`crate::family::FamilyContext::ranks`]).
+    pub(crate) fn load_str_on(text: &str, file: &str, registry: &Registry, on: Option<(u32, u32)>) -> Result<Self, InputError> {
         let mut sf: SceneFile<BodySpec<D>> = parse(text, file)?;
         let cx = Ctx {
             text,
             file,
             families: !sf.sections.is_empty(),
+            ranks: on,
         };
         dimension_is::<D>(&cx, &sf)?;
         let sections = std::mem::take(&mut sf.sections);
@@ -252,6 +262,7 @@ impl<D: SceneDim> Scene<D> {
                 world: &self.world,
                 dir: scene_dir(cx.file),
                 max_memory: registry.max_memory(),
+                ranks: cx.ranks,
             };
             let mut fam = kind.load(&entries, &fcx).map_err(|e| entry_error(cx, &name, e))?;
             fam.share_world(&mut self.world);
@@ -321,6 +332,7 @@ fn family_boxes<D: SceneDim>(
             world: &scene.world,
             dir: scene_dir(cx.file),
             max_memory: registry.max_memory(),
+            ranks: cx.ranks,
         };
         let state = saved.and_then(|m| m.get(name));
         match kind.load_boxes(&entries, &fcx, state).map_err(|e| entry_error(cx, name, e))? {

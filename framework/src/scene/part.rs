@@ -89,6 +89,7 @@ fn load_with<D: SceneDim>(text: &str, file: &str, registry: &Registry, part: Par
         text,
         file,
         families: !sf.sections.is_empty(),
+        ranks: None,
     };
     super::dimension_is::<D>(&cx, &sf)?;
     let sections = std::mem::take(&mut sf.sections);
@@ -103,6 +104,7 @@ fn survey<D: SceneDim>(text: &str, file: &str, registry: &Registry) -> Result<Op
         text,
         file,
         families: !sections.is_empty(),
+        ranks: None,
     };
     let Some(boxes) = super::family_boxes(&cx, &scene, &sections, registry, None)? else {
         return Ok(None);
@@ -161,7 +163,7 @@ pub fn load_on<D: SceneDim>(s: &mut Scene<D>, registry: &Registry, (ranks, me): 
         .filter(|c| ranks > 1 && c.dd.nx as u64 * c.dd.ny as u64 * c.dd.nz as u64 >= u64::from(ranks))
         .and_then(|c| crate::dd::first_part::provisional(&sv.centres, [c.dd.nx, c.dd.ny, c.dd.nz], ranks));
     let Some(first) = first else {
-        load_whole(s, registry, &sv, decomposition)?;
+        load_whole(s, registry, &sv, decomposition, (me, ranks))?;
         return Ok(false);
     };
     // (a margin on the alert distance: a body kept in excess leaves at the first step)
@@ -170,7 +172,7 @@ pub fn load_on<D: SceneDim>(s: &mut Scene<D>, registry: &Registry, (ranks, me): 
     let near = crate::dd::first_part::Halo::around(sv.boxes.clone(), D::N, alert);
     let everywhere = sv.everywhere.clone();
     let keep = move |g: u32, b: &[[f64; 3]; 2]| everywhere.binary_search(&g).is_ok() || halo.meets(b) || near.meets(b);
-    load_part(s, registry, &sv, Part::new(Box::new(keep), 1.0 / f64::from(ranks)))?;
+    load_part(s, registry, &sv, Part::new(Box::new(keep), 1.0 / f64::from(ranks)), (me, ranks))?;
     check_family_part(s, &sv.boxes, &sv.file)?;
     s.decomposition = decomposition;
     s.part = Some(first);
@@ -184,28 +186,30 @@ pub fn load_on<D: SceneDim>(s: &mut Scene<D>, registry: &Registry, (ranks, me): 
     Ok(true)
 }
 
-/// The surveyed scene loaded as `part` keeps it (a rank's part), its families
-/// loaded against that part.
-fn load_part<D: SceneDim>(s: &mut Scene<D>, registry: &Registry, sv: &Survey, part: Part) -> Result<(), InputError> {
+/// The surveyed scene loaded as `part` keeps it (rank `on` = (this rank, ranks)'s
+/// part), its families loaded against that part.
+fn load_part<D: SceneDim>(s: &mut Scene<D>, registry: &Registry, sv: &Survey, part: Part, on: (u32, u32)) -> Result<(), InputError> {
     let (scene, _, sections) = load_with::<D>(&sv.text, &sv.file, registry, part)?;
     *s = scene;
     let cx = Ctx {
         text: &sv.text,
         file: &sv.file,
         families: sv.families,
+        ranks: (on.1 > 1).then_some(on),
     };
     s.add_families(&cx, sections, registry)
 }
 
 /// The surveyed scene loaded whole (as [`super::load_any`] loads it), with the
-/// flags' `decomposition`.
+/// flags' `decomposition`, for rank `on` = (this rank, ranks).
 fn load_whole<D: SceneDim>(
     s: &mut Scene<D>,
     registry: &Registry,
     sv: &Survey,
     decomposition: Option<crate::dd::DdConfig>,
+    on: (u32, u32),
 ) -> Result<(), InputError> {
-    *s = Scene::<D>::load_str(&sv.text, &sv.file, registry)?;
+    *s = Scene::<D>::load_str_on(&sv.text, &sv.file, registry, (on.1 > 1).then_some(on))?;
     s.decomposition = decomposition;
     Ok(())
 }
@@ -256,7 +260,7 @@ pub fn restart_on<D: SceneDim>(
     });
     let decomposition = s.decomposition.take();
     let (Some(scanned), Some(boxes)) = (scanned, boxes) else {
-        load_whole(s, registry, &sv, decomposition)?;
+        load_whole(s, registry, &sv, decomposition, (me, ranks))?;
         // (a whole scene with families reads every contact, as before)
         return match sv.families {
             true => super::restart_scene_on(s, path, on),
@@ -266,7 +270,7 @@ pub fn restart_on<D: SceneDim>(
     let keep = scanned.keep;
     let near = crate::dd::first_part::Halo::around(boxes.clone(), D::N, s.world.alert * 1.01);
     let keep = move |g: u32, b: &[[f64; 3]; 2]| keep[g as usize] || near.meets(b);
-    load_part(s, registry, &sv, Part::new(Box::new(keep), 1.0 / f64::from(ranks)))?;
+    load_part(s, registry, &sv, Part::new(Box::new(keep), 1.0 / f64::from(ranks)), (me, ranks))?;
     s.decomposition = decomposition;
     let contacts = super::restart::restart_scene_with(s, path, rp)?;
     check_family_part(s, &boxes, &sv.file)?;
@@ -302,6 +306,7 @@ fn saved_boxes<D: SceneDim>(
         text: &sv.text,
         file: &sv.file,
         families: true,
+        ranks: None,
     };
     let Some(mut boxes) = super::family_boxes(&cx, s, &sv.sections, registry, Some(&saved))? else {
         return Ok(None);

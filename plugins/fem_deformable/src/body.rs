@@ -13,7 +13,9 @@
 //! θ = ½ conserves the energy ½ VᵀMV + ½ uᵀKu − u·F_ext of a free body; θ > ½
 //! dissipates it. M̂ is factored once (faer's supernodal Cholesky: the symbolic
 //! analysis once per body, a numeric refactorization only when h, θ or the
-//! material change). Degrees of freedom held fixed (Dirichlet, zero velocity) have
+//! material change; on MPI ranks only where the body is stepped: a rank drops the
+//! factors of a body it does not step, [`FeBody::release_factor`], and makes them
+//! again, the same numbers, when it steps it). Degrees of freedom held fixed (Dirichlet, zero velocity) have
 //! their rows and columns of M̂ replaced by the identity and a zero right-hand side.
 //!
 //! Contacts need columns of M̂⁻¹ at their nodes (the Delassus blocks and the NLGS
@@ -56,7 +58,10 @@ pub struct FeBody {
     pattern: SymbolicSparseColMat<usize>,
     m_val: Vec<f64>,
     k_val: Vec<f64>,
-    symbolic: SymbolicLlt<usize>,
+    /// The symbolic and numeric Cholesky factors of M̂ (`None` until first needed,
+    /// or dropped by [`Self::release_factor`]: rebuilt from the pattern, M and K
+    /// with the same bits).
+    symbolic: Option<SymbolicLlt<usize>>,
     factor: Option<Llt<usize, f64>>,
     /// (h, θ) the factor was computed for.
     factored_for: (f64, f64),
@@ -123,7 +128,6 @@ impl FeBody {
             col_ptr[c + 1] = rows.len();
         }
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows);
-        let symbolic = SymbolicLlt::try_new(pattern.as_ref(), Side::Lower).map_err(|e| format!("symbolic Cholesky failed: {e:?}"))?;
         let f_ext = vec![0.0; n];
         Ok(FeBody {
             name,
@@ -133,7 +137,7 @@ impl FeBody {
             pattern,
             m_val: mv,
             k_val: kv,
-            symbolic,
+            symbolic: None,
             factor: None,
             factored_for: (f64::NAN, f64::NAN),
             fixed: vec![false; n],
@@ -202,12 +206,21 @@ impl FeBody {
         self.generation += 1;
     }
 
-    /// Factors M̂ = (1 + hθα) M + (h²θ² + hθβ) K if (h, θ) changed (the symbolic
-    /// analysis is reused). Returns whether a numeric factorization was done.
+    /// Factors M̂ = (1 + hθα) M + (h²θ² + hθβ) K if (h, θ) changed or the factor
+    /// was released (the symbolic analysis is reused while kept). Returns whether a
+    /// numeric factorization was done.
     pub fn factorize(&mut self, h: f64, theta: f64) -> Result<bool, String> {
         if self.factor.is_some() && self.factored_for == (h, theta) {
             return Ok(false);
         }
+        let symbolic = match &self.symbolic {
+            Some(s) => s.clone(),
+            None => {
+                let s = SymbolicLlt::try_new(self.pattern.as_ref(), Side::Lower).map_err(|e| format!("symbolic Cholesky failed: {e:?}"))?;
+                self.symbolic = Some(s.clone());
+                s
+            }
+        };
         let [al, be] = self.elastic.rayleigh;
         let (a, b) = (1.0 + h * theta * al, h * h * theta * theta + h * theta * be);
         let cp = self.pattern.col_ptr();
@@ -228,7 +241,7 @@ impl FeBody {
             }
         }
         let mat = SparseColMat::new(self.pattern.clone(), val);
-        let llt = Llt::try_new_with_symbolic(self.symbolic.clone(), mat.as_ref(), Side::Lower)
+        let llt = Llt::try_new_with_symbolic(symbolic, mat.as_ref(), Side::Lower)
             .map_err(|e| format!("M̂ = M + h²θ²K is not positive definite ({e:?}): check E, ν, ρ and the mesh"))?;
         self.factor = Some(llt);
         self.factored_for = (h, theta);
@@ -342,6 +355,22 @@ impl FeBody {
     /// steps, [`crate::stepped`]).
     pub fn release_columns(&mut self) {
         self.columns = HashMap::new();
+    }
+
+    /// Drops the factors of M̂ and the cached columns (a body this MPI rank does not
+    /// step, [`crate::stepped`]); the next [`Self::factorize`] makes them again, the
+    /// same numbers (the symbolic analysis and the numeric factorization are
+    /// deterministic functions of the pattern, M, K, h, θ and the fixed dofs).
+    pub fn release_factor(&mut self) {
+        self.release_columns();
+        (self.factor, self.symbolic) = (None, None);
+        self.factored_for = (f64::NAN, f64::NAN);
+        self.generation += 1;
+    }
+
+    /// Whether M̂ is factored now.
+    pub fn is_factored(&self) -> bool {
+        self.factor.is_some()
     }
 
     /// Keeps the cached columns of `keep` only (memory bound between steps).

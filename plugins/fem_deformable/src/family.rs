@@ -30,15 +30,7 @@ pub struct DeformableKind;
 
 impl FamilyKind<D2> for DeformableKind {
     fn load(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D2>) -> Result<Box<dyn SceneFamily<D2>>, EntryError> {
-        let bodies = crate::scene::bodies_from(
-            entries,
-            cx.dir,
-            &cx.world.materials,
-            2,
-            &cx.world.gravity,
-            &cx.world.time,
-            &|b, w| cx.check_memory(b, w),
-        )?;
+        let bodies = crate::scene::bodies_from(entries, cx)?;
         crate::scene::refuse_compliant(&bodies, cx.world)?;
         Ok(Box::new(Deformables2::new(bodies, cx.world.alert)))
     }
@@ -54,15 +46,7 @@ impl FamilyKind<D2> for DeformableKind {
 
 impl FamilyKind<D3> for DeformableKind {
     fn load(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D3>) -> Result<Box<dyn SceneFamily<D3>>, EntryError> {
-        let bodies = crate::scene::bodies_from(
-            entries,
-            cx.dir,
-            &cx.world.materials,
-            3,
-            &cx.world.gravity,
-            &cx.world.time,
-            &|b, w| cx.check_memory(b, w),
-        )?;
+        let bodies = crate::scene::bodies_from(entries, cx)?;
         crate::scene::refuse_compliant(&bodies, cx.world)?;
         Ok(Box::new(Deformables3::new(bodies, cx.world.alert)))
     }

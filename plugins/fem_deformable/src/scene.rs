@@ -37,7 +37,7 @@ use nscdd::family::{EntryError, SceneFamily};
 use nscdd::registry::Registry;
 use nscdd::scene::schema::SceneDim;
 use nscdd::scene::{OutputSettings, Scene};
-use nscdd::world::{Material, TimeSettings, World};
+use nscdd::world::{Material, World};
 use serde::Deserialize;
 use std::path::Path;
 
@@ -156,16 +156,16 @@ pub fn spec_of(i: usize, e: &toml::Table) -> Result<DeformableSpec, EntryError> 
 }
 
 /// Builds the deformable bodies of a scene's `[[deformable]]` entries, factored
-/// for the scene's h and θ; mesh files are relative to `dir`.
-pub fn bodies_from(
+/// for the scene's h and θ (mesh files are relative to the scene's folder). Loaded
+/// for a run on several MPI ranks (`cx.ranks`), each body's factorization is
+/// checked and then dropped: a rank makes it again when it first steps the body
+/// ([`crate::stepped`]), so that no rank holds the factors of every body.
+pub fn bodies_from<D: nscdd::dim::Dim>(
     entries: &[toml::Table],
-    dir: &Path,
-    materials: &[Material],
-    dim: usize,
-    gravity: &[f64],
-    time: &TimeSettings,
-    memory: &dyn Fn(f64, &str) -> Result<(), String>,
+    cx: &nscdd::family::FamilyContext<'_, D>,
 ) -> Result<Vec<FeBody>, EntryError> {
+    let (dir, dim, time) = (cx.dir, D::N, &cx.world.time);
+    let materials = &cx.world.materials;
     let mut bodies = Vec::new();
     // bytes of the bodies before entry i
     let mut held = 0.0;
@@ -178,11 +178,14 @@ pub fn bodies_from(
                 0 => format!("a deformable body of about {nodes:.0} nodes"),
                 _ => format!("{} deformable bodies, the last of about {nodes:.0} nodes", i + 1),
             };
-            memory(held + bytes, &what).map(|()| held += bytes)
+            cx.check_memory(held + bytes, &what).map(|()| held += bytes)
         };
         let mut b = build(&spec, materials, dim, dir, &mut check).map_err(|(k, m)| at(k, m))?;
-        b.set_gravity(gravity);
+        b.set_gravity(&cx.world.gravity.as_ref()[..dim]);
         b.factorize(time.h, time.theta).map_err(|m| at("", m))?;
+        if cx.ranks.is_some() {
+            b.release_factor();
+        }
         bodies.push(b);
     }
     Ok(bodies)

@@ -317,12 +317,15 @@ impl Deformables2 {
     }
 }
 
-/// Factors M̂ of every body if h or θ changed, then the free velocity of those
-/// `stepped` (`None`: all; the others keep V⁻ only); the times of both stages.
+/// Factors M̂ of the bodies `stepped` (`None`: all) if h or θ changed or their
+/// factors were released, then their free velocity (the others keep V⁻ only); the
+/// times of both stages.
 pub fn free_velocities(bodies: &mut [FeBody], h: f64, theta: f64, stepped: Option<&[bool]>) -> Result<FeTimes, String> {
     let t0 = Instant::now();
-    for b in bodies.iter_mut() {
-        b.factorize(h, theta)?;
+    for (bi, b) in bodies.iter_mut().enumerate() {
+        if stepped.is_none_or(|m| m[bi]) {
+            b.factorize(h, theta)?;
+        }
     }
     let t1 = Instant::now();
     for (bi, b) in bodies.iter_mut().enumerate() {

@@ -13,16 +13,17 @@
 //! impulses, u_free and targets come with their parts' results, from the rank that
 //! solved them ([`crate::nodes::FeContacts::pack_results`]). A body not stepped
 //! here builds no G (its contacts' W_αα and parts are never used here), and
-//! once it has gone [`RELEASE_AFTER`] steps unstepped here its columns of M̂⁻¹
-//! and its G are dropped (memory per rank; stepped again, it solves them anew,
-//! the same numbers).
+//! once it has gone [`RELEASE_AFTER`] steps unstepped here the factors of its M̂,
+//! its columns of M̂⁻¹ and its G are dropped (memory per rank; stepped again, it
+//! factors and solves them anew, the same numbers). Loaded on ranks, a body
+//! holds no factor until a rank steps it ([`crate::scene::bodies_from`]).
 
 use crate::body::FeBody;
 use crate::nodes::NodeSet;
 use nscdd::dd::SolvedOn;
 
-/// Steps a body goes unstepped on a rank before the rank drops its columns of M̂⁻¹
-/// and its G (a body stepped on alternate steps keeps them).
+/// Steps a body goes unstepped on a rank before the rank drops its factors of M̂,
+/// its columns of M̂⁻¹ and its G (a body stepped on alternate steps keeps them).
 pub const RELEASE_AFTER: u32 = 10;
 
 /// Which bodies this rank steps in the step in progress (module docs).
@@ -107,16 +108,16 @@ impl Stepped {
         true
     }
 
-    /// The bodies whose columns of M̂⁻¹ and G this rank may drop now (after
+    /// The bodies whose factors, columns of M̂⁻¹ and G this rank may drop now (after
     /// [`Self::decide`]: [`RELEASE_AFTER`] steps unstepped here).
     pub fn to_release(&self) -> &[u32] {
         &self.release
     }
 
-    /// Drops the columns and G of [`Self::to_release`]'s bodies.
+    /// Drops the factors of M̂, the columns and G of [`Self::to_release`]'s bodies.
     pub fn release<const D: usize>(&self, bodies: &mut [FeBody], sets: &mut [NodeSet<D>]) {
         for &b in &self.release {
-            bodies[b as usize].release_columns();
+            bodies[b as usize].release_factor();
             sets[b as usize].release_g();
         }
     }

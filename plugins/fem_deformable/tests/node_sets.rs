@@ -1,5 +1,6 @@
 //! A node set's G (the blocks of M̂⁻¹ among a body's contact nodes) is kept while
-//! its nodes and the body's M̂⁻¹ stay, and only then (`nodes::fill_set`).
+//! its nodes and the body's M̂⁻¹ stay, and only then (`nodes::fill_set`); a body's
+//! factors dropped (on MPI ranks) are made again with the same numbers.
 mod common;
 use common::*;
 use nscdd_fem_deformable::nodes::{fill_nodes, fill_set, NodeSet};
@@ -83,4 +84,63 @@ fn g_is_kept_while_the_nodes_and_the_factor_stay() {
     assert_eq!(set.side_block(&side), [[0.0; 2]; 2]);
     fill_set(&mut set, body, &nodes, 1.0);
     assert_eq!(set.g, fresh.g);
+}
+
+/// A body whose factors a rank dropped ([`FeBody::release_factor`], a body it does
+/// not step) factors M̂ again when stepped: the same columns, G and free velocity,
+/// bit for bit.
+#[test]
+fn a_released_factor_is_made_again_with_the_same_numbers() {
+    let mut s = scene(SCENE);
+    let body = &mut s.fe.bodies[0];
+    let nodes = [0u32, 3, 7, 20, 31];
+    let (h, theta) = (1e-3, 0.5);
+    body.u.iter_mut().enumerate().for_each(|(i, u)| *u = 1e-4 * (i as f64).sin());
+    body.v.iter_mut().enumerate().for_each(|(i, v)| *v = 1e-2 * (i as f64).cos());
+    let (u0, v0) = (body.u.clone(), body.v.clone());
+    let mut before = NodeSet::<2>::default();
+    fill_set(&mut before, body, &nodes, 1.0);
+    body.free_velocity(h, theta);
+    let v_free = body.v_free.clone();
+    body.release_factor();
+    assert!(!body.is_factored());
+    assert_eq!(body.cached_columns(), 0);
+    // what an unstepped body still does: its energies (M and K are kept)
+    let e = body.energies(&body.u, &body.v);
+    assert!(e[0] > 0.0 && e[1] > 0.0);
+    assert!(body.factorize(h, theta).unwrap());
+    assert!(body.is_factored());
+    let mut after = NodeSet::<2>::default();
+    fill_set(&mut after, body, &nodes, 1.0);
+    assert_eq!(after.g, before.g);
+    (body.u, body.v) = (u0, v0);
+    body.free_velocity(h, theta);
+    assert_eq!(body.v_free, v_free);
+    // the same (h, θ): no factorization
+    assert!(!body.factorize(h, theta).unwrap());
+}
+
+/// Loaded for a run on MPI ranks (`FamilyContext::ranks`), the bodies' factors are
+/// checked and dropped (a rank factors M̂ when it first steps a body); loaded for
+/// one process, they are kept.
+#[test]
+fn bodies_loaded_on_ranks_hold_no_factor() {
+    let s = scene(SCENE);
+    let t: toml::Table = toml::from_str(SCENE).unwrap();
+    let entries: Vec<toml::Table> = t["deformable"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e.as_table().unwrap().clone())
+        .collect();
+    for (ranks, factored) in [(None, true), (Some((1, 2)), false)] {
+        let cx = nscdd::family::FamilyContext {
+            world: &s.world,
+            dir: std::path::Path::new("."),
+            max_memory: None,
+            ranks,
+        };
+        let bodies = nscdd_fem_deformable::scene::bodies_from(&entries, &cx).unwrap();
+        assert_eq!(bodies[0].is_factored(), factored, "{ranks:?}");
+    }
 }
