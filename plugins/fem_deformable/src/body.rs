@@ -23,11 +23,12 @@
 //! first use and caches them while M̂ is unchanged (see docs/DEFORMABLE.md for the
 //! choice and its cost).
 
+use crate::matrices::Matrices;
 use crate::mesh::Mesh;
 use crate::python::Csr;
 use faer::prelude::*;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+use faer::sparse::SparseColMat;
 use faer::{Mat, Side};
 use std::collections::HashMap;
 
@@ -53,11 +54,14 @@ pub struct FeBody {
     pub elastic: Elastic,
     /// Index of the body's material among the scene's materials (for the laws).
     pub material: u16,
-    /// Pattern shared by M, K and M̂ (the union of M's and K's), CSC of a symmetric
-    /// matrix; values of M and K on it.
-    pattern: SymbolicSparseColMat<usize>,
-    m_val: Vec<f64>,
-    k_val: Vec<f64>,
+    /// M and K ([`Matrices`]; `None` on an MPI rank that does not step the body:
+    /// [`Self::ensure_matrices`] assembles them again, the same numbers).
+    mats: Option<Matrices>,
+    /// Whether [`Self::release_matrices`] may drop M, K and F_ext (a body whose M,
+    /// K and F_ext are made from its mesh, material and gravity alone).
+    releasable: bool,
+    /// The acceleration of gravity F_ext = M g is made of.
+    gravity: Vec<f64>,
     /// The symbolic and numeric Cholesky factors of M̂ (`None` until first needed,
     /// or dropped by [`Self::release_factor`]: rebuilt from the pattern, M and K
     /// with the same bits).
@@ -73,7 +77,7 @@ pub struct FeBody {
     pub v: Vec<f64>,
     pub v_begin: Vec<f64>,
     pub v_free: Vec<f64>,
-    /// External load per dof (gravity: M g).
+    /// External load per dof (gravity: M g; empty while M is not held).
     pub f_ext: Vec<f64>,
     /// A force of the step beside F_ext (empty: none): a continuum's plastic strains'
     /// share f_p of the internal force K u − f_p ([`crate::continuum::plastic`]).
@@ -103,40 +107,25 @@ impl FeBody {
         if m.n != n || k.n != n {
             return Err(format!("assembled matrices of size {}, {} for {} dofs", m.n, k.n, n));
         }
-        // union pattern, column by column (the matrices are symmetric: CSR = CSC)
-        let mut col_ptr = vec![0usize; n + 1];
-        let mut rows = Vec::with_capacity(m.indices.len().max(k.indices.len()));
-        let (mut mv, mut kv) = (Vec::new(), Vec::new());
-        for c in 0..n {
-            let (ma, mb) = (m.indptr[c], m.indptr[c + 1]);
-            let (ka, kb) = (k.indptr[c], k.indptr[c + 1]);
-            let (mut i, mut j) = (ma, ka);
-            while i < mb || j < kb {
-                let ri = if i < mb { m.indices[i] } else { usize::MAX };
-                let rj = if j < kb { k.indices[j] } else { usize::MAX };
-                let r = ri.min(rj);
-                rows.push(r);
-                mv.push(if ri == r { m.data[i] } else { 0.0 });
-                kv.push(if rj == r { k.data[j] } else { 0.0 });
-                if ri == r {
-                    i += 1;
-                }
-                if rj == r {
-                    j += 1;
-                }
-            }
-            col_ptr[c + 1] = rows.len();
-        }
-        let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows);
-        let f_ext = vec![0.0; n];
-        Ok(FeBody {
+        let mut b = FeBody::light(name, mesh, elastic, material);
+        b.mats = Some(Matrices::from_csr(m, k)?);
+        b.f_ext = vec![0.0; n];
+        b.skfem_version = skfem_version;
+        Ok(b)
+    }
+
+    /// A body without M and K (a body an MPI rank does not step): its mesh, material
+    /// and state; [`Self::ensure_matrices`] assembles them when it is stepped.
+    pub fn light(name: Option<String>, mesh: Mesh, elastic: Elastic, material: u16) -> FeBody {
+        let n = mesh.x0.len();
+        FeBody {
             name,
             mesh,
             elastic,
             material,
-            pattern,
-            m_val: mv,
-            k_val: kv,
+            mats: None,
+            releasable: false,
+            gravity: Vec::new(),
             symbolic: None,
             factor: None,
             factored_for: (f64::NAN, f64::NAN),
@@ -145,13 +134,56 @@ impl FeBody {
             v: vec![0.0; n],
             v_begin: vec![0.0; n],
             v_free: vec![0.0; n],
-            f_ext,
+            f_ext: Vec::new(),
             f_plastic: Vec::new(),
             columns: HashMap::new(),
             solves: 0,
             generation: 0,
-            skfem_version,
-        })
+            skfem_version: String::new(),
+        }
+    }
+
+    /// M and K, held ([`Self::ensure_matrices`] before any use).
+    fn mats(&self) -> &Matrices {
+        self.mats
+            .as_ref()
+            .expect("M and K are assembled before use (FeBody::ensure_matrices)")
+    }
+
+    /// Whether M and K are held now.
+    pub fn has_matrices(&self) -> bool {
+        self.mats.is_some()
+    }
+
+    /// Assembles M and K (and F_ext = M g) if they are not held (a body an MPI rank
+    /// starts to step): the same scikit-fem assembly of the same mesh and material
+    /// as at load, the same numbers. Returns whether it assembled.
+    pub fn ensure_matrices(&mut self) -> Result<bool, String> {
+        if self.mats.is_some() {
+            return Ok(false);
+        }
+        let (m, version) = crate::matrices::assemble(&self.mesh, &self.elastic)?;
+        self.f_ext = m.weight(self.dim(), &self.gravity);
+        self.mats = Some(m);
+        self.skfem_version = version;
+        Ok(true)
+    }
+
+    /// Lets [`Self::release_matrices`] drop M, K and F_ext (a body whose M and K
+    /// are its mesh's and material's unweighted assembly and F_ext = M g).
+    pub fn allow_release(&mut self) {
+        self.releasable = true;
+    }
+
+    /// Drops M, K, F_ext, the factors and the columns of a body
+    /// [`Self::allow_release`] was called for (else the factors and columns only):
+    /// a body this MPI rank does not step ([`crate::stepped`]).
+    pub fn release_matrices(&mut self) {
+        self.release_factor();
+        if self.releasable {
+            self.mats = None;
+            self.f_ext = Vec::new();
+        }
     }
 
     pub fn dim(&self) -> usize {
@@ -162,31 +194,20 @@ impl FeBody {
     }
     /// Nonzeros of M̂ (both triangles).
     pub fn nnz(&self) -> usize {
-        self.m_val.len()
+        self.mats().nnz()
     }
 
     /// y += a M x + b K x (M and K on the shared pattern).
     pub fn mul_add(&self, a: f64, b: f64, x: &[f64], y: &mut [f64]) {
-        let cp = self.pattern.col_ptr();
-        let ri = self.pattern.row_idx();
-        for c in 0..self.n_dofs() {
-            let xc = x[c];
-            if xc == 0.0 {
-                continue;
-            }
-            for p in cp[c]..cp[c + 1] {
-                y[ri[p]] += (a * self.m_val[p] + b * self.k_val[p]) * xc;
-            }
-        }
+        self.mats().mul_add(a, b, x, y);
     }
 
-    /// Loads of gravity: F_ext = M g.
+    /// Loads of gravity: F_ext = M g (made when M is, if it is not held now).
     pub fn set_gravity(&mut self, g: &[f64]) {
-        let (d, n) = (self.dim(), self.n_dofs());
-        let gv: Vec<f64> = (0..n).map(|i| g[i % d]).collect();
-        let mut f = vec![0.0; n];
-        self.mul_add(1.0, 0.0, &gv, &mut f);
-        self.f_ext = f;
+        self.gravity = g.to_vec();
+        if let Some(m) = &self.mats {
+            self.f_ext = m.weight(self.dim(), g);
+        }
     }
 
     /// Holds the given nodes fixed (all their components).
@@ -216,31 +237,21 @@ impl FeBody {
         let symbolic = match &self.symbolic {
             Some(s) => s.clone(),
             None => {
-                let s = SymbolicLlt::try_new(self.pattern.as_ref(), Side::Lower).map_err(|e| format!("symbolic Cholesky failed: {e:?}"))?;
+                let Some(mats) = &self.mats else {
+                    return Err("M and K are not assembled (FeBody::ensure_matrices)".into());
+                };
+                let s = SymbolicLlt::try_new(mats.pattern.as_ref(), Side::Lower).map_err(|e| format!("symbolic Cholesky failed: {e:?}"))?;
                 self.symbolic = Some(s.clone());
                 s
             }
         };
         let [al, be] = self.elastic.rayleigh;
         let (a, b) = (1.0 + h * theta * al, h * h * theta * theta + h * theta * be);
-        let cp = self.pattern.col_ptr();
-        let ri = self.pattern.row_idx();
-        let mut val = Vec::with_capacity(self.m_val.len());
-        for c in 0..self.n_dofs() {
-            for p in cp[c]..cp[c + 1] {
-                let r = ri[p];
-                val.push(if self.fixed[r] || self.fixed[c] {
-                    if r == c {
-                        1.0
-                    } else {
-                        0.0
-                    }
-                } else {
-                    a * self.m_val[p] + b * self.k_val[p]
-                });
-            }
-        }
-        let mat = SparseColMat::new(self.pattern.clone(), val);
+        let Some(mats) = &self.mats else {
+            return Err("M and K are not assembled (FeBody::ensure_matrices)".into());
+        };
+        let val = mats.m_hat(a, b, &self.fixed);
+        let mat = SparseColMat::new(mats.pattern.clone(), val);
         let llt = Llt::try_new_with_symbolic(symbolic, mat.as_ref(), Side::Lower)
             .map_err(|e| format!("M̂ = M + h²θ²K is not positive definite ({e:?}): check E, ν, ρ and the mesh"))?;
         self.factor = Some(llt);
@@ -395,6 +406,18 @@ impl FeBody {
         p
     }
 
+    /// [`Self::energies`] at the body's u and V; M and K assembled aside if they are
+    /// not held (the same numbers: a body an MPI rank does not step).
+    pub fn energies_now(&self) -> Result<[f64; 3], String> {
+        if self.mats.is_some() {
+            return Ok(self.energies(&self.u, &self.v));
+        }
+        let (m, _) = crate::matrices::assemble(&self.mesh, &self.elastic)?;
+        let f_ext = m.weight(self.dim(), &self.gravity);
+        let [ke, se] = m.energies(&self.u, &self.v);
+        Ok([ke, se, -dot(&self.u, &f_ext)])
+    }
+
     /// ½ VᵀMV.
     pub fn kinetic_energy(&self) -> f64 {
         self.energies(&self.u, &self.v)[0]
@@ -416,20 +439,8 @@ impl FeBody {
     /// pass over the pattern of M and K (stored whole: column c's sums times x_c),
     /// without allocation.
     pub fn energies(&self, u: &[f64], v: &[f64]) -> [f64; 3] {
-        let cp = self.pattern.col_ptr();
-        let ri = self.pattern.row_idx();
-        let (mut ke, mut se) = (0.0, 0.0);
-        for c in 0..self.n_dofs() {
-            let (mut mv, mut ku) = (0.0, 0.0);
-            for p in cp[c]..cp[c + 1] {
-                let r = ri[p];
-                mv += self.m_val[p] * v[r];
-                ku += self.k_val[p] * u[r];
-            }
-            ke += v[c] * mv;
-            se += u[c] * ku;
-        }
-        [0.5 * ke, 0.5 * se, -dot(u, &self.f_ext)]
+        let [ke, se] = self.mats().energies(u, v);
+        [ke, se, -dot(u, &self.f_ext)]
     }
     /// Total mass (Σ of M's entries of one component).
     pub fn mass(&self) -> f64 {

@@ -127,19 +127,28 @@ struct State {
     contacts: Vec<ContactState>,
 }
 
-fn save<C, A, F, B, const N: usize>(bodies: &[FeBody], c: &FeContacts<C, A, F, B, N>) -> serde_json::Value {
+/// The saved state; `known`: each body's energies after the step, as the rank
+/// stepping it computed them ([`crate::stepped::Stepped::energies`]; the same
+/// numbers as [`FeBody::energies_now`], which a body whose M and K are not held
+/// here assembles them aside for: NaN if that fails).
+fn save<C, A, F, B, const N: usize>(bodies: &[FeBody], c: &FeContacts<C, A, F, B, N>, known: Option<&[[f64; 3]]>) -> serde_json::Value {
+    let energies = |i: usize, b: &FeBody| known.map_or_else(|| b.energies_now().unwrap_or([f64::NAN; 3]), |k| k[i]);
     let state = State {
         bodies: bodies
             .iter()
-            .map(|b| BodyState {
-                name: b.name.clone(),
-                nodes: b.mesh.n_nodes(),
-                cells: b.mesh.n_cells(),
-                max_displacement: b.u.iter().fold(0.0f64, |m, x| m.max(x.abs())),
-                kinetic_energy: b.kinetic_energy(),
-                elastic_energy: b.elastic_energy(),
-                displacement: b.u.clone(),
-                velocity: b.v.clone(),
+            .enumerate()
+            .map(|(i, b)| {
+                let [kinetic_energy, elastic_energy, _] = energies(i, b);
+                BodyState {
+                    name: b.name.clone(),
+                    nodes: b.mesh.n_nodes(),
+                    cells: b.mesh.n_cells(),
+                    max_displacement: b.u.iter().fold(0.0f64, |m, x| m.max(x.abs())),
+                    kinetic_energy,
+                    elastic_energy,
+                    displacement: b.u.clone(),
+                    velocity: b.v.clone(),
+                }
             })
             .collect(),
         contacts: c
@@ -278,7 +287,7 @@ macro_rules! scene_family {
                 crate::output::write_pvd(dir, self.bodies.len(), &self.frames)
             }
             fn save_state(&self) -> serde_json::Value {
-                save(&self.bodies, &self.contacts)
+                save(&self.bodies, &self.contacts, self.stepped.energies())
             }
             fn load_state(&mut self, state: &serde_json::Value) -> Result<(), String> {
                 self.stepped = Default::default();

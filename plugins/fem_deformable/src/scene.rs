@@ -157,9 +157,13 @@ pub fn spec_of(i: usize, e: &toml::Table) -> Result<DeformableSpec, EntryError> 
 
 /// Builds the deformable bodies of a scene's `[[deformable]]` entries, factored
 /// for the scene's h and θ (mesh files are relative to the scene's folder). Loaded
-/// for a run on several MPI ranks (`cx.ranks`), each body's factorization is
-/// checked and then dropped: a rank makes it again when it first steps the body
-/// ([`crate::stepped`]), so that no rank holds the factors of every body.
+/// for a run on P MPI ranks (`cx.ranks`), rank r assembles and factors only the
+/// bodies i with ⌊i P / N⌋ = r (N bodies: a contiguous share, as the subdomains
+/// of a rank are), to check them; it holds every body's mesh and state, drops at
+/// the first step the matrices of the bodies it does not step, and assembles and
+/// factors a body (the same numbers) when it first steps it ([`crate::stepped`]):
+/// no rank holds, nor assembles at load, every body's matrices. A body's error
+/// is then reported by the rank that checks it.
 pub fn bodies_from<D: nscdd::dim::Dim>(
     entries: &[toml::Table],
     cx: &nscdd::family::FamilyContext<'_, D>,
@@ -172,19 +176,27 @@ pub fn bodies_from<D: nscdd::dim::Dim>(
     for (i, e) in entries.iter().enumerate() {
         let at = |key: &str, message: String| entry_error(i, key, message);
         let spec = spec_of(i, e)?;
+        // (on P ranks a body counts 1/P: a rank holds the matrices of the bodies it
+        // checks, then of those it steps, about 1/P of them)
+        let share = cx.ranks.map_or(1.0, |(_, p)| 1.0 / f64::from(p.max(1)));
         let mut check = |nodes: f64| {
-            let bytes = mesh_bytes(dim, nodes);
+            let bytes = share * mesh_bytes(dim, nodes);
             let what = match i {
                 0 => format!("a deformable body of about {nodes:.0} nodes"),
                 _ => format!("{} deformable bodies, the last of about {nodes:.0} nodes", i + 1),
             };
             cx.check_memory(held + bytes, &what).map(|()| held += bytes)
         };
-        let mut b = build(&spec, materials, dim, dir, &mut check).map_err(|(k, m)| at(k, m))?;
+        // (on ranks: checked by one rank, ⌊i P / N⌋)
+        let check_here = cx
+            .ranks
+            .is_none_or(|(me, p)| (i as u64 * u64::from(p)) / entries.len() as u64 == u64::from(me));
+        let assembly = if check_here { Assembly::Now } else { Assembly::Deferred };
+        let mut b = build_with(&spec, materials, dim, dir, &mut check, assembly).map_err(|(k, m)| at(k, m))?;
+        b.allow_release();
         b.set_gravity(&cx.world.gravity.as_ref()[..dim]);
-        b.factorize(time.h, time.theta).map_err(|m| at("", m))?;
-        if cx.ranks.is_some() {
-            b.release_factor();
+        if check_here {
+            b.factorize(time.h, time.theta).map_err(|m| at("", m))?;
         }
         bodies.push(b);
     }
@@ -249,22 +261,33 @@ pub fn build(
     dir: &Path,
     memory: &mut dyn FnMut(f64) -> Result<(), String>,
 ) -> Result<FeBody, (&'static str, String)> {
-    build_scaled(s, materials, dim, dir, memory, &|_| Ok(None))
+    build_with(s, materials, dim, dir, memory, Assembly::Now)
 }
 
 /// A cell-by-cell weight of M and K (None: 1 everywhere), from the mesh; an error
 /// names its key.
 pub type CellScale<'a> = &'a dyn Fn(&Mesh) -> Result<Option<Vec<f64>>, (&'static str, String)>;
 
-/// [`build`] with M and K weighted cell by cell by `scale` (a continuum region's
-/// share of its overlap band, [`crate::continuum`]).
-pub fn build_scaled(
+/// How [`build_with`] makes a body's M and K.
+pub enum Assembly<'a> {
+    /// Now, unweighted.
+    Now,
+    /// Now, weighted cell by cell by the scale (a continuum region's share of its
+    /// overlap band, [`crate::continuum`]).
+    Scaled(CellScale<'a>),
+    /// Not now: a body an MPI rank does not step yet ([`FeBody::light`];
+    /// [`FeBody::ensure_matrices`] assembles them, unweighted, when it is stepped).
+    Deferred,
+}
+
+/// [`build`] with M and K made as `assembly` says.
+pub fn build_with(
     s: &DeformableSpec,
     materials: &[Material],
     dim: usize,
     dir: &Path,
     memory: &mut dyn FnMut(f64) -> Result<(), String>,
-    scale: CellScale<'_>,
+    assembly: Assembly<'_>,
 ) -> Result<FeBody, (&'static str, String)> {
     let mat = materials
         .iter()
@@ -298,21 +321,25 @@ pub fn build_scaled(
         plane_stress,
         rayleigh: s.rayleigh,
     };
-    let weights = scale(&mesh)?;
-    let a = python::assemble_scaled(
-        &crate::python::RawMesh {
-            dim,
-            points: mesh.x0.clone(),
-            cells: mesh.cells.clone(),
-        },
-        el.young,
-        el.poisson,
-        el.density,
-        plane_stress,
-        weights.as_deref(),
-    )
-    .map_err(|e| ("mesh", e.0))?;
-    let mut body = FeBody::new(s.name.clone(), mesh, el, mat as u16, &a.m, &a.k, a.skfem_version).map_err(|m| ("mesh", m))?;
+    // (None: not now; Some(None): unweighted)
+    let weights = match assembly {
+        Assembly::Deferred => None,
+        Assembly::Now => Some(None),
+        Assembly::Scaled(scale) => Some(scale(&mesh)?),
+    };
+    let mut body = match weights {
+        None => FeBody::light(s.name.clone(), mesh, el, mat as u16),
+        Some(weights) => {
+            let raw = crate::python::RawMesh {
+                dim,
+                points: mesh.x0.clone(),
+                cells: mesh.cells.clone(),
+            };
+            let a = python::assemble_scaled(&raw, el.young, el.poisson, el.density, plane_stress, weights.as_deref())
+                .map_err(|e| ("mesh", e.0))?;
+            FeBody::new(s.name.clone(), mesh, el, mat as u16, &a.m, &a.k, a.skfem_version).map_err(|m| ("mesh", m))?
+        }
+    };
     let fix: Vec<u32> = fixed_nodes(&body.mesh, &s.fix).map_err(|m| ("fix", m))?;
     body.fix_nodes(&fix);
     match s.velocity.len() {

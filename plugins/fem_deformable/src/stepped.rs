@@ -15,8 +15,11 @@
 //! here builds no G (its contacts' W_αα and parts are never used here), and
 //! once it has gone [`RELEASE_AFTER`] steps unstepped here the factors of its M̂,
 //! its columns of M̂⁻¹ and its G are dropped (memory per rank; stepped again, it
-//! factors and solves them anew, the same numbers). Loaded on ranks, a body
-//! holds no factor until a rank steps it ([`crate::scene::bodies_from`]).
+//! factors and solves them anew, the same numbers). Loaded on ranks, a rank
+//! holds the matrices of the bodies it checked at load only
+//! ([`crate::scene::bodies_from`]), until the first step: a body it does not step
+//! then is dropped at once, and one it steps without holding them is assembled and
+//! factored there ([`crate::stage2::free_velocities`]).
 
 use crate::body::FeBody;
 use crate::nodes::NodeSet;
@@ -43,7 +46,8 @@ pub struct Stepped {
     /// the step ([`FeBody::energies`] at u⁺, V⁺), as its sender computed them.
     energy: Vec<[f64; 3]>,
     energy_known: bool,
-    /// Per body, in part: the steps since this rank last stepped it.
+    /// Per body, in part: the steps since this rank last stepped it (a body not
+    /// stepped here since the load counts RELEASE_AFTER − 1 at the first step).
     idle: Vec<u32>,
     /// The bodies that have just reached [`RELEASE_AFTER`] idle steps.
     release: Vec<u32>,
@@ -98,7 +102,7 @@ impl Stepped {
                 *m = *s == on.rank;
             }
         }
-        self.idle.resize(n, 0);
+        self.idle.resize(n, RELEASE_AFTER - 1);
         for (b, (i, &m)) in self.idle.iter_mut().zip(&self.mine).enumerate() {
             *i = if m { 0 } else { i.saturating_add(1) };
             if *i == RELEASE_AFTER {
@@ -114,10 +118,11 @@ impl Stepped {
         &self.release
     }
 
-    /// Drops the factors of M̂, the columns and G of [`Self::to_release`]'s bodies.
+    /// Drops M, K, the factors of M̂, the columns and G of [`Self::to_release`]'s
+    /// bodies.
     pub fn release<const D: usize>(&self, bodies: &mut [FeBody], sets: &mut [NodeSet<D>]) {
         for &b in &self.release {
-            bodies[b as usize].release_factor();
+            bodies[b as usize].release_matrices();
             sets[b as usize].release_g();
         }
     }
@@ -200,6 +205,14 @@ mod tests {
     #[test]
     fn a_body_unstepped_here_is_released_once_after_release_after_steps() {
         let mut s = Stepped::default();
+        // never stepped here since the load: released at the first step
+        for step in 1..=3 {
+            assert!(decide(&mut s, 1));
+            assert!(!s.steps(0) && s.steps(1));
+            let expect: &[u32] = if step == 1 { &[0] } else { &[] };
+            assert_eq!(s.to_release(), expect, "step {step}");
+        }
+        assert!(decide(&mut s, 0));
         for step in 1..=RELEASE_AFTER + 3 {
             assert!(decide(&mut s, 1));
             assert!(!s.steps(0) && s.steps(1));

@@ -120,11 +120,12 @@ fn a_released_factor_is_made_again_with_the_same_numbers() {
     assert!(!body.factorize(h, theta).unwrap());
 }
 
-/// Loaded for a run on MPI ranks (`FamilyContext::ranks`), the bodies' factors are
-/// checked and dropped (a rank factors M̂ when it first steps a body); loaded for
-/// one process, they are kept.
+/// Loaded for a run on MPI ranks (`FamilyContext::ranks`), a body is assembled and
+/// factored only by the rank checking it (⌊i P / N⌋); any other rank assembles and
+/// factors it, the same numbers, when it steps it. Loaded for one process, M, K and
+/// the factor are kept.
 #[test]
-fn bodies_loaded_on_ranks_hold_no_factor() {
+fn bodies_loaded_on_ranks_hold_no_matrices() {
     let s = scene(SCENE);
     let t: toml::Table = toml::from_str(SCENE).unwrap();
     let entries: Vec<toml::Table> = t["deformable"]
@@ -133,14 +134,40 @@ fn bodies_loaded_on_ranks_hold_no_factor() {
         .iter()
         .map(|e| e.as_table().unwrap().clone())
         .collect();
-    for (ranks, factored) in [(None, true), (Some((1, 2)), false)] {
+    let load = |ranks| {
         let cx = nscdd::family::FamilyContext {
             world: &s.world,
             dir: std::path::Path::new("."),
             max_memory: None,
             ranks,
         };
-        let bodies = nscdd_fem_deformable::scene::bodies_from(&entries, &cx).unwrap();
-        assert_eq!(bodies[0].is_factored(), factored, "{ranks:?}");
+        nscdd_fem_deformable::scene::bodies_from(&entries, &cx).unwrap().remove(0)
+    };
+    let mut one = load(None);
+    assert!(one.is_factored() && one.has_matrices());
+    let nodes = [0u32, 3, 7, 20, 31];
+    let mut g_one = NodeSet::<2>::default();
+    fill_set(&mut g_one, &mut one, &nodes, 1.0);
+    let (h, theta) = (s.world.time.h, s.world.time.theta);
+    // rank 0 of 2 checks body 0 (the same numbers as one process); rank 1 does not
+    let mut b = load(Some((0, 2)));
+    assert!(b.is_factored() && b.has_matrices() && b.f_ext == one.f_ext);
+    b.release_matrices();
+    for mut b in [b, load(Some((1, 2)))] {
+        assert!(!b.is_factored() && !b.has_matrices() && b.f_ext.is_empty());
+        // the saved energies, assembled aside: the same numbers
+        assert_eq!(b.energies_now().unwrap(), one.energies_now().unwrap());
+        assert!(b.ensure_matrices().unwrap());
+        assert!(b.factorize(h, theta).unwrap());
+        assert_eq!(b.f_ext, one.f_ext);
+        let mut g = NodeSet::<2>::default();
+        fill_set(&mut g, &mut b, &nodes, 1.0);
+        assert_eq!(g.g, g_one.g);
+        b.free_velocity(h, theta);
+        one.free_velocity(h, theta);
+        assert_eq!(b.v_free, one.v_free);
+        // dropped again (a body idle on the rank): all of it
+        b.release_matrices();
+        assert!(!b.is_factored() && !b.has_matrices() && b.cached_columns() == 0);
     }
 }

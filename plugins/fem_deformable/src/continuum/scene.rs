@@ -207,7 +207,8 @@ fn load<D: Dim, const N: usize>(entries: &[toml::Table], cx: &FamilyContext<'_, 
             *made.borrow_mut() = (frames, alpha.clone());
             Ok(Some(alpha))
         };
-        let mut b = crate::scene::build_scaled(&spec, &w.materials, N, cx.dir, &mut memory, &scale).map_err(|(k, m)| at(k, m))?;
+        let mut b = crate::scene::build_with(&spec, &w.materials, N, cx.dir, &mut memory, crate::scene::Assembly::Scaled(&scale))
+            .map_err(|(k, m)| at(k, m))?;
         let (frames, alpha) = made.into_inner();
         b.set_gravity(&w.gravity.as_ref()[..N]);
         let shares = super::sides::load(&mut b, &loads, &|x| band.alpha(x)).map_err(|m| at("load", m))?;
