@@ -82,6 +82,33 @@ fn deformable_bodies_are_stepped_per_rank() {
     stepped_on_ranks(&dir, "3d", (&s3, 2 * 30), &[2]);
 }
 
+/// A rank drops the factors, M and K of the bodies it does not step and makes
+/// them again (assembled from the mesh and material, factored) when it steps
+/// them; at load it assembles only the bodies it checks. With every body dropped
+/// soon (`NSCDD_FE_RELEASE`: any size, factors after 2 idle steps, M and K after
+/// 5; the blocks re-partitioned every 5 steps) the results are the one-process
+/// files.
+#[test]
+fn bodies_dropped_where_not_stepped_give_the_same_results() {
+    let dir = scratch("fe_released");
+    let s2 = write(&dir, "blocks.toml", BLOCKS);
+    let one = dir.join("one");
+    ok(&nscdd(&args(&s2, &one, &[])), "in one process");
+    let reference = final_json(&one);
+    for n in [2, 4] {
+        let out = dir.join(format!("ranks{n}"));
+        let mut c = mpirun_command(&[(n, args(&s2, &out, &[]))]);
+        c.env("NSCDD_FE_RELEASE", "0 2 5");
+        ok(&run_limited(c), &format!("{n} ranks dropping what they do not step"));
+        assert!(final_json(&out) == reference, "{n} ranks: final.json differs from one process");
+        assert_eq!(
+            common::history_physics(&out),
+            common::history_physics(&one),
+            "{n} ranks: the history differs from one process"
+        );
+    }
+}
+
 /// Four deformable blocks on a floor (the first two 2 mm apart: node–segment
 /// contacts between them), two layers of disks resting on them, 4 cells,
 /// re-partitioned every 5 steps.

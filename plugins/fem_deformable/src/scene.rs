@@ -159,11 +159,11 @@ pub fn spec_of(i: usize, e: &toml::Table) -> Result<DeformableSpec, EntryError> 
 /// for the scene's h and θ (mesh files are relative to the scene's folder). Loaded
 /// for a run on P MPI ranks (`cx.ranks`), rank r assembles and factors only the
 /// bodies i with ⌊i P / N⌋ = r (N bodies: a contiguous share, as the subdomains
-/// of a rank are), to check them; it holds every body's mesh and state, drops at
-/// the first step the matrices of the bodies it does not step, and assembles and
-/// factors a body (the same numbers) when it first steps it ([`crate::stepped`]):
-/// no rank holds, nor assembles at load, every body's matrices. A body's error
-/// is then reported by the rank that checks it.
+/// of a rank are), to check them; it holds every body's mesh and state, and
+/// assembles and factors a body (the same numbers) when it first steps it
+/// ([`crate::stepped`]: a large body it does not step is dropped, factors
+/// first): no rank assembles every body at load, nor holds every large body's
+/// matrices. A body's error is then reported by the rank that checks it.
 pub fn bodies_from<D: nscdd::dim::Dim>(
     entries: &[toml::Table],
     cx: &nscdd::family::FamilyContext<'_, D>,
@@ -187,13 +187,12 @@ pub fn bodies_from<D: nscdd::dim::Dim>(
             };
             cx.check_memory(held + bytes, &what).map(|()| held += bytes)
         };
-        // (on ranks: checked by one rank, ⌊i P / N⌋)
-        let check_here = cx
-            .ranks
-            .is_none_or(|(me, p)| (i as u64 * u64::from(p)) / entries.len() as u64 == u64::from(me));
+        let check_here = cx.ranks.is_none_or(|(me, p)| checked_by(i, entries.len(), p) == me);
         let assembly = if check_here { Assembly::Now } else { Assembly::Deferred };
         let mut b = build_with(&spec, materials, dim, dir, &mut check, assembly).map_err(|(k, m)| at(k, m))?;
-        b.allow_release();
+        if mesh_bytes(dim, b.mesh.n_nodes() as f64) >= crate::stepped::release_rule().0 {
+            b.allow_release();
+        }
         b.set_gravity(&cx.world.gravity.as_ref()[..dim]);
         if check_here {
             b.factorize(time.h, time.theta).map_err(|m| at("", m))?;
@@ -201,6 +200,13 @@ pub fn bodies_from<D: nscdd::dim::Dim>(
         bodies.push(b);
     }
     Ok(bodies)
+}
+
+/// The rank of `ranks` that checks body `b` of `n` at load ([`bodies_from`]) and
+/// steps it while it has no contact ([`crate::stepped`]): ⌊b P / n⌋, a contiguous
+/// share of the bodies (as the subdomains of a rank are).
+pub fn checked_by(b: usize, n: usize, ranks: u32) -> u32 {
+    ((b as u64 * u64::from(ranks)) / (n as u64).max(1)) as u32
 }
 
 /// A law with a compliance ([`nscdd::law::Law::compliance`], law `compliant`)

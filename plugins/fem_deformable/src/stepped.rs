@@ -4,8 +4,8 @@
 //! it the framework tells the family which rank solves each contact
 //! ([`nscdd::dd::SolvedOn`]), and only a rank solving some of a body's contacts
 //! computes the body's V_free, its columns of M̂⁻¹, its W_αα and u_free (the list
-//! built again, the same) and its V⁺. A body without contact is stepped by rank
-//! `b mod P`. Every rank still detects every contact and builds every part
+//! built again, the same) and its V⁺. A body without contact is stepped by the
+//! rank that checked it at load ([`crate::scene::checked_by`]). Every rank still detects every contact and builds every part
 //! (positions, V⁻ and the impulses are the same on every rank). After the
 //! write-back, the first rank stepping a body sends its V⁺ to every rank
 //! ([`Stepped::pack`], [`Stepped::unpack`]) with the body's energies after the
@@ -14,12 +14,14 @@
 //! solved them ([`crate::nodes::FeContacts::pack_results`]). A body not stepped
 //! here builds no G (its contacts' W_αα and parts are never used here), and
 //! once it has gone [`RELEASE_AFTER`] steps unstepped here the factors of its M̂,
-//! its columns of M̂⁻¹ and its G are dropped (memory per rank; stepped again, it
-//! factors and solves them anew, the same numbers). Loaded on ranks, a rank
-//! holds the matrices of the bodies it checked at load only
-//! ([`crate::scene::bodies_from`]), until the first step: a body it does not step
-//! then is dropped at once, and one it steps without holding them is assembled and
-//! factored there ([`crate::stage2::free_velocities`]).
+//! its columns of M̂⁻¹ and its G are dropped, and after [`RELEASE_MATRICES_AFTER`]
+//! its M and K (memory per rank; stepped again, it assembles, factors and solves
+//! them anew, the same numbers). Loaded on ranks, a rank holds the matrices of
+//! the bodies it checked at load only ([`crate::scene::bodies_from`]): the factors
+//! of a body it does not step at the first step are dropped then (its M and K
+//! [`RELEASE_MATRICES_AFTER`] − [`RELEASE_AFTER`] steps later), and a body it
+//! steps without them is assembled and factored there
+//! ([`crate::stage2::free_velocities`]).
 
 use crate::body::FeBody;
 use crate::nodes::NodeSet;
@@ -28,6 +30,36 @@ use nscdd::dd::SolvedOn;
 /// Steps a body goes unstepped on a rank before the rank drops its factors of M̂,
 /// its columns of M̂⁻¹ and its G (a body stepped on alternate steps keeps them).
 pub const RELEASE_AFTER: u32 = 10;
+
+/// Steps a body goes unstepped on a rank before the rank drops its M and K too
+/// (assembling them again costs a scikit-fem assembly: a body whose contacts
+/// move between ranks at repartitions keeps them).
+pub const RELEASE_MATRICES_AFTER: u32 = 100;
+
+/// The size of a body ([`crate::scene::mesh_bytes`]'s estimate of its mesh, M,
+/// K and factor) from which a rank drops its factors, M and K when it does not
+/// step it: a smaller body keeps them once made (only its columns and G are
+/// dropped), since making them again costs more time than they hold memory
+/// (docs/SCALING.md, "M̂'s factors, M and K held where a body is stepped").
+pub const RELEASE_MIN_BYTES: f64 = 16.0 * 1024.0 * 1024.0;
+
+/// When a rank drops what it does not step: ([`RELEASE_MIN_BYTES`],
+/// [`RELEASE_AFTER`], [`RELEASE_MATRICES_AFTER`]), or the three numbers of
+/// `NSCDD_FE_RELEASE` (tests: every body dropped soon, e.g. `"0 2 5"`); results
+/// never depend on them.
+pub fn release_rule() -> (f64, u32, u32) {
+    static RULE: std::sync::OnceLock<(f64, u32, u32)> = std::sync::OnceLock::new();
+    *RULE.get_or_init(|| {
+        let given = std::env::var("NSCDD_FE_RELEASE").ok().and_then(|v| {
+            let x: Vec<f64> = v.split_whitespace().filter_map(|x| x.parse().ok()).collect();
+            match x[..] {
+                [b, a, m] if b >= 0.0 && a >= 1.0 && m > a => Some((b, a as u32, m as u32)),
+                _ => None,
+            }
+        });
+        given.unwrap_or((RELEASE_MIN_BYTES, RELEASE_AFTER, RELEASE_MATRICES_AFTER))
+    })
+}
 
 /// Which bodies this rank steps in the step in progress (module docs).
 #[derive(Default)]
@@ -47,10 +79,12 @@ pub struct Stepped {
     energy: Vec<[f64; 3]>,
     energy_known: bool,
     /// Per body, in part: the steps since this rank last stepped it (a body not
-    /// stepped here since the load counts RELEASE_AFTER − 1 at the first step).
+    /// stepped here since the load counts RELEASE_AFTER − 1 at the first step;
+    /// [`release_rule`]).
     idle: Vec<u32>,
-    /// The bodies that have just reached [`RELEASE_AFTER`] idle steps.
-    release: Vec<u32>,
+    /// The bodies that have just reached [`RELEASE_AFTER`] idle steps, and whether
+    /// they have reached [`RELEASE_MATRICES_AFTER`].
+    release: Vec<(u32, bool)>,
 }
 
 impl Stepped {
@@ -98,31 +132,40 @@ impl Stepped {
         }
         for (b, (s, m)) in self.sender.iter_mut().zip(self.mine.iter_mut()).enumerate() {
             if *s == u32::MAX {
-                *s = (b % on.ranks as usize) as u32;
+                // (the rank that checked it at load: [`crate::scene::bodies_from`])
+                *s = crate::scene::checked_by(b, n, on.ranks);
                 *m = *s == on.rank;
             }
         }
-        self.idle.resize(n, RELEASE_AFTER - 1);
+        let (_, after, matrices_after) = release_rule();
+        self.idle.resize(n, after - 1);
         for (b, (i, &m)) in self.idle.iter_mut().zip(&self.mine).enumerate() {
             *i = if m { 0 } else { i.saturating_add(1) };
-            if *i == RELEASE_AFTER {
-                self.release.push(b as u32);
+            if *i == after || *i == matrices_after {
+                self.release.push((b as u32, *i == matrices_after));
             }
         }
         true
     }
 
     /// The bodies whose factors, columns of M̂⁻¹ and G this rank may drop now (after
-    /// [`Self::decide`]: [`RELEASE_AFTER`] steps unstepped here).
-    pub fn to_release(&self) -> &[u32] {
+    /// [`Self::decide`]: [`RELEASE_AFTER`] steps unstepped here), each with whether
+    /// its M and K go too ([`RELEASE_MATRICES_AFTER`]).
+    pub fn to_release(&self) -> &[(u32, bool)] {
         &self.release
     }
 
-    /// Drops M, K, the factors of M̂, the columns and G of [`Self::to_release`]'s
-    /// bodies.
+    /// Drops the columns and G of [`Self::to_release`]'s bodies, and the factors of
+    /// M̂ (and M and K, as it says) of those large enough ([`FeBody::is_releasable`]:
+    /// [`RELEASE_MIN_BYTES`]).
     pub fn release<const D: usize>(&self, bodies: &mut [FeBody], sets: &mut [NodeSet<D>]) {
-        for &b in &self.release {
-            bodies[b as usize].release_matrices();
+        for &(b, matrices) in &self.release {
+            let body = &mut bodies[b as usize];
+            match (body.is_releasable(), matrices) {
+                (false, _) => body.release_columns(),
+                (true, false) => body.release_factor(),
+                (true, true) => body.release_matrices(),
+            }
             sets[b as usize].release_g();
         }
     }
@@ -205,18 +248,29 @@ mod tests {
     #[test]
     fn a_body_unstepped_here_is_released_once_after_release_after_steps() {
         let mut s = Stepped::default();
-        // never stepped here since the load: released at the first step
-        for step in 1..=3 {
+        // never stepped here since the load: its factors released at the first step,
+        // its matrices RELEASE_MATRICES_AFTER − RELEASE_AFTER steps later
+        for step in 1..=RELEASE_MATRICES_AFTER {
             assert!(decide(&mut s, 1));
             assert!(!s.steps(0) && s.steps(1));
-            let expect: &[u32] = if step == 1 { &[0] } else { &[] };
+            let expect: &[(u32, bool)] = match step {
+                1 => &[(0, false)],
+                _ if step == RELEASE_MATRICES_AFTER - RELEASE_AFTER + 1 => &[(0, true)],
+                _ => &[],
+            };
             assert_eq!(s.to_release(), expect, "step {step}");
         }
+        // stepped, then idle: its factors after RELEASE_AFTER steps, its matrices
+        // after RELEASE_MATRICES_AFTER
         assert!(decide(&mut s, 0));
-        for step in 1..=RELEASE_AFTER + 3 {
+        for step in 1..=RELEASE_MATRICES_AFTER + 3 {
             assert!(decide(&mut s, 1));
             assert!(!s.steps(0) && s.steps(1));
-            let expect: &[u32] = if step == RELEASE_AFTER { &[0] } else { &[] };
+            let expect: &[(u32, bool)] = match step {
+                RELEASE_AFTER => &[(0, false)],
+                RELEASE_MATRICES_AFTER => &[(0, true)],
+                _ => &[],
+            };
             assert_eq!(s.to_release(), expect, "step {step}");
         }
         // stepped here again: the count starts over
@@ -227,7 +281,7 @@ mod tests {
             assert!(s.to_release().is_empty());
         }
         decide(&mut s, 1);
-        assert_eq!(s.to_release(), &[0]);
+        assert_eq!(s.to_release(), &[(0, false)]);
         // one process: nothing stepped in part, nothing released
         assert!(!s.decide(2, None, std::iter::empty(), (1e-3, 0.5)));
         assert!(s.to_release().is_empty() && s.energies().is_none());

@@ -152,8 +152,14 @@ fn bodies_loaded_on_ranks_hold_no_matrices() {
     // rank 0 of 2 checks body 0 (the same numbers as one process); rank 1 does not
     let mut b = load(Some((0, 2)));
     assert!(b.is_factored() && b.has_matrices() && b.f_ext == one.f_ext);
+    // (a body this small keeps its matrices once made: `stepped::RELEASE_MIN_BYTES`)
+    assert!(!b.is_releasable());
+    b.release_matrices();
+    assert!(!b.is_factored() && b.has_matrices());
+    b.allow_release();
     b.release_matrices();
     for mut b in [b, load(Some((1, 2)))] {
+        b.allow_release();
         assert!(!b.is_factored() && !b.has_matrices() && b.f_ext.is_empty());
         // the saved energies, assembled aside: the same numbers
         assert_eq!(b.energies_now().unwrap(), one.energies_now().unwrap());
