@@ -175,6 +175,11 @@ impl FeBody {
         self.releasable = true;
     }
 
+    /// Whether [`Self::allow_release`] was called.
+    pub fn is_releasable(&self) -> bool {
+        self.releasable
+    }
+
     /// Drops M, K, F_ext, the factors and the columns of a body
     /// [`Self::allow_release`] was called for (else the factors and columns only):
     /// a body this MPI rank does not step ([`crate::stepped`]).
