@@ -157,13 +157,14 @@ pub fn spec_of(i: usize, e: &toml::Table) -> Result<DeformableSpec, EntryError> 
 
 /// Builds the deformable bodies of a scene's `[[deformable]]` entries, factored
 /// for the scene's h and θ (mesh files are relative to the scene's folder). Loaded
-/// for a run on P MPI ranks (`cx.ranks`), rank r assembles and factors only the
-/// bodies i with ⌊i P / N⌋ = r (N bodies: a contiguous share, as the subdomains
-/// of a rank are), to check them; it holds every body's mesh and state, and
-/// assembles and factors a body (the same numbers) when it first steps it
-/// ([`crate::stepped`]: a large body it does not step is dropped, factors
-/// first): no rank assembles every body at load, nor holds every large body's
-/// matrices. A body's error is then reported by the rank that checks it.
+/// for a run on P MPI ranks (`cx.ranks`), rank r assembles and factors, of the
+/// large bodies ([`crate::stepped::RELEASE_MIN_BYTES`]), only the bodies i with
+/// ⌊i P / N⌋ = r (N bodies: a contiguous share, as the subdomains of a rank are),
+/// to check them; it holds every body's mesh and state, and assembles and factors
+/// a large body (the same numbers) when it first steps it ([`crate::stepped`]: a
+/// large body it does not step is dropped, factors first). No rank assembles
+/// every large body at load, nor holds every large body's matrices; a large
+/// body's error is reported by the rank that checks it.
 pub fn bodies_from<D: nscdd::dim::Dim>(
     entries: &[toml::Table],
     cx: &nscdd::family::FamilyContext<'_, D>,
@@ -176,10 +177,13 @@ pub fn bodies_from<D: nscdd::dim::Dim>(
     for (i, e) in entries.iter().enumerate() {
         let at = |key: &str, message: String| entry_error(i, key, message);
         let spec = spec_of(i, e)?;
-        // (on P ranks a body counts 1/P: a rank holds the matrices of the bodies it
+        // (on P ranks a large body counts 1/P: a rank holds the matrices of those it
         // checks, then of those it steps, about 1/P of them)
-        let share = cx.ranks.map_or(1.0, |(_, p)| 1.0 / f64::from(p.max(1)));
         let mut check = |nodes: f64| {
+            let share = match cx.ranks {
+                Some((_, p)) if large(dim, nodes) => 1.0 / f64::from(p.max(1)),
+                _ => 1.0,
+            };
             let bytes = share * mesh_bytes(dim, nodes);
             let what = match i {
                 0 => format!("a deformable body of about {nodes:.0} nodes"),
@@ -187,19 +191,27 @@ pub fn bodies_from<D: nscdd::dim::Dim>(
             };
             cx.check_memory(held + bytes, &what).map(|()| held += bytes)
         };
-        let check_here = cx.ranks.is_none_or(|(me, p)| checked_by(i, entries.len(), p) == me);
-        let assembly = if check_here { Assembly::Now } else { Assembly::Deferred };
-        let mut b = build_with(&spec, materials, dim, dir, &mut check, assembly).map_err(|(k, m)| at(k, m))?;
-        if mesh_bytes(dim, b.mesh.n_nodes() as f64) >= crate::stepped::release_rule().0 {
+        let mut b = build_with(&spec, materials, dim, dir, &mut check, Assembly::Deferred).map_err(|(k, m)| at(k, m))?;
+        b.set_gravity(&cx.world.gravity.as_ref()[..dim]);
+        let large = large(dim, b.mesh.n_nodes() as f64);
+        if large {
             b.allow_release();
         }
-        b.set_gravity(&cx.world.gravity.as_ref()[..dim]);
-        if check_here {
+        // (a large body on ranks: assembled by the rank checking it only)
+        if !large || cx.ranks.is_none_or(|(me, p)| checked_by(i, entries.len(), p) == me) {
+            b.ensure_matrices().map_err(|m| at("mesh", m))?;
             b.factorize(time.h, time.theta).map_err(|m| at("", m))?;
         }
         bodies.push(b);
     }
     Ok(bodies)
+}
+
+/// Whether a body of `nodes` nodes is large: its M, K and factors
+/// ([`matrices_bytes`]) reach [`crate::stepped::RELEASE_MIN_BYTES`] (or
+/// `NSCDD_FE_RELEASE`'s size, [`crate::stepped::release_rule`]).
+fn large(dim: usize, nodes: f64) -> bool {
+    matrices_bytes(dim, nodes) >= crate::stepped::release_rule().0
 }
 
 /// The rank of `ranks` that checks body `b` of `n` at load ([`bodies_from`]) and
@@ -243,6 +255,21 @@ pub fn mesh_bytes(dim: usize, nodes: f64) -> f64 {
         3000.0 * dofs
     } else {
         500.0 * dofs * dofs.cbrt()
+    }
+}
+
+/// Bytes of a body's M, K and factors of M̂ alone (what a rank drops when it does
+/// not step the body, [`crate::stepped::RELEASE_MIN_BYTES`]): measured with peak
+/// RSS on 16 blocks of 3 321 nodes (2D: 4.4 MB a body, 650 B per degree of
+/// freedom) and 8 boxes of 4 851 nodes (3D: about 106 MB a body, 7.3 kB per degree
+/// of freedom, growing as the factor's fill-in, d^⅓), rounded. An order of
+/// magnitude.
+pub fn matrices_bytes(dim: usize, nodes: f64) -> f64 {
+    let dofs = dim as f64 * nodes.max(0.0);
+    if dim == 2 {
+        650.0 * dofs
+    } else {
+        300.0 * dofs * dofs.cbrt()
     }
 }
 

@@ -36,11 +36,12 @@ pub const RELEASE_AFTER: u32 = 10;
 /// move between ranks at repartitions keeps them).
 pub const RELEASE_MATRICES_AFTER: u32 = 100;
 
-/// The size of a body ([`crate::scene::mesh_bytes`]'s estimate of its mesh, M,
-/// K and factor) from which a rank drops its factors, M and K when it does not
-/// step it: a smaller body keeps them once made (only its columns and G are
-/// dropped), since making them again costs more time than they hold memory
-/// (docs/SCALING.md, "M̂'s factors, M and K held where a body is stepped").
+/// The size of a body's M, K and factors ([`crate::scene::matrices_bytes`]'s
+/// estimate) from which a rank drops them when it does not step the body: a
+/// smaller body keeps them once made (only its columns and G are dropped), since
+/// making them again costs more time than they hold memory (docs/SCALING.md,
+/// "M̂'s factors, M and K held where a body is stepped": 2D bodies of fewer than
+/// about 13 000 nodes, 3D bodies of fewer than about 1 200).
 pub const RELEASE_MIN_BYTES: f64 = 16.0 * 1024.0 * 1024.0;
 
 /// When a rank drops what it does not step: ([`RELEASE_MIN_BYTES`],

@@ -120,46 +120,51 @@ fn a_released_factor_is_made_again_with_the_same_numbers() {
     assert!(!body.factorize(h, theta).unwrap());
 }
 
-/// Loaded for a run on MPI ranks (`FamilyContext::ranks`), a body is assembled and
-/// factored only by the rank checking it (⌊i P / N⌋); any other rank assembles and
-/// factors it, the same numbers, when it steps it. Loaded for one process, M, K and
-/// the factor are kept.
+/// Loaded for a run on MPI ranks (`FamilyContext::ranks`), a large body
+/// (`stepped::RELEASE_MIN_BYTES`) is assembled and factored only by the rank
+/// checking it (⌊i P / N⌋); any other rank assembles and factors it, the same
+/// numbers, when it steps it. A small body is assembled everywhere and kept; loaded
+/// for one process, every body is.
 #[test]
-fn bodies_loaded_on_ranks_hold_no_matrices() {
-    let s = scene(SCENE);
-    let t: toml::Table = toml::from_str(SCENE).unwrap();
+fn large_bodies_loaded_on_ranks_hold_no_matrices() {
+    // 131 × 101 nodes: M, K and factors of about 17 MB
+    let text = SCENE.replace("size = [0.4, 0.2], cells = [8, 4]", "size = [1.3, 1.0], cells = [130, 100]");
+    let s = scene(&text);
+    let t: toml::Table = toml::from_str(&text).unwrap();
     let entries: Vec<toml::Table> = t["deformable"]
         .as_array()
         .unwrap()
         .iter()
         .map(|e| e.as_table().unwrap().clone())
         .collect();
-    let load = |ranks| {
+    let small: Vec<toml::Table> = toml::from_str::<toml::Table>(SCENE).unwrap()["deformable"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e.as_table().unwrap().clone())
+        .collect();
+    let load = |entries: &[toml::Table], ranks| {
         let cx = nscdd::family::FamilyContext {
             world: &s.world,
             dir: std::path::Path::new("."),
             max_memory: None,
             ranks,
         };
-        nscdd_fem_deformable::scene::bodies_from(&entries, &cx).unwrap().remove(0)
+        nscdd_fem_deformable::scene::bodies_from(entries, &cx).unwrap().remove(0)
     };
-    let mut one = load(None);
-    assert!(one.is_factored() && one.has_matrices());
+    let small_on_1 = load(&small, Some((1, 2)));
+    assert!(small_on_1.is_factored() && !small_on_1.is_releasable());
+    let mut one = load(&entries, None);
+    assert!(one.is_factored() && one.has_matrices() && one.is_releasable());
     let nodes = [0u32, 3, 7, 20, 31];
     let mut g_one = NodeSet::<2>::default();
     fill_set(&mut g_one, &mut one, &nodes, 1.0);
     let (h, theta) = (s.world.time.h, s.world.time.theta);
     // rank 0 of 2 checks body 0 (the same numbers as one process); rank 1 does not
-    let mut b = load(Some((0, 2)));
+    let mut b = load(&entries, Some((0, 2)));
     assert!(b.is_factored() && b.has_matrices() && b.f_ext == one.f_ext);
-    // (a body this small keeps its matrices once made: `stepped::RELEASE_MIN_BYTES`)
-    assert!(!b.is_releasable());
     b.release_matrices();
-    assert!(!b.is_factored() && b.has_matrices());
-    b.allow_release();
-    b.release_matrices();
-    for mut b in [b, load(Some((1, 2)))] {
-        b.allow_release();
+    for mut b in [b, load(&entries, Some((1, 2)))] {
         assert!(!b.is_factored() && !b.has_matrices() && b.f_ext.is_empty());
         // the saved energies, assembled aside: the same numbers
         assert_eq!(b.energies_now().unwrap(), one.energies_now().unwrap());
