@@ -203,13 +203,13 @@ fn load<C: Copy, A: Copy, F: Copy, B: Copy, const N: usize>(
     Ok(())
 }
 
-/// The contacts and the sums over the bodies of [`FeBody::energies`], added in body
-/// order; `known`: each body's, already computed by the rank stepping it
+/// The contacts and the sums over the bodies of [`FeBody::energies_now`], added in
+/// body order; `known`: each body's, already computed by the rank stepping it
 /// ([`crate::stepped::Stepped::energies`]).
 fn history_values(bodies: &[FeBody], contacts: usize, known: Option<&[[f64; 3]]>, out: &mut Vec<f64>) {
     let mut sum = [0.0; 3];
     for (b, body) in bodies.iter().enumerate() {
-        let e = known.map_or_else(|| body.energies(&body.u, &body.v), |k| k[b]);
+        let e = known.map_or_else(|| body.energies_now().unwrap_or([f64::NAN; 3]), |k| k[b]);
         for (s, x) in sum.iter_mut().zip(e) {
             *s += x;
         }

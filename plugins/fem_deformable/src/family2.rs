@@ -123,9 +123,11 @@ impl Attached<Rigid2> for Deformables2 {
         });
         let part = self.stepped.decide(self.bodies.len(), on, sides, (w.time.h, w.time.theta));
         self.stepped.release(&mut self.bodies, &mut self.sets);
-        // (M̂ is factored at load time for the scene's h and θ: nothing can fail here)
+        // (a large body this rank steps first is assembled here: if that fails, no
+        // body is stepped here and the step's end reports it)
         if let Err(e) = self.free_step(w) {
             self.error = Some(e);
+            self.stepped.hold(self.bodies.len());
         }
         self.build_contacts(w);
         part
