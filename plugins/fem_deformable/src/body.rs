@@ -13,10 +13,12 @@
 //! θ = ½ conserves the energy ½ VᵀMV + ½ uᵀKu − u·F_ext of a free body; θ > ½
 //! dissipates it. M̂ is factored once (faer's supernodal Cholesky: the symbolic
 //! analysis once per body, a numeric refactorization only when h, θ or the
-//! material change; on MPI ranks only where the body is stepped: a rank drops the
-//! factors of a body it does not step, [`FeBody::release_factor`], and makes them
-//! again, the same numbers, when it steps it). Degrees of freedom held fixed (Dirichlet, zero velocity) have
-//! their rows and columns of M̂ replaced by the identity and a zero right-hand side.
+//! material change). On MPI ranks a large body's M and K ([`Matrices`]) and
+//! factors are held only where it is stepped: a rank drops them when it does not
+//! step it ([`FeBody::release_matrices`], [`crate::stepped`]) and assembles and
+//! factors them again, the same numbers, when it does ([`FeBody::ensure_matrices`]).
+//! Degrees of freedom held fixed (Dirichlet, zero velocity) have their rows and
+//! columns of M̂ replaced by the identity and a zero right-hand side.
 //!
 //! Contacts need columns of M̂⁻¹ at their nodes (the Delassus blocks and the NLGS
 //! velocity updates): [`FeBody::column`] solves for the `dim` columns of a node on

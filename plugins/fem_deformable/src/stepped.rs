@@ -5,22 +5,24 @@
 //! ([`nscdd::dd::SolvedOn`]), and only a rank solving some of a body's contacts
 //! computes the body's V_free, its columns of M̂⁻¹, its W_αα and u_free (the list
 //! built again, the same) and its V⁺. A body without contact is stepped by the
-//! rank that checked it at load ([`crate::scene::checked_by`]). Every rank still detects every contact and builds every part
-//! (positions, V⁻ and the impulses are the same on every rank). After the
+//! rank that checked it at load ([`crate::scene::checked_by`]). Every rank still
+//! detects every contact and builds every part (positions, V⁻ and the impulses
+//! are the same on every rank). After the
 //! write-back, the first rank stepping a body sends its V⁺ to every rank
 //! ([`Stepped::pack`], [`Stepped::unpack`]) with the body's energies after the
 //! step (the history's columns, each body's computed once); the contacts'
 //! impulses, u_free and targets come with their parts' results, from the rank that
 //! solved them ([`crate::nodes::FeContacts::pack_results`]). A body not stepped
 //! here builds no G (its contacts' W_αα and parts are never used here), and
-//! once it has gone [`RELEASE_AFTER`] steps unstepped here the factors of its M̂,
-//! its columns of M̂⁻¹ and its G are dropped, and after [`RELEASE_MATRICES_AFTER`]
-//! its M and K (memory per rank; stepped again, it assembles, factors and solves
-//! them anew, the same numbers). Loaded on ranks, a rank holds the matrices of
-//! the bodies it checked at load only ([`crate::scene::bodies_from`]): the factors
-//! of a body it does not step at the first step are dropped then (its M and K
-//! [`RELEASE_MATRICES_AFTER`] − [`RELEASE_AFTER`] steps later), and a body it
-//! steps without them is assembled and factored there
+//! once it has gone [`RELEASE_AFTER`] steps unstepped here its columns of M̂⁻¹
+//! and its G are dropped, with the factors of its M̂ if it is large
+//! ([`RELEASE_MIN_BYTES`]), and after [`RELEASE_MATRICES_AFTER`] a large body's
+//! M and K (memory per rank; stepped again, it assembles, factors and solves them
+//! anew, the same numbers). Loaded on ranks, a rank holds the matrices of the
+//! large bodies it checked at load only ([`crate::scene::bodies_from`]): the
+//! factors of one it does not step at the first step are dropped then (its M and
+//! K [`RELEASE_MATRICES_AFTER`] − [`RELEASE_AFTER`] steps later), and a large body
+//! it steps without them is assembled and factored there
 //! ([`crate::stage2::free_velocities`]).
 
 use crate::body::FeBody;
