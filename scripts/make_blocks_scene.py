@@ -80,18 +80,8 @@ ny = 4
 nz = 2
 spacing = 0.042
 """)
-    for i in range(a.blocks):
-        x = 0.01 + i * pitch
-        print(f"""[[deformable]]
-name = "b{i}"
-material = "soil"
-young = 2e6
-poisson = 0.3
-fix = ["bottom"]
-mesh = {{ box = {{ origin = [{x:.3f}, 0.0, 0.001], size = [0.2, 0.2, 0.1], cells = [{a.cells[0]}, {a.cells[1]}, {a.cells[2]}] }} }}
-""")
-    raise SystemExit
-print(f"""[[bodies]]
+else:
+    print(f"""[[bodies]]
 name = "floor"
 shape = "wall"
 material = "stone"
@@ -111,10 +101,16 @@ spacing = 0.042
 """)
 for i in range(a.blocks):
     x = 0.01 + i * pitch
+    if a.dim == 3:
+        fix = 'fix = ["bottom"]\n'
+        mesh = f"box = {{ origin = [{x:.3f}, 0.0, 0.001], size = [0.2, 0.2, 0.1], cells = [{a.cells[0]}, {a.cells[1]}, {a.cells[2]}] }}"
+    else:
+        fix = ""
+        mesh = f"rectangle = {{ origin = [{x:.3f}, 0.001], size = [0.2, 0.1], cells = [{a.cells[0]}, {a.cells[1]}] }}"
     print(f"""[[deformable]]
 name = "b{i}"
 material = "soil"
 young = 2e6
 poisson = 0.3
-mesh = {{ rectangle = {{ origin = [{x:.3f}, 0.001], size = [0.2, 0.1], cells = [{a.cells[0]}, {a.cells[1]}] }} }}
+{fix}mesh = {{ {mesh} }}
 """)
