@@ -87,7 +87,7 @@ fn deformable_bodies_are_stepped_per_rank() {
 /// them; at load it assembles only the bodies it checks. With every body dropped
 /// soon (`NSCDD_FE_RELEASE`: any size, factors after 2 idle steps, M and K after
 /// 5; the blocks re-partitioned every 5 steps) the results are the one-process
-/// files.
+/// files, and so are those of a restart on 3 ranks of a state of 2.
 #[test]
 fn bodies_dropped_where_not_stepped_give_the_same_results() {
     let dir = scratch("fe_released");
@@ -107,6 +107,18 @@ fn bodies_dropped_where_not_stepped_give_the_same_results() {
             "{n} ranks: the history differs from one process"
         );
     }
+    // a state of 2 ranks restarted on 3 (every body loaded light where not checked)
+    let first = write(&dir, "first.toml", &BLOCKS.replace("steps = 60", "steps = 33"));
+    let half = dir.join("half");
+    let mut c = mpirun_command(&[(2, args(&first, &half, &[]))]);
+    c.env("NSCDD_FE_RELEASE", "0 2 5");
+    ok(&run_limited(c), "33 steps on 2 ranks");
+    let on3 = dir.join("restart3");
+    let state = half.join("final.json");
+    let mut c = mpirun_command(&[(3, args(&s2, &on3, &["--restart", state.to_str().unwrap()]))]);
+    c.env("NSCDD_FE_RELEASE", "0 2 5");
+    ok(&run_limited(c), "the restart on 3 ranks");
+    assert!(final_json(&on3) == reference, "a restart on 3 ranks ends elsewhere");
 }
 
 /// Four deformable blocks on a floor (the first two 2 mm apart: node–segment
