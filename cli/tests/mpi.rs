@@ -111,6 +111,12 @@ fn two_and_four_ranks_give_the_one_process_result_2d() {
     let wide = every(PILE2D, 4).replacen("[solver]\n", "[detection]\nalert = 0.5\n[solver]\n", 1);
     let wide = write(&dir, "wide.toml", &wide);
     same_as_threads(&wide, &dir, "2x1", "decentralized", &[2]);
+    // no step at all: the state has no grid yet on ranks either (the loader's
+    // provisional one is not written)
+    let none_dir = scratch("same2d_no_step");
+    let none = write(&none_dir, "none.toml", &PILE2D.replacen("steps = 15", "steps = 0", 1));
+    same_as_threads(&none, &none_dir, "2x1", "decentralized", &[2]);
+    let _ = std::fs::remove_dir_all(&none_dir);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -193,7 +193,9 @@ impl<D: Family> NscddOf<D> {
             grid_of: [self.settings.nx, self.settings.ny, self.settings.nz],
             by_model: self.by_model,
             steps: self.steps,
-            grid: self.grid.clone(),
+            // (before the first step: none, as in one process, even where the
+            // loader gave ranks the first step's provisional grid)
+            grid: self.grid.clone().filter(|_| self.steps > 0),
             grid_empty: self.grid_empty,
             balance: self.balance,
             kept,
