@@ -319,8 +319,7 @@ impl Deformables2 {
 
 /// Factors M̂ of the bodies `stepped` (`None`: all) if h or θ changed or their
 /// factors were released (assembling M and K first if they were), then their free
-/// velocity (the others keep V⁻ only); the
-/// times of both stages.
+/// velocity (the others keep V⁻ only); the times of both stages.
 pub fn free_velocities(bodies: &mut [FeBody], h: f64, theta: f64, stepped: Option<&[bool]>) -> Result<FeTimes, String> {
     let t0 = Instant::now();
     for (bi, b) in bodies.iter_mut().enumerate() {
