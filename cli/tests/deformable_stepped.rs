@@ -106,6 +106,15 @@ fn bodies_dropped_where_not_stepped_give_the_same_results() {
             common::history_physics(&one),
             "{n} ranks: the history differs from one process"
         );
+        // each rank held the matrices of fewer bodies than all of them, and of no
+        // fewer than it stepped
+        let built = per_rank_count(&out, "family_bodies_built");
+        let stepped = per_rank_count(&out, "family_bodies_stepped");
+        let all = per_rank_count(&out, "family_bodies");
+        assert!(
+            built.iter().zip(&stepped).zip(&all).all(|((&b, &s), &a)| s <= b && b < a),
+            "{n} ranks: matrices held {built:?}, bodies stepped {stepped:?} of {all:?}"
+        );
     }
     // a state of 2 ranks restarted on 3 (every body loaded light where not checked)
     let first = write(&dir, "first.toml", &BLOCKS.replace("steps = 60", "steps = 33"));

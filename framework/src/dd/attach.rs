@@ -170,6 +170,11 @@ pub trait Attached<F: Family> {
     fn stepped_bodies(&self) -> Option<(usize, usize)> {
         None
     }
+    /// In a step stepped in part: its bodies whose data only a rank stepping them
+    /// needs (a deformable body's M, K and factors) this rank holds (`ranks.json`).
+    fn built_bodies(&self) -> Option<usize> {
+        None
+    }
 }
 
 /// The world bodies that `fams` read or touch ([`Attached::held_everywhere`]),

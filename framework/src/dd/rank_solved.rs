@@ -34,6 +34,7 @@ pub(super) fn share_stepped<D: Family>(fams: &mut [&mut dyn Attached<D>], on: &[
             rs.totals.family_bodies_stepped += here as u64;
             rs.totals.family_bodies += n as u64;
         }
+        rs.totals.family_bodies_built += fam.built_bodies().unwrap_or(0) as u64;
     }
 }
 

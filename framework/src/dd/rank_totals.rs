@@ -20,9 +20,11 @@ use super::ranks::RankState;
 /// restart (`loaded_bodies`: a scene loaded in part, [`crate::scene::part`], gives
 /// each rank its halo); the attached families' bodies it stepped and their bodies,
 /// summed over the steps stepped in part (`family_bodies_stepped`,
-/// `family_bodies`, [`super::Attached::solved_on`]).
+/// `family_bodies`, [`super::Attached::solved_on`]), and of those the bodies whose
+/// data only their stepping ranks need it held (`family_bodies_built`, a
+/// deformable body's M, K and factors: [`super::Attached::built_bodies`]).
 pub fn totals_json(st: &mut RankState) -> String {
-    const H: usize = 25;
+    const H: usize = 26;
     let p = st.cluster.size() as usize;
     let t = &st.totals;
     let (wait_wall, wait_cpu) = st.cluster.waited();
@@ -53,6 +55,7 @@ pub fn totals_json(st: &mut RankState) -> String {
         t.loaded_bodies as f64,
         t.family_bodies_stepped as f64,
         t.family_bodies as f64,
+        t.family_bodies_built as f64,
         t.peers.len() as f64,
     ];
     mine.extend(t.peers.iter().map(|&x| x as f64));
@@ -92,6 +95,7 @@ pub fn totals_json(st: &mut RankState) -> String {
                 "loaded_bodies": x[21] as u64,
                 "family_bodies_stepped": x[22] as u64,
                 "family_bodies": x[23] as u64,
+                "family_bodies_built": x[24] as u64,
                 "peers": peers,
                 "last_subdomains": subs,
             })

@@ -101,6 +101,9 @@ pub struct RankTotals {
     /// over the steps stepped in part ([`super::Attached::solved_on`]).
     pub family_bodies_stepped: u64,
     pub family_bodies: u64,
+    /// The attached families' bodies whose data only their stepping ranks need
+    /// this rank held, summed over the same steps ([`super::Attached::built_bodies`]).
+    pub family_bodies_built: u64,
 }
 
 /// The multi-process state of an NSCDD solver.

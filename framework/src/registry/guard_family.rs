@@ -170,6 +170,9 @@ impl<D: Dim> Attached<Rigid<D>> for GuardedFamily<D> {
     fn stepped_bodies(&self) -> Option<(usize, usize)> {
         self.guard.call(|| self.inner.stepped_bodies())
     }
+    fn built_bodies(&self) -> Option<usize> {
+        self.guard.call(|| self.inner.built_bodies())
+    }
 }
 
 struct GuardedPart<F: Family> {

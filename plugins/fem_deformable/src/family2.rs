@@ -202,6 +202,11 @@ impl Attached<Rigid2> for Deformables2 {
     fn stepped_bodies(&self) -> Option<(usize, usize)> {
         self.stepped.counts()
     }
+    fn built_bodies(&self) -> Option<usize> {
+        self.stepped
+            .counts()
+            .map(|_| self.bodies.iter().filter(|b| b.has_matrices()).count())
+    }
 }
 
 impl FePart2 {

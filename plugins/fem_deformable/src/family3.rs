@@ -210,4 +210,9 @@ impl Attached<Rigid3> for Deformables3 {
     fn stepped_bodies(&self) -> Option<(usize, usize)> {
         self.stepped.counts()
     }
+    fn built_bodies(&self) -> Option<usize> {
+        self.stepped
+            .counts()
+            .map(|_| self.bodies.iter().filter(|b| b.has_matrices()).count())
+    }
 }
