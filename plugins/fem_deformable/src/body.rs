@@ -421,8 +421,7 @@ impl FeBody {
         }
         let (m, _) = crate::matrices::assemble(&self.mesh, &self.elastic)?;
         let f_ext = m.weight(self.dim(), &self.gravity);
-        let [ke, se] = m.energies(&self.u, &self.v);
-        Ok([ke, se, -dot(&self.u, &f_ext)])
+        Ok(energies_with(&m, &f_ext, &self.u, &self.v))
     }
 
     /// ½ VᵀMV.
@@ -446,8 +445,7 @@ impl FeBody {
     /// pass over the pattern of M and K (stored whole: column c's sums times x_c),
     /// without allocation.
     pub fn energies(&self, u: &[f64], v: &[f64]) -> [f64; 3] {
-        let [ke, se] = self.mats().energies(u, v);
-        [ke, se, -dot(u, &self.f_ext)]
+        energies_with(self.mats(), &self.f_ext, u, v)
     }
     /// Total mass (Σ of M's entries of one component).
     pub fn mass(&self) -> f64 {
@@ -456,6 +454,12 @@ impl FeBody {
         self.mul_add(1.0, 0.0, &ones, &mut m1);
         dot(&ones, &m1)
     }
+}
+
+/// [½ vᵀMv, ½ uᵀKu, −u·F_ext] of M and K `m` and the load `f_ext`.
+fn energies_with(m: &Matrices, f_ext: &[f64], u: &[f64], v: &[f64]) -> [f64; 3] {
+    let [ke, se] = m.energies(u, v);
+    [ke, se, -dot(u, f_ext)]
 }
 
 pub fn dot(a: &[f64], b: &[f64]) -> f64 {

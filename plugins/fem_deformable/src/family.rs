@@ -132,13 +132,12 @@ struct State {
 /// numbers as [`FeBody::energies_now`], which a body whose M and K are not held
 /// here assembles them aside for: NaN if that fails).
 fn save<C, A, F, B, const N: usize>(bodies: &[FeBody], c: &FeContacts<C, A, F, B, N>, known: Option<&[[f64; 3]]>) -> serde_json::Value {
-    let energies = |i: usize, b: &FeBody| known.map_or_else(|| b.energies_now().unwrap_or([f64::NAN; 3]), |k| k[i]);
     let state = State {
         bodies: bodies
             .iter()
             .enumerate()
             .map(|(i, b)| {
-                let [kinetic_energy, elastic_energy, _] = energies(i, b);
+                let [kinetic_energy, elastic_energy, _] = energies_of(b, i, known);
                 BodyState {
                     name: b.name.clone(),
                     nodes: b.mesh.n_nodes(),
@@ -203,14 +202,20 @@ fn load<C: Copy, A: Copy, F: Copy, B: Copy, const N: usize>(
     Ok(())
 }
 
+/// Body `i`'s energies after the step: `known`'s (the rank stepping it computed
+/// them, [`crate::stepped::Stepped::energies`]), else [`FeBody::energies_now`]
+/// (NaN if its assembly aside fails).
+fn energies_of(b: &FeBody, i: usize, known: Option<&[[f64; 3]]>) -> [f64; 3] {
+    known.map_or_else(|| b.energies_now().unwrap_or([f64::NAN; 3]), |k| k[i])
+}
+
 /// The contacts and the sums over the bodies of [`FeBody::energies_now`], added in
 /// body order; `known`: each body's, already computed by the rank stepping it
 /// ([`crate::stepped::Stepped::energies`]).
 fn history_values(bodies: &[FeBody], contacts: usize, known: Option<&[[f64; 3]]>, out: &mut Vec<f64>) {
     let mut sum = [0.0; 3];
     for (b, body) in bodies.iter().enumerate() {
-        let e = known.map_or_else(|| body.energies_now().unwrap_or([f64::NAN; 3]), |k| k[b]);
-        for (s, x) in sum.iter_mut().zip(e) {
+        for (s, x) in sum.iter_mut().zip(energies_of(body, b, known)) {
             *s += x;
         }
     }

@@ -203,9 +203,7 @@ impl Attached<Rigid2> for Deformables2 {
         self.stepped.counts()
     }
     fn built_bodies(&self) -> Option<usize> {
-        self.stepped
-            .counts()
-            .map(|_| self.bodies.iter().filter(|b| b.has_matrices()).count())
+        self.stepped.built(&self.bodies)
     }
 }
 

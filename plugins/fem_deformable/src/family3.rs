@@ -211,8 +211,6 @@ impl Attached<Rigid3> for Deformables3 {
         self.stepped.counts()
     }
     fn built_bodies(&self) -> Option<usize> {
-        self.stepped
-            .counts()
-            .map(|_| self.bodies.iter().filter(|b| b.has_matrices()).count())
+        self.stepped.built(&self.bodies)
     }
 }

@@ -183,6 +183,12 @@ impl Stepped {
         self.mask().is_none_or(|m| m[b])
     }
 
+    /// The bodies whose M and K this rank holds, stepped in part
+    /// ([`nscdd::dd::Attached::built_bodies`]).
+    pub fn built(&self, bodies: &[FeBody]) -> Option<usize> {
+        self.on.map(|_| bodies.iter().filter(|b| b.has_matrices()).count())
+    }
+
     /// (bodies stepped here, bodies), stepped in part.
     pub fn counts(&self) -> Option<(usize, usize)> {
         self.on.map(|_| (self.mine.iter().filter(|&&x| x).count(), self.mine.len()))
