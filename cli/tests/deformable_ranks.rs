@@ -83,14 +83,22 @@ fn same_on_ranks(dir: &std::path::Path, tag: &str, (scene, steps, cells): (&std:
     reference
 }
 
-/// A restart on `n` ranks (one cell each) loaded its part: no rank built every body.
-fn restarted_in_part(out: &std::path::Path, reference: &str, n: usize) {
+/// A restart from `state` on `n` ranks (one cell each) loaded its part: no rank
+/// built every body, and each read only its own contacts of the state, each
+/// contact one rank (`loaded_bodies`, `restart_contacts` in ranks.json).
+fn restarted_in_part(out: &std::path::Path, reference: &str, state: &std::path::Path, n: usize) {
     let loaded = per_rank_count(out, "loaded_bodies");
     let all = bodies(reference);
     assert!(
         loaded.len() == n && loaded.iter().all(|&l| l > 0 && l < all),
         "{loaded:?} bodies loaded of {all}"
     );
+    let saved: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(state).expect("state")).expect("state");
+    let nc = saved["contacts"].as_array().expect("contacts").len() as u64;
+    let read = per_rank_count(out, "restart_contacts");
+    assert!(nc > 0, "a state without contacts");
+    assert_eq!(read.iter().sum::<u64>(), nc, "{read:?} contacts read of {nc}");
+    assert!(read.iter().all(|&r| r < nc), "{read:?} contacts read of {nc}");
 }
 
 #[test]
@@ -109,7 +117,7 @@ fn deformable_scenes_by_geometry_hold_bodies_per_rank() {
     let on4 = dir.join("restart4");
     ok(&mpirun(&[(4, args(&s2, &on4, &restart))]), "the restart on 4 ranks");
     assert!(final_json(&on4) == reference, "a restart on 4 ranks ends elsewhere");
-    restarted_in_part(&on4, &reference, 4);
+    restarted_in_part(&on4, &reference, &state, 4);
     let on1 = dir.join("restart1");
     ok(&nscdd(&args(&s2, &on1, &restart)), "the restart in one process");
     assert!(final_json(&on1) == reference, "a restart in one process ends elsewhere");
@@ -121,7 +129,22 @@ fn deformable_scenes_by_geometry_hold_bodies_per_rank() {
         "by_model.toml",
         &scene("foundation", (40, "by_model = true\nnx = 2"), lattice),
     );
-    same_on_ranks(&dir, "by_model", (&sm, 40, 2), &[2, 4]);
+    let reference = same_on_ranks(&dir, "by_model", (&sm, 40, 2), &[2, 4]);
+    // restarted by model on 2 ranks from a state of 2: each rank reads its part of
+    // the state, as by geometry
+    let first = write(
+        &dir,
+        "by_model20.toml",
+        &scene("foundation", (20, "by_model = true\nnx = 2"), lattice),
+    );
+    let half = dir.join("by_model_half");
+    ok(&mpirun(&[(2, args(&first, &half, &[]))]), "20 steps by model on 2 ranks");
+    let state = half.join("final.json");
+    let on2 = dir.join("by_model_restart2");
+    let restart = ["--restart", state.to_str().unwrap()];
+    ok(&mpirun(&[(2, args(&sm, &on2, &restart))]), "the restart by model on 2 ranks");
+    assert!(final_json(&on2) == reference, "a restart by model on 2 ranks ends elsewhere");
+    restarted_in_part(&on2, &reference, &state, 2);
     // a free block thrown onto a layer of disks, bouncing off: the disks enter the
     // block's reach as it comes down (sent to every rank) and leave it as it goes
     let drop = write(&dir, "drop.toml", DROP);
@@ -139,7 +162,7 @@ fn deformable_scenes_by_geometry_hold_bodies_per_rank() {
         "the drop restarted on 4 ranks",
     );
     assert!(final_json(&on4) == reference, "the drop restarted on 4 ranks ends elsewhere");
-    restarted_in_part(&on4, &reference, 4);
+    restarted_in_part(&on4, &reference, &state, 4);
     // 3D: spheres on a deformable block
     let lattice = ("origin = [0.2, 0.2, 0.42]", "origin = [0.2, 0.2, 0.36]");
     let s3 = write(&dir, "foundation3d.toml", &scene("foundation3d", (15, "nx = 2"), lattice));

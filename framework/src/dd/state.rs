@@ -152,7 +152,7 @@ impl NscddState {
     /// `NscddOf::load_state` refuses).
     pub fn rank_part(&self, grid_of: [u32; 3], by_model: bool, ranks: u32, me: u32) -> Option<RestartPart> {
         let grid = self.grid.as_ref()?;
-        if ranks < 2 || by_model || self.by_model || self.grid_of != grid_of || self.grid_empty {
+        if ranks < 2 || by_model != self.by_model || self.grid_of != grid_of || self.grid_empty {
             return None;
         }
         // a grid of other cells, or too few for the ranks: the run refuses it (exit 2)

@@ -29,8 +29,10 @@
 //!    deformable body's reach); every rank also holds the bodies near them, and the
 //!    families are loaded against the rank's part; restarted, the boxes also hold
 //!    the families' first step at the saved state (the state's `families` read
-//!    alone). A family without such boxes, or a restart decomposed by model, loads
-//!    the scene whole, as before (each rank keeps its part before the first step).
+//!    alone), and the bodies near them are chosen at their saved poses as well as
+//!    at the scene's. A family without such boxes loads the scene whole, as before
+//!    (each rank keeps its part before the first step). Decomposed by model, as by
+//!    geometry: a family's subdomain of a cell goes with the cell to its rank.
 //!
 //! Scenes with no decomposition, and restarts from a state of another
 //! decomposition, are loaded whole, as before. The ranks agree on the survey's
@@ -247,14 +249,19 @@ pub fn restart_on<D: SceneDim>(
         true => saved_boxes(s, registry, &sv, path)?,
         false => Some(sv.boxes.clone()),
     };
-    let scanned = rp.as_mut().filter(|_| boxes.is_some()).and_then(|rp| {
-        // (a margin on the alert distance: a body kept in excess leaves at the first step)
+    // (a margin on the alert distance: a body kept in excess leaves at the first step)
+    let near = |b: &[[[f64; 3]; 2]]| crate::dd::first_part::Halo::around(b.to_vec(), D::N, s.world.alert * 1.01);
+    let scanned = rp.as_mut().zip(boxes.as_ref()).and_then(|(rp, boxes)| {
         let halo = rp.halo(D::N, s.world.alert * 1.01);
+        // (the families' first step reads the bodies near their boxes at the saved
+        // positions; their load, at the scene's: both kept)
+        let near = near(boxes);
         let scene = super::restart_scan::ScanInput {
             shapes: &sv.shapes,
             stores: &s.world.shapes,
             everywhere: &sv.everywhere,
             halo: &halo,
+            near: &near,
         };
         super::restart_scan::scan::<D>(path, &scene, rp)
     });
@@ -268,7 +275,7 @@ pub fn restart_on<D: SceneDim>(
         };
     };
     let keep = scanned.keep;
-    let near = crate::dd::first_part::Halo::around(boxes.clone(), D::N, s.world.alert * 1.01);
+    let near = near(&boxes);
     let keep = move |g: u32, b: &[[f64; 3]; 2]| keep[g as usize] || near.meets(b);
     load_part(s, registry, &sv, Part::new(Box::new(keep), 1.0 / f64::from(ranks)), (me, ranks))?;
     s.decomposition = decomposition;

@@ -174,7 +174,7 @@ pub fn restart_scene_on<D: Dim>(scene: &mut super::Scene<D>, path: &Path, on: Op
 /// contact read.
 pub(super) fn rank_part_of<D: Dim>(path: &Path, scene: &super::Scene<D>, on: Option<(u32, u32)>) -> Option<crate::dd::RestartPart> {
     match (on, &scene.decomposition) {
-        (Some((ranks, me)), Some(c)) if ranks > 1 && scene.families.is_empty() && !c.by_model => {
+        (Some((ranks, me)), Some(c)) if ranks > 1 && scene.families.is_empty() => {
             let grid_of = [c.dd.nx, c.dd.ny, c.dd.nz];
             nscdd_of(path).and_then(|s| s.rank_part(grid_of, c.by_model, ranks, me))
         }
@@ -367,7 +367,8 @@ mod tests {
     /// The `nscdd` part is found in a pretty state (also across the scan's 1 MiB
     /// chunks), in a compact one (parsed whole), the last of two keys as the
     /// streaming reader keeps it; none when absent. Its rank part gives every
-    /// contact to one rank of two: the kept one by its subdomain, another by its cell.
+    /// contact to one rank of two: the kept one by its subdomain, another by its cell,
+    /// by geometry and by model alike.
     #[test]
     fn the_nscdd_part_alone_and_its_rank_parts() {
         let pretty = |before: &str, value: &str| format!("{{\n  \"step\": 3,{before}\n  \"nscdd\": {value}\n}}\n");
@@ -395,6 +396,23 @@ mod tests {
         // kept in cell 1 although its point lies in cell 0: with the contacts of cell 1
         assert_eq!(kept, cell1);
         assert_ne!(cell0, cell1);
+        // by model: the same parts (a family's subdomain of a cell goes with the
+        // cell to its rank); a state by geometry read by model, or the reverse, is
+        // of another decomposition
+        let bm = read("g.json", &pretty("", &STATE.replace("\"by_model\": false", "\"by_model\": true"))).expect("by model");
+        let mut by_model: Vec<_> = (0..2).map(|me| bm.rank_part([2, 1, 1], true, 2, me).expect("a part")).collect();
+        let probes = [
+            (key(0, 1), [0.5, 0.5, 0.0]),
+            (key(2, 3), [0.5, 0.5, 0.0]),
+            (key(2, 3), [1.5, 0.5, 0.0]),
+        ];
+        for (k, p) in probes {
+            let by_cells: Vec<bool> = parts.iter_mut().map(|r| r.keeps(k, p)).collect();
+            let by_models: Vec<bool> = by_model.iter_mut().map(|r| r.keeps(k, p)).collect();
+            assert_eq!(by_cells, by_models, "{k:?} at {p:?}");
+        }
+        assert!(state.rank_part([2, 1, 1], true, 2, 0).is_none());
+        assert!(bm.rank_part([2, 1, 1], false, 2, 0).is_none());
         // one rank, another decomposition, more ranks than cells: every contact read
         assert!(state.rank_part([2, 1, 1], false, 1, 0).is_none());
         assert!(state.rank_part([1, 2, 1], false, 2, 0).is_none());

@@ -3,8 +3,9 @@
 //! first step after the restart keeps on this rank, decided before any body is
 //! built. A body is kept when its box at the saved position and orientation, grown
 //! by the alert distance, meets one of the rank's cells of the saved grid (the
-//! halo's own test, [`crate::dd::first_part::Halo`]), when it is one every rank
-//! steps, or when it is a body of a contact the rank keeps
+//! halo's own test, [`crate::dd::first_part::Halo`]) or the halo of the body
+//! families' boxes (the bodies their first step may read), when it is one every
+//! rank steps, or when it is a body of a contact the rank keeps
 //! ([`crate::dd::RestartPart`]). The second pass is the restart itself, into the
 //! part world ([`super::restart`]).
 //!
@@ -17,7 +18,7 @@
 //!
 //! ```text
 //! let halo = part.halo(D::N, alert * 1.01);
-//! let input = ScanInput { shapes: &survey_shapes, stores: &world.shapes, everywhere, halo: &halo };
+//! let input = ScanInput { shapes: &survey_shapes, stores: &world.shapes, everywhere, halo: &halo, near: &near };
 //! let kept = scan::<D>(path, &input, &mut part);
 //! // kept.keep[g]: build body g; kept.digest: every saved body's bits
 //! ```
@@ -59,6 +60,9 @@ pub(super) struct ScanInput<'a, D: Dim> {
     pub stores: &'a [Box<dyn ShapeStore<D>>],
     pub everywhere: &'a [u32],
     pub halo: &'a Halo,
+    /// Around the body families' boxes ([`crate::family::FamilyKind::load_boxes`]
+    /// given the saved state): the bodies their first step may read.
+    pub near: &'a Halo,
 }
 
 /// The scan of the state at `path` (module docs); `None` when the state cannot be
@@ -180,7 +184,7 @@ impl<'de, D: Dim> Visitor<'de> for Bodies<'_, '_, '_, D> {
             values.for_each(|x| s.hash.write_u64(x.to_bits()));
             // the box the first step computes (the world's orientation as read)
             let bx = store.aabb(shape.index, sb.position, rot).corners3();
-            s.keep[k] |= sc.halo.meets(&bx);
+            s.keep[k] |= sc.halo.meets(&bx) || sc.near.meets(&bx);
             k += 1;
         }
         if k != n {
