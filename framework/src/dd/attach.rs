@@ -121,6 +121,16 @@ pub trait Attached<F: Family> {
     /// (‖F(r)‖², ‖q‖²) of its contacts for the natural-map residual, from the written-back
     /// state and the world's velocities.
     fn residual_parts(&self, w: &F::World) -> (f64, f64);
+    /// [`Self::residual_parts`] of the contacts `contacts` ([`Self::points`] order,
+    /// ascending: those of one subdomain), after the step's results are shared
+    /// ([`Self::unpack_stepped`]). A family that gives them has its sums taken per
+    /// subdomain, by the rank solving it, and added in subdomain order with the
+    /// rigid contacts' of the subdomain (so on ranks only a subdomain's rank reads
+    /// its contacts' results). `None` (the default): its sums are taken whole, after
+    /// the subdomains'.
+    fn residual_parts_in(&self, _w: &F::World, _contacts: &[u32]) -> Option<(f64, f64)> {
+        None
+    }
     /// On MPI ranks with bodies held per rank ([`super::local`], [`super::owned`]):
     /// world bodies the family reads or its contacts touch, for the whole run
     /// (ascending global ids; those it may touch as it moves come from
@@ -234,24 +244,16 @@ impl<F: Family> std::fmt::Debug for Parts<F> {
 
 /// The attached families' results from the subdomains' parts into `w`; returns the
 /// natural-map residual of the whole contact problem (rigid and families'), its sums
-/// taken per subdomain and added in subdomain order.
+/// taken per subdomain (the rigid contacts' and each family's of the subdomain, for
+/// families giving them: [`Attached::residual_parts_in`]) and added in subdomain
+/// order, then the other families' whole. `owner`: each family's contacts'
+/// subdomains.
 pub(super) fn write_back_families<D: Family>(
     d: &super::partition::Decomposition<D>,
     w: &mut D::World,
-    (fams, stepped): (&mut [&mut dyn Attached<D>], &[bool]),
+    (fams, stepped, owner): (&mut [&mut dyn Attached<D>], &[bool], &[Vec<u32>]),
     mut ranks: Option<&mut super::ranks::RankState>,
 ) -> f64 {
-    // each subdomain's sums, by the rank that holds it, added in subdomain order
-    let sums = |s: usize, out: &mut Vec<f64>| {
-        let (a, b) = D::residual_parts_in(w, &d.subs[s].contact_global);
-        out.extend([a, b]);
-    };
-    let ns = d.subs.len();
-    let per_sub = super::rank_reduce::per_subdomain(ranks.as_deref_mut(), ns, 2, sums);
-    let (mut f2, mut q2) = (0.0, 0.0);
-    for x in per_sub.chunks_exact(2) {
-        (f2, q2) = (f2 + x[0], q2 + x[1]);
-    }
     for (f, fam) in fams.iter_mut().enumerate() {
         let parts: Vec<(u32, &dyn LocalPart<D>)> = d
             .subs
@@ -260,12 +262,43 @@ pub(super) fn write_back_families<D: Family>(
             .collect();
         fam.write_back(w, &parts);
     }
-    super::rank_solved::share_stepped(fams, stepped, ranks);
-    for fam in fams.iter() {
+    super::rank_solved::share_stepped(fams, stepped, ranks.as_deref_mut());
+    // each family's contacts by subdomain (ascending), whether it gives its sums per
+    // subdomain (the same answer for every call: a property of the family)
+    let by_sub: Vec<Vec<(u32, u32)>> = owner.iter().map(|o| by_subdomain(o)).collect();
+    let per_sub_fam: Vec<bool> = fams.iter().map(|f| f.residual_parts_in(w, &[]).is_some()).collect();
+    // each subdomain's sums, by the rank that holds it, added in subdomain order
+    let sums = |s: usize, out: &mut Vec<f64>| {
+        let (mut a, mut b) = D::residual_parts_in(w, &d.subs[s].contact_global);
+        for (f, fam) in fams.iter().enumerate().filter(|(f, _)| per_sub_fam[*f]) {
+            let list = &by_sub[f];
+            let lo = list.partition_point(|x| x.0 < s as u32);
+            let hi = list.partition_point(|x| x.0 <= s as u32);
+            let contacts: Vec<u32> = list[lo..hi].iter().map(|x| x.1).collect();
+            let (fa, fb) = fam.residual_parts_in(w, &contacts).unwrap_or_default();
+            (a, b) = (a + fa, b + fb);
+        }
+        out.extend([a, b]);
+    };
+    let ns = d.subs.len();
+    let per_sub = super::rank_reduce::per_subdomain(ranks, ns, 2, sums);
+    let (mut f2, mut q2) = (0.0, 0.0);
+    for x in per_sub.chunks_exact(2) {
+        (f2, q2) = (f2 + x[0], q2 + x[1]);
+    }
+    for (fam, _) in fams.iter().zip(&per_sub_fam).filter(|x| !*x.1) {
         let (a, b) = fam.residual_parts(w);
         (f2, q2) = (f2 + a, q2 + b);
     }
     crate::solver::nlgs::residual_of(f2, q2)
+}
+
+/// (subdomain, contact) of the contacts of `owner` (each contact's subdomain),
+/// ascending.
+fn by_subdomain(owner: &[u32]) -> Vec<(u32, u32)> {
+    let mut v: Vec<(u32, u32)> = owner.iter().enumerate().map(|(a, &s)| (s, a as u32)).collect();
+    v.sort_unstable();
+    v
 }
 
 /// Global impulses and velocities from the subdomains: a body with one copy takes

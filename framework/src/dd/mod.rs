@@ -551,7 +551,7 @@ impl<D: Family> NscddOf<D> {
             None => attach::write_back(d, w),
         }
         self.store.keep(&d.subs);
-        rep.solve.residual = attach::write_back_families(d, w, (fams, &self.fam_stepped), self.ranks.as_mut());
+        rep.solve.residual = attach::write_back_families(d, w, (fams, &self.fam_stepped, &self.fam_owner), self.ranks.as_mut());
         self.local.body_sub.clear();
         if let (true, false, Some(rs)) = (self.local.now, self.local.skip_view, self.ranks.as_mut()) {
             self.local.body_sub = shells::body_subdomains(rs, d, D::n_bodies(w));

@@ -152,6 +152,9 @@ impl<D: Dim> Attached<Rigid<D>> for GuardedFamily<D> {
     fn residual_parts(&self, w: &World<D>) -> (f64, f64) {
         self.guard.call(|| self.inner.residual_parts(w))
     }
+    fn residual_parts_in(&self, w: &World<D>, contacts: &[u32]) -> Option<(f64, f64)> {
+        self.guard.call(|| self.inner.residual_parts_in(w, contacts))
+    }
     fn held_everywhere(&self) -> Option<Vec<u32>> {
         self.guard.call(|| self.inner.held_everywhere())
     }

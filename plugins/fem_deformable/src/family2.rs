@@ -185,6 +185,11 @@ impl Attached<Rigid2> for Deformables2 {
     fn residual_parts(&self, w: &World2) -> (f64, f64) {
         Deformables2::residual_parts(self, &w.bodies.vel, |g| crate::family::slot(w, g))
     }
+    /// Per subdomain: on ranks only the contacts solved here are read.
+    fn residual_parts_in(&self, w: &World2, contacts: &[u32]) -> Option<(f64, f64)> {
+        let at = |g| crate::family::slot(w, g);
+        Some(self.residual_parts_of(&w.bodies.vel, at, contacts.iter().map(|&a| a as usize)))
+    }
     /// None by id: the world bodies near the deformable bodies ([`Self::reach`]).
     fn held_everywhere(&self) -> Option<Vec<u32>> {
         Some(Vec::new())

@@ -302,9 +302,14 @@ impl Deformables2 {
     /// (‖F(r)‖², ‖q‖²) of the deformable contacts (natural map, as the rigid ones).
     /// `at(g)`: the index in `vel` of the rigid body of global id g.
     pub fn residual_parts(&self, vel: &[[f64; 3]], at: impl Fn(u32) -> usize) -> (f64, f64) {
+        self.residual_parts_of(vel, at, 0..self.contacts.len())
+    }
+
+    /// [`Self::residual_parts`] of the contacts `contacts` only.
+    pub fn residual_parts_of(&self, vel: &[[f64; 3]], at: impl Fn(u32) -> usize, contacts: impl Iterator<Item = usize>) -> (f64, f64) {
         let c = &self.contacts;
         let (mut f2, mut q2) = (0.0, 0.0);
-        for a in 0..c.len() {
+        for a in contacts {
             let t = c.target[a];
             let anta = c.anta[a].rigid_at(&at);
             let mut u = local_velocity(&self.sets, vel, c.cand[a], anta, c.frame[a]);

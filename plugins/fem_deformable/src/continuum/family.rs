@@ -305,7 +305,16 @@ impl<D: Dim, const N: usize> Attached<Rigid<D>> for Continuum<D, N> {
         self.finish_velocities();
     }
     fn residual_parts(&self, w: &World<D>) -> (f64, f64) {
-        ties::residual_parts::<D, N>(&self.ties, &self.sets, (&w.bodies.vel, |g| slot(w, g)))
+        ties::residual_parts::<D, N>(&self.ties, &self.sets, (&w.bodies.vel, |g| slot(w, g)), 0..self.ties.len())
+    }
+    fn residual_parts_in(&self, w: &World<D>, contacts: &[u32]) -> Option<(f64, f64)> {
+        let ties = contacts.iter().map(|&a| a as usize);
+        Some(ties::residual_parts::<D, N>(
+            &self.ties,
+            &self.sets,
+            (&w.bodies.vel, |g| slot(w, g)),
+            ties,
+        ))
     }
     /// The tied grains, which it reads, and the band's grains, whose mass it shares
     /// (every rank holds and steps them; the family reads no other world body).

@@ -347,9 +347,10 @@ pub fn residual_parts<D: Dim, const N: usize>(
     t: &TieSet<N>,
     sets: &[NodeSet<N>],
     (vel, at): (&[D::Twist], impl Fn(u32) -> usize + Copy),
+    ties: impl Iterator<Item = usize>,
 ) -> (f64, f64) {
     let (mut f2, mut q2) = (0.0, 0.0);
-    for a in 0..t.len() {
+    for a in ties {
         let u = tie_velocity::<D, N>(t, a, (vel, at), &sets[t.body[a] as usize]);
         for c in 0..N {
             let (f, q) = (u[c] - t.target[a][c], t.u_free[a][c] - t.target[a][c]);
