@@ -31,11 +31,17 @@ pub struct FePart2 {
     contacts: FeContacts2,
     /// Index of each local contact in the family's contact set.
     global: Vec<u32>,
+    /// A part of another rank's subdomain, stepped in part: its entities and its
+    /// contacts' indices only, which receive their impulses ([`LocalPart::unpack`])
+    /// for [`Attached::write_back`].
+    shell: bool,
+    /// A shell's contacts' impulses, received.
+    r_in: Vec<[f64; 2]>,
 }
 
 impl LocalPart<Rigid2> for FePart2 {
     fn len(&self) -> usize {
-        self.contacts.len()
+        self.global.len()
     }
     fn entities(&self) -> &[u32] {
         &self.fe
@@ -85,14 +91,20 @@ impl LocalPart<Rigid2> for FePart2 {
             v[1] += d[1];
         }
     }
+    /// The impulses (the other ranks' families need no other number of a contact:
+    /// each rank's residual reads its own subdomains' contacts).
     fn pack(&self, out: &mut Vec<f64>) {
-        self.contacts.pack_results(out);
+        out.extend(self.contacts.r.iter().flatten());
     }
     fn packed_len(&self) -> usize {
-        FeContacts2::RESULTS * self.contacts.len()
+        2 * self.global.len()
     }
     fn unpack(&mut self, values: &[f64]) {
-        self.contacts.unpack_results(values);
+        let r = values.chunks_exact(2).map(|x| std::array::from_fn(|q| x[q]));
+        match self.shell {
+            true => self.r_in = r.collect(),
+            false => self.contacts.r.iter_mut().zip(r).for_each(|(a, b)| *a = b),
+        }
     }
     fn as_any(&self) -> &dyn Any {
         self
@@ -149,8 +161,15 @@ impl Attached<Rigid2> for Deformables2 {
     }
     fn split(&self, _w: &World2, owner: &[u32], copy: &mut dyn FnMut(u32, u32) -> u32) -> Vec<(u32, Box<dyn LocalPart<Rigid2>>)> {
         let c = &self.contacts;
-        let make = |p: &mut FePart2, b: u32| p.push_entity(b, self);
+        // stepped in part: the contacts solved here come from their own list, the
+        // other ranks' subdomains get shells ([`FePart2::shell`])
+        let own = self.stepped.solved();
+        let make = |p: &mut FePart2, b: u32| match p.shell {
+            true => p.fe.push(b),
+            false => p.push_entity(b, self),
+        };
         let parts = split_by(owner, self.bodies.len(), make, |s, part: &mut FePart2, contacts, entity| {
+            part.shell = own.is_some_and(|o| !o[contacts[0] as usize]);
             for &a in contacts {
                 let a = a as usize;
                 let mut cand = c.cand[a];
@@ -162,8 +181,12 @@ impl Attached<Rigid2> for Deformables2 {
                         Anta::Fe(side)
                     }
                 };
-                part.contacts.push_from(c, a, cand, anta);
                 part.global.push(a as u32);
+                match (part.shell, own) {
+                    (true, _) => {}
+                    (false, Some(_)) => part.contacts.push_from(&self.solved.list, self.solved.of[a] as usize, cand, anta),
+                    (false, None) => part.contacts.push_from(c, a, cand, anta),
+                }
             }
         });
         parts
@@ -175,7 +198,10 @@ impl Attached<Rigid2> for Deformables2 {
         for (_, p) in parts {
             let Some(p) = p.as_any().downcast_ref::<FePart2>() else { continue };
             for (l, &g) in p.global.iter().enumerate() {
-                self.contacts.results_from(g as usize, &p.contacts, l);
+                match p.shell {
+                    true => self.contacts.r[g as usize] = p.r_in[l],
+                    false => self.contacts.results_from(g as usize, &p.contacts, l),
+                }
             }
         }
         self.finish_velocities();

@@ -356,27 +356,6 @@ impl<C, A, F, B, const D: usize> Default for FeContacts<C, A, F, B, D> {
 }
 
 impl<C, A, F: Copy, B: Copy, const D: usize> FeContacts<C, A, F, B, D> {
-    /// Values per contact of [`Self::pack_results`].
-    pub const RESULTS: usize = 2 * D + 2;
-    /// A part's results between MPI ranks, flat: per contact its impulse, and its
-    /// u_free and target (computed by the rank solving it only, when the bodies
-    /// are stepped per rank: [`crate::stepped`]).
-    pub fn pack_results(&self, out: &mut Vec<f64>) {
-        for a in 0..self.r.len() {
-            out.extend_from_slice(&self.r[a]);
-            out.extend_from_slice(&self.u_free[a]);
-            out.extend([self.target[a].u_target, self.target[a].mu]);
-        }
-    }
-    /// Results [`Self::pack_results`]ed by another rank.
-    pub fn unpack_results(&mut self, v: &[f64]) {
-        for (a, x) in v.chunks_exact(Self::RESULTS).enumerate().take(self.r.len()) {
-            self.r[a].copy_from_slice(&x[..D]);
-            self.u_free[a].copy_from_slice(&x[D..2 * D]);
-            self.target[a].u_target = x[2 * D];
-            self.target[a].mu = x[2 * D + 1];
-        }
-    }
     /// Contact `a`'s results from contact `l` of `part` (a part's write-back).
     pub fn results_from(&mut self, a: usize, part: &Self, l: usize) {
         self.r[a] = part.r[l];

@@ -66,6 +66,8 @@ pub struct Deformables2 {
     pub frames: Vec<(f64, u32)>,
     /// The bodies this MPI rank steps ([`crate::stepped`]).
     pub stepped: crate::stepped::Stepped,
+    /// The contacts this MPI rank solves, stepped in part ([`crate::stepped::Solved`]).
+    pub solved: crate::stepped::Solved<FeContacts2>,
 }
 
 impl Deformables2 {
@@ -126,10 +128,24 @@ impl Deformables2 {
         self.prev
             .extend(self.contacts.key.iter().copied().zip(self.contacts.r.iter().copied()));
         self.prev.sort_unstable_by_key(|x| x.0);
-        let mut c = std::mem::take(&mut self.contacts);
+        // stepped in part, after the partition: only the contacts solved here, into
+        // `solved` (the family's list, built before it, keeps every contact)
+        let own = self.stepped.solved().map(<[bool]>::to_vec);
+        let mut c = match own {
+            None => std::mem::take(&mut self.contacts),
+            Some(_) => std::mem::take(&mut self.solved.list),
+        };
         c.clear();
+        self.solved.at.clear();
+        if own.is_none() {
+            self.solved.raw_at.clear();
+            self.solved.raw_at.resize(self.raw.len(), u32::MAX);
+        }
         let v_begin = w.velocity_begin();
-        for rc in &self.raw {
+        for (i, rc) in self.raw.iter().enumerate() {
+            if own.as_ref().is_some_and(|o| !self.solved.again(i, o)) {
+                continue;
+            }
             let bi = rc.body as usize;
             let set = &self.sets[bi];
             let k = set.nodes.binary_search(&rc.node).unwrap() as u32;
@@ -157,6 +173,9 @@ impl Deformables2 {
                 Ok(p) => self.prev[p].1,
                 Err(_) => [0.0, 0.0],
             };
+            if own.is_none() {
+                self.solved.raw_at[i] = c.len() as u32;
+            }
             c.cand.push(cand);
             c.anta.push(anta);
             c.frame.push(n);
@@ -174,7 +193,14 @@ impl Deformables2 {
             c.point.push(rc.point);
             c.key.push(key);
         }
-        self.contacts = c;
+        debug_assert!(own.is_none() || self.solved.at.len() == c.len(), "the contacts solved here built again");
+        match own {
+            None => self.contacts = c,
+            Some(_) => {
+                self.solved.list = c;
+                self.solved.index(self.contacts.len());
+            }
+        }
         let solves1: u64 = self.bodies.iter().map(|b| b.solves).sum();
         self.times.solves = solves1.saturating_sub(solves0);
         self.times.columns = (t1 - t0).as_secs_f64();

@@ -6,13 +6,16 @@
 //! computes the body's V_free, its columns of M̂⁻¹, its W_αα and u_free (the list
 //! built again, the same) and its V⁺. A body without contact is stepped by the
 //! rank that checked it at load ([`crate::scene::checked_by`]). Every rank still
-//! detects every contact and builds every part (positions, V⁻ and the impulses
-//! are the same on every rank). After the
-//! write-back, the first rank stepping a body sends its V⁺ to every rank
-//! ([`Stepped::pack`], [`Stepped::unpack`]) with the body's energies after the
-//! step (the history's columns, each body's computed once); the contacts'
-//! impulses, u_free and targets come with their parts' results, from the rank that
-//! solved them ([`crate::nodes::FeContacts::pack_results`]). A body not stepped
+//! detects every contact and builds the family's list of every contact
+//! (positions, V⁻ and the impulses are the same on every rank), but builds again
+//! with their numbers only the contacts it solves ([`Solved`]), and only the
+//! parts of its own subdomains; another rank's subdomain gets a shell part (its
+//! entities, and its contacts' indices, which receive their impulses from the
+//! rank solving them). After the write-back, the first rank stepping a body
+//! sends its V⁺ to every rank ([`Stepped::pack`], [`Stepped::unpack`]) with the
+//! body's energies after the step (the history's columns, each body's computed
+//! once). Each rank's residual reads only the contacts it solved (the family's
+//! sums per subdomain, [`nscdd::dd::Attached::residual_parts_in`]). A body not stepped
 //! here builds no G (its contacts' W_αα and parts are never used here), and
 //! once it has gone [`RELEASE_AFTER`] steps unstepped here its columns of M̂⁻¹
 //! and its G are dropped, with the factors of its M̂ if it is large
@@ -88,6 +91,8 @@ pub struct Stepped {
     /// The bodies that have just reached [`RELEASE_AFTER`] idle steps, and whether
     /// they have reached [`RELEASE_MATRICES_AFTER`].
     release: Vec<(u32, bool)>,
+    /// Per contact (the family's list), in part: whether this rank solves it.
+    solved: Vec<bool>,
 }
 
 impl Stepped {
@@ -121,12 +126,14 @@ impl Stepped {
             return false;
         };
         self.on = Some((on.rank, on.ranks));
+        self.solved.clear();
         self.mine.clear();
         self.mine.resize(n, false);
         self.sender.clear();
         self.sender.resize(n, u32::MAX);
         for (a, (c, f)) in contacts.enumerate() {
             let r = (on.rank_of)(a);
+            self.solved.push(r == on.rank);
             for x in std::iter::once(c).chain(f) {
                 let x = x as usize;
                 self.sender[x] = self.sender[x].min(r);
@@ -176,6 +183,13 @@ impl Stepped {
     /// Which bodies this rank steps (`None`: all of them).
     pub fn mask(&self) -> Option<&[bool]> {
         (self.held || self.on.is_some()).then_some(&self.mine[..])
+    }
+
+    /// Whether this rank solves each contact of the family's list, stepped in part
+    /// (after [`Self::decide`]; `None`: all of them, in one process and before the
+    /// partition).
+    pub fn solved(&self) -> Option<&[bool]> {
+        (self.on.is_some() && !self.held).then_some(&self.solved[..])
     }
 
     /// Whether this rank steps body `b`.
@@ -238,6 +252,49 @@ impl Stepped {
     }
 }
 
+/// The contacts this rank solves in a step stepped in part ([`Stepped::solved`]):
+/// built again after the partition with their numbers (W_αα, u_free, targets),
+/// while the family's list keeps every contact as one process has it (keys,
+/// sides, frames and, after the step, every impulse: [`crate::family2`]'s parts
+/// of other ranks' subdomains receive them).
+#[derive(Default)]
+pub struct Solved<Cs> {
+    /// Each raw contact's index in the family's list (`u32::MAX`: dropped), from
+    /// the build of the whole list.
+    pub raw_at: Vec<u32>,
+    /// The contacts solved here.
+    pub list: Cs,
+    /// Their indices in the family's list (ascending).
+    pub at: Vec<u32>,
+    /// Per contact of the family's list, its index in `list` (`u32::MAX`: solved
+    /// elsewhere).
+    pub of: Vec<u32>,
+}
+
+impl<Cs> Solved<Cs> {
+    /// After a build of the contacts solved here (`at` filled): `of` for a family
+    /// list of `n` contacts.
+    pub fn index(&mut self, n: usize) {
+        self.of.clear();
+        self.of.resize(n, u32::MAX);
+        for (l, &a) in self.at.iter().enumerate() {
+            self.of[a as usize] = l as u32;
+        }
+    }
+
+    /// Whether raw contact `i` is to be built again here (`own`: the family's
+    /// contacts solved here), its list index recorded in `at` if so.
+    pub fn again(&mut self, i: usize, own: &[bool]) -> bool {
+        match self.raw_at.get(i) {
+            Some(&a) if a != u32::MAX && own[a as usize] => {
+                self.at.push(a);
+                true
+            }
+            _ => false,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -294,5 +351,33 @@ mod tests {
         // one process: nothing stepped in part, nothing released
         assert!(!s.decide(2, None, std::iter::empty(), (1e-3, 0.5)));
         assert!(s.to_release().is_empty() && s.energies().is_none());
+    }
+
+    /// The contacts solved here: those of the rank's subdomains after the
+    /// partition, none before it (every contact built) nor in one process; built
+    /// again from the raw contacts kept in the family's list.
+    #[test]
+    fn the_contacts_solved_here_and_their_places() {
+        let mut s = Stepped::default();
+        s.hold(2);
+        assert!(s.solved().is_none(), "before the partition");
+        decide(&mut s, 1);
+        assert_eq!(s.solved(), Some(&[false, true][..]));
+        decide(&mut s, 0);
+        assert_eq!(s.solved(), Some(&[true, true][..]));
+        assert!(!s.decide(2, None, std::iter::empty(), (1e-3, 0.5)));
+        assert!(s.solved().is_none(), "one process");
+        // raw contacts 0, 2, 3 are the list's 0, 1, 2 (raw 1 dropped); list 1 is
+        // solved elsewhere
+        let mut sv = Solved::<()> {
+            raw_at: vec![0, u32::MAX, 1, 2],
+            ..Default::default()
+        };
+        let own = [true, false, true];
+        let again: Vec<bool> = (0..4).map(|i| sv.again(i, &own)).collect();
+        assert_eq!(again, [true, false, false, true]);
+        assert_eq!(sv.at, [0, 2]);
+        sv.index(3);
+        assert_eq!(sv.of, [0, u32::MAX, 1]);
     }
 }
