@@ -141,8 +141,23 @@ impl Attached<Rigid2> for Deformables2 {
             self.error = Some(e);
             self.stepped.hold(self.bodies.len());
         }
-        self.build_contacts(w);
+        // stepped in part, the contacts are built once the other ranks' columns of
+        // the bodies not stepped here have come ([`Self::unpack_solved`])
+        match part {
+            true => self.fill_step(),
+            false => self.build_contacts(w),
+        }
         part
+    }
+    /// The bodies stepped here whose contacts other ranks solve too: their free
+    /// velocity and G at their contact nodes.
+    fn pack_solved(&self, out: &mut Vec<(u32, Vec<f64>)>) {
+        crate::stepped::pack_solved(&self.stepped, &self.sets, out);
+    }
+    /// The other ranks' bodies of contacts solved here, then the contacts solved here.
+    fn unpack_solved(&mut self, w: &World2, from: &[(u32, Vec<f64>)]) {
+        crate::stepped::unpack_solved(&self.stepped, &mut self.sets, from);
+        self.build_list(w);
     }
     fn points(&self, out: &mut Vec<[f64; 3]>) {
         out.extend(self.contacts.point.iter().map(|p| [p[0], p[1], 0.0]));
@@ -239,15 +254,12 @@ impl Attached<Rigid2> for Deformables2 {
 }
 
 impl FePart2 {
-    /// A copy of body `b`: its contact nodes at their free velocity.
+    /// A copy of body `b`: its contact nodes at their free velocity (the family's
+    /// set holds it: [`crate::nodes::fill_set`], or the rank stepping the body sent
+    /// it, [`crate::stepped::unpack_solved`]).
     fn push_entity(&mut self, b: u32, fe: &Deformables2) {
         self.fe.push(b);
-        let body = &fe.bodies[b as usize];
-        let mut set = fe.sets[b as usize].clone();
-        for (kk, &nd) in set.nodes.iter().enumerate() {
-            set.v[kk] = [body.v_free[2 * nd as usize], body.v_free[2 * nd as usize + 1]];
-        }
-        self.sets.push(set);
+        self.sets.push(fe.sets[b as usize].clone());
     }
 }
 

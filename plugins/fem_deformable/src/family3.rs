@@ -30,16 +30,12 @@ pub struct FePart3 {
 }
 
 impl FePart3 {
-    /// A copy of body `b`: its contact nodes at their free velocity.
+    /// A copy of body `b`: its contact nodes at their free velocity (the family's
+    /// set holds it: [`crate::nodes::fill_set`], or the rank stepping the body sent
+    /// it, [`crate::stepped::unpack_solved`]).
     fn push_entity(&mut self, b: u32, fe: &Deformables3) {
         self.fe.push(b);
-        let body = &fe.bodies[b as usize];
-        let mut set = fe.sets[b as usize].clone();
-        for (kk, &nd) in set.nodes.iter().enumerate() {
-            let i = 3 * nd as usize;
-            set.v[kk] = [body.v_free[i], body.v_free[i + 1], body.v_free[i + 2]];
-        }
-        self.sets.push(set);
+        self.sets.push(fe.sets[b as usize].clone());
     }
 }
 
@@ -149,8 +145,23 @@ impl Attached<Rigid3> for Deformables3 {
             self.error = Some(e);
             self.stepped.hold(self.bodies.len());
         }
-        self.build_contacts(w);
+        // stepped in part, the contacts are built once the other ranks' columns of
+        // the bodies not stepped here have come ([`Self::unpack_solved`])
+        match part {
+            true => self.fill_step(),
+            false => self.build_contacts(w),
+        }
         part
+    }
+    /// The bodies stepped here whose contacts other ranks solve too: their free
+    /// velocity and G at their contact nodes.
+    fn pack_solved(&self, out: &mut Vec<(u32, Vec<f64>)>) {
+        crate::stepped::pack_solved(&self.stepped, &self.sets, out);
+    }
+    /// The other ranks' bodies of contacts solved here, then the contacts solved here.
+    fn unpack_solved(&mut self, w: &World3, from: &[(u32, Vec<f64>)]) {
+        crate::stepped::unpack_solved(&self.stepped, &mut self.sets, from);
+        self.build_list(w);
     }
     fn points(&self, out: &mut Vec<[f64; 3]>) {
         out.extend_from_slice(&self.contacts.point);

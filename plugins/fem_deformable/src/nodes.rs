@@ -65,6 +65,31 @@ impl<const D: usize> Clone for NodeSet<D> {
 }
 
 impl<const D: usize> NodeSet<D> {
+    /// The free velocity at the set's nodes and G (`v`: D values a node, `g`: its
+    /// blocks as [`fill_set`] lays them out), computed by the MPI rank stepping the
+    /// body ([`crate::stepped::Stepped::receives`]): the same numbers. Not kept as
+    /// a cache for a later [`fill_set`]. Wrong lengths leave v at 0 and G reading
+    /// as 0 (a rank that failed to step the body reports it).
+    pub fn set_received(&mut self, v: &[f64], g: &[f64]) {
+        let n = self.nodes.len();
+        if v.len() != D * n || g.len() != D * D * n * n {
+            return;
+        }
+        self.v.clear();
+        self.v.extend(v.chunks_exact(D).map(|x| std::array::from_fn(|c| x[c])));
+        self.g.clear();
+        self.g.extend_from_slice(g);
+        self.g_nodes.clone_from(&self.nodes);
+        self.g_of = (u64::MAX, f64::NAN);
+        self.g_current = true;
+    }
+
+    /// [`Self::set_received`]'s values, appended to `out`.
+    pub fn pack_received(&self, out: &mut Vec<f64>) {
+        out.extend(self.v.iter().flatten());
+        out.extend_from_slice(&self.g);
+    }
+
     /// Drops G (a body this MPI rank no longer steps,
     /// [`crate::stepped::RELEASE_AFTER`]); the next [`fill_set`] reads every block
     /// from the columns.

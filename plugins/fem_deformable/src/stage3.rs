@@ -105,9 +105,24 @@ impl Deformables3 {
     /// bodies this rank steps) and, for the bodies it steps ([`crate::stepped`]),
     /// G, W_αα, u_free and the targets.
     pub fn build_contacts(&mut self, w: &World3) {
+        self.fill_step();
+        self.build_list(w);
+    }
+
+    /// The node sets of the step's contact nodes: G and the free velocities there
+    /// of the bodies this rank steps (timed as the columns).
+    pub fn fill_step(&mut self) {
         let t0 = Instant::now();
         let solves0: u64 = self.bodies.iter().map(|b| b.solves).sum();
         self.fill_sets();
+        let solves1: u64 = self.bodies.iter().map(|b| b.solves).sum();
+        self.times.solves = solves1.saturating_sub(solves0);
+        self.times.columns = t0.elapsed().as_secs_f64();
+    }
+
+    /// [`Self::build_contacts`] after [`Self::fill_step`]: the contacts (frames,
+    /// W_αα, ū, warm start), stepped in part only those solved here.
+    pub fn build_list(&mut self, w: &World3) {
         let (h, theta) = (w.time.h, w.time.theta);
         self.prev.clear();
         self.prev
@@ -196,7 +211,10 @@ impl Deformables3 {
             c.point.push(rc.point);
             c.key.push(key);
         }
-        debug_assert!(own.is_none() || self.solved.at.len() == c.len(), "the contacts solved here built again");
+        debug_assert!(
+            own.is_none() || self.solved.at.len() == c.len(),
+            "the contacts solved here built again"
+        );
         match own {
             None => self.contacts = c,
             Some(_) => {
@@ -204,9 +222,6 @@ impl Deformables3 {
                 self.solved.index(self.contacts.len());
             }
         }
-        let solves1: u64 = self.bodies.iter().map(|b| b.solves).sum();
-        self.times.solves = solves1.saturating_sub(solves0);
-        self.times.columns = t0.elapsed().as_secs_f64();
     }
 
     /// The contact nodes of each body (sorted, unique) and their node sets (G blocks,

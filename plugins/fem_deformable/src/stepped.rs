@@ -74,8 +74,16 @@ pub struct Stepped {
     on: Option<(u32, u32)>,
     /// Before the partition of an NSCDD step: no body stepped yet.
     held: bool,
-    /// Per body, in part: whether this rank steps it.
+    /// Per body, in part: whether this rank steps it (the sender: the rank solving
+    /// most of its contacts; without contact, the rank that checked it).
     mine: Vec<bool>,
+    /// Per body, in part: whether this rank solves one of its contacts, and
+    /// whether another rank does too.
+    touched: Vec<bool>,
+    shared: Vec<bool>,
+    /// In part: (body, rank solving one of its contacts) of the bodies whose
+    /// contacts several ranks solve, ascending, once each.
+    solvers: Vec<(u32, u32)>,
     /// Per body, in part: the rank whose V⁺ every rank takes.
     sender: Vec<u32>,
     /// (h, θ) of the step in progress, in part.
@@ -127,25 +135,46 @@ impl Stepped {
         };
         self.on = Some((on.rank, on.ranks));
         self.solved.clear();
-        self.mine.clear();
-        self.mine.resize(n, false);
+        for v in [&mut self.mine, &mut self.touched, &mut self.shared] {
+            v.clear();
+            v.resize(n, false);
+        }
         self.sender.clear();
         self.sender.resize(n, u32::MAX);
+        // (body, rank solving one of its contacts), once per contact side
+        let mut by_body = Vec::new();
         for (a, (c, f)) in contacts.enumerate() {
             let r = (on.rank_of)(a);
             self.solved.push(r == on.rank);
             for x in std::iter::once(c).chain(f) {
-                let x = x as usize;
-                self.sender[x] = self.sender[x].min(r);
-                self.mine[x] |= r == on.rank;
+                by_body.push((x, r));
+                self.touched[x as usize] |= r == on.rank;
             }
         }
-        for (b, (s, m)) in self.sender.iter_mut().zip(self.mine.iter_mut()).enumerate() {
+        // a body is stepped by the rank solving most of its contacts (the lowest of
+        // those tied), the other ranks solving some receive its columns
+        by_body.sort_unstable();
+        self.solvers.clear();
+        for run in by_body.chunk_by(|a, b| a.0 == b.0) {
+            let x = run[0].0 as usize;
+            let mut best = (0usize, u32::MAX);
+            for same in run.chunk_by(|a, b| a.1 == b.1) {
+                if same.len() > best.0 {
+                    best = (same.len(), same[0].1);
+                }
+            }
+            self.sender[x] = best.1;
+            self.shared[x] = run[0].1 != run[run.len() - 1].1;
+            if self.shared[x] {
+                self.solvers.extend(run.chunk_by(|a, b| a.1 == b.1).map(|same| same[0]));
+            }
+        }
+        for (b, s) in self.sender.iter_mut().enumerate() {
             if *s == u32::MAX {
                 // (the rank that checked it at load: [`crate::scene::bodies_from`])
                 *s = crate::scene::checked_by(b, n, on.ranks);
-                *m = *s == on.rank;
             }
+            self.mine[b] = *s == on.rank;
         }
         let (_, after, matrices_after) = release_rule();
         self.idle.resize(n, after - 1);
@@ -190,6 +219,19 @@ impl Stepped {
     /// partition).
     pub fn solved(&self) -> Option<&[bool]> {
         (self.on.is_some() && !self.held).then_some(&self.solved[..])
+    }
+
+    /// Whether this rank sends body `b`'s columns at its contact nodes and its
+    /// free velocity there to the other ranks solving its contacts (it steps the
+    /// body, and another rank solves one of its contacts).
+    pub fn sends(&self, b: usize) -> bool {
+        self.on.is_some() && !self.held && self.mine[b] && self.shared[b]
+    }
+
+    /// Whether this rank solves one of body `b`'s contacts without stepping it (it
+    /// receives what [`Self::sends`] sends).
+    pub fn receives(&self, b: usize) -> bool {
+        self.on.is_some() && !self.held && self.touched[b] && !self.mine[b]
     }
 
     /// Whether this rank steps body `b`.
@@ -249,6 +291,51 @@ impl Stepped {
     /// exchanged.
     pub fn energies(&self) -> Option<&[[f64; 3]]> {
         self.energy_known.then_some(&self.energy[..])
+    }
+}
+
+/// The bodies stepped here whose contacts other ranks solve too, each as (body,
+/// its free velocity and G at its contact nodes: [`NodeSet::pack_received`]), in
+/// a message to each of those ranks; an empty message to the rank stepping a body
+/// whose contacts this rank solves (the relation is symmetric, as
+/// [`nscdd::dd::Attached::pack_solved`] needs).
+pub fn pack_solved<const D: usize>(stepped: &Stepped, sets: &[NodeSet<D>], out: &mut Vec<(u32, Vec<f64>)>) {
+    let Some((me, _)) = stepped.on.filter(|_| !stepped.held) else {
+        return;
+    };
+    let mut to: std::collections::BTreeMap<u32, Vec<f64>> = Default::default();
+    for run in stepped.solvers.chunk_by(|a, b| a.0 == b.0) {
+        let b = run[0].0 as usize;
+        let sender = stepped.sender[b];
+        if sender == me {
+            for &(_, r) in run.iter().filter(|x| x.1 != me) {
+                let m = to.entry(r).or_default();
+                m.push(b as f64);
+                sets[b].pack_received(m);
+            }
+        } else if run.iter().any(|x| x.1 == me) {
+            to.entry(sender).or_default();
+        }
+    }
+    out.extend(to);
+}
+
+/// The messages of [`pack_solved`]: the bodies whose contacts this rank solves
+/// without stepping them get their sender's free velocity and G
+/// ([`NodeSet::set_received`]; every rank holds the same node sets).
+pub fn unpack_solved<const D: usize>(stepped: &Stepped, sets: &mut [NodeSet<D>], from: &[(u32, Vec<f64>)]) {
+    for (_, all) in from {
+        let mut i = 0;
+        while let Some(&b) = all.get(i) {
+            let Some(set) = sets.get_mut(b as usize) else { break };
+            let n = set.len();
+            let (nv, ng) = (D * n, D * D * n * n);
+            let Some(x) = all.get(i + 1..i + 1 + nv + ng) else { break };
+            if stepped.receives(b as usize) {
+                set.set_received(&x[..nv], &x[nv..]);
+            }
+            i += 1 + nv + ng;
+        }
     }
 }
 
@@ -379,5 +466,43 @@ mod tests {
         assert_eq!(sv.at, [0, 2]);
         sv.index(3);
         assert_eq!(sv.of, [0, u32::MAX, 1]);
+    }
+
+    /// A body whose contacts ranks 0 (two) and 1 (one) solve, on 3 ranks: rank 0
+    /// steps it and sends its free velocity and G to rank 1 alone, which lists rank
+    /// 0 with an empty message (symmetric), and takes them; rank 2 sends nothing.
+    #[test]
+    fn a_shared_body_is_stepped_once_and_its_columns_sent() {
+        let rank_of = |a: usize| if a < 2 { 0 } else { 1 };
+        let decide_on = |me: u32| {
+            let mut s = Stepped::default();
+            let on = SolvedOn {
+                rank: me,
+                ranks: 3,
+                rank_of: &rank_of,
+            };
+            assert!(s.decide(1, Some(&on), [(0, None); 3].into_iter(), (1e-3, 0.5)));
+            s
+        };
+        let [s0, s1, s2] = [0, 1, 2].map(decide_on);
+        assert!(s0.steps(0) && !s1.steps(0) && !s2.steps(0));
+        assert!(s0.sends(0) && s1.receives(0) && !s2.receives(0));
+        let mut set = NodeSet::<2>::default();
+        set.nodes = vec![4];
+        set.v = vec![[1.0, 2.0]];
+        set.g = vec![3.0, 4.0, 5.0, 6.0];
+        let packed = |s: &Stepped| {
+            let mut out = Vec::new();
+            pack_solved(s, std::slice::from_ref(&set), &mut out);
+            out
+        };
+        let (p0, p1, p2) = (packed(&s0), packed(&s1), packed(&s2));
+        assert_eq!(p0, [(1, vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0])]);
+        assert_eq!(p1, [(0, vec![])]);
+        assert!(p2.is_empty());
+        let mut got = vec![NodeSet::<2>::default()];
+        got[0].nodes = vec![4];
+        unpack_solved(&s1, &mut got, &[(0, p0[0].1.clone())]);
+        assert_eq!((got[0].v.clone(), got[0].g.clone()), (set.v.clone(), set.g.clone()));
     }
 }
