@@ -207,17 +207,7 @@ impl Deformables2 {
             c.point.push(rc.point);
             c.key.push(key);
         }
-        debug_assert!(
-            own.is_none() || self.solved.at.len() == c.len(),
-            "the contacts solved here built again"
-        );
-        match own {
-            None => self.contacts = c,
-            Some(_) => {
-                self.solved.list = c;
-                self.solved.index(self.contacts.len());
-            }
-        }
+        self.solved.keep(c, &mut self.contacts, own.is_some(), FeContacts2::len);
     }
 
     /// The contact nodes of each body (sorted, unique) and their node sets (G blocks,

@@ -211,17 +211,7 @@ impl Deformables3 {
             c.point.push(rc.point);
             c.key.push(key);
         }
-        debug_assert!(
-            own.is_none() || self.solved.at.len() == c.len(),
-            "the contacts solved here built again"
-        );
-        match own {
-            None => self.contacts = c,
-            Some(_) => {
-                self.solved.list = c;
-                self.solved.index(self.contacts.len());
-            }
-        }
+        self.solved.keep(c, &mut self.contacts, own.is_some(), FeContacts3::len);
     }
 
     /// The contact nodes of each body (sorted, unique) and their node sets (G blocks,

@@ -2,17 +2,20 @@
 //! stepped per rank"). On an NSCDD step the family builds its contact list before
 //! the partition without any solve ([`Stepped::hold`]: no body stepped yet); after
 //! it the framework tells the family which rank solves each contact
-//! ([`nscdd::dd::SolvedOn`]), and only a rank solving some of a body's contacts
-//! computes the body's V_free, its columns of M̂⁻¹, its W_αα and u_free (the list
-//! built again, the same) and its V⁺. A body without contact is stepped by the
-//! rank that checked it at load ([`crate::scene::checked_by`]). Every rank still
+//! ([`nscdd::dd::SolvedOn`]), and one rank, the one solving most of a body's
+//! contacts, steps the body: computes its V_free, its columns of M̂⁻¹ and G at its
+//! contact nodes, and its V⁺. Another rank solving some of its contacts receives
+//! the free velocity and G at its contact nodes from it, point to point
+//! ([`pack_solved`], [`unpack_solved`]), for its W_αα, u_free and parts. A body
+//! without contact is stepped by the rank that checked it at load
+//! ([`crate::scene::checked_by`]). Every rank still
 //! detects every contact and builds the family's list of every contact
 //! (positions, V⁻ and the impulses are the same on every rank), but builds again
 //! with their numbers only the contacts it solves ([`Solved`]), and only the
 //! parts of its own subdomains; another rank's subdomain gets a shell part (its
 //! entities, and its contacts' indices, which receive their impulses from the
-//! rank solving them). After the write-back, the first rank stepping a body
-//! sends its V⁺ to every rank ([`Stepped::pack`], [`Stepped::unpack`]) with the
+//! rank solving them). After the write-back, the rank stepping a body sends its
+//! V⁺ to every rank ([`Stepped::pack`], [`Stepped::unpack`]) with the
 //! body's energies after the step (the history's columns, each body's computed
 //! once). Each rank's residual reads only the contacts it solved (the family's
 //! sums per subdomain, [`nscdd::dd::Attached::residual_parts_in`]). A body not stepped
@@ -116,7 +119,8 @@ impl Stepped {
 
     /// After the partition ([`nscdd::dd::Attached::solved_on`]; `None`: every body
     /// here), from the contacts' bodies (candidate, deformable antagonist) in the
-    /// family's order: a body is stepped by every rank solving one of its contacts.
+    /// family's order: a body is stepped by the rank solving most of its contacts
+    /// (the lowest of those tied).
     /// Whether the family is stepped in part. `ht`: the step's h and θ.
     pub fn decide(
         &mut self,
@@ -366,6 +370,19 @@ impl<Cs> Solved<Cs> {
         self.of.resize(n, u32::MAX);
         for (l, &a) in self.at.iter().enumerate() {
             self.of[a as usize] = l as u32;
+        }
+    }
+
+    /// A build's contacts `c` (`n`: their count): the family's list `list` (`own`
+    /// false: every contact), or the contacts solved here, one for each of `at`.
+    pub fn keep(&mut self, c: Cs, list: &mut Cs, own: bool, n: impl Fn(&Cs) -> usize) {
+        debug_assert!(!own || self.at.len() == n(&c), "the contacts solved here built again");
+        match own {
+            false => *list = c,
+            true => {
+                self.list = c;
+                self.index(n(list));
+            }
         }
     }
 
