@@ -139,7 +139,7 @@ impl Attached<Rigid2> for Deformables2 {
         // body is stepped here and the step's end reports it)
         if let Err(e) = self.free_step(w) {
             self.error = Some(e);
-            self.stepped.hold(self.bodies.len());
+            self.stepped.fail();
         }
         // stepped in part, the contacts are built once the other ranks' columns of
         // the bodies not stepped here have come ([`Self::unpack_solved`])

@@ -143,7 +143,7 @@ impl Attached<Rigid3> for Deformables3 {
         // body is stepped here and the step's end reports it)
         if let Err(e) = self.free_step(w) {
             self.error = Some(e);
-            self.stepped.hold(self.bodies.len());
+            self.stepped.fail();
         }
         // stepped in part, the contacts are built once the other ranks' columns of
         // the bodies not stepped here have come ([`Self::unpack_solved`])

@@ -73,12 +73,26 @@ impl<const D: usize> NodeSet<D> {
     pub fn set_received(&mut self, v: &[f64], g: &[f64]) {
         let n = self.nodes.len();
         if v.len() != D * n || g.len() != D * D * n * n {
-            return;
+            debug_assert!(false, "columns of {n} nodes received as {} and {} values", v.len(), g.len());
+            return self.forget_g();
         }
         self.v.clear();
         self.v.extend(v.chunks_exact(D).map(|x| std::array::from_fn(|c| x[c])));
         self.g.clear();
         self.g.extend_from_slice(g);
+        self.g_nodes.clone_from(&self.nodes);
+        self.g_of = (u64::MAX, f64::NAN);
+        self.g_current = true;
+    }
+
+    /// G and the velocities at the set's nodes all 0 (not kept as a cache): a body
+    /// whose sender failed in the step (which reports it).
+    pub fn forget_g(&mut self) {
+        let n = self.nodes.len();
+        self.v.clear();
+        self.v.resize(n, [0.0; D]);
+        self.g.clear();
+        self.g.resize(D * D * n * n, 0.0);
         self.g_nodes.clone_from(&self.nodes);
         self.g_of = (u64::MAX, f64::NAN);
         self.g_current = true;

@@ -51,6 +51,11 @@ pub struct FeTimes {
 #[derive(Default)]
 pub struct Deformables2 {
     pub bodies: Vec<FeBody>,
+    /// The step's contacts, every one (one process's list). Stepped in part on MPI
+    /// ranks, only the keys, sides, frames, points and impulses are the step's for
+    /// the contacts solved elsewhere; their W_αα, u_free and targets are the
+    /// build's before the partition, without solves (never read there: the
+    /// residual reads each rank's own contacts, [`crate::stepped::Solved`]).
     pub contacts: FeContacts2,
     pub sets: Vec<NodeSet>,
     pub alert: f64,

@@ -34,6 +34,11 @@ type AntaSide3 = (Anta3, [f64; 3], [f64; 3], u16, u32, u32, bool);
 #[derive(Default)]
 pub struct Deformables3 {
     pub bodies: Vec<FeBody>,
+    /// The step's contacts, every one (one process's list). Stepped in part on MPI
+    /// ranks, only the keys, sides, frames, points and impulses are the step's for
+    /// the contacts solved elsewhere; their W_αα, u_free and targets are the
+    /// build's before the partition, without solves (never read there: the
+    /// residual reads each rank's own contacts, [`crate::stepped::Solved`]).
     pub contacts: FeContacts3,
     pub sets: Vec<NodeSet3>,
     pub alert: f64,

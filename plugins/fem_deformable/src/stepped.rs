@@ -104,6 +104,8 @@ pub struct Stepped {
     release: Vec<(u32, bool)>,
     /// Per contact (the family's list), in part: whether this rank solves it.
     solved: Vec<bool>,
+    /// A failure in the step in progress on this rank ([`Self::fail`]).
+    failed: bool,
 }
 
 impl Stepped {
@@ -112,6 +114,7 @@ impl Stepped {
     pub fn hold(&mut self, n: usize) {
         self.on = None;
         self.held = true;
+        self.failed = false;
         self.energy_known = false;
         self.mine.clear();
         self.mine.resize(n, false);
@@ -130,6 +133,7 @@ impl Stepped {
         ht: (f64, f64),
     ) -> bool {
         self.held = false;
+        self.failed = false;
         self.energy_known = false;
         self.ht = ht;
         self.release.clear();
@@ -215,7 +219,7 @@ impl Stepped {
 
     /// Which bodies this rank steps (`None`: all of them).
     pub fn mask(&self) -> Option<&[bool]> {
-        (self.held || self.on.is_some()).then_some(&self.mine[..])
+        (self.held || self.failed || self.on.is_some()).then_some(&self.mine[..])
     }
 
     /// Whether this rank solves each contact of the family's list, stepped in part
@@ -223,6 +227,17 @@ impl Stepped {
     /// partition).
     pub fn solved(&self) -> Option<&[bool]> {
         (self.on.is_some() && !self.held).then_some(&self.solved[..])
+    }
+
+    /// A failure in the step on this rank after [`Self::decide`] (the assembly or
+    /// factorization of a body it steps; the step's end reports it): no body is
+    /// stepped here any more and nothing of them is sent ([`Self::pack`],
+    /// [`pack_solved`]), but this rank still exchanges (empty messages) with the
+    /// ranks it would have, so that none waits for it.
+    pub fn fail(&mut self) {
+        self.failed = true;
+        self.energy_known = false;
+        self.mine.fill(false);
     }
 
     /// Whether this rank sends body `b`'s columns at its contact nodes and its
@@ -257,7 +272,9 @@ impl Stepped {
     /// The bodies this rank sends: (body, its V⁺, its energies after the step) each,
     /// the energies at u⁺ ([`FeBody::u_next`], the position update's arithmetic).
     pub fn pack(&self, bodies: &[FeBody], out: &mut Vec<f64>) {
-        let Some((rank, _)) = self.on else { return };
+        let Some((rank, _)) = self.on.filter(|_| !self.failed) else {
+            return;
+        };
         let (h, theta) = self.ht;
         let mut u_next = Vec::new();
         for (b, body) in bodies.iter().enumerate().filter(|(b, _)| self.sender[*b] == rank) {
@@ -312,10 +329,13 @@ pub fn pack_solved<const D: usize>(stepped: &Stepped, sets: &[NodeSet<D>], out: 
         let b = run[0].0 as usize;
         let sender = stepped.sender[b];
         if sender == me {
+            // (an empty message after a failure here: [`Stepped::fail`])
             for &(_, r) in run.iter().filter(|x| x.1 != me) {
                 let m = to.entry(r).or_default();
-                m.push(b as f64);
-                sets[b].pack_received(m);
+                if stepped.sends(b) {
+                    m.push(b as f64);
+                    sets[b].pack_received(m);
+                }
             }
         } else if run.iter().any(|x| x.1 == me) {
             to.entry(sender).or_default();
@@ -328,6 +348,7 @@ pub fn pack_solved<const D: usize>(stepped: &Stepped, sets: &[NodeSet<D>], out: 
 /// without stepping them get their sender's free velocity and G
 /// ([`NodeSet::set_received`]; every rank holds the same node sets).
 pub fn unpack_solved<const D: usize>(stepped: &Stepped, sets: &mut [NodeSet<D>], from: &[(u32, Vec<f64>)]) {
+    let mut got = vec![false; sets.len()];
     for (_, all) in from {
         let mut i = 0;
         while let Some(&b) = all.get(i) {
@@ -337,9 +358,14 @@ pub fn unpack_solved<const D: usize>(stepped: &Stepped, sets: &mut [NodeSet<D>],
             let Some(x) = all.get(i + 1..i + 1 + nv + ng) else { break };
             if stepped.receives(b as usize) {
                 set.set_received(&x[..nv], &x[nv..]);
+                got[b as usize] = true;
             }
             i += 1 + nv + ng;
         }
+    }
+    // (a body whose sender failed in the step, which reports it: G and V_free 0)
+    for (_, set) in sets.iter_mut().enumerate().filter(|(b, _)| stepped.receives(*b) && !got[*b]) {
+        set.forget_g();
     }
 }
 
@@ -521,5 +547,18 @@ mod tests {
         got[0].nodes = vec![4];
         unpack_solved(&s1, &mut got, &[(0, p0[0].1.clone())]);
         assert_eq!((got[0].v.clone(), got[0].g.clone()), (set.v.clone(), set.g.clone()));
+        // rank 0 fails in the step (its body's assembly): it steps nothing, sends
+        // nothing of the body and no V⁺, but still exchanges with rank 1 (an empty
+        // message), whose set then reads no G and zero velocities
+        let mut f0 = decide_on(0);
+        f0.fail();
+        assert!(!f0.steps(0) && !f0.sends(0) && f0.mask() == Some(&[false][..]));
+        assert_eq!(packed(&f0), [(1, vec![])]);
+        let mut v = Vec::new();
+        f0.pack(&[], &mut v);
+        assert!(v.is_empty());
+        unpack_solved(&s1, &mut got, &[(0, vec![])]);
+        assert_eq!(got[0].v, [[0.0, 0.0]]);
+        assert_eq!(got[0].block(0, 0), [[0.0; 2]; 2]);
     }
 }
