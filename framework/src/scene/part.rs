@@ -218,7 +218,8 @@ fn load_whole<D: SceneDim>(
 
 /// [`load_on`] for a run restarted from the state at `path`, then the restart
 /// ([`super::restart_scene_on`]; returns what it returns). When the state's
-/// contacts are read in part (the state of the same decomposition by geometry), a
+/// contacts are read in part (the state of the same decomposition, by geometry or
+/// by model), a
 /// surveyed scene is loaded in part too: a first pass over the state marks the
 /// bodies of the rank's first step ([`super::restart_scan`]: its halo of the
 /// saved grid at the saved poses, those every rank steps, those of its kept

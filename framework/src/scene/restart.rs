@@ -156,8 +156,10 @@ pub fn restart_scene<D: Dim>(scene: &mut super::Scene<D>, path: &Path) -> Result
 }
 
 /// [`restart_scene`] as rank `me` of `ranks` MPI ranks (`on`; `None`: one process).
-/// When the run will hold its contacts per rank (a decomposition by geometry, no
-/// body families, the state of the same decomposition), the state's `nscdd` part is
+/// When the run will hold its contacts per rank (a decomposition by geometry or
+/// by model on no more ranks than cells, the families not yet loaded: a surveyed
+/// scene, [`super::part::restart_on`]; the state of the same decomposition), the
+/// state's `nscdd` part is
 /// read first (the rest of the file skipped) and then, as the file streams, each
 /// rank keeps only the contacts its subdomains get in the first step
 /// ([`crate::dd::RestartPart`]): the sample's contacts are never all on one rank.
