@@ -152,7 +152,13 @@ impl Attached<Rigid2> for Deformables2 {
     /// The bodies stepped here whose contacts other ranks solve too: their free
     /// velocity and G at their contact nodes.
     fn pack_solved(&self, out: &mut Vec<(u32, Vec<f64>)>) {
-        crate::stepped::pack_solved(&self.stepped, &self.sets, out);
+        let c = &self.contacts;
+        let anta = |a: usize| match c.anta[a] {
+            Anta::Fe(s) => Some((a, s)),
+            Anta::Rigid { .. } => None,
+        };
+        let sides = (0..c.len()).flat_map(|a| std::iter::once((a, c.cand[a])).chain(anta(a)));
+        crate::stepped::pack_solved(&self.stepped, &self.sets, sides, out);
     }
     /// The other ranks' bodies of contacts solved here, then the contacts solved here.
     fn unpack_solved(&mut self, w: &World2, from: &[(u32, Vec<f64>)]) {

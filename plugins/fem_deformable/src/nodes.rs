@@ -65,24 +65,46 @@ impl<const D: usize> Clone for NodeSet<D> {
 }
 
 impl<const D: usize> NodeSet<D> {
-    /// The free velocity at the set's nodes and G (`v`: D values a node, `g`: its
-    /// blocks as [`fill_set`] lays them out), computed by the MPI rank stepping the
-    /// body ([`crate::stepped::Stepped::receives`]): the same numbers. Not kept as
-    /// a cache for a later [`fill_set`]. Wrong lengths leave v at 0 and G reading
-    /// as 0 (a rank that failed to step the body reports it).
-    pub fn set_received(&mut self, v: &[f64], g: &[f64]) {
+    /// The free velocity at the set's nodes and the rows of G of the nodes `ks`
+    /// (`v`: D values a node; `rows`: for each node k of `ks`, the D rows D k + c of
+    /// G as [`fill_set`] lays them out), computed by the MPI rank stepping the body
+    /// ([`crate::stepped::Stepped::receives`]): the same numbers. The other rows are
+    /// 0: this rank reads only those of its contacts' nodes (W_αα's blocks, the
+    /// impulses' [`Self::apply`]). Not kept as a cache for a later [`fill_set`].
+    /// Wrong lengths or nodes leave G and v at 0 (a rank that failed to step the
+    /// body reports it).
+    pub fn set_received(&mut self, v: &[f64], ks: &[f64], rows: &[f64]) {
         let n = self.nodes.len();
-        if v.len() != D * n || g.len() != D * D * n * n {
-            debug_assert!(false, "columns of {n} nodes received as {} and {} values", v.len(), g.len());
+        let row = D * n;
+        let fits = v.len() == row && rows.len() == ks.len() * D * row && ks.iter().all(|&k| k >= 0.0 && (k as usize) < n);
+        if !fits {
+            debug_assert!(false, "the columns of {n} nodes received as {} values, {} rows", v.len(), ks.len());
             return self.forget_g();
         }
         self.v.clear();
         self.v.extend(v.chunks_exact(D).map(|x| std::array::from_fn(|c| x[c])));
         self.g.clear();
-        self.g.extend_from_slice(g);
+        self.g.resize(D * D * n * n, 0.0);
+        for (&k, block) in ks.iter().zip(rows.chunks_exact(D * row)) {
+            let at = D * k as usize * row;
+            self.g[at..at + D * row].copy_from_slice(block);
+        }
         self.g_nodes.clone_from(&self.nodes);
         self.g_of = (u64::MAX, f64::NAN);
         self.g_current = true;
+    }
+
+    /// [`Self::set_received`]'s values for the nodes `ks` (set indices, ascending),
+    /// appended to `out`: v, the count of `ks`, `ks`, their rows of G.
+    pub fn pack_received(&self, ks: &[u32], out: &mut Vec<f64>) {
+        let row = D * self.nodes.len();
+        out.extend(self.v.iter().flatten());
+        out.push(ks.len() as f64);
+        out.extend(ks.iter().map(|&k| k as f64));
+        for &k in ks {
+            let at = D * k as usize * row;
+            out.extend_from_slice(&self.g[at..at + D * row]);
+        }
     }
 
     /// G and the velocities at the set's nodes all 0 (not kept as a cache): a body
@@ -96,12 +118,6 @@ impl<const D: usize> NodeSet<D> {
         self.g_nodes.clone_from(&self.nodes);
         self.g_of = (u64::MAX, f64::NAN);
         self.g_current = true;
-    }
-
-    /// [`Self::set_received`]'s values, appended to `out`.
-    pub fn pack_received(&self, out: &mut Vec<f64>) {
-        out.extend(self.v.iter().flatten());
-        out.extend_from_slice(&self.g);
     }
 
     /// Drops G (a body this MPI rank no longer steps,

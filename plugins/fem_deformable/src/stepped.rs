@@ -32,7 +32,7 @@
 //! ([`crate::stage2::free_velocities`]).
 
 use crate::body::FeBody;
-use crate::nodes::NodeSet;
+use crate::nodes::{FeSide, NodeSet};
 use nscdd::dd::SolvedOn;
 
 /// Steps a body goes unstepped on a rank before the rank drops its factors of M̂,
@@ -102,8 +102,10 @@ pub struct Stepped {
     /// The bodies that have just reached [`RELEASE_AFTER`] idle steps, and whether
     /// they have reached [`RELEASE_MATRICES_AFTER`].
     release: Vec<(u32, bool)>,
-    /// Per contact (the family's list), in part: whether this rank solves it.
+    /// Per contact (the family's list), in part: whether this rank solves it, and
+    /// the rank that does.
     solved: Vec<bool>,
+    rank: Vec<u32>,
     /// A failure in the step in progress on this rank ([`Self::fail`]).
     failed: bool,
 }
@@ -143,6 +145,7 @@ impl Stepped {
         };
         self.on = Some((on.rank, on.ranks));
         self.solved.clear();
+        self.rank.clear();
         for v in [&mut self.mine, &mut self.touched, &mut self.shared] {
             v.clear();
             v.resize(n, false);
@@ -154,6 +157,7 @@ impl Stepped {
         for (a, (c, f)) in contacts.enumerate() {
             let r = (on.rank_of)(a);
             self.solved.push(r == on.rank);
+            self.rank.push(r);
             for x in std::iter::once(c).chain(f) {
                 by_body.push((x, r));
                 self.touched[x as usize] |= r == on.rank;
@@ -316,25 +320,42 @@ impl Stepped {
 }
 
 /// The bodies stepped here whose contacts other ranks solve too, each as (body,
-/// its free velocity and G at its contact nodes: [`NodeSet::pack_received`]), in
-/// a message to each of those ranks; an empty message to the rank stepping a body
-/// whose contacts this rank solves (the relation is symmetric, as
-/// [`nscdd::dd::Attached::pack_solved`] needs).
-pub fn pack_solved<const D: usize>(stepped: &Stepped, sets: &[NodeSet<D>], out: &mut Vec<(u32, Vec<f64>)>) {
+/// its free velocity at its contact nodes, and the rows of G of the nodes the
+/// receiver's contacts touch: [`NodeSet::pack_received`]), in a message to each of
+/// those ranks; an empty message to the rank stepping a body whose contacts this
+/// rank solves (the relation is symmetric, as
+/// [`nscdd::dd::Attached::pack_solved`] needs). `sides`: the deformable sides of
+/// the family's contacts, (contact, side).
+pub fn pack_solved<const D: usize>(
+    stepped: &Stepped,
+    sets: &[NodeSet<D>],
+    sides: impl Iterator<Item = (usize, FeSide<D>)>,
+    out: &mut Vec<(u32, Vec<f64>)>,
+) {
     let Some((me, _)) = stepped.on.filter(|_| !stepped.held) else {
         return;
     };
+    // (body, receiving rank, node of the set) of the bodies sent, ascending, once
+    let mut rows: Vec<(u32, u32, u32)> = sides
+        .filter(|(a, s)| stepped.sends(s.body as usize) && stepped.rank[*a] != me)
+        .flat_map(|(a, s)| s.k.map(|k| (s.body, stepped.rank[a], k)))
+        .collect();
+    rows.sort_unstable();
+    rows.dedup();
     let mut to: std::collections::BTreeMap<u32, Vec<f64>> = Default::default();
     for run in stepped.solvers.chunk_by(|a, b| a.0 == b.0) {
-        let b = run[0].0 as usize;
-        let sender = stepped.sender[b];
+        let b = run[0].0;
+        let sender = stepped.sender[b as usize];
         if sender == me {
             // (an empty message after a failure here: [`Stepped::fail`])
             for &(_, r) in run.iter().filter(|x| x.1 != me) {
                 let m = to.entry(r).or_default();
-                if stepped.sends(b) {
-                    m.push(b as f64);
-                    sets[b].pack_received(m);
+                if stepped.sends(b as usize) {
+                    let lo = rows.partition_point(|x| (x.0, x.1) < (b, r));
+                    let hi = rows.partition_point(|x| (x.0, x.1) <= (b, r));
+                    let ks: Vec<u32> = rows[lo..hi].iter().map(|x| x.2).collect();
+                    m.push(f64::from(b));
+                    sets[b as usize].pack_received(&ks, m);
                 }
             }
         } else if run.iter().any(|x| x.1 == me) {
@@ -351,16 +372,21 @@ pub fn unpack_solved<const D: usize>(stepped: &Stepped, sets: &mut [NodeSet<D>],
     let mut got = vec![false; sets.len()];
     for (_, all) in from {
         let mut i = 0;
+        // (body, v: D n, m, m nodes, their m D rows of D n values) each
         while let Some(&b) = all.get(i) {
             let Some(set) = sets.get_mut(b as usize) else { break };
-            let n = set.len();
-            let (nv, ng) = (D * n, D * D * n * n);
-            let Some(x) = all.get(i + 1..i + 1 + nv + ng) else { break };
+            let nv = D * set.len();
+            let Some(&m) = all.get(i + 1 + nv) else { break };
+            let (ks, rows) = (i + 2 + nv, i + 2 + nv + m as usize);
+            let end = rows + m as usize * D * nv;
+            if all.len() < end {
+                break;
+            }
             if stepped.receives(b as usize) {
-                set.set_received(&x[..nv], &x[nv..]);
+                set.set_received(&all[i + 1..i + 1 + nv], &all[ks..rows], &all[rows..end]);
                 got[b as usize] = true;
             }
-            i += 1 + nv + ng;
+            i = end;
         }
     }
     // (a body whose sender failed in the step, which reports it: G and V_free 0)
@@ -536,17 +562,38 @@ mod tests {
         set.g = vec![3.0, 4.0, 5.0, 6.0];
         let packed = |s: &Stepped| {
             let mut out = Vec::new();
-            pack_solved(s, std::slice::from_ref(&set), &mut out);
+            let sides = (0..3).map(|a| (a, FeSide::node(0, 0)));
+            pack_solved(s, std::slice::from_ref(&set), sides, &mut out);
             out
         };
         let (p0, p1, p2) = (packed(&s0), packed(&s1), packed(&s2));
-        assert_eq!(p0, [(1, vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0])]);
+        // (body 0, v, one node: set index 0, its two rows of G)
+        assert_eq!(p0, [(1, vec![0.0, 1.0, 2.0, 1.0, 0.0, 3.0, 4.0, 5.0, 6.0])]);
         assert_eq!(p1, [(0, vec![])]);
         assert!(p2.is_empty());
         let mut got = vec![NodeSet::<2>::default()];
         got[0].nodes = vec![4];
         unpack_solved(&s1, &mut got, &[(0, p0[0].1.clone())]);
         assert_eq!((got[0].v.clone(), got[0].g.clone()), (set.v.clone(), set.g.clone()));
+        // two contact nodes, rank 1's contact at the second only: only its rows of G
+        // are sent, the others read 0 there
+        let mut two = NodeSet::<2>::default();
+        two.nodes = vec![4, 7];
+        two.v = vec![[1.0, 2.0], [3.0, 4.0]];
+        two.g = (0..16).map(f64::from).collect();
+        let mut out = Vec::new();
+        let sides = [(0, FeSide::node(0, 0)), (1, FeSide::node(0, 0)), (2, FeSide::node(0, 1))];
+        pack_solved(&s0, std::slice::from_ref(&two), sides.into_iter(), &mut out);
+        let mut rows: Vec<f64> = vec![0.0, 1.0, 2.0, 3.0, 4.0, 1.0, 1.0];
+        rows.extend((8..16).map(f64::from));
+        assert_eq!(out, [(1, rows.clone())]);
+        let mut got2 = vec![NodeSet::<2>::default()];
+        got2[0].nodes = vec![4, 7];
+        unpack_solved(&s1, &mut got2, &[(0, rows)]);
+        assert_eq!(got2[0].v, two.v);
+        assert_eq!(got2[0].block(1, 0), two.block(1, 0));
+        assert_eq!(got2[0].block(1, 1), two.block(1, 1));
+        assert_eq!(got2[0].block(0, 0), [[0.0; 2]; 2]);
         // rank 0 fails in the step (its body's assembly): it steps nothing, sends
         // nothing of the body and no V⁺, but still exchanges with rank 1 (an empty
         // message), whose set then reads no G and zero velocities
