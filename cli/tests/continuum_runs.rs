@@ -60,8 +60,9 @@ mod mpi_common;
 /// On 2 and 4 ranks, by model and by geometry: final.json is one process's. Each
 /// rank holds only its part of the grains (its halo and the tied grains,
 /// `Attached::held_everywhere`; by model only with at least as many cells as ranks),
-/// and by geometry a state written by 2 ranks restarts on 4 and in one process to
-/// the same end; with compliant grains too (the band's stiffness shares).
+/// and a state written by 2 ranks restarts on 4 (by model: on 2) and in one
+/// process to the same end, each rank reading its part of the state; with
+/// compliant grains too (the band's stiffness shares).
 #[cfg(feature = "mpi")]
 #[test]
 fn continuum_scenes_on_ranks_give_the_one_process_result() {
@@ -105,25 +106,34 @@ fn continuum_scenes_on_ranks_give_the_one_process_result() {
                 "{dec:?}, {n} ranks: {loaded:?} of {bodies} bodies loaded"
             );
         }
-        if geometry {
-            let first = write(&dir, "first.toml", &footing(10, "", dec));
-            let half = dir.join("half");
-            ok(&mpirun(&[(2, args(&first, &half, &[]))]), "10 steps on 2 ranks");
-            let state = half.join("final.json");
-            let restart = ["--restart", state.to_str().unwrap()];
-            let on4 = dir.join("restart4");
-            ok(&mpirun(&[(4, args(&scene, &on4, &restart))]), "the restart on 4 ranks");
-            assert!(final_json(&on4) == reference, "a restart on 4 ranks ends elsewhere");
-            // loaded in part (the region's mesh box, the saved state's halos)
-            let loaded = per_rank_count(&on4, "loaded_bodies");
-            assert!(
-                loaded.iter().all(|&l| l > 0 && l < bodies),
-                "the restart on 4 ranks: {loaded:?} of {bodies} bodies loaded"
-            );
-            let on1 = dir.join("restart1");
-            ok(&nscdd(&args(&scene, &on1, &restart)), "the restart in one process");
-            assert!(final_json(&on1) == reference, "a restart in one process ends elsewhere");
-        }
+        // a state written by 2 ranks restarts on 4 ranks (by model: on 2, as many as
+        // its cells) and in one process to the same end
+        let first = write(&dir, "first.toml", &footing(10, "", dec));
+        let half = dir.join(format!("half{cells}"));
+        ok(&mpirun(&[(2, args(&first, &half, &[]))]), "10 steps on 2 ranks");
+        let state = half.join("final.json");
+        let restart = ["--restart", state.to_str().unwrap()];
+        let m = if geometry { 4 } else { 2 };
+        let on = dir.join(format!("restart{cells}_{m}"));
+        ok(&mpirun(&[(m, args(&scene, &on, &restart))]), "the restart on ranks");
+        assert!(final_json(&on) == reference, "{dec:?}: a restart on {m} ranks ends elsewhere");
+        // loaded in part (the region's mesh box, the saved state's halos), each rank
+        // reading its contacts of the state
+        let loaded = per_rank_count(&on, "loaded_bodies");
+        assert!(
+            loaded.iter().all(|&l| l > 0 && l < bodies),
+            "{dec:?}: the restart on {m} ranks: {loaded:?} of {bodies} bodies loaded"
+        );
+        let saved: serde_json::Value = serde_json::from_str(&final_json(&half)).expect("state");
+        let nc = saved["contacts"].as_array().expect("contacts").len() as u64;
+        let read = per_rank_count(&on, "restart_contacts");
+        assert!(
+            nc > 0 && read.iter().sum::<u64>() == nc && read.iter().all(|&r| r < nc),
+            "{dec:?}: the restart on {m} ranks read {read:?} of {nc} contacts"
+        );
+        let on1 = dir.join(format!("restart{cells}_1"));
+        ok(&nscdd(&args(&scene, &on1, &restart)), "the restart in one process");
+        assert!(final_json(&on1) == reference, "{dec:?}: a restart in one process ends elsewhere");
     }
     // compliant grains: the band's share 1 − α of a contact's stiffness looks up its
     // grains by id, on a rank's world holding a part as in one process
