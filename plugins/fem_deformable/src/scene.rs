@@ -250,12 +250,7 @@ pub fn refuse_compliant<D: nscdd::dim::Dim>(bodies: &[FeBody], w: &World<D>) -> 
 /// degree of freedom; of a box of 20³ and 30³ cells, 18 and 17 kB per degree of
 /// freedom, growing as the factor's fill-in), rounded up. An order of magnitude.
 pub fn mesh_bytes(dim: usize, nodes: f64) -> f64 {
-    let dofs = dim as f64 * nodes.max(0.0);
-    if dim == 2 {
-        3000.0 * dofs
-    } else {
-        500.0 * dofs * dofs.cbrt()
-    }
+    bytes_per_dof(dim, nodes, (3000.0, 500.0))
 }
 
 /// Bytes of a body's M, K and factors of M̂ alone (what a rank drops when it does
@@ -265,11 +260,17 @@ pub fn mesh_bytes(dim: usize, nodes: f64) -> f64 {
 /// of freedom, growing as the factor's fill-in, d^⅓), rounded. An order of
 /// magnitude.
 pub fn matrices_bytes(dim: usize, nodes: f64) -> f64 {
+    bytes_per_dof(dim, nodes, (650.0, 300.0))
+}
+
+/// `c2` bytes a degree of freedom d in 2D, `c3` d^⅓ in 3D (the factor's fill-in),
+/// for a body of `nodes` nodes.
+fn bytes_per_dof(dim: usize, nodes: f64, (c2, c3): (f64, f64)) -> f64 {
     let dofs = dim as f64 * nodes.max(0.0);
     if dim == 2 {
-        650.0 * dofs
+        c2 * dofs
     } else {
-        300.0 * dofs * dofs.cbrt()
+        c3 * dofs * dofs.cbrt()
     }
 }
 
