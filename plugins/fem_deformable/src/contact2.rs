@@ -54,6 +54,15 @@ impl Anta {
             side => side,
         }
     }
+
+    /// The deformable side, if the antagonist is one.
+    #[inline]
+    pub fn fe(self) -> Option<FeSide> {
+        match self {
+            Anta::Fe(s) => Some(s),
+            Anta::Rigid { .. } => None,
+        }
+    }
 }
 
 impl NodeSet {

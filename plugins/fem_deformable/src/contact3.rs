@@ -58,6 +58,15 @@ impl Anta3 {
             side => side,
         }
     }
+
+    /// The deformable side, if the antagonist is one.
+    #[inline]
+    pub fn fe(self) -> Option<FeSide3> {
+        match self {
+            Anta3::Fe(s) => Some(s),
+            Anta3::Rigid { .. } => None,
+        }
+    }
 }
 
 /// The 3D contacts of deformable bodies of one step; the frame is the basis

@@ -32,7 +32,7 @@ pub struct FePart3 {
 impl FePart3 {
     /// A copy of body `b`: its contact nodes at their free velocity (the family's
     /// set holds it: [`crate::nodes::fill_set`], or the rank stepping the body sent
-    /// it, [`crate::stepped::unpack_solved`]).
+    /// it, [`crate::solved::unpack_solved`]).
     fn push_entity(&mut self, b: u32, fe: &Deformables3) {
         self.fe.push(b);
         self.sets.push(fe.sets[b as usize].clone());
@@ -130,13 +130,7 @@ impl Attached<Rigid3> for Deformables3 {
     /// velocities, and the contacts built again with their numbers.
     fn solved_on(&mut self, w: &World3, on: Option<&SolvedOn<'_>>) -> bool {
         let c = &self.contacts;
-        let sides = (0..c.len()).map(|a| {
-            let anta = match c.anta[a] {
-                Anta3::Fe(s) => Some(s.body),
-                Anta3::Rigid { .. } => None,
-            };
-            (c.cand[a].body, anta)
-        });
+        let sides = (0..c.len()).map(|a| (c.cand[a].body, c.anta[a].fe().map(|s| s.body)));
         let part = self.stepped.decide(self.bodies.len(), on, sides, (w.time.h, w.time.theta));
         self.stepped.release(&mut self.bodies, &mut self.sets);
         // (a large body this rank steps first is assembled here: if that fails, no
@@ -157,16 +151,12 @@ impl Attached<Rigid3> for Deformables3 {
     /// velocity and G at their contact nodes.
     fn pack_solved(&self, out: &mut Vec<(u32, Vec<f64>)>) {
         let c = &self.contacts;
-        let anta = |a: usize| match c.anta[a] {
-            Anta3::Fe(s) => Some((a, s)),
-            Anta3::Rigid { .. } => None,
-        };
-        let sides = (0..c.len()).flat_map(|a| std::iter::once((a, c.cand[a])).chain(anta(a)));
-        crate::stepped::pack_solved(&self.stepped, &self.sets, sides, out);
+        let sides = (0..c.len()).flat_map(|a| std::iter::once((a, c.cand[a])).chain(c.anta[a].fe().map(|s| (a, s))));
+        crate::solved::pack_solved(&self.stepped, &self.sets, sides, out);
     }
     /// The other ranks' bodies of contacts solved here, then the contacts solved here.
     fn unpack_solved(&mut self, w: &World3, from: &[(u32, Vec<f64>)]) {
-        crate::stepped::unpack_solved(&self.stepped, &mut self.sets, from);
+        crate::solved::unpack_solved(&self.stepped, &mut self.sets, from);
         self.build_list(w);
     }
     fn points(&self, out: &mut Vec<[f64; 3]>) {

@@ -103,10 +103,7 @@ pub fn share<A: Copy, F: Copy, B: Copy, const D: usize>(
 pub fn share2(fe: &crate::stage2::Deformables2, w: &nscdd::world::World2) -> FamilyShare {
     use crate::contact2::Anta;
     let rows = |n: &[f64; 2]| [[n[0], n[1]], [-n[1], n[0]]];
-    let anta_fe = |a: &Anta| match a {
-        Anta::Fe(s) => Some(*s),
-        Anta::Rigid { .. } => None,
-    };
+    let anta_fe = |a: &Anta| a.fe();
     let rigid = |a: &Anta, n: &[f64; 2]| match a {
         Anta::Rigid { body, arm } => Some((*body, vec![-n[0], -n[1], -arm[0], n[1], -n[0], -arm[1]])),
         Anta::Fe(_) => None,
@@ -124,10 +121,7 @@ pub fn share3(fe: &crate::stage3::Deformables3, w: &nscdd::world::World3) -> Fam
     use crate::contact3::{Anta3, Basis};
     use nscdd::dim::d3::cross;
     let rows = |b: &Basis| *b;
-    let anta_fe = |a: &Anta3| match a {
-        Anta3::Fe(s) => Some(*s),
-        Anta3::Rigid { .. } => None,
-    };
+    let anta_fe = |a: &Anta3| a.fe();
     let rigid = |a: &Anta3, b: &Basis| match a {
         Anta3::Rigid { body, d } => {
             let mut rows = Vec::with_capacity(18);

@@ -55,7 +55,7 @@ pub struct Deformables2 {
     /// ranks, only the keys, sides, frames, points and impulses are the step's for
     /// the contacts solved elsewhere; their W_αα, u_free and targets are the
     /// build's before the partition, without solves (never read there: the
-    /// residual reads each rank's own contacts, [`crate::stepped::Solved`]).
+    /// residual reads each rank's own contacts, [`crate::solved::Solved`]).
     pub contacts: FeContacts2,
     pub sets: Vec<NodeSet>,
     pub alert: f64,
@@ -71,8 +71,8 @@ pub struct Deformables2 {
     pub frames: Vec<(f64, u32)>,
     /// The bodies this MPI rank steps ([`crate::stepped`]).
     pub stepped: crate::stepped::Stepped,
-    /// The contacts this MPI rank solves, stepped in part ([`crate::stepped::Solved`]).
-    pub solved: crate::stepped::Solved<FeContacts2>,
+    /// The contacts this MPI rank solves, stepped in part ([`crate::solved::Solved`]).
+    pub solved: crate::solved::Solved<FeContacts2>,
 }
 
 impl Deformables2 {
@@ -149,7 +149,7 @@ impl Deformables2 {
         self.prev.sort_unstable_by_key(|x| x.0);
         // stepped in part, after the partition: only the contacts solved here, into
         // `solved` (the family's list, built before it, keeps every contact)
-        let own = self.stepped.solved().map(<[bool]>::to_vec);
+        let own = self.stepped.solved();
         let mut c = match own {
             None => std::mem::take(&mut self.contacts),
             Some(_) => std::mem::take(&mut self.solved.list),
@@ -162,7 +162,7 @@ impl Deformables2 {
         }
         let v_begin = w.velocity_begin();
         for (i, rc) in self.raw.iter().enumerate() {
-            if own.as_ref().is_some_and(|o| !self.solved.again(i, o)) {
+            if own.is_some_and(|o| !self.solved.again(i, o)) {
                 continue;
             }
             let bi = rc.body as usize;
@@ -312,10 +312,7 @@ impl Deformables2 {
     pub fn finish_velocities(&mut self) {
         let c = &self.contacts;
         let impulses = (0..c.len()).map(|a| {
-            let anta = match c.anta[a] {
-                Anta::Fe(s) => Some(s),
-                Anta::Rigid { .. } => None,
-            };
+            let anta = c.anta[a].fe();
             (c.cand[a], anta, global(c.frame[a], c.r[a]))
         });
         crate::nodes::velocities_after(&mut self.bodies, &self.sets, impulses, self.stepped.mask());
