@@ -42,7 +42,7 @@
 //! [`LocalPart::sweep`] visits all its contacts in the family's own code.
 
 use super::family::Family;
-pub use super::rank_solved::SolvedOn;
+pub use super::rank_solved::{Rounds, SolvedOn};
 use super::subdomain::SubdomainSolver;
 use crate::norms::Sums;
 use std::any::Any;

@@ -81,7 +81,7 @@ pub mod team;
 pub mod transport;
 
 use crate::model::ContactKey;
-pub use attach::{Attached, EntityInfo, LocalPart, SolvedOn};
+pub use attach::{Attached, EntityInfo, LocalPart, Rounds, SolvedOn};
 pub use census::Census;
 pub use cluster::{Cluster, Solo};
 pub use config::{Balance, DdConfig};
@@ -384,7 +384,7 @@ impl<D: Family> NscddOf<D> {
         // several processes: each builds only the subdomains of its rank (chosen by
         // the distributed repartition when contacts are held per rank)
         let build = self.ranks.as_mut().map(|rs| rs.assign(&owner, ns, repart && !self.local.now));
-        rank_solved::solved_on(w, fams, (&self.fam_owner, self.ranks.as_ref()), &mut self.fam_stepped);
+        rank_solved::solved_on(w, fams, (&self.fam_owner, self.ranks.as_mut()), &mut self.fam_stepped);
         rank_solved::share_solved(w, fams, &self.fam_stepped, self.ranks.as_mut());
         let fo = FamilyOwners {
             fams: &*fams,

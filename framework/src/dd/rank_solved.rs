@@ -18,6 +18,48 @@ pub struct SolvedOn<'a> {
     pub ranks: u32,
     /// The rank solving contact `a` (the family's [`Attached::points`] order).
     pub rank_of: &'a dyn Fn(usize) -> u32,
+    /// Rounds among the ranks the family may run in [`Attached::solved_on`]
+    /// (collective: every rank's family runs the same rounds in the same order).
+    pub rounds: &'a dyn Rounds,
+}
+
+/// Communication rounds among the ranks for a family stepped in part
+/// ([`SolvedOn::rounds`]), counted with the reductions in `ranks.json`.
+pub trait Rounds {
+    /// Every rank's `mine` (any length), by rank (collective).
+    fn all_gather(&self, mine: &[f64]) -> Vec<Vec<f64>>;
+    /// One point-to-point round: `out[i]` goes to rank `peers[i]`, whose message
+    /// comes back in the same place. The relation is symmetric (a peer lists this
+    /// rank in the same round; a message may be empty).
+    fn exchange(&self, peers: &[u32], out: &[Vec<f64>]) -> Vec<Vec<f64>>;
+}
+
+/// [`Rounds`] over the ranks of a run.
+struct RankRounds<'a>(std::cell::RefCell<&'a mut RankState>);
+
+impl Rounds for RankRounds<'_> {
+    fn all_gather(&self, mine: &[f64]) -> Vec<Vec<f64>> {
+        let (counts, all) = self.0.borrow_mut().all_gather_any(mine);
+        let mut at = 0;
+        counts
+            .iter()
+            .map(|&n| {
+                at += n;
+                all[at - n..at].to_vec()
+            })
+            .collect()
+    }
+    fn exchange(&self, peers: &[u32], out: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        let mut inbox = vec![Vec::new(); peers.len()];
+        if !peers.is_empty() {
+            let rs = &mut *self.0.borrow_mut();
+            rs.cluster.exchange(peers, out, &mut inbox);
+            // (counted with the reductions' messages and values)
+            rs.totals.reduce.messages += peers.len() as u64;
+            rs.totals.reduce.values += out.iter().map(|m| m.len() as u64).sum::<u64>();
+        }
+        inbox
+    }
 }
 
 /// After the families' write-back: each family stepped in part (`on`) packs what
@@ -44,18 +86,13 @@ pub(super) fn share_stepped<D: Family>(fams: &mut [&mut dyn Attached<D>], on: &[
 /// it receives ([`Attached::unpack_solved`]).
 pub(super) fn share_solved<D: Family>(w: &D::World, fams: &mut [&mut dyn Attached<D>], on: &[bool], ranks: Option<&mut RankState>) {
     let Some(rs) = ranks else { return };
+    let rounds = RankRounds(std::cell::RefCell::new(rs));
     for (fam, _) in fams.iter_mut().zip(on).filter(|x| *x.1) {
         let mut out = Vec::new();
         fam.pack_solved(&mut out);
         let peers: Vec<u32> = out.iter().map(|x| x.0).collect();
         let send: Vec<Vec<f64>> = out.into_iter().map(|x| x.1).collect();
-        let mut inbox = vec![Vec::new(); peers.len()];
-        if !peers.is_empty() {
-            rs.cluster.exchange(&peers, &send, &mut inbox);
-            // (counted with the reductions' messages and values)
-            rs.totals.reduce.messages += peers.len() as u64;
-            rs.totals.reduce.values += send.iter().map(|m| m.len() as u64).sum::<u64>();
-        }
+        let inbox = rounds.exchange(&peers, &send);
         let from: Vec<(u32, Vec<f64>)> = peers.into_iter().zip(inbox).collect();
         fam.unpack_solved(w, &from);
     }
@@ -76,19 +113,23 @@ pub(super) fn write_back_alone<D: Family>(w: &mut D::World, fams: &mut [&mut dyn
 pub(super) fn solved_on<D: Family>(
     w: &D::World,
     fams: &mut [&mut dyn Attached<D>],
-    (owner, ranks): (&[Vec<u32>], Option<&RankState>),
+    (owner, mut ranks): (&[Vec<u32>], Option<&mut RankState>),
     stepped: &mut Vec<bool>,
 ) {
     stepped.clear();
     for (f, fam) in fams.iter_mut().enumerate() {
-        let s = match ranks {
+        let s = match ranks.as_deref_mut() {
             Some(rs) => {
                 let o = &owner[f];
-                let rank_of = |a: usize| rs.rank_of[o[a] as usize];
+                let sub_rank = rs.rank_of.clone();
+                let rank_of = |a: usize| sub_rank[o[a] as usize];
+                let (rank, size) = (rs.cluster.rank(), rs.cluster.size());
+                let rounds = RankRounds(std::cell::RefCell::new(rs));
                 let on = SolvedOn {
-                    rank: rs.cluster.rank(),
-                    ranks: rs.cluster.size(),
+                    rank,
+                    ranks: size,
                     rank_of: &rank_of,
+                    rounds: &rounds,
                 };
                 fam.solved_on(w, Some(&on))
             }

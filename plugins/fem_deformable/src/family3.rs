@@ -133,6 +133,14 @@ impl Attached<Rigid3> for Deformables3 {
         let sides = (0..c.len()).map(|a| (c.cand[a].body, c.anta[a].fe().map(|s| s.body)));
         let part = self.stepped.decide(self.bodies.len(), on, sides, (w.time.h, w.time.theta));
         self.stepped.release(&mut self.bodies, &mut self.sets);
+        // the nodes of the bodies stepped elsewhere that the contacts solved here touch
+        if let Some(on) = on.filter(|_| part) {
+            let (c, sets, st) = (&self.contacts, &self.sets, &self.stepped);
+            let own = (0..c.len()).filter(|&a| st.rank_of(a) == on.rank);
+            let sides = own.flat_map(|a| std::iter::once(c.cand[a]).chain(c.anta[a].fe()));
+            let nodes = sides.flat_map(|s| s.k.map(|k| (s.body, sets[s.body as usize].nodes[k as usize])));
+            self.solved.asked = crate::solved::ask_nodes(st, nodes, on.rounds);
+        }
         // (a large body this rank steps first is assembled here: if that fails, no
         // body is stepped here and the step's end reports it)
         if let Err(e) = self.free_step(w) {
@@ -150,9 +158,7 @@ impl Attached<Rigid3> for Deformables3 {
     /// The bodies stepped here whose contacts other ranks solve too: their free
     /// velocity and G at their contact nodes.
     fn pack_solved(&self, out: &mut Vec<(u32, Vec<f64>)>) {
-        let c = &self.contacts;
-        let sides = (0..c.len()).flat_map(|a| std::iter::once((a, c.cand[a])).chain(c.anta[a].fe().map(|s| (a, s))));
-        crate::solved::pack_solved(&self.stepped, &self.sets, sides, out);
+        crate::solved::pack_solved(&self.stepped, &self.sets, &self.solved.asked, out);
     }
     /// The other ranks' bodies of contacts solved here, then the contacts solved here.
     fn unpack_solved(&mut self, w: &World3, from: &[(u32, Vec<f64>)]) {

@@ -7,74 +7,154 @@
 //! the rows of G their contacts read ([`pack_solved`], [`unpack_solved`], through
 //! [`nscdd::dd::Attached::pack_solved`]).
 
-use crate::nodes::{FeSide, NodeSet};
+use crate::nodes::NodeSet;
 use crate::stepped::Stepped;
+use nscdd::dd::Rounds;
+use std::collections::BTreeMap;
 
-/// The bodies stepped here whose contacts other ranks solve too, each as (body,
-/// its free velocity at its contact nodes, and the rows of G of the nodes the
-/// receiver's contacts touch: [`NodeSet::pack_received`]), in a message to each of
-/// those ranks; an empty message to the rank stepping a body whose contacts this
-/// rank solves (the relation is symmetric, as
-/// [`nscdd::dd::Attached::pack_solved`] needs). `sides`: the deformable sides of
-/// the family's contacts, (contact, side).
-pub fn pack_solved<const D: usize>(
-    stepped: &Stepped,
-    sets: &[NodeSet<D>],
-    sides: impl Iterator<Item = (usize, FeSide<D>)>,
-    out: &mut Vec<(u32, Vec<f64>)>,
-) {
-    let Some(me) = stepped.rank_here() else {
-        return;
-    };
-    // (body, receiving rank, node of the set) of the bodies sent, ascending, once
-    let mut rows: Vec<(u32, u32, u32)> = sides
-        .filter(|(a, s)| stepped.sends(s.body as usize) && stepped.rank_of(*a) != me)
-        .flat_map(|(a, s)| s.k.map(|k| (s.body, stepped.rank_of(a), k)))
-        .collect();
-    rows.sort_unstable();
-    rows.dedup();
-    let mut to: std::collections::BTreeMap<u32, Vec<f64>> = Default::default();
+/// (body, rank, its nodes) that other ranks asked of the bodies this rank steps
+/// ([`ask_nodes`]), ascending by (body, rank).
+pub type Asked = Vec<(u32, u32, Vec<u32>)>;
+
+/// This rank's peers in the rounds for the bodies whose contacts several ranks
+/// solve, each with a message started: for a body it steps, the other ranks
+/// solving its contacts; for a body whose contacts it solves without stepping it,
+/// the rank stepping it (a symmetric relation). `fill(peer, body, message)` adds
+/// to the message for each (peer, body) in turn.
+fn rounds_with(stepped: &Stepped, me: u32, mut fill: impl FnMut(u32, u32, &mut Vec<f64>)) -> BTreeMap<u32, Vec<f64>> {
+    let mut to: BTreeMap<u32, Vec<f64>> = BTreeMap::new();
     for run in stepped.solvers().chunk_by(|a, b| a.0 == b.0) {
         let b = run[0].0;
         let sender = stepped.sender(b as usize);
         if sender == me {
-            // (an empty message after a failure here: [`crate::stepped::Stepped::fail`])
             for &(_, r) in run.iter().filter(|x| x.1 != me) {
-                let m = to.entry(r).or_default();
-                if stepped.sends(b as usize) {
-                    let lo = rows.partition_point(|x| (x.0, x.1) < (b, r));
-                    let hi = rows.partition_point(|x| (x.0, x.1) <= (b, r));
-                    let ks: Vec<u32> = rows[lo..hi].iter().map(|x| x.2).collect();
-                    m.push(f64::from(b));
-                    sets[b as usize].pack_received(&ks, m);
-                }
+                fill(r, b, to.entry(r).or_default());
             }
         } else if run.iter().any(|x| x.1 == me) {
-            to.entry(sender).or_default();
+            fill(sender, b, to.entry(sender).or_default());
         }
     }
+    to
+}
+
+/// The first round for the bodies whose contacts several ranks solve (after
+/// [`Stepped::decide`], before the free velocities): each rank solving some of a
+/// body's contacts without stepping it sends the rank stepping it the body's
+/// nodes its contacts touch (mesh node ids), which that rank adds to the body's
+/// contact nodes ([`shared_nodes`]) and sends the rows of G of ([`pack_solved`]).
+/// `sides`: the deformable sides of the contacts solved here, (body, node).
+/// Returns what the bodies stepped here were asked.
+pub fn ask_nodes(stepped: &Stepped, sides: impl Iterator<Item = (u32, u32)>, rounds: &dyn Rounds) -> Asked {
+    let mut asked = Asked::new();
+    let Some(me) = stepped.rank_here() else {
+        return asked;
+    };
+    let mut mine: Vec<(u32, u32)> = sides.filter(|s| stepped.receives(s.0 as usize)).collect();
+    mine.sort_unstable();
+    mine.dedup();
+    let to = rounds_with(stepped, me, |peer, b, m| {
+        if peer == stepped.sender(b as usize) {
+            let lo = mine.partition_point(|x| x.0 < b);
+            let hi = mine.partition_point(|x| x.0 <= b);
+            m.extend([f64::from(b), (hi - lo) as f64]);
+            m.extend(mine[lo..hi].iter().map(|x| f64::from(x.1)));
+        }
+    });
+    let peers: Vec<u32> = to.keys().copied().collect();
+    let out: Vec<Vec<f64>> = to.into_values().collect();
+    for (&r, m) in peers.iter().zip(rounds.exchange(&peers, &out)) {
+        // (body, count, its nodes) each
+        let mut i = 0;
+        while let (Some(&b), Some(&n)) = (m.get(i), m.get(i + 1)) {
+            let Some(nodes) = m.get(i + 2..i + 2 + n as usize) else { break };
+            if stepped.sends(b as usize) {
+                asked.push((b as u32, r, nodes.iter().map(|&x| x as u32).collect()));
+            }
+            i += 2 + n as usize;
+        }
+    }
+    asked.sort_unstable_by_key(|x| (x.0, x.1));
+    asked
+}
+
+/// The contact nodes of the bodies this rank steps whose contacts other ranks
+/// solve too: the nodes of the raw contacts solved here or dropped by the build
+/// (`raw`: (raw contact, body, node) of every side), and those the other ranks
+/// asked ([`ask_nodes`]), into `nodes` (each body's sorted nodes). The others'
+/// entries stay.
+pub fn shared_nodes<Cs>(stepped: &Stepped, solved: &Solved<Cs>, raw: impl Iterator<Item = (usize, u32, u32)>, nodes: &mut [Vec<u32>]) {
+    let Some(own) = stepped.solved() else {
+        return;
+    };
+    let here = |i: usize| solved.raw_at.get(i).is_none_or(|&a| a == u32::MAX || own[a as usize]);
+    let mut pairs: Vec<(u32, u32)> = raw
+        .filter(|&(i, b, _)| stepped.sends(b as usize) && here(i))
+        .map(|x| (x.1, x.2))
+        .collect();
+    for (b, _, ns) in &solved.asked {
+        pairs.extend(ns.iter().map(|&k| (*b, k)));
+    }
+    pairs.sort_unstable();
+    pairs.dedup();
+    for run in pairs.chunk_by(|a, b| a.0 == b.0) {
+        let b = run[0].0 as usize;
+        let union: Vec<u32> = run.iter().map(|x| x.1).collect();
+        debug_assert_eq!(union, nodes[b], "body {b}'s contact nodes from the ranks solving its contacts");
+        nodes[b] = union;
+    }
+}
+
+/// The bodies stepped here whose contacts other ranks solve too, each as (body,
+/// its contact nodes, its free velocity there, and the rows of G of the nodes the
+/// receiver asked for: [`NodeSet::pack_received`]), in a message to each of those
+/// ranks; an empty message to the rank stepping a body whose contacts this rank
+/// solves (the relation is symmetric, as [`nscdd::dd::Attached::pack_solved`]
+/// needs). `asked`: [`ask_nodes`]'s.
+pub fn pack_solved<const D: usize>(stepped: &Stepped, sets: &[NodeSet<D>], asked: &Asked, out: &mut Vec<(u32, Vec<f64>)>) {
+    let Some(me) = stepped.rank_here() else {
+        return;
+    };
+    // (an empty message after a failure here: [`crate::stepped::Stepped::fail`])
+    let to = rounds_with(stepped, me, |r, b, m| {
+        if stepped.sends(b as usize) {
+            let set = &sets[b as usize];
+            let at = asked.binary_search_by_key(&(b, r), |x| (x.0, x.1));
+            let ks: Vec<u32> = at
+                .map_or(&[][..], |p| &asked[p].2[..])
+                .iter()
+                .filter_map(|k| set.nodes.binary_search(k).ok().map(|k| k as u32))
+                .collect();
+            m.extend([f64::from(b), set.len() as f64]);
+            m.extend(set.nodes.iter().map(|&k| f64::from(k)));
+            set.pack_received(&ks, m);
+        }
+    });
     out.extend(to);
 }
 
 /// The messages of [`pack_solved`]: the bodies whose contacts this rank solves
-/// without stepping them get their sender's free velocity and G
-/// ([`NodeSet::set_received`]; every rank holds the same node sets).
+/// without stepping them get their sender's contact nodes, free velocity and G
+/// ([`NodeSet::set_received`]).
 pub fn unpack_solved<const D: usize>(stepped: &Stepped, sets: &mut [NodeSet<D>], from: &[(u32, Vec<f64>)]) {
     let mut got = vec![false; sets.len()];
     for (_, all) in from {
         let mut i = 0;
-        // (body, v: D n, m, m nodes, their m D rows of D n values) each
-        while let Some(&b) = all.get(i) {
+        // (body, n, n nodes, v: D n, m, m nodes, their m D rows of D n values) each
+        while let (Some(&b), Some(&n)) = (all.get(i), all.get(i + 1)) {
+            let (n, nodes) = (n as usize, i + 2);
             let Some(set) = sets.get_mut(b as usize) else { break };
-            let nv = D * set.len();
-            let Some(&m) = all.get(i + 1 + nv) else { break };
-            let (ks, rows) = (i + 2 + nv, i + 2 + nv + m as usize);
+            let nv = D * n;
+            let Some(&m) = all.get(nodes + n + nv) else { break };
+            let (ks, rows) = (nodes + n + nv + 1, nodes + n + nv + 1 + m as usize);
             let end = rows + m as usize * D * nv;
             if all.len() < end {
                 break;
             }
             if stepped.receives(b as usize) {
-                set.set_received(&all[i + 1..i + 1 + nv], &all[ks..rows], &all[rows..end]);
+                let sent: Vec<u32> = all[nodes..nodes + n].iter().map(|&k| k as u32).collect();
+                debug_assert_eq!(sent, set.nodes, "body {b}'s contact nodes");
+                set.nodes = sent;
+                set.set_received(&all[nodes + n..nodes + n + nv], &all[ks..rows], &all[rows..end]);
                 got[b as usize] = true;
             }
             i = end;
@@ -103,6 +183,8 @@ pub struct Solved<Cs> {
     /// Per contact of the family's list, its index in `list` (`u32::MAX`: solved
     /// elsewhere).
     pub of: Vec<u32>,
+    /// What the other ranks asked of the bodies stepped here ([`ask_nodes`]).
+    pub asked: Asked,
 }
 
 impl<Cs> Solved<Cs> {
@@ -145,6 +227,7 @@ impl<Cs> Solved<Cs> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::stepped::AllRanks;
     use nscdd::dd::SolvedOn;
 
     /// The contacts solved here are built again from the raw contacts kept in the
@@ -166,17 +249,26 @@ mod tests {
     }
 
     /// A body whose contacts ranks 0 (two) and 1 (one) solve, on 3 ranks: rank 0
-    /// steps it and sends its free velocity and G to rank 1 alone, which lists rank
-    /// 0 with an empty message (symmetric), and takes them; rank 2 sends nothing.
+    /// steps it; rank 1 asks it for the nodes of its contact, rank 0 sends its
+    /// contact nodes, free velocity and those rows of G to rank 1 alone, which
+    /// lists rank 0 with an empty message (symmetric), and takes them; rank 2
+    /// sends nothing.
     #[test]
     fn a_shared_body_is_stepped_once_and_its_columns_sent() {
         let rank_of = |a: usize| if a < 2 { 0 } else { 1 };
+        let rounds = AllRanks {
+            ranks: 3,
+            rank_of: &rank_of,
+            contacts: vec![(0, None); 3],
+            replies: Default::default(),
+        };
         let decide_on = |me: u32| {
             let mut s = Stepped::default();
             let on = SolvedOn {
                 rank: me,
                 ranks: 3,
                 rank_of: &rank_of,
+                rounds: &rounds,
             };
             assert!(s.decide(1, Some(&on), [(0, None); 3].into_iter(), (1e-3, 0.5)));
             s
@@ -184,56 +276,50 @@ mod tests {
         let [s0, s1, s2] = [0, 1, 2].map(decide_on);
         assert!(s0.steps(0) && !s1.steps(0) && !s2.steps(0));
         assert!(s0.sends(0) && s1.receives(0) && !s2.receives(0));
-        let mut set = NodeSet::<2>::default();
-        set.nodes = vec![4];
-        set.v = vec![[1.0, 2.0]];
-        set.g = vec![3.0, 4.0, 5.0, 6.0];
-        let packed = |s: &Stepped| {
-            let mut out = Vec::new();
-            let sides = (0..3).map(|a| (a, FeSide::node(0, 0)));
-            pack_solved(s, std::slice::from_ref(&set), sides, &mut out);
-            out
-        };
-        let (p0, p1, p2) = (packed(&s0), packed(&s1), packed(&s2));
-        // (body 0, v, one node: set index 0, its two rows of G)
-        assert_eq!(p0, [(1, vec![0.0, 1.0, 2.0, 1.0, 0.0, 3.0, 4.0, 5.0, 6.0])]);
-        assert_eq!(p1, [(0, vec![])]);
-        assert!(p2.is_empty());
-        let mut got = vec![NodeSet::<2>::default()];
-        got[0].nodes = vec![4];
-        unpack_solved(&s1, &mut got, &[(0, p0[0].1.clone())]);
-        assert_eq!((got[0].v.clone(), got[0].g.clone()), (set.v.clone(), set.g.clone()));
-        // two contact nodes, rank 1's contact at the second only: only its rows of G
-        // are sent, the others read 0 there
+        // two contact nodes (4 and 7), rank 1's contact at node 7 only: it asks for
+        // it, and only its rows of G are sent; the others read 0 there
         let mut two = NodeSet::<2>::default();
         two.nodes = vec![4, 7];
         two.v = vec![[1.0, 2.0], [3.0, 4.0]];
         two.g = (0..16).map(f64::from).collect();
-        let mut out = Vec::new();
-        let sides = [(0, FeSide::node(0, 0)), (1, FeSide::node(0, 0)), (2, FeSide::node(0, 1))];
-        pack_solved(&s0, std::slice::from_ref(&two), sides.into_iter(), &mut out);
-        let mut rows: Vec<f64> = vec![0.0, 1.0, 2.0, 3.0, 4.0, 1.0, 1.0];
+        // (rank 1's message to rank 0: body 0, one node, node 7)
+        let ask = vec![0.0, 1.0, 7.0];
+        *rounds.replies.borrow_mut() = vec![ask];
+        let asked = ask_nodes(&s0, [(0, 4)].into_iter(), &rounds);
+        assert_eq!(asked, [(0, 1, vec![7])]);
+        assert!(ask_nodes(&s1, [(0, 7)].into_iter(), &rounds).is_empty());
+        assert!(ask_nodes(&s2, std::iter::empty(), &rounds).is_empty());
+        let packed = |s: &Stepped, asked: &Asked| {
+            let mut out = Vec::new();
+            pack_solved(s, std::slice::from_ref(&two), asked, &mut out);
+            out
+        };
+        let (p0, p1, p2) = (packed(&s0, &asked), packed(&s1, &vec![]), packed(&s2, &vec![]));
+        // (body 0, 2 nodes: 4 and 7, v, one row node: set index 1, its two rows of G)
+        let mut rows: Vec<f64> = vec![0.0, 2.0, 4.0, 7.0, 1.0, 2.0, 3.0, 4.0, 1.0, 1.0];
         rows.extend((8..16).map(f64::from));
-        assert_eq!(out, [(1, rows.clone())]);
-        let mut got2 = vec![NodeSet::<2>::default()];
-        got2[0].nodes = vec![4, 7];
-        unpack_solved(&s1, &mut got2, &[(0, rows)]);
-        assert_eq!(got2[0].v, two.v);
-        assert_eq!(got2[0].block(1, 0), two.block(1, 0));
-        assert_eq!(got2[0].block(1, 1), two.block(1, 1));
-        assert_eq!(got2[0].block(0, 0), [[0.0; 2]; 2]);
+        assert_eq!(p0, [(1, rows.clone())]);
+        assert_eq!(p1, [(0, vec![])]);
+        assert!(p2.is_empty());
+        let mut got = vec![NodeSet::<2>::default()];
+        got[0].nodes = vec![4, 7];
+        unpack_solved(&s1, &mut got, &[(0, rows)]);
+        assert_eq!((&got[0].nodes, &got[0].v), (&two.nodes, &two.v));
+        assert_eq!(got[0].block(1, 0), two.block(1, 0));
+        assert_eq!(got[0].block(1, 1), two.block(1, 1));
+        assert_eq!(got[0].block(0, 0), [[0.0; 2]; 2]);
         // rank 0 fails in the step (its body's assembly): it steps nothing, sends
         // nothing of the body and no V⁺, but still exchanges with rank 1 (an empty
         // message), whose set then reads no G and zero velocities
         let mut f0 = decide_on(0);
         f0.fail();
         assert!(!f0.steps(0) && !f0.sends(0) && f0.mask() == Some(&[false][..]));
-        assert_eq!(packed(&f0), [(1, vec![])]);
+        assert_eq!(packed(&f0, &asked), [(1, vec![])]);
         let mut v = Vec::new();
         f0.pack(&[], &mut v);
         assert!(v.is_empty());
         unpack_solved(&s1, &mut got, &[(0, vec![])]);
-        assert_eq!(got[0].v, [[0.0, 0.0]]);
+        assert_eq!(got[0].v, [[0.0, 0.0]; 2]);
         assert_eq!(got[0].block(0, 0), [[0.0; 2]; 2]);
     }
 }

@@ -229,6 +229,16 @@ impl Deformables2 {
             ns.sort_unstable();
             ns.dedup();
         }
+        // stepped in part: a body stepped here whose contacts other ranks solve
+        // too, from the contacts solved here and the nodes the others asked for
+        let raw = self.raw.iter().enumerate().flat_map(|(i, rc)| {
+            let anta = match rc.anta {
+                RawAnta::Segment { body, a, b, .. } => [Some((i, body, a)), Some((i, body, b))],
+                _ => [None, None],
+            };
+            std::iter::once((i, rc.body, rc.node)).chain(anta.into_iter().flatten())
+        });
+        crate::solved::shared_nodes(&self.stepped, &self.solved, raw, &mut nodes);
         crate::nodes::fill_sets(&mut self.bodies, &mut self.sets, &nodes, self.stepped.mask());
     }
 

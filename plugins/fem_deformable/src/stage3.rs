@@ -236,6 +236,20 @@ impl Deformables3 {
             ns.sort_unstable();
             ns.dedup();
         }
+        // stepped in part: a body stepped here whose contacts other ranks solve
+        // too, from the contacts solved here and the nodes the others asked for
+        let raw = self.raw.iter().enumerate().flat_map(|(i, rc)| {
+            let cand = match rc.cand {
+                RawCand3::Node(k) => [k; 3].map(|k| (i, rc.body, k)),
+                RawCand3::Face { nodes: f, .. } => f.map(|k| (i, rc.body, k)),
+            };
+            let anta = match rc.anta {
+                RawAnta3::Face { body, nodes: f, .. } => f.map(|k| Some((i, body, k))),
+                _ => [None; 3],
+            };
+            cand.into_iter().chain(anta.into_iter().flatten())
+        });
+        crate::solved::shared_nodes(&self.stepped, &self.solved, raw, &mut nodes);
         crate::nodes::fill_sets(&mut self.bodies, &mut self.sets, &nodes, self.stepped.mask());
     }
 

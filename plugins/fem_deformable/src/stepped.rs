@@ -3,10 +3,12 @@
 //! the partition without any solve ([`Stepped::hold`]: no body stepped yet); after
 //! it the framework tells the family which rank solves each contact
 //! ([`nscdd::dd::SolvedOn`]), and one rank, the one solving most of a body's
-//! contacts, steps the body: computes its V_free, its columns of M̂⁻¹ and G at its
-//! contact nodes, and its V⁺. Another rank solving some of its contacts receives
-//! the free velocity and G at its contact nodes from it, point to point, for its
-//! W_αα, u_free and parts ([`crate::solved`]). A body without contact is stepped
+//! contacts (from every rank's counts, [`Stepped::decide`]), steps the body:
+//! computes its V_free, its columns of M̂⁻¹ and G at its contact nodes, and its
+//! V⁺. Another rank solving some of its contacts asks it for the nodes these
+//! touch and receives the body's contact nodes, the free velocity there and
+//! those rows of G from it, point to point, for its W_αα, u_free and parts
+//! ([`crate::solved`]). A body without contact is stepped
 //! by the rank that checked it at load ([`crate::scene::checked_by`]). Every rank
 //! still detects every contact and builds the family's list of every contact
 //! (positions, V⁻ and the impulses are the same on every rank), but builds again
@@ -124,8 +126,10 @@ impl Stepped {
     /// After the partition ([`nscdd::dd::Attached::solved_on`]; `None`: every body
     /// here), from the contacts' bodies (candidate, deformable antagonist) in the
     /// family's order: a body is stepped by the rank solving most of its contacts
-    /// (the lowest of those tied).
-    /// Whether the family is stepped in part. `ht`: the step's h and θ.
+    /// (the lowest of those tied), decided from each rank's count of the sides of
+    /// the contacts it solves, per body (one all-gather of those counts: a rank
+    /// reads no other rank's contacts). Whether the family is stepped in part.
+    /// `ht`: the step's h and θ.
     pub fn decide(
         &mut self,
         n: usize,
@@ -151,33 +155,46 @@ impl Stepped {
         }
         self.sender.clear();
         self.sender.resize(n, u32::MAX);
-        // (body, rank solving one of its contacts), once per contact side
-        let mut by_body = Vec::new();
+        // (body, sides of its contacts solved here), once per contact side
+        let mut here = Vec::new();
         for (a, (c, f)) in contacts.enumerate() {
             let r = (on.rank_of)(a);
             self.solved.push(r == on.rank);
             self.rank.push(r);
-            for x in std::iter::once(c).chain(f) {
-                by_body.push((x, r));
-                self.touched[x as usize] |= r == on.rank;
+            if r == on.rank {
+                for x in std::iter::once(c).chain(f).filter(|&x| (x as usize) < n) {
+                    here.push(x);
+                    self.touched[x as usize] = true;
+                }
             }
         }
+        here.sort_unstable();
+        let mine: Vec<f64> = here
+            .chunk_by(|a, b| a == b)
+            .flat_map(|run| [f64::from(run[0]), run.len() as f64])
+            .collect();
+        // every rank's counts (one all-gather: no rank reads another's contacts)
+        let mut by_body: Vec<(u32, u32, usize)> = Vec::new();
+        for (r, m) in on.rounds.all_gather(&mine).iter().enumerate() {
+            by_body.extend(m.chunks_exact(2).map(|x| (x[0] as u32, r as u32, x[1] as usize)));
+        }
+        by_body.retain(|x| (x.0 as usize) < n);
+        by_body.sort_unstable();
         // a body is stepped by the rank solving most of its contacts (the lowest of
         // those tied), the other ranks solving some receive its columns
-        by_body.sort_unstable();
         self.solvers.clear();
         for run in by_body.chunk_by(|a, b| a.0 == b.0) {
             let x = run[0].0 as usize;
             let mut best = (0usize, u32::MAX);
-            for same in run.chunk_by(|a, b| a.1 == b.1) {
-                if same.len() > best.0 {
-                    best = (same.len(), same[0].1);
+            for &(_, r, k) in run {
+                if k > best.0 {
+                    best = (k, r);
                 }
             }
             self.sender[x] = best.1;
-            self.shared[x] = run[0].1 != run[run.len() - 1].1;
+            self.shared[x] = run.len() > 1;
             if self.shared[x] {
-                self.solvers.extend(run.chunk_by(|a, b| a.1 == b.1).map(|same| same[0]));
+                self.solvers.extend(run.iter().map(|&(b, r, _)| (b, r)));
             }
         }
         for (b, s) in self.sender.iter_mut().enumerate() {
@@ -340,6 +357,41 @@ impl Stepped {
     }
 }
 
+/// The rounds of every rank simulated in one process (unit tests): the
+/// all-gather gives every rank's sides per body from the whole list of contacts
+/// (body, deformable antagonist) and their ranks; the point-to-point round gives
+/// back `replies` (one message per peer, in order).
+#[cfg(test)]
+pub(crate) struct AllRanks<'a> {
+    pub ranks: u32,
+    pub rank_of: &'a dyn Fn(usize) -> u32,
+    pub contacts: Vec<(u32, Option<u32>)>,
+    pub replies: std::cell::RefCell<Vec<Vec<f64>>>,
+}
+
+#[cfg(test)]
+impl nscdd::dd::Rounds for AllRanks<'_> {
+    fn all_gather(&self, _mine: &[f64]) -> Vec<Vec<f64>> {
+        (0..self.ranks)
+            .map(|r| {
+                let mut m: std::collections::BTreeMap<u32, usize> = Default::default();
+                for (_, (c, f)) in self.contacts.iter().enumerate().filter(|x| (self.rank_of)(x.0) == r) {
+                    for x in std::iter::once(*c).chain(*f) {
+                        *m.entry(x).or_default() += 1;
+                    }
+                }
+                m.into_iter().flat_map(|(b, k)| [f64::from(b), k as f64]).collect()
+            })
+            .collect()
+    }
+    fn exchange(&self, peers: &[u32], _out: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        let mut r = self.replies.borrow_mut();
+        (0..peers.len())
+            .map(|i| r.get_mut(i).map(std::mem::take).unwrap_or_default())
+            .collect()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -348,12 +400,20 @@ mod tests {
     /// rank 0; seen from rank 0.
     fn decide(s: &mut Stepped, rank_of_0: u32) -> bool {
         let rank_of = |a: usize| if a == 0 { rank_of_0 } else { 0 };
+        let contacts = vec![(0, None), (1, None)];
+        let rounds = AllRanks {
+            ranks: 2,
+            rank_of: &rank_of,
+            contacts: contacts.clone(),
+            replies: Default::default(),
+        };
         let on = SolvedOn {
             rank: 0,
             ranks: 2,
             rank_of: &rank_of,
+            rounds: &rounds,
         };
-        s.decide(2, Some(&on), [(0, None), (1, None)].into_iter(), (1e-3, 0.5))
+        s.decide(2, Some(&on), contacts.into_iter(), (1e-3, 0.5))
     }
 
     #[test]
