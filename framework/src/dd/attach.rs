@@ -191,6 +191,12 @@ pub trait Attached<F: Family> {
     /// Every rank's [`Self::pack_stepped`], in rank order: after it the family's
     /// state is the same on every rank.
     fn unpack_stepped(&mut self, _all: &[f64]) {}
+    /// On MPI ranks, before the outputs read the family's state (an output frame, a
+    /// saved state): what rank 0 lacks of it, sent there (collective: every rank
+    /// calls it; a family stepped in part may hold on a rank only what its next
+    /// steps read of the bodies it does not step). The default: nothing (the state
+    /// is the same on every rank).
+    fn gather_whole(&mut self, _rounds: &dyn Rounds) {}
     /// (its bodies stepped here, its bodies) in a step stepped in part (`ranks.json`).
     fn stepped_bodies(&self) -> Option<(usize, usize)> {
         None

@@ -87,6 +87,7 @@ pub use cluster::{Cluster, Solo};
 pub use config::{Balance, DdConfig};
 pub use family::{Family, Rigid, Rigid2, Rigid3};
 pub use partition::{Decomposition, FGammaStore, FamilyOwners, Grid, Interface};
+pub use rank_solved::with_rounds;
 pub use ranks::RankState;
 pub use report::{DdStepReport, DdView, Piece, Prevailing};
 pub use schemes::Scheme;

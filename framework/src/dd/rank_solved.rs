@@ -34,6 +34,12 @@ pub trait Rounds {
     fn exchange(&self, peers: &[u32], out: &[Vec<f64>]) -> Vec<Vec<f64>>;
 }
 
+/// Runs `f` with the [`Rounds`] of the ranks `rs` (a family's collective rounds
+/// outside the step: [`Attached::gather_whole`]).
+pub fn with_rounds(rs: &mut RankState, f: impl FnOnce(&dyn Rounds)) {
+    f(&RankRounds(std::cell::RefCell::new(rs)))
+}
+
 /// [`Rounds`] over the ranks of a run.
 struct RankRounds<'a>(std::cell::RefCell<&'a mut RankState>);
 

@@ -176,6 +176,9 @@ impl<D: Dim> Attached<Rigid<D>> for GuardedFamily<D> {
     fn unpack_stepped(&mut self, all: &[f64]) {
         self.guard.call(|| self.inner.unpack_stepped(all))
     }
+    fn gather_whole(&mut self, rounds: &dyn crate::dd::Rounds) {
+        self.guard.call(|| self.inner.gather_whole(rounds))
+    }
     fn stepped_bodies(&self) -> Option<(usize, usize)> {
         self.guard.call(|| self.inner.stepped_bodies())
     }

@@ -193,6 +193,15 @@ pub(crate) fn write_rank_totals<D: crate::dd::Family>(dd: &mut Option<crate::dd:
     Ok(())
 }
 
+/// On MPI ranks, before an output reads the families' state: what rank 0 lacks of
+/// it, sent there ([`crate::dd::Attached::gather_whole`]; collective).
+pub(crate) fn gather_families<D: Dim>(dd: &mut Option<NscddOf<Rigid<D>>>, families: &mut [Box<dyn SceneFamily<D>>]) {
+    let Some(rs) = dd.as_mut().and_then(|n| n.ranks_mut()) else {
+        return;
+    };
+    crate::dd::with_rounds(rs, |r| families.iter_mut().for_each(|f| f.gather_whole(r)));
+}
+
 /// Writes the state on rank 0. Collective on MPI ranks (F_Γ is gathered from every
 /// rank, and the bodies, contacts and kept contacts other ranks hold are merged on
 /// rank 0 as it writes them, [`crate::dd::rank_merge`]): every rank calls it at the
@@ -201,9 +210,11 @@ pub(crate) fn save_state<D: Dim>(
     dir: &Path,
     name: &str,
     w: &mut World<D>,
-    families: &[Box<dyn SceneFamily<D>>],
+    families: &mut [Box<dyn SceneFamily<D>>],
     dd: &mut Option<NscddOf<Rigid<D>>>,
 ) -> Result<(), RunError> {
+    gather_families(dd, families);
+    let families = &*families;
     // bodies held per rank: every body's record from its owner; contacts held per
     // rank: every rank's, in key order
     let bodies = dd.as_mut().and_then(|n| n.own_body_records(w));

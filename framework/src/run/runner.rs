@@ -130,6 +130,9 @@ impl<D: Dim> Runner<D> {
                 None => wr.write(w, dir, self.frame)?,
             }
         }
+        if scene.output.vtk {
+            crate::run::gather_families(&mut self.dd, &mut scene.families);
+        }
         if self.vtk {
             for f in scene.families.iter_mut() {
                 f.write_frame(dir, self.frame, w.t)?;
@@ -193,7 +196,7 @@ impl<D: Dim> Runner<D> {
     pub fn checkpoint(&mut self, scene: &mut Scene<D>, name: &str) -> Result<(), RunError> {
         let Some(dir) = self.dir.clone() else { return Ok(()) };
         self.hist.flush().map_err(io(&dir, "history.csv"))?;
-        crate::run::save_state(&dir, name, &mut scene.world, &scene.families, &mut self.dd)
+        crate::run::save_state(&dir, name, &mut scene.world, &mut scene.families, &mut self.dd)
     }
 
     /// Writes the state as a restart file at `path` (any name; its folder made if
@@ -205,7 +208,7 @@ impl<D: Dim> Runner<D> {
             .and_then(|n| n.to_str())
             .ok_or_else(|| RunError::Io(format!("{}: not a file name (UTF-8)", path.display())))?;
         std::fs::create_dir_all(dir).map_err(io(dir, name))?;
-        crate::run::save_state(dir, name, &mut scene.world, &scene.families, &mut self.dd)
+        crate::run::save_state(dir, name, &mut scene.world, &mut scene.families, &mut self.dd)
     }
 
     /// Whether a stop was asked ([`crate::run::request_stop`]) on this process or,
@@ -264,7 +267,7 @@ impl<D: Dim> Runner<D> {
         }
         self.finish_outputs(scene)?;
         if let Some(dir) = self.dir.clone() {
-            crate::run::save_state(&dir, "final.json", &mut scene.world, &scene.families, &mut self.dd)?;
+            crate::run::save_state(&dir, "final.json", &mut scene.world, &mut scene.families, &mut self.dd)?;
             // after final.json: the peak memory of each rank counts its writing
             crate::run::write_rank_totals(&mut self.dd, &dir)?;
         }

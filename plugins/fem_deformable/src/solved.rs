@@ -261,6 +261,7 @@ mod tests {
             rank_of: &rank_of,
             contacts: vec![(0, None); 3],
             replies: Default::default(),
+            sent: Default::default(),
         };
         let decide_on = |me: u32| {
             let mut s = Stepped::default();

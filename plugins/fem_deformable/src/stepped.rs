@@ -90,6 +90,9 @@ pub struct Stepped {
     solvers: Vec<(u32, u32)>,
     /// Per body, in part: the rank whose V⁺ every rank takes.
     sender: Vec<u32>,
+    /// Per body, the last step's `sender` (empty: the state is whole on every
+    /// rank, as after a load).
+    prev: Vec<u32>,
     /// (h, θ) of the step in progress, in part.
     ht: (f64, f64),
     /// Per body, after the exchange of a step stepped in part: its energies after
@@ -153,6 +156,7 @@ impl Stepped {
             v.clear();
             v.resize(n, false);
         }
+        std::mem::swap(&mut self.prev, &mut self.sender);
         self.sender.clear();
         self.sender.resize(n, u32::MAX);
         // (body, sides of its contacts solved here), once per contact side
@@ -311,8 +315,9 @@ impl Stepped {
         self.on.map(|_| (self.mine.iter().filter(|&&x| x).count(), self.mine.len()))
     }
 
-    /// The bodies this rank sends: (body, its V⁺, its energies after the step) each,
-    /// the energies at u⁺ ([`FeBody::u_next`], the position update's arithmetic).
+    /// The bodies this rank sends: (body, its V⁺ at its boundary nodes, its
+    /// energies after the step) each, the energies at u⁺ ([`FeBody::u_next`], the
+    /// position update's arithmetic).
     pub fn pack(&self, bodies: &[FeBody], out: &mut Vec<f64>) {
         let Some((rank, _)) = self.on.filter(|_| !self.failed) else {
             return;
@@ -321,7 +326,8 @@ impl Stepped {
         let mut u_next = Vec::new();
         for (b, body) in bodies.iter().enumerate().filter(|(b, _)| self.sender[*b] == rank) {
             out.push(b as f64);
-            out.extend_from_slice(&body.v);
+            let d = body.dim();
+            out.extend(body.mesh.boundary.iter().flat_map(|&k| &body.v[d * k as usize..d * k as usize + d]));
             u_next.clear();
             u_next.extend((0..body.u.len()).map(|i| body.u_next(i, h, theta)));
             out.extend(body.energies(&u_next, &body.v));
@@ -329,24 +335,74 @@ impl Stepped {
     }
 
     /// Every rank's [`Self::pack`] (rank order): the V⁺ of the bodies not stepped
-    /// here, every body's energies.
+    /// here at their boundary nodes (all that detection, the contacts and the
+    /// position update there read of them; the rest of their state is their
+    /// stepping rank's, [`Self::hand_over`], [`Self::gather_whole`]), every body's
+    /// energies.
     pub fn unpack(&mut self, bodies: &mut [FeBody], all: &[f64]) {
         self.energy.clear();
         self.energy.resize(bodies.len(), [f64::NAN; 3]);
         let mut i = 0;
         while let Some(&b) = all.get(i) {
             let Some(body) = bodies.get_mut(b as usize) else { return };
-            let n = body.v.len();
+            let (d, nb) = (body.dim(), body.mesh.boundary.len());
+            let n = d * nb;
             let (Some(v), Some(e)) = (all.get(i + 1..i + 1 + n), all.get(i + 1 + n..i + 4 + n)) else {
                 return;
             };
             if !self.steps(b as usize) {
-                body.v.copy_from_slice(v);
+                for (&k, x) in body.mesh.boundary.iter().zip(v.chunks_exact(d)) {
+                    body.v[d * k as usize..d * k as usize + d].copy_from_slice(x);
+                }
             }
             self.energy[b as usize] = [e[0], e[1], e[2]];
             i += 4 + n;
         }
         self.energy_known = true;
+    }
+
+    /// After [`Self::decide`] in part: a body whose stepping rank changed gets its
+    /// whole state (u, V) from the rank that stepped it in the last step (the only
+    /// one holding it whole since, [`Self::unpack`]), point to point.
+    pub fn hand_over(&self, bodies: &mut [FeBody], rounds: &dyn nscdd::dd::Rounds) {
+        let Some(me) = self.rank_here() else { return };
+        let moved = |b: &usize| self.prev.get(*b).is_some_and(|&p| p != u32::MAX && p != self.sender[*b]);
+        let mut to: std::collections::BTreeMap<u32, Vec<f64>> = Default::default();
+        for b in (0..bodies.len()).filter(moved) {
+            let (p, q) = (self.prev[b], self.sender[b]);
+            if p == me {
+                let m = to.entry(q).or_default();
+                m.push(b as f64);
+                m.extend(bodies[b].u.iter().chain(&bodies[b].v));
+            } else if q == me {
+                to.entry(p).or_default();
+            }
+        }
+        let peers: Vec<u32> = to.keys().copied().collect();
+        let out: Vec<Vec<f64>> = to.into_values().collect();
+        for m in rounds.exchange(&peers, &out) {
+            take_whole(bodies, &m, |b| self.sender.get(b) == Some(&me));
+        }
+    }
+
+    /// [`nscdd::dd::Attached::gather_whole`]: rank 0 gets the whole state (u, V)
+    /// of the bodies another rank stepped in the last step stepped in part.
+    pub fn gather_whole(&self, bodies: &mut [FeBody], rounds: &dyn nscdd::dd::Rounds) {
+        let Some((me, ranks)) = self.on else { return };
+        let (peers, out): (Vec<u32>, Vec<Vec<f64>>) = match me {
+            0 => ((1..ranks).collect(), vec![Vec::new(); ranks as usize - 1]),
+            _ => {
+                let mut m = Vec::new();
+                for (b, body) in bodies.iter().enumerate().filter(|(b, _)| self.sender.get(*b) == Some(&me)) {
+                    m.push(b as f64);
+                    m.extend(body.u.iter().chain(&body.v));
+                }
+                (vec![0], vec![m])
+            }
+        };
+        for m in rounds.exchange(&peers, &out) {
+            take_whole(bodies, &m, |_| me == 0);
+        }
     }
 
     /// Every body's energies after the step, as their senders computed them
@@ -361,12 +417,29 @@ impl Stepped {
 /// all-gather gives every rank's sides per body from the whole list of contacts
 /// (body, deformable antagonist) and their ranks; the point-to-point round gives
 /// back `replies` (one message per peer, in order).
+/// Bodies' whole states (body, u, V each) into `bodies`, those `take` says.
+fn take_whole(bodies: &mut [FeBody], m: &[f64], take: impl Fn(usize) -> bool) {
+    let mut i = 0;
+    while let Some(&b) = m.get(i) {
+        let Some(body) = bodies.get_mut(b as usize) else { return };
+        let n = body.u.len();
+        let Some(x) = m.get(i + 1..i + 1 + 2 * n) else { return };
+        if take(b as usize) {
+            body.u.copy_from_slice(&x[..n]);
+            body.v.copy_from_slice(&x[n..]);
+        }
+        i += 1 + 2 * n;
+    }
+}
+
 #[cfg(test)]
 pub(crate) struct AllRanks<'a> {
     pub ranks: u32,
     pub rank_of: &'a dyn Fn(usize) -> u32,
     pub contacts: Vec<(u32, Option<u32>)>,
     pub replies: std::cell::RefCell<Vec<Vec<f64>>>,
+    /// The point-to-point rounds' peers and messages sent, in order.
+    pub sent: std::cell::RefCell<Vec<(Vec<u32>, Vec<Vec<f64>>)>>,
 }
 
 #[cfg(test)]
@@ -384,7 +457,8 @@ impl nscdd::dd::Rounds for AllRanks<'_> {
             })
             .collect()
     }
-    fn exchange(&self, peers: &[u32], _out: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    fn exchange(&self, peers: &[u32], out: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        self.sent.borrow_mut().push((peers.to_vec(), out.to_vec()));
         let mut r = self.replies.borrow_mut();
         (0..peers.len())
             .map(|i| r.get_mut(i).map(std::mem::take).unwrap_or_default())
@@ -406,6 +480,7 @@ mod tests {
             rank_of: &rank_of,
             contacts: contacts.clone(),
             replies: Default::default(),
+            sent: Default::default(),
         };
         let on = SolvedOn {
             rank: 0,
@@ -472,5 +547,88 @@ mod tests {
         assert_eq!(s.solved(), Some(&[true, true][..]));
         assert!(!s.decide(2, None, std::iter::empty(), (1e-3, 0.5)));
         assert!(s.solved().is_none(), "one process");
+    }
+
+    /// A square of four triangles around an interior node (node 4).
+    fn square() -> FeBody {
+        let raw = crate::python::RawMesh {
+            dim: 2,
+            points: vec![0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0, 0.5, 0.5],
+            cells: vec![0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4],
+        };
+        let el = crate::body::Elastic {
+            young: 1e6,
+            poisson: 0.3,
+            density: 1e3,
+            plane_stress: false,
+            rayleigh: [0.0; 2],
+        };
+        FeBody::light(None, crate::mesh::Mesh::new(raw).unwrap(), el, 0)
+    }
+
+    /// A body stepped by rank 0, then by rank 1, seen from rank 1: it takes the
+    /// body's V⁺ at its boundary only, then its whole state from rank 0 when it
+    /// steps it, and sends that to rank 0 for the outputs; rank 0 sends its whole
+    /// state to rank 1 when rank 1 takes it over.
+    #[test]
+    fn a_body_not_stepped_here_holds_its_boundary_and_is_handed_over_whole() {
+        let mut bodies = vec![square()];
+        assert_eq!(bodies[0].mesh.boundary, [0, 1, 2, 3]);
+        let on_rank = std::cell::Cell::new(0u32);
+        let rank_of = |_: usize| on_rank.get();
+        let rounds = AllRanks {
+            ranks: 2,
+            rank_of: &rank_of,
+            contacts: vec![(0, None)],
+            replies: Default::default(),
+            sent: Default::default(),
+        };
+        let decide = |s: &mut Stepped, me: u32| {
+            let on = SolvedOn {
+                rank: me,
+                ranks: 2,
+                rank_of: &rank_of,
+                rounds: &rounds,
+            };
+            s.decide(1, Some(&on), [(0, None)].into_iter(), (1e-3, 0.5))
+        };
+        let (mut s0, mut s1) = (Stepped::default(), Stepped::default());
+        decide(&mut s0, 0);
+        decide(&mut s1, 1);
+        // the first step after a load: the state is whole everywhere, nothing handed over
+        s1.hand_over(&mut bodies, &rounds);
+        assert_eq!(rounds.sent.borrow().last(), Some(&(vec![], vec![])));
+        // rank 0's V⁺ at the four boundary nodes, and the energies
+        let mut msg = vec![0.0];
+        msg.extend((1..=8).map(f64::from));
+        msg.extend([0.5, 0.25, 0.0]);
+        s1.unpack(&mut bodies, &msg);
+        assert_eq!(bodies[0].v, [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 0.0, 0.0]);
+        assert_eq!(s1.energies(), Some(&[[0.5, 0.25, 0.0]][..]));
+        // the contact moves to rank 1: rank 0 sends the whole state, rank 1 takes it
+        on_rank.set(1);
+        decide(&mut s0, 0);
+        decide(&mut s1, 1);
+        assert!(!s0.steps(0) && s1.steps(0));
+        let whole: Vec<f64> = (0..20).map(f64::from).collect();
+        bodies[0].u.copy_from_slice(&whole[..10]);
+        bodies[0].v.copy_from_slice(&whole[10..]);
+        s0.hand_over(&mut bodies, &rounds);
+        let mut expect = vec![0.0];
+        expect.extend(&whole);
+        assert_eq!(rounds.sent.borrow().last(), Some(&(vec![1], vec![expect.clone()])));
+        let mut got = vec![square()];
+        *rounds.replies.borrow_mut() = vec![expect.clone()];
+        s1.hand_over(&mut got, &rounds);
+        assert_eq!(rounds.sent.borrow().last(), Some(&(vec![0], vec![vec![]])));
+        assert_eq!((&got[0].u[..], &got[0].v[..]), (&whole[..10], &whole[10..]));
+        // before an output, rank 1 sends the bodies it stepped to rank 0
+        s1.gather_whole(&mut got, &rounds);
+        assert_eq!(rounds.sent.borrow().last(), Some(&(vec![0], vec![expect.clone()])));
+        let mut at0 = vec![square()];
+        *rounds.replies.borrow_mut() = vec![expect];
+        s0.gather_whole(&mut at0, &rounds);
+        assert_eq!(rounds.sent.borrow().last(), Some(&(vec![1], vec![vec![]])));
+        assert_eq!((&at0[0].u[..], &at0[0].v[..]), (&whole[..10], &whole[10..]));
     }
 }
