@@ -135,7 +135,7 @@ impl Attached<Rigid3> for Deformables3 {
         self.stepped.release(&mut self.bodies, &mut self.sets);
         // the nodes of the bodies stepped elsewhere that the contacts solved here touch
         if let Some(on) = on.filter(|_| part) {
-            self.stepped.hand_over(&mut self.bodies, on.rounds);
+            crate::whole::hand_over(&self.stepped, &mut self.bodies, on.rounds);
             let (c, sets, st) = (&self.contacts, &self.sets, &self.stepped);
             let own = (0..c.len()).filter(|&a| st.rank_of(a) == on.rank);
             let sides = own.flat_map(|a| std::iter::once(c.cand[a]).chain(c.anta[a].fe()));
@@ -253,7 +253,7 @@ impl Attached<Rigid3> for Deformables3 {
         crate::nodes::sets_at_velocities(&self.bodies, &mut self.sets);
     }
     fn gather_whole(&mut self, rounds: &dyn nscdd::dd::Rounds) {
-        self.stepped.gather_whole(&mut self.bodies, rounds);
+        crate::whole::gather_whole(&self.stepped, &mut self.bodies, rounds);
     }
     fn stepped_bodies(&self) -> Option<(usize, usize)> {
         self.stepped.counts()

@@ -361,48 +361,21 @@ impl Stepped {
         self.energy_known = true;
     }
 
-    /// After [`Self::decide`] in part: a body whose stepping rank changed gets its
-    /// whole state (u, V) from the rank that stepped it in the last step (the only
-    /// one holding it whole since, [`Self::unpack`]), point to point.
-    pub fn hand_over(&self, bodies: &mut [FeBody], rounds: &dyn nscdd::dd::Rounds) {
-        let Some(me) = self.rank_here() else { return };
-        let moved = |b: &usize| self.prev.get(*b).is_some_and(|&p| p != u32::MAX && p != self.sender[*b]);
-        let mut to: std::collections::BTreeMap<u32, Vec<f64>> = Default::default();
-        for b in (0..bodies.len()).filter(moved) {
-            let (p, q) = (self.prev[b], self.sender[b]);
-            if p == me {
-                let m = to.entry(q).or_default();
-                m.push(b as f64);
-                m.extend(bodies[b].u.iter().chain(&bodies[b].v));
-            } else if q == me {
-                to.entry(p).or_default();
-            }
-        }
-        let peers: Vec<u32> = to.keys().copied().collect();
-        let out: Vec<Vec<f64>> = to.into_values().collect();
-        for m in rounds.exchange(&peers, &out) {
-            take_whole(bodies, &m, |b| self.sender.get(b) == Some(&me));
-        }
+    /// The last step's stepping rank of body `b` (`None`: the state was whole on
+    /// every rank, as after a load).
+    pub fn prev_sender(&self, b: usize) -> Option<u32> {
+        self.prev.get(b).copied().filter(|&p| p != u32::MAX)
     }
 
-    /// [`nscdd::dd::Attached::gather_whole`]: rank 0 gets the whole state (u, V)
-    /// of the bodies another rank stepped in the last step stepped in part.
-    pub fn gather_whole(&self, bodies: &mut [FeBody], rounds: &dyn nscdd::dd::Rounds) {
-        let Some((me, ranks)) = self.on else { return };
-        let (peers, out): (Vec<u32>, Vec<Vec<f64>>) = match me {
-            0 => ((1..ranks).collect(), vec![Vec::new(); ranks as usize - 1]),
-            _ => {
-                let mut m = Vec::new();
-                for (b, body) in bodies.iter().enumerate().filter(|(b, _)| self.sender.get(*b) == Some(&me)) {
-                    m.push(b as f64);
-                    m.extend(body.u.iter().chain(&body.v));
-                }
-                (vec![0], vec![m])
-            }
-        };
-        for m in rounds.exchange(&peers, &out) {
-            take_whole(bodies, &m, |_| me == 0);
-        }
+    /// (this rank, ranks) of the last step stepped in part.
+    pub fn ranks(&self) -> Option<(u32, u32)> {
+        self.on
+    }
+
+    /// The stepping rank of body `b` in the step in progress or the last one
+    /// stepped in part.
+    pub fn sender_of(&self, b: usize) -> Option<u32> {
+        self.sender.get(b).copied()
     }
 
     /// Every body's energies after the step, as their senders computed them
@@ -417,21 +390,6 @@ impl Stepped {
 /// all-gather gives every rank's sides per body from the whole list of contacts
 /// (body, deformable antagonist) and their ranks; the point-to-point round gives
 /// back `replies` (one message per peer, in order).
-/// Bodies' whole states (body, u, V each) into `bodies`, those `take` says.
-fn take_whole(bodies: &mut [FeBody], m: &[f64], take: impl Fn(usize) -> bool) {
-    let mut i = 0;
-    while let Some(&b) = m.get(i) {
-        let Some(body) = bodies.get_mut(b as usize) else { return };
-        let n = body.u.len();
-        let Some(x) = m.get(i + 1..i + 1 + 2 * n) else { return };
-        if take(b as usize) {
-            body.u.copy_from_slice(&x[..n]);
-            body.v.copy_from_slice(&x[n..]);
-        }
-        i += 1 + 2 * n;
-    }
-}
-
 #[cfg(test)]
 pub(crate) struct AllRanks<'a> {
     pub ranks: u32,
@@ -547,88 +505,5 @@ mod tests {
         assert_eq!(s.solved(), Some(&[true, true][..]));
         assert!(!s.decide(2, None, std::iter::empty(), (1e-3, 0.5)));
         assert!(s.solved().is_none(), "one process");
-    }
-
-    /// A square of four triangles around an interior node (node 4).
-    fn square() -> FeBody {
-        let raw = crate::python::RawMesh {
-            dim: 2,
-            points: vec![0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0, 0.5, 0.5],
-            cells: vec![0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4],
-        };
-        let el = crate::body::Elastic {
-            young: 1e6,
-            poisson: 0.3,
-            density: 1e3,
-            plane_stress: false,
-            rayleigh: [0.0; 2],
-        };
-        FeBody::light(None, crate::mesh::Mesh::new(raw).unwrap(), el, 0)
-    }
-
-    /// A body stepped by rank 0, then by rank 1, seen from rank 1: it takes the
-    /// body's V⁺ at its boundary only, then its whole state from rank 0 when it
-    /// steps it, and sends that to rank 0 for the outputs; rank 0 sends its whole
-    /// state to rank 1 when rank 1 takes it over.
-    #[test]
-    fn a_body_not_stepped_here_holds_its_boundary_and_is_handed_over_whole() {
-        let mut bodies = vec![square()];
-        assert_eq!(bodies[0].mesh.boundary, [0, 1, 2, 3]);
-        let on_rank = std::cell::Cell::new(0u32);
-        let rank_of = |_: usize| on_rank.get();
-        let rounds = AllRanks {
-            ranks: 2,
-            rank_of: &rank_of,
-            contacts: vec![(0, None)],
-            replies: Default::default(),
-            sent: Default::default(),
-        };
-        let decide = |s: &mut Stepped, me: u32| {
-            let on = SolvedOn {
-                rank: me,
-                ranks: 2,
-                rank_of: &rank_of,
-                rounds: &rounds,
-            };
-            s.decide(1, Some(&on), [(0, None)].into_iter(), (1e-3, 0.5))
-        };
-        let (mut s0, mut s1) = (Stepped::default(), Stepped::default());
-        decide(&mut s0, 0);
-        decide(&mut s1, 1);
-        // the first step after a load: the state is whole everywhere, nothing handed over
-        s1.hand_over(&mut bodies, &rounds);
-        assert_eq!(rounds.sent.borrow().last(), Some(&(vec![], vec![])));
-        // rank 0's V⁺ at the four boundary nodes, and the energies
-        let mut msg = vec![0.0];
-        msg.extend((1..=8).map(f64::from));
-        msg.extend([0.5, 0.25, 0.0]);
-        s1.unpack(&mut bodies, &msg);
-        assert_eq!(bodies[0].v, [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 0.0, 0.0]);
-        assert_eq!(s1.energies(), Some(&[[0.5, 0.25, 0.0]][..]));
-        // the contact moves to rank 1: rank 0 sends the whole state, rank 1 takes it
-        on_rank.set(1);
-        decide(&mut s0, 0);
-        decide(&mut s1, 1);
-        assert!(!s0.steps(0) && s1.steps(0));
-        let whole: Vec<f64> = (0..20).map(f64::from).collect();
-        bodies[0].u.copy_from_slice(&whole[..10]);
-        bodies[0].v.copy_from_slice(&whole[10..]);
-        s0.hand_over(&mut bodies, &rounds);
-        let mut expect = vec![0.0];
-        expect.extend(&whole);
-        assert_eq!(rounds.sent.borrow().last(), Some(&(vec![1], vec![expect.clone()])));
-        let mut got = vec![square()];
-        *rounds.replies.borrow_mut() = vec![expect.clone()];
-        s1.hand_over(&mut got, &rounds);
-        assert_eq!(rounds.sent.borrow().last(), Some(&(vec![0], vec![vec![]])));
-        assert_eq!((&got[0].u[..], &got[0].v[..]), (&whole[..10], &whole[10..]));
-        // before an output, rank 1 sends the bodies it stepped to rank 0
-        s1.gather_whole(&mut got, &rounds);
-        assert_eq!(rounds.sent.borrow().last(), Some(&(vec![0], vec![expect.clone()])));
-        let mut at0 = vec![square()];
-        *rounds.replies.borrow_mut() = vec![expect];
-        s0.gather_whole(&mut at0, &rounds);
-        assert_eq!(rounds.sent.borrow().last(), Some(&(vec![1], vec![vec![]])));
-        assert_eq!((&at0[0].u[..], &at0[0].v[..]), (&whole[..10], &whole[10..]));
     }
 }
