@@ -39,6 +39,7 @@ fn stepped_on_ranks(
             common::history_physics(&one),
             "{tag}, {n} ranks: the history differs from one process"
         );
+        same_outputs(&one, &out, &format!("{tag}, {n} ranks"));
         // each body stepped by one rank a step (the rank solving most of its
         // contacts; the others solving some receive its columns)
         let stepped = per_rank_count(&out, "family_bodies_stepped");
@@ -49,6 +50,19 @@ fn stepped_on_ranks(
         );
     }
     reference
+}
+
+/// The deformable bodies' frames (`deformable*.vtu`) and the checkpoint of `one`
+/// are in `out`, the same bytes (a rank that does not step a body holds its
+/// boundary only: rank 0 gathers the whole state before each output).
+fn same_outputs(one: &std::path::Path, out: &std::path::Path, what: &str) {
+    for e in std::fs::read_dir(one).unwrap() {
+        let name = e.unwrap().file_name().into_string().unwrap();
+        if (name.starts_with("deformable") && name.ends_with(".vtu")) || name == "checkpoint.json" {
+            let (a, b) = (std::fs::read(one.join(&name)).unwrap(), std::fs::read(out.join(&name)));
+            assert!(b.as_ref().is_ok_and(|b| *b == a), "{what}: {name} differs from one process");
+        }
+    }
 }
 
 /// `mpirun -n n nscdd args` with the environment `env` added.
@@ -62,7 +76,16 @@ fn mpirun_env(n: u32, args: Vec<String>, env: &[(&str, &str)]) -> std::process::
 fn deformable_bodies_are_stepped_per_rank() {
     let dir = scratch("fe_stepped");
     let s2 = write(&dir, "blocks.toml", BLOCKS);
-    let reference = stepped_on_ranks(&dir, "2d", (&s2, 4 * 60), &[2, 4], &[]);
+    // the frames and a checkpoint (steps 0, 30, 60; 20, 40) the one-process files
+    let framed = BLOCKS.replace("vtk = false", "vtk = true\ncheckpoint_every = 20");
+    let sv = write(&dir, "framed.toml", &framed);
+    let reference = stepped_on_ranks(&dir, "2d", (&sv, 4 * 60), &[2, 4], &[]);
+    let vtus = std::fs::read_dir(dir.join("2d_ranks2")).unwrap().filter(|e| {
+        let n = e.as_ref().unwrap().file_name().into_string().unwrap();
+        n.starts_with("deformable") && n.ends_with(".vtu")
+    });
+    assert_eq!(vtus.count(), 4 * 3, "four blocks' three frames");
+    assert!(dir.join("2d_ranks2/checkpoint.json").exists());
     // threads inside the ranks: the same file
     let hybrid = dir.join("hybrid");
     ok(&mpirun(&[(2, args(&s2, &hybrid, &["--threads", "2"]))]), "2 ranks of 2 threads");
