@@ -18,6 +18,8 @@ pub struct SolvedOn<'a> {
     pub ranks: u32,
     /// The rank solving contact `a` (the family's [`Attached::points`] order).
     pub rank_of: &'a dyn Fn(usize) -> u32,
+    /// The subdomain of contact `a` (the `owner` [`Attached::split`] gets).
+    pub subdomain_of: &'a dyn Fn(usize) -> u32,
     /// Rounds among the ranks the family may run in [`Attached::solved_on`]
     /// (collective: every rank's family runs the same rounds in the same order).
     pub rounds: &'a dyn Rounds,
@@ -129,12 +131,14 @@ pub(super) fn solved_on<D: Family>(
                 let o = &owner[f];
                 let sub_rank = rs.rank_of.clone();
                 let rank_of = |a: usize| sub_rank[o[a] as usize];
+                let subdomain_of = |a: usize| o[a];
                 let (rank, size) = (rs.cluster.rank(), rs.cluster.size());
                 let rounds = RankRounds(std::cell::RefCell::new(rs));
                 let on = SolvedOn {
                     rank,
                     ranks: size,
                     rank_of: &rank_of,
+                    subdomain_of: &subdomain_of,
                     rounds: &rounds,
                 };
                 fam.solved_on(w, Some(&on))

@@ -137,6 +137,12 @@ impl Attached<Rigid2> for Deformables2 {
             let sides = own.flat_map(|a| std::iter::once(c.cand[a]).chain(c.anta[a].fe()));
             let nodes = sides.flat_map(|s| s.k.map(|k| (s.body, sets[s.body as usize].nodes[k as usize])));
             self.solved.asked = crate::solved::ask_nodes(st, nodes, on.rounds);
+            let rigid = |a: usize| match c.anta[a] {
+                Anta::Rigid { body, .. } => Some(body),
+                _ => None,
+            };
+            let sides = |a: usize| (c.cand[a].body, c.anta[a].fe().map(|s| s.body), rigid(a));
+            self.solved.shells = crate::shells::share(on, c.len(), sides);
         }
         // (a large body this rank steps first is assembled here: if that fails, no
         // body is stepped here and the step's end reports it)
@@ -180,14 +186,12 @@ impl Attached<Rigid2> for Deformables2 {
     fn split(&self, _w: &World2, owner: &[u32], copy: &mut dyn FnMut(u32, u32) -> u32) -> Vec<(u32, Box<dyn LocalPart<Rigid2>>)> {
         let c = &self.contacts;
         // stepped in part: the contacts solved here come from their own list, the
-        // other ranks' subdomains get shells ([`FePart2::shell`])
+        // other ranks' subdomains are shells made from their ranks' descriptions
+        // ([`crate::shells`], [`FePart2::shell`])
         let own = self.stepped.solved();
-        let make = |p: &mut FePart2, b: u32| match p.shell {
-            true => p.fe.push(b),
-            false => p.push_entity(b, self),
-        };
-        let parts = split_by(owner, self.bodies.len(), make, |s, part: &mut FePart2, contacts, entity| {
-            part.shell = own.is_some_and(|o| !o[contacts[0] as usize]);
+        let make = |p: &mut FePart2, b: u32| p.push_entity(b, self);
+        let pairs = by_subdomain(owner, |a| own.is_none_or(|o| o[a]));
+        let mut parts = split_pairs(&pairs, self.bodies.len(), make, |s, part: &mut FePart2, contacts, entity| {
             for &a in contacts {
                 let a = a as usize;
                 let mut cand = c.cand[a];
@@ -200,13 +204,22 @@ impl Attached<Rigid2> for Deformables2 {
                     }
                 };
                 part.global.push(a as u32);
-                match (part.shell, own) {
-                    (true, _) => {}
-                    (false, Some(_)) => part.contacts.push_from(&self.solved.list, self.solved.of[a] as usize, cand, anta),
-                    (false, None) => part.contacts.push_from(c, a, cand, anta),
+                match own {
+                    Some(_) => part.contacts.push_from(&self.solved.list, self.solved.of[a] as usize, cand, anta),
+                    None => part.contacts.push_from(c, a, cand, anta),
                 }
             }
         });
+        if let Some(o) = own {
+            let others = by_subdomain(owner, |a| !o[a]);
+            parts.extend(crate::shells::make(&self.solved.shells, &others, copy, |fe, global| FePart2 {
+                fe,
+                global,
+                shell: true,
+                ..Default::default()
+            }));
+            parts.sort_by_key(|x| x.0);
+        }
         parts
             .into_iter()
             .map(|(s, p)| (s, Box::new(p) as Box<dyn LocalPart<Rigid2>>))
@@ -277,10 +290,31 @@ pub fn split_by<P: Default>(
     owner: &[u32],
     n_bodies: usize,
     make: impl Fn(&mut P, u32),
+    fill: impl FnMut(u32, &mut P, &[u32], &mut dyn FnMut(&mut P, u32) -> u32),
+) -> Vec<(u32, P)> {
+    split_pairs(&by_subdomain(owner, |_| true), n_bodies, make, fill)
+}
+
+/// (subdomain, contact) of the contacts `keep` says, ascending (`owner`: each
+/// contact's subdomain).
+pub fn by_subdomain(owner: &[u32], keep: impl Fn(usize) -> bool) -> Vec<(u32, u32)> {
+    let mut by_sub: Vec<(u32, u32)> = owner
+        .iter()
+        .enumerate()
+        .filter(|x| keep(x.0))
+        .map(|(a, &s)| (s, a as u32))
+        .collect();
+    by_sub.sort_unstable();
+    by_sub
+}
+
+/// [`split_by`] of the contacts `by_sub` ((subdomain, contact), ascending).
+pub fn split_pairs<P: Default>(
+    by_sub: &[(u32, u32)],
+    n_bodies: usize,
+    make: impl Fn(&mut P, u32),
     mut fill: impl FnMut(u32, &mut P, &[u32], &mut dyn FnMut(&mut P, u32) -> u32),
 ) -> Vec<(u32, P)> {
-    let mut by_sub: Vec<(u32, u32)> = owner.iter().enumerate().map(|(a, &s)| (s, a as u32)).collect();
-    by_sub.sort_unstable();
     let mut out = Vec::new();
     // (subdomain, local id) of each body's last copy made
     let mut seen = vec![(u32::MAX, 0u32); n_bodies];

@@ -3,7 +3,7 @@
 //! contacts' frames are 3D bases and their local problem the 3D Coulomb solver).
 
 use crate::contact3::*;
-use crate::family2::split_by;
+use crate::family2::{by_subdomain, split_pairs};
 use crate::stage3::{self, Deformables3};
 use nscdd::dd::{Attached, EntityInfo, LocalPart, Rigid3, SolvedOn};
 use nscdd::dim::coulomb3 as coulomb;
@@ -141,6 +141,12 @@ impl Attached<Rigid3> for Deformables3 {
             let sides = own.flat_map(|a| std::iter::once(c.cand[a]).chain(c.anta[a].fe()));
             let nodes = sides.flat_map(|s| s.k.map(|k| (s.body, sets[s.body as usize].nodes[k as usize])));
             self.solved.asked = crate::solved::ask_nodes(st, nodes, on.rounds);
+            let rigid = |a: usize| match c.anta[a] {
+                Anta3::Rigid { body, .. } => Some(body),
+                _ => None,
+            };
+            let sides = |a: usize| (c.cand[a].body, c.anta[a].fe().map(|s| s.body), rigid(a));
+            self.solved.shells = crate::shells::share(on, c.len(), sides);
         }
         // (a large body this rank steps first is assembled here: if that fails, no
         // body is stepped here and the step's end reports it)
@@ -184,14 +190,12 @@ impl Attached<Rigid3> for Deformables3 {
     fn split(&self, _w: &World3, owner: &[u32], copy: &mut dyn FnMut(u32, u32) -> u32) -> Vec<(u32, Box<dyn LocalPart<Rigid3>>)> {
         let c = &self.contacts;
         // stepped in part: the contacts solved here come from their own list, the
-        // other ranks' subdomains get shells ([`FePart3::shell`])
+        // other ranks' subdomains are shells made from their ranks' descriptions
+        // ([`crate::shells`], [`FePart3::shell`])
         let own = self.stepped.solved();
-        let make = |p: &mut FePart3, b: u32| match p.shell {
-            true => p.fe.push(b),
-            false => p.push_entity(b, self),
-        };
-        let parts = split_by(owner, self.bodies.len(), make, |s, part: &mut FePart3, contacts, entity| {
-            part.shell = own.is_some_and(|o| !o[contacts[0] as usize]);
+        let make = |p: &mut FePart3, b: u32| p.push_entity(b, self);
+        let pairs = by_subdomain(owner, |a| own.is_none_or(|o| o[a]));
+        let mut parts = split_pairs(&pairs, self.bodies.len(), make, |s, part: &mut FePart3, contacts, entity| {
             for &a in contacts {
                 let a = a as usize;
                 let mut cand = c.cand[a];
@@ -204,13 +208,22 @@ impl Attached<Rigid3> for Deformables3 {
                     }
                 };
                 part.global.push(a as u32);
-                match (part.shell, own) {
-                    (true, _) => {}
-                    (false, Some(_)) => part.contacts.push_from(&self.solved.list, self.solved.of[a] as usize, cand, anta),
-                    (false, None) => part.contacts.push_from(c, a, cand, anta),
+                match own {
+                    Some(_) => part.contacts.push_from(&self.solved.list, self.solved.of[a] as usize, cand, anta),
+                    None => part.contacts.push_from(c, a, cand, anta),
                 }
             }
         });
+        if let Some(o) = own {
+            let others = by_subdomain(owner, |a| !o[a]);
+            parts.extend(crate::shells::make(&self.solved.shells, &others, copy, |fe, global| FePart3 {
+                fe,
+                global,
+                shell: true,
+                ..Default::default()
+            }));
+            parts.sort_by_key(|x| x.0);
+        }
         parts
             .into_iter()
             .map(|(s, p)| (s, Box::new(p) as Box<dyn LocalPart<Rigid3>>))

@@ -19,6 +19,7 @@ pub mod output;
 pub mod problem;
 pub mod python;
 pub mod scene;
+pub mod shells;
 pub mod solved;
 pub mod stage2;
 pub mod stage3;

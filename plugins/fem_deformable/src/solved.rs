@@ -185,6 +185,9 @@ pub struct Solved<Cs> {
     pub of: Vec<u32>,
     /// What the other ranks asked of the bodies stepped here ([`ask_nodes`]).
     pub asked: Asked,
+    /// The other ranks' subdomains, as their ranks describe them
+    /// ([`crate::shells::share`]).
+    pub shells: Vec<crate::shells::Shell>,
 }
 
 impl<Cs> Solved<Cs> {
@@ -269,6 +272,7 @@ mod tests {
                 rank: me,
                 ranks: 3,
                 rank_of: &rank_of,
+                subdomain_of: &rank_of,
                 rounds: &rounds,
             };
             assert!(s.decide(1, Some(&on), [(0, None); 3].into_iter(), (1e-3, 0.5)));

@@ -444,6 +444,7 @@ mod tests {
             rank: 0,
             ranks: 2,
             rank_of: &rank_of,
+            subdomain_of: &rank_of,
             rounds: &rounds,
         };
         s.decide(2, Some(&on), contacts.into_iter(), (1e-3, 0.5))

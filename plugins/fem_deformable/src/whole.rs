@@ -118,6 +118,7 @@ mod tests {
                 rank: me,
                 ranks: 2,
                 rank_of: &rank_of,
+                subdomain_of: &rank_of,
                 rounds: &rounds,
             };
             s.decide(1, Some(&on), [(0, None)].into_iter(), (1e-3, 0.5))
