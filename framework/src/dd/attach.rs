@@ -123,7 +123,7 @@ pub trait Attached<F: Family> {
     fn residual_parts(&self, w: &F::World) -> (f64, f64);
     /// [`Self::residual_parts`] of the contacts `contacts` ([`Self::points`] order,
     /// ascending: those of one subdomain), after the step's results are shared
-    /// ([`Self::unpack_stepped`]). A family that gives them has its sums taken per
+    /// ([`Self::share_stepped`]). A family that gives them has its sums taken per
     /// subdomain, by the rank solving it, and added in subdomain order with the
     /// rigid contacts' of the subdomain (so on ranks only a subdomain's rank reads
     /// its contacts' results). `None` (the default): its sums are taken whole, after
@@ -162,8 +162,8 @@ pub trait Attached<F: Family> {
     /// bodies without contact, shared among the ranks) returns true: the ranks
     /// then exchange what one computed for another's contacts
     /// ([`Self::pack_solved`], [`Self::unpack_solved`]) before [`Self::split`], and
-    /// after its [`Self::write_back`] the results ([`Self::pack_stepped`],
-    /// [`Self::unpack_stepped`]), before [`Self::residual_parts`]. It still gives
+    /// after its [`Self::write_back`] the results ([`Self::share_stepped`]),
+    /// before [`Self::residual_parts`]. It still gives
     /// every contact and a part for every subdomain, the same on every rank (their
     /// order and packed results are those of one process); the parts of other
     /// ranks' subdomains are never prepared nor swept here (they may be shells,
@@ -184,13 +184,13 @@ pub trait Attached<F: Family> {
     /// (rank, message) in the same order; the family then builds what its parts
     /// need. Called on every rank [`Self::solved_on`] returned true on.
     fn unpack_solved(&mut self, _w: &F::World, _from: &[(u32, Vec<f64>)]) {}
-    /// After [`Self::write_back`] of a step [`Self::solved_on`] returned true for:
-    /// the results computed here that the other ranks need (any length), appended
-    /// to `out`.
-    fn pack_stepped(&self, _out: &mut Vec<f64>) {}
-    /// Every rank's [`Self::pack_stepped`], in rank order: after it the family's
-    /// state is the same on every rank.
-    fn unpack_stepped(&mut self, _all: &[f64]) {}
+    /// After [`Self::write_back`] of a step [`Self::solved_on`] returned true for,
+    /// on every rank (collective): the family's rounds that finish the step (the
+    /// deformable bodies: the impulses of a body's contacts solved elsewhere to the
+    /// rank stepping it, its V⁺ computed there and sent at its boundary), after
+    /// which what the family's residual, outputs and position update read is the
+    /// same on every rank.
+    fn share_stepped(&mut self, _rounds: &dyn Rounds) {}
     /// On MPI ranks, before the outputs read the family's state (an output frame, a
     /// saved state): what rank 0 lacks of it, sent there (collective: every rank
     /// calls it; a family stepped in part may hold on a rank only what its next

@@ -4,8 +4,8 @@
 //! [`Attached::solved_on`]), before they split their contacts into parts. A family
 //! that uses it does the work of its contacts' bodies on the ranks solving them
 //! only, and after its [`Attached::write_back`] the ranks exchange what each
-//! computed ([`Attached::pack_stepped`], one all-gather), so that its state is the
-//! same on every rank again before its residual, outputs and position update.
+//! computed ([`Attached::share_stepped`], the family's rounds), so that what its
+//! residual, outputs and position update read is the same on every rank again.
 
 use super::attach::Attached;
 use super::family::Family;
@@ -70,16 +70,13 @@ impl Rounds for RankRounds<'_> {
     }
 }
 
-/// After the families' write-back: each family stepped in part (`on`) packs what
-/// it computed, every rank receives every rank's pack (one all-gather per family;
-/// collective: `on` is the same on every rank).
+/// After the families' write-back: each family stepped in part (`on`) runs its
+/// rounds ([`Attached::share_stepped`]; collective: `on` is the same on every
+/// rank).
 pub(super) fn share_stepped<D: Family>(fams: &mut [&mut dyn Attached<D>], on: &[bool], mut ranks: Option<&mut RankState>) {
     for (fam, _) in fams.iter_mut().zip(on).filter(|x| *x.1) {
         let Some(rs) = ranks.as_deref_mut() else { return };
-        let mut mine = Vec::new();
-        fam.pack_stepped(&mut mine);
-        let (_, all) = rs.all_gather_any(&mine);
-        fam.unpack_stepped(&all);
+        with_rounds(rs, |r| fam.share_stepped(r));
         if let Some((here, n)) = fam.stepped_bodies() {
             rs.totals.family_bodies_stepped += here as u64;
             rs.totals.family_bodies += n as u64;

@@ -170,11 +170,8 @@ impl<D: Dim> Attached<Rigid<D>> for GuardedFamily<D> {
     fn unpack_solved(&mut self, w: &World<D>, from: &[(u32, Vec<f64>)]) {
         self.guard.call(|| self.inner.unpack_solved(w, from))
     }
-    fn pack_stepped(&self, out: &mut Vec<f64>) {
-        self.guard.call(|| self.inner.pack_stepped(out))
-    }
-    fn unpack_stepped(&mut self, all: &[f64]) {
-        self.guard.call(|| self.inner.unpack_stepped(all))
+    fn share_stepped(&mut self, rounds: &dyn crate::dd::Rounds) {
+        self.guard.call(|| self.inner.share_stepped(rounds))
     }
     fn gather_whole(&mut self, rounds: &dyn crate::dd::Rounds) {
         self.guard.call(|| self.inner.gather_whole(rounds))

@@ -239,9 +239,13 @@ impl Attached<Rigid3> for Deformables3 {
                 }
             }
         }
-        self.finish_velocities();
-        // the one-domain sets hold V⁺ at the contact nodes (for the residual)
-        crate::nodes::sets_at_velocities(&self.bodies, &mut self.sets);
+        // stepped in part, V⁺ comes once the impulses of the bodies' contacts solved
+        // elsewhere have come ([`Self::share_stepped`])
+        if self.stepped.solved().is_none() {
+            self.finish_velocities();
+            // the one-domain sets hold V⁺ at the contact nodes (for the residual)
+            crate::nodes::sets_at_velocities(&self.bodies, &mut self.sets);
+        }
     }
     fn residual_parts(&self, w: &World3) -> (f64, f64) {
         Deformables3::residual_parts(self, &w.bodies.vel, |g| crate::family::slot(w, g))
@@ -258,12 +262,16 @@ impl Attached<Rigid3> for Deformables3 {
     fn reach(&self, w: &World3, out: &mut Vec<[[f64; 3]; 2]>) {
         crate::family::reach(&self.bodies, w.time.h, self.alert, out);
     }
-    fn pack_stepped(&self, out: &mut Vec<f64>) {
-        self.stepped.pack(&self.bodies, out);
-    }
-    fn unpack_stepped(&mut self, all: &[f64]) {
-        self.stepped.unpack(&mut self.bodies, all);
-        crate::nodes::sets_at_velocities(&self.bodies, &mut self.sets);
+    /// V⁺ of the bodies stepped here, their contacts' impulses solved elsewhere
+    /// received ([`crate::impulses`]), and V⁺ at every body's boundary shared.
+    fn share_stepped(&mut self, rounds: &dyn nscdd::dd::Rounds) {
+        let (c, st) = (&self.contacts, &self.stepped);
+        let me = st.rank_here();
+        let own = (0..c.len()).filter(|&a| Some(st.rank_of(a)) == me);
+        let own: Vec<_> = own
+            .map(|a| (a as u32, c.cand[a], c.anta[a].fe(), global(&c.frame[a], c.r[a])))
+            .collect();
+        crate::impulses::finish(&mut self.stepped, &mut self.bodies, &mut self.sets, own.into_iter(), rounds);
     }
     fn gather_whole(&mut self, rounds: &dyn nscdd::dd::Rounds) {
         crate::whole::gather_whole(&self.stepped, &mut self.bodies, rounds);

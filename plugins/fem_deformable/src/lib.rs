@@ -12,6 +12,7 @@ pub mod continuum;
 pub mod family;
 pub mod family2;
 pub mod family3;
+pub mod impulses;
 pub mod matrices;
 pub mod mesh;
 pub mod nodes;

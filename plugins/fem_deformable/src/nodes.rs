@@ -333,19 +333,30 @@ pub fn velocities_after<const D: usize>(
     impulses: impl Iterator<Item = (FeSide<D>, Option<FeSide<D>>, [f64; D])>,
     stepped: Option<&[bool]>,
 ) {
+    let sides = impulses.flat_map(|(cand, anta, p)| std::iter::once((cand, 1.0, p)).chain(anta.map(|s| (s, -1.0, p))));
+    velocities_from(bodies, sets, sides, stepped);
+}
+
+/// [`velocities_after`] from the impulses' sides, each (side, sign, P): the
+/// side's nodes take sign · P (the one-domain order: the contacts in the
+/// family's order, the candidate side before the antagonist).
+pub fn velocities_from<const D: usize>(
+    bodies: &mut [FeBody],
+    sets: &[NodeSet<D>],
+    sides: impl Iterator<Item = (FeSide<D>, f64, [f64; D])>,
+    stepped: Option<&[bool]>,
+) {
     let steps = |b: usize| stepped.is_none_or(|m| m[b]);
     let mut f: Vec<Vec<f64>> = vec![Vec::new(); bodies.len()];
-    for (cand, anta, p) in impulses {
-        for (s, sign) in std::iter::once((cand, 1.0)).chain(anta.map(|s| (s, -1.0))) {
-            let b = s.body as usize;
-            if !steps(b) {
-                continue;
-            }
-            if f[b].is_empty() {
-                f[b] = vec![0.0; bodies[b].n_dofs()];
-            }
-            sets[b].add_side_force(&s, p, sign, &mut f[b]);
+    for (s, sign, p) in sides {
+        let b = s.body as usize;
+        if !steps(b) {
+            continue;
         }
+        if f[b].is_empty() {
+            f[b] = vec![0.0; bodies[b].n_dofs()];
+        }
+        sets[b].add_side_force(&s, p, sign, &mut f[b]);
     }
     for (bi, (b, mut dv)) in bodies.iter_mut().zip(f).enumerate() {
         if !steps(bi) {

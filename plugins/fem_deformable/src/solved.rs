@@ -21,7 +21,7 @@ pub type Asked = Vec<(u32, u32, Vec<u32>)>;
 /// solving its contacts; for a body whose contacts it solves without stepping it,
 /// the rank stepping it (a symmetric relation). `fill(peer, body, message)` adds
 /// to the message for each (peer, body) in turn.
-fn rounds_with(stepped: &Stepped, me: u32, mut fill: impl FnMut(u32, u32, &mut Vec<f64>)) -> BTreeMap<u32, Vec<f64>> {
+pub(crate) fn rounds_with(stepped: &Stepped, me: u32, mut fill: impl FnMut(u32, u32, &mut Vec<f64>)) -> BTreeMap<u32, Vec<f64>> {
     let mut to: BTreeMap<u32, Vec<f64>> = BTreeMap::new();
     for run in stepped.solvers().chunk_by(|a, b| a.0 == b.0) {
         let b = run[0].0;

@@ -1,0 +1,184 @@
+//! V⁺ of a deformable body from the impulses of its contacts, those solved on other
+//! MPI ranks sent to the rank stepping it (docs/SCALING.md, "V⁺ from the
+//! impulses sent to the stepping rank"). After the sweeps each rank holds the
+//! impulses of the contacts it solved; a body stepped elsewhere gets, from each
+//! rank solving some of its contacts, the shares of those impulses on its side
+//! (the side's nodes and weights, the impulse P and its sign), point to point, in
+//! [`nscdd::dd::Attached::share_stepped`]. The rank stepping it adds them to its
+//! own contacts' in the one-process order (the contacts in the family's order,
+//! the candidate side before the antagonist): V⁺ is the one-process number.
+
+use crate::nodes::{FeSide, NodeSet};
+use crate::stepped::Stepped;
+use nscdd::dd::Rounds;
+
+/// One side's share of a contact's impulse: the contact's place in the family's
+/// order, which side (0: candidate, 1: antagonist), the side, its sign and the
+/// global impulse P on the candidate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Share<const D: usize> {
+    pub at: u32,
+    pub which: u32,
+    pub side: FeSide<D>,
+    pub sign: f64,
+    pub p: [f64; D],
+}
+
+/// The shares of the contacts solved here (`contacts`: (place, candidate,
+/// deformable antagonist, P), in the family's order) on the bodies other ranks
+/// step go to those ranks; returns the shares on the bodies stepped here, this
+/// rank's and those received, in the one-process order. `sets`: the node sets
+/// (the sides' set indices; a set of a body stepped here holds every node the
+/// other ranks' contacts touch, [`crate::solved::shared_nodes`]).
+pub fn share<const D: usize>(
+    st: &Stepped,
+    sets: &[NodeSet<D>],
+    contacts: impl Iterator<Item = (u32, FeSide<D>, Option<FeSide<D>>, [f64; D])>,
+    rounds: &dyn Rounds,
+) -> Vec<Share<D>> {
+    let Some(me) = st.rank_here() else {
+        return Vec::new();
+    };
+    let mut here = Vec::new();
+    // (the ranks solving some contacts of a body stepped here, or stepping a body
+    // some of whose contacts are solved here: the symmetric relation of the columns)
+    let mut to = crate::solved::rounds_with(st, me, |_, _, _| {});
+    for (at, cand, anta, p) in contacts {
+        for (which, side, sign) in [(0, Some(cand), 1.0), (1, anta, -1.0)] {
+            let Some(side) = side else { continue };
+            let q = st.sender_of(side.body as usize).unwrap_or(me);
+            if q == me {
+                here.push(Share { at, which, side, sign, p });
+            } else if let Some(m) = to.get_mut(&q) {
+                // (place, which, body, sign, the side's D nodes and weights, P)
+                m.extend([f64::from(at), f64::from(which), f64::from(side.body), sign]);
+                let set = &sets[side.body as usize];
+                m.extend(side.k.map(|k| f64::from(set.nodes[k as usize])));
+                m.extend(side.w);
+                m.extend(p);
+            } else {
+                debug_assert!(
+                    false,
+                    "body {} is stepped by rank {q}, which solves none of its contacts",
+                    side.body
+                );
+            }
+        }
+    }
+    let peers: Vec<u32> = to.keys().copied().collect();
+    let out: Vec<Vec<f64>> = to.into_values().collect();
+    let len = 4 + 3 * D;
+    for m in rounds.exchange(&peers, &out) {
+        for x in m.chunks_exact(len) {
+            let body = x[2] as u32;
+            let Some(set) = sets.get(body as usize).filter(|_| st.steps(body as usize)) else {
+                continue;
+            };
+            let k = std::array::from_fn(|q| {
+                let found = set.nodes.binary_search(&(x[4 + q] as u32));
+                debug_assert!(
+                    found.is_ok(),
+                    "body {body}: node {} of a contact solved elsewhere not in its set",
+                    x[4 + q]
+                );
+                found.map_or(0, |k| k as u32)
+            });
+            here.push(Share {
+                at: x[0] as u32,
+                which: x[1] as u32,
+                side: FeSide {
+                    body,
+                    k,
+                    w: std::array::from_fn(|q| x[4 + D + q]),
+                },
+                sign: x[3],
+                p: std::array::from_fn(|q| x[4 + 2 * D + q]),
+            });
+        }
+    }
+    here.sort_by_key(|s| (s.at, s.which));
+    here
+}
+
+/// [`nscdd::dd::Attached::share_stepped`] of the deformable bodies: V⁺ of the
+/// bodies stepped here from the shares of their contacts' impulses ([`share`];
+/// `own`: the contacts solved here, as [`share`] takes them), then every rank's
+/// V⁺ at the boundary of the bodies it stepped, with their energies
+/// ([`Stepped::pack`], one all-gather), and the node sets at V⁺ (the residual).
+pub fn finish<const D: usize>(
+    st: &mut Stepped,
+    bodies: &mut [crate::body::FeBody],
+    sets: &mut [NodeSet<D>],
+    own: impl Iterator<Item = (u32, FeSide<D>, Option<FeSide<D>>, [f64; D])>,
+    rounds: &dyn Rounds,
+) {
+    let shares = share(st, sets, own, rounds);
+    crate::nodes::velocities_from(bodies, sets, shares.iter().map(|s| (s.side, s.sign, s.p)), st.mask());
+    let mut mine = Vec::new();
+    st.pack(bodies, &mut mine);
+    let all: Vec<f64> = rounds.all_gather(&mine).concat();
+    st.unpack(bodies, &all);
+    crate::nodes::sets_at_velocities(bodies, sets);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::stepped::AllRanks;
+    use nscdd::dd::SolvedOn;
+
+    /// Body 0's contacts 0 and 2 are solved on rank 0, which steps it, contact 1
+    /// (body 1 on body 0's segment) on rank 1, which steps body 1: rank 1 sends the
+    /// antagonist side's share to rank 0, which merges it between its own two in
+    /// the family's order.
+    #[test]
+    fn a_body_stepped_here_gets_the_shares_of_its_contacts_solved_elsewhere() {
+        let rank_of = |a: usize| u32::from(a == 1);
+        let contacts = vec![(0, None), (1, Some(0)), (0, None)];
+        let rounds = AllRanks {
+            ranks: 2,
+            rank_of: &rank_of,
+            contacts: contacts.clone(),
+            replies: Default::default(),
+            sent: Default::default(),
+        };
+        let decide = |me: u32| {
+            let mut s = Stepped::default();
+            let on = SolvedOn {
+                rank: me,
+                ranks: 2,
+                rank_of: &rank_of,
+                subdomain_of: &rank_of,
+                rounds: &rounds,
+            };
+            s.decide(2, Some(&on), contacts.clone().into_iter(), (1e-3, 0.5));
+            s
+        };
+        let (s0, s1) = (decide(0), decide(1));
+        assert!(s0.steps(0) && s1.steps(1) && !s1.steps(0));
+        let mut sets = vec![NodeSet::<2>::default(), NodeSet::<2>::default()];
+        sets[0].nodes = vec![3, 8, 9];
+        sets[1].nodes = vec![5];
+        let seg = FeSide {
+            body: 0,
+            k: [1, 2],
+            w: [0.25, 0.75],
+        };
+        // rank 1: its contact's candidate side on body 1 stays, the antagonist's goes
+        let own1 = [(1, FeSide::node(1, 0), Some(seg), [1.0, 2.0])];
+        let here1 = share(&s1, &sets, own1.into_iter(), &rounds);
+        assert_eq!(here1.iter().map(|s| (s.at, s.which)).collect::<Vec<_>>(), [(1, 0)]);
+        let sent = rounds.sent.borrow().last().cloned().unwrap();
+        // (place 1, antagonist, body 0, sign −1, nodes 8 and 9, weights, P)
+        assert_eq!(sent, (vec![0], vec![vec![1.0, 1.0, 0.0, -1.0, 8.0, 9.0, 0.25, 0.75, 1.0, 2.0]]));
+        // rank 0 receives it and merges it between its contacts 0 and 2
+        *rounds.replies.borrow_mut() = sent.1.clone();
+        let own0 = [(0, FeSide::node(0, 0), None, [3.0, 4.0]), (2, FeSide::node(0, 0), None, [5.0, 6.0])];
+        let here0 = share(&s0, &sets, own0.into_iter(), &rounds);
+        assert_eq!(rounds.sent.borrow().last().cloned().unwrap(), (vec![1], vec![vec![]]));
+        let got: Vec<(u32, u32, f64)> = here0.iter().map(|s| (s.at, s.which, s.sign)).collect();
+        assert_eq!(got, [(0, 0, 1.0), (1, 1, -1.0), (2, 0, 1.0)]);
+        assert_eq!(here0[1].side, seg);
+        assert_eq!(here0[1].p, [1.0, 2.0]);
+    }
+}
