@@ -137,12 +137,6 @@ impl Attached<Rigid2> for Deformables2 {
             let sides = own.flat_map(|a| std::iter::once(c.cand[a]).chain(c.anta[a].fe()));
             let nodes = sides.flat_map(|s| s.k.map(|k| (s.body, sets[s.body as usize].nodes[k as usize])));
             self.solved.asked = crate::solved::ask_nodes(st, nodes, on.rounds);
-            let rigid = |a: usize| match c.anta[a] {
-                Anta::Rigid { body, .. } => Some(body),
-                _ => None,
-            };
-            let sides = |a: usize| (c.cand[a].body, c.anta[a].fe().map(|s| s.body), rigid(a));
-            self.solved.shells = crate::shells::share(on, c.len(), sides);
         }
         // (a large body this rank steps first is assembled here: if that fails, no
         // body is stepped here and the step's end reports it)
@@ -155,6 +149,18 @@ impl Attached<Rigid2> for Deformables2 {
         match part {
             true => self.fill_step(),
             false => self.build_contacts(w),
+        }
+        // the other ranks' subdomains, and the node counts of the bodies stepped here
+        if let Some(on) = on.filter(|_| part) {
+            let (c, st) = (&self.contacts, &self.stepped);
+            let rigid = |a: usize| match c.anta[a] {
+                Anta::Rigid { body, .. } => Some(body),
+                _ => None,
+            };
+            let sides = |a: usize| (c.cand[a].body, c.anta[a].fe().map(|s| s.body), rigid(a));
+            let sets = self.sets.iter().enumerate().filter(|(b, s)| st.steps(*b) && !s.is_empty());
+            let stepped: Vec<(u32, u32)> = sets.map(|(b, s)| (b as u32, s.len() as u32)).collect();
+            (self.solved.shells, self.solved.set_lens) = crate::shells::share(on, c.len(), sides, &stepped);
         }
         part
     }
@@ -174,8 +180,11 @@ impl Attached<Rigid2> for Deformables2 {
     fn n_entities(&self) -> usize {
         self.bodies.len()
     }
+    /// Stepped in part, its contact nodes as the rank stepping it filled them.
     fn entity(&self, e: u32) -> EntityInfo {
-        let n = self.sets[e as usize].len();
+        let here = self.sets[e as usize].len();
+        let n = self.stepped.solved().and_then(|_| self.solved.set_len(e)).unwrap_or(here);
+        debug_assert_eq!(n, here, "body {e}'s contact nodes");
         EntityInfo {
             dofs: 2 * n as u32,
             space: 2 * n as u32,

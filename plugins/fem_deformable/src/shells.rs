@@ -25,17 +25,26 @@ pub struct Shell {
     pub contacts: u32,
 }
 
-/// This rank's subdomains described ([`Shell`]) and all-gathered; returns the
-/// other ranks' (ascending subdomains). `sides(a)`: contact `a`'s candidate body,
-/// deformable antagonist body if any, and rigid antagonist (global id) if any, for
-/// the `n` contacts of the family's list in its order.
-pub fn share(on: &SolvedOn<'_>, n: usize, sides: impl Fn(usize) -> (u32, Option<u32>, Option<u32>)) -> Vec<Shell> {
+/// This rank's subdomains described ([`Shell`]) and all-gathered, with the
+/// number of contact nodes of each body this rank steps (`stepped`: (body, nodes),
+/// the sets it filled: an entity's values in the gluing, [`crate::nodes`]);
+/// returns the other ranks' subdomains (ascending) and every rank's node counts
+/// (ascending bodies). `sides(a)`: contact `a`'s candidate body, deformable
+/// antagonist body if any, and rigid antagonist (global id) if any, for the `n`
+/// contacts of the family's list in its order.
+pub fn share(
+    on: &SolvedOn<'_>,
+    n: usize,
+    sides: impl Fn(usize) -> (u32, Option<u32>, Option<u32>),
+    stepped: &[(u32, u32)],
+) -> (Vec<Shell>, Vec<(u32, u32)>) {
     let mut own: Vec<(u32, u32)> = (0..n)
         .filter(|&a| (on.rank_of)(a) == on.rank)
         .map(|a| ((on.subdomain_of)(a), a as u32))
         .collect();
     own.sort_unstable();
-    let mut mine = Vec::new();
+    let mut mine = vec![stepped.len() as f64];
+    mine.extend(stepped.iter().flat_map(|&(b, k)| [f64::from(b), f64::from(k)]));
     for run in own.chunk_by(|x, y| x.0 == y.0) {
         let mut d = Shell {
             sub: run[0].0,
@@ -55,14 +64,18 @@ pub fn share(on: &SolvedOn<'_>, n: usize, sides: impl Fn(usize) -> (u32, Option<
         }
         pack(&d, &mut mine);
     }
-    let mut out = Vec::new();
+    let (mut out, mut nodes) = (Vec::new(), Vec::new());
     for (r, m) in on.rounds.all_gather(&mine).iter().enumerate() {
+        let k = m.first().map_or(0, |&k| k as usize);
+        let Some(counts) = m.get(1..1 + 2 * k) else { continue };
+        nodes.extend(counts.chunks_exact(2).map(|x| (x[0] as u32, x[1] as u32)));
         if r as u32 != on.rank {
-            unpack(m, &mut out);
+            unpack(&m[1 + 2 * k..], &mut out);
         }
     }
     out.sort_by_key(|d| d.sub);
-    out
+    nodes.sort_unstable();
+    (out, nodes)
 }
 
 /// The shell parts of the other ranks' subdomains `shells` ([`share`]), each
@@ -165,13 +178,16 @@ mod tests {
                 subdomain_of: &subdomain_of,
                 rounds: &g,
             };
-            let out = share(&on, 4, sides);
+            let stepped = [(rank, 10 + rank)];
+            let out = share(&on, 4, sides, &stepped);
             *all.borrow_mut() = g.0.into_inner();
             out
         };
         run(1);
-        let at0 = run(0);
-        let at1 = run(1);
+        let (at0, nodes0) = run(0);
+        let (at1, nodes1) = run(1);
+        // (every rank's node counts of the bodies it steps)
+        assert_eq!((&nodes0, &nodes1), (&vec![(0, 10), (1, 11)], &vec![(0, 10), (1, 11)]));
         let shell = |sub, entities: &[u32], rigid: &[u32], contacts| Shell {
             sub,
             entities: entities.to_vec(),
@@ -182,7 +198,7 @@ mod tests {
         assert_eq!(at1, [shell(0, &[2, 1], &[7], 2), shell(1, &[0], &[7], 1)]);
         // a truncated message drops the description it cuts
         let mut out = Vec::new();
-        unpack(&all.borrow()[0][..10], &mut out);
+        unpack(&all.borrow()[0][3..13], &mut out);
         assert_eq!(out, [shell(0, &[2, 1], &[7], 2)]);
     }
 }

@@ -188,6 +188,18 @@ pub struct Solved<Cs> {
     /// The other ranks' subdomains, as their ranks describe them
     /// ([`crate::shells::share`]).
     pub shells: Vec<crate::shells::Shell>,
+    /// (body, its contact nodes) of the bodies every rank steps, ascending
+    /// ([`crate::shells::share`]).
+    pub set_lens: Vec<(u32, u32)>,
+}
+
+impl<Cs> Solved<Cs> {
+    /// The number of contact nodes of body `b` (its entity's values in the
+    /// gluing), as the rank stepping it filled its set; `None` if no rank did.
+    pub fn set_len(&self, b: u32) -> Option<usize> {
+        let at = self.set_lens.binary_search_by_key(&b, |x| x.0).ok()?;
+        Some(self.set_lens[at].1 as usize)
+    }
 }
 
 impl<Cs> Solved<Cs> {
