@@ -86,6 +86,11 @@ fn deformable_bodies_are_stepped_per_rank() {
     });
     assert_eq!(vtus.count(), 4 * 3, "four blocks' three frames");
     assert!(dir.join("2d_ranks2/checkpoint.json").exists());
+    // 8 cells on 3 ranks: blocks change stepping rank (7 hand-overs of a whole
+    // state, `whole::hand_over`; without them this run ends elsewhere, checked
+    // when the test was written), their frames and checkpoints gathered from them
+    let s8 = write(&dir, "nx8.toml", &framed.replace("nx = 4\n", "nx = 8\n"));
+    stepped_on_ranks(&dir, "nx8", (&s8, 4 * 60), &[3], &[]);
     // threads inside the ranks: the same file
     let hybrid = dir.join("hybrid");
     ok(&mpirun(&[(2, args(&s2, &hybrid, &["--threads", "2"]))]), "2 ranks of 2 threads");
