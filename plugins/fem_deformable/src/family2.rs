@@ -129,14 +129,10 @@ impl Attached<Rigid2> for Deformables2 {
         let sides = (0..c.len()).map(|a| (c.cand[a].body, c.anta[a].fe().map(|s| s.body)));
         let part = self.stepped.decide(self.bodies.len(), on, sides, (w.time.h, w.time.theta));
         self.stepped.release(&mut self.bodies, &mut self.sets);
-        // the nodes of the bodies stepped elsewhere that the contacts solved here touch
+        // the whole states handed over, the nodes of the bodies stepped elsewhere asked
         if let Some(on) = on.filter(|_| part) {
-            crate::whole::hand_over(&self.stepped, &mut self.bodies, on.rounds);
-            let (c, sets, st) = (&self.contacts, &self.sets, &self.stepped);
-            let own = (0..c.len()).filter(|&a| st.rank_of(a) == on.rank);
-            let sides = own.flat_map(|a| std::iter::once(c.cand[a]).chain(c.anta[a].fe()));
-            let nodes = sides.flat_map(|s| s.k.map(|k| (s.body, sets[s.body as usize].nodes[k as usize])));
-            self.solved.asked = crate::solved::ask_nodes(st, nodes, on.rounds);
+            let (c, st, sets) = (&self.contacts, &self.stepped, &self.sets);
+            self.solved.asked = crate::solved::rounds_before(st, &mut self.bodies, sets, (c.len(), round_sides(c)), on);
         }
         // (a large body this rank steps first is assembled here: if that fails, no
         // body is stepped here and the step's end reports it)
@@ -152,15 +148,8 @@ impl Attached<Rigid2> for Deformables2 {
         }
         // the other ranks' subdomains, and the node counts of the bodies stepped here
         if let Some(on) = on.filter(|_| part) {
-            let (c, st) = (&self.contacts, &self.stepped);
-            let rigid = |a: usize| match c.anta[a] {
-                Anta::Rigid { body, .. } => Some(body),
-                _ => None,
-            };
-            let sides = |a: usize| (c.cand[a].body, c.anta[a].fe().map(|s| s.body), rigid(a));
-            let sets = self.sets.iter().enumerate().filter(|(b, s)| st.steps(*b) && !s.is_empty());
-            let stepped: Vec<(u32, u32)> = sets.map(|(b, s)| (b as u32, s.len() as u32)).collect();
-            (self.solved.shells, self.solved.set_lens) = crate::shells::share(on, c.len(), sides, &stepped);
+            let c = &self.contacts;
+            crate::solved::rounds_after(&self.stepped, &self.sets, (c.len(), round_sides(c)), on, &mut self.solved);
         }
         part
     }
@@ -358,4 +347,16 @@ pub fn split_pairs<P: Default>(
         p = q;
     }
     out
+}
+
+/// Each contact's sides for the rounds of a step stepped in part
+/// ([`crate::solved::Sides`]).
+fn round_sides(c: &FeContacts2) -> impl Fn(usize) -> crate::solved::Sides<2> + '_ {
+    |a| {
+        let rigid = match c.anta[a] {
+            Anta::Rigid { body, .. } => Some(body),
+            _ => None,
+        };
+        (c.cand[a], c.anta[a].fe(), rigid)
+    }
 }

@@ -125,7 +125,6 @@ pub fn finish<const D: usize>(
 mod tests {
     use super::*;
     use crate::stepped::AllRanks;
-    use nscdd::dd::SolvedOn;
 
     /// Body 0's contacts 0 and 2 are solved on rank 0, which steps it, contact 1
     /// (body 1 on body 0's segment) on rank 1, which steps body 1: rank 1 sends the
@@ -135,26 +134,8 @@ mod tests {
     fn a_body_stepped_here_gets_the_shares_of_its_contacts_solved_elsewhere() {
         let rank_of = |a: usize| u32::from(a == 1);
         let contacts = vec![(0, None), (1, Some(0)), (0, None)];
-        let rounds = AllRanks {
-            ranks: 2,
-            rank_of: &rank_of,
-            contacts: contacts.clone(),
-            replies: Default::default(),
-            sent: Default::default(),
-        };
-        let decide = |me: u32| {
-            let mut s = Stepped::default();
-            let on = SolvedOn {
-                rank: me,
-                ranks: 2,
-                rank_of: &rank_of,
-                subdomain_of: &rank_of,
-                rounds: &rounds,
-            };
-            s.decide(2, Some(&on), contacts.clone().into_iter(), (1e-3, 0.5));
-            s
-        };
-        let (s0, s1) = (decide(0), decide(1));
+        let rounds = AllRanks::new(2, &rank_of, contacts);
+        let (s0, s1) = (rounds.decide(0, 2), rounds.decide(1, 2));
         assert!(s0.steps(0) && s1.steps(1) && !s1.steps(0));
         let mut sets = vec![NodeSet::<2>::default(), NodeSet::<2>::default()];
         sets[0].nodes = vec![3, 8, 9];

@@ -7,9 +7,9 @@
 //! the rows of G their contacts read ([`pack_solved`], [`unpack_solved`], through
 //! [`nscdd::dd::Attached::pack_solved`]).
 
-use crate::nodes::NodeSet;
+use crate::nodes::{FeSide, NodeSet};
 use crate::stepped::Stepped;
-use nscdd::dd::Rounds;
+use nscdd::dd::{Rounds, SolvedOn};
 use std::collections::BTreeMap;
 
 /// (body, rank, its nodes) that other ranks asked of the bodies this rank steps
@@ -75,6 +75,52 @@ pub fn ask_nodes(stepped: &Stepped, sides: impl Iterator<Item = (u32, u32)>, rou
     }
     asked.sort_unstable_by_key(|x| (x.0, x.1));
     asked
+}
+
+/// A contact's sides for the rounds of a step stepped in part: its candidate
+/// side, its deformable antagonist side if any, its rigid antagonist (global id)
+/// if any.
+pub type Sides<const D: usize> = (FeSide<D>, Option<FeSide<D>>, Option<u32>);
+
+/// [`nscdd::dd::Attached::solved_on`]'s rounds before the free velocities,
+/// stepped in part: the whole states handed over ([`crate::whole::hand_over`]),
+/// then the nodes of the bodies stepped elsewhere that the contacts solved here
+/// touch asked of their stepping ranks ([`ask_nodes`]). `sides(a)`: the `n`
+/// contacts of the family's list.
+pub fn rounds_before<const D: usize>(
+    st: &Stepped,
+    bodies: &mut [crate::body::FeBody],
+    sets: &[NodeSet<D>],
+    (n, sides): (usize, impl Fn(usize) -> Sides<D>),
+    on: &SolvedOn<'_>,
+) -> Asked {
+    crate::whole::hand_over(st, bodies, on.rounds);
+    let own = (0..n).filter(|&a| st.rank_of(a) == on.rank);
+    let fe = own.flat_map(|a| {
+        let (c, f, _) = sides(a);
+        std::iter::once(c).chain(f)
+    });
+    let nodes = fe.flat_map(|s| s.k.map(|k| (s.body, sets[s.body as usize].nodes[k as usize])));
+    ask_nodes(st, nodes, on.rounds)
+}
+
+/// [`nscdd::dd::Attached::solved_on`]'s round once the sets are filled, stepped
+/// in part: the other ranks' subdomains and the node counts of the bodies every
+/// rank steps ([`crate::shells::share`]), into `solved`.
+pub fn rounds_after<const D: usize, Cs>(
+    st: &Stepped,
+    sets: &[NodeSet<D>],
+    (n, sides): (usize, impl Fn(usize) -> Sides<D>),
+    on: &SolvedOn<'_>,
+    solved: &mut Solved<Cs>,
+) {
+    let bodies = |a: usize| {
+        let (c, f, r) = sides(a);
+        (c.body, f.map(|s| s.body), r)
+    };
+    let filled = sets.iter().enumerate().filter(|(b, s)| st.steps(*b) && !s.is_empty());
+    let stepped: Vec<(u32, u32)> = filled.map(|(b, s)| (b as u32, s.len() as u32)).collect();
+    (solved.shells, solved.set_lens) = crate::shells::share(on, n, bodies, &stepped);
 }
 
 /// The contact nodes of the bodies this rank steps whose contacts other ranks
@@ -243,7 +289,6 @@ impl<Cs> Solved<Cs> {
 mod tests {
     use super::*;
     use crate::stepped::AllRanks;
-    use nscdd::dd::SolvedOn;
 
     /// The contacts solved here are built again from the raw contacts kept in the
     /// family's list.
@@ -271,25 +316,8 @@ mod tests {
     #[test]
     fn a_shared_body_is_stepped_once_and_its_columns_sent() {
         let rank_of = |a: usize| if a < 2 { 0 } else { 1 };
-        let rounds = AllRanks {
-            ranks: 3,
-            rank_of: &rank_of,
-            contacts: vec![(0, None); 3],
-            replies: Default::default(),
-            sent: Default::default(),
-        };
-        let decide_on = |me: u32| {
-            let mut s = Stepped::default();
-            let on = SolvedOn {
-                rank: me,
-                ranks: 3,
-                rank_of: &rank_of,
-                subdomain_of: &rank_of,
-                rounds: &rounds,
-            };
-            assert!(s.decide(1, Some(&on), [(0, None); 3].into_iter(), (1e-3, 0.5)));
-            s
-        };
+        let rounds = AllRanks::new(3, &rank_of, vec![(0, None); 3]);
+        let decide_on = |me: u32| rounds.decide(me, 1);
         let [s0, s1, s2] = [0, 1, 2].map(decide_on);
         assert!(s0.steps(0) && !s1.steps(0) && !s2.steps(0));
         assert!(s0.sends(0) && s1.receives(0) && !s2.receives(0));

@@ -401,6 +401,38 @@ pub(crate) struct AllRanks<'a> {
 }
 
 #[cfg(test)]
+impl<'a> AllRanks<'a> {
+    /// `ranks` ranks, contact `a` (`contacts`' a-th) solved on `rank_of(a)`.
+    pub fn new(ranks: u32, rank_of: &'a dyn Fn(usize) -> u32, contacts: Vec<(u32, Option<u32>)>) -> Self {
+        AllRanks {
+            ranks,
+            rank_of,
+            contacts,
+            replies: Default::default(),
+            sent: Default::default(),
+        }
+    }
+
+    /// Rank `rank`'s view (each contact's subdomain its rank).
+    pub fn on(&self, rank: u32) -> SolvedOn<'_> {
+        SolvedOn {
+            rank,
+            ranks: self.ranks,
+            rank_of: self.rank_of,
+            subdomain_of: self.rank_of,
+            rounds: self,
+        }
+    }
+
+    /// Rank `me`'s decision over `n` bodies.
+    pub fn decide(&self, me: u32, n: usize) -> Stepped {
+        let mut s = Stepped::default();
+        assert!(s.decide(n, Some(&self.on(me)), self.contacts.clone().into_iter(), (1e-3, 0.5)));
+        s
+    }
+}
+
+#[cfg(test)]
 impl nscdd::dd::Rounds for AllRanks<'_> {
     fn all_gather(&self, _mine: &[f64]) -> Vec<Vec<f64>> {
         (0..self.ranks)
@@ -433,21 +465,8 @@ mod tests {
     fn decide(s: &mut Stepped, rank_of_0: u32) -> bool {
         let rank_of = |a: usize| if a == 0 { rank_of_0 } else { 0 };
         let contacts = vec![(0, None), (1, None)];
-        let rounds = AllRanks {
-            ranks: 2,
-            rank_of: &rank_of,
-            contacts: contacts.clone(),
-            replies: Default::default(),
-            sent: Default::default(),
-        };
-        let on = SolvedOn {
-            rank: 0,
-            ranks: 2,
-            rank_of: &rank_of,
-            subdomain_of: &rank_of,
-            rounds: &rounds,
-        };
-        s.decide(2, Some(&on), contacts.into_iter(), (1e-3, 0.5))
+        let rounds = AllRanks::new(2, &rank_of, contacts.clone());
+        s.decide(2, Some(&rounds.on(0)), contacts.into_iter(), (1e-3, 0.5))
     }
 
     #[test]

@@ -77,7 +77,6 @@ fn take_whole(bodies: &mut [FeBody], m: &[f64], take: impl Fn(usize) -> bool) {
 mod tests {
     use super::*;
     use crate::stepped::AllRanks;
-    use nscdd::dd::SolvedOn;
 
     /// A square of four triangles around an interior node (node 4).
     fn square() -> FeBody {
@@ -106,23 +105,8 @@ mod tests {
         assert_eq!(bodies[0].mesh.boundary, [0, 1, 2, 3]);
         let on_rank = std::cell::Cell::new(0u32);
         let rank_of = |_: usize| on_rank.get();
-        let rounds = AllRanks {
-            ranks: 2,
-            rank_of: &rank_of,
-            contacts: vec![(0, None)],
-            replies: Default::default(),
-            sent: Default::default(),
-        };
-        let decide = |s: &mut Stepped, me: u32| {
-            let on = SolvedOn {
-                rank: me,
-                ranks: 2,
-                rank_of: &rank_of,
-                subdomain_of: &rank_of,
-                rounds: &rounds,
-            };
-            s.decide(1, Some(&on), [(0, None)].into_iter(), (1e-3, 0.5))
-        };
+        let rounds = AllRanks::new(2, &rank_of, vec![(0, None)]);
+        let decide = |s: &mut Stepped, me: u32| s.decide(1, Some(&rounds.on(me)), [(0, None)].into_iter(), (1e-3, 0.5));
         let (mut s0, mut s1) = (Stepped::default(), Stepped::default());
         decide(&mut s0, 0);
         decide(&mut s1, 1);
