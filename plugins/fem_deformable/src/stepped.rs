@@ -397,8 +397,12 @@ pub(crate) struct AllRanks<'a> {
     pub contacts: Vec<(u32, Option<u32>)>,
     pub replies: std::cell::RefCell<Vec<Vec<f64>>>,
     /// The point-to-point rounds' peers and messages sent, in order.
-    pub sent: std::cell::RefCell<Vec<(Vec<u32>, Vec<Vec<f64>>)>>,
+    pub sent: std::cell::RefCell<Vec<Sent>>,
 }
+
+/// A point-to-point round's peers and messages ([`AllRanks::sent`]).
+#[cfg(test)]
+pub(crate) type Sent = (Vec<u32>, Vec<Vec<f64>>);
 
 #[cfg(test)]
 impl<'a> AllRanks<'a> {
