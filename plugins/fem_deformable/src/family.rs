@@ -130,8 +130,20 @@ struct State {
 /// The saved state; `known`: each body's energies after the step, as the rank
 /// stepping it computed them ([`crate::stepped::Stepped::energies`]; the same
 /// numbers as [`FeBody::energies_now`], which a body whose M and K are not held
-/// here assembles them aside for: NaN if that fails).
-fn save<C, A, F, B, const N: usize>(bodies: &[FeBody], c: &FeContacts<C, A, F, B, N>, known: Option<&[[f64; 3]]>) -> serde_json::Value {
+/// here assembles them aside for: NaN if that fails). The contacts in key order:
+/// `gathered`'s on MPI ranks (every rank's, [`crate::whole::gather_contacts`]),
+/// else the family's list's.
+fn save<C, A, F, B, const N: usize>(
+    bodies: &[FeBody],
+    c: &FeContacts<C, A, F, B, N>,
+    known: Option<&[[f64; 3]]>,
+    gathered: Option<&[(FeKey, [f64; N])]>,
+) -> serde_json::Value {
+    let mut contacts: Vec<(FeKey, [f64; N])> = match gathered {
+        Some(g) => g.to_vec(),
+        None => c.key.iter().copied().zip(c.r.iter().copied()).collect(),
+    };
+    contacts.sort_unstable_by_key(|x| x.0);
     let state = State {
         bodies: bodies
             .iter()
@@ -150,12 +162,7 @@ fn save<C, A, F, B, const N: usize>(bodies: &[FeBody], c: &FeContacts<C, A, F, B
                 }
             })
             .collect(),
-        contacts: c
-            .key
-            .iter()
-            .zip(&c.r)
-            .map(|(k, r)| ContactState { key: *k, r: r.to_vec() })
-            .collect(),
+        contacts: contacts.into_iter().map(|(key, r)| ContactState { key, r: r.to_vec() }).collect(),
     };
     serde_json::to_value(state).expect("plain data")
 }
@@ -283,7 +290,8 @@ macro_rules! scene_family {
                 .to_vec()
             }
             fn history_values(&self, out: &mut Vec<f64>) {
-                history_values(&self.bodies, self.contacts.len(), self.stepped.energies(), out)
+                let contacts = self.stepped.contacts_total().unwrap_or(self.contacts.len());
+                history_values(&self.bodies, contacts, self.stepped.energies(), out)
             }
             fn write_frame(&mut self, dir: &Path, frame: u32, t: f64) -> std::io::Result<()> {
                 write_frame(&self.bodies, "deformable", &mut self.frames, dir, frame, t)
@@ -292,7 +300,12 @@ macro_rules! scene_family {
                 crate::output::write_pvd(dir, self.bodies.len(), &self.frames)
             }
             fn save_state(&self) -> serde_json::Value {
-                save(&self.bodies, &self.contacts, self.stepped.energies())
+                save(
+                    &self.bodies,
+                    &self.contacts,
+                    self.stepped.energies(),
+                    self.gathered.as_deref(),
+                )
             }
             fn load_state(&mut self, state: &serde_json::Value) -> Result<(), String> {
                 self.stepped = Default::default();

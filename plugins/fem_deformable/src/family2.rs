@@ -267,8 +267,13 @@ impl Attached<Rigid2> for Deformables2 {
             .collect();
         crate::impulses::finish(&mut self.stepped, &mut self.bodies, &mut self.sets, own.into_iter(), rounds);
     }
+    /// The bodies stepped elsewhere whole, every rank's contacts (the saved state).
     fn gather_whole(&mut self, rounds: &dyn nscdd::dd::Rounds) {
         crate::whole::gather_whole(&self.stepped, &mut self.bodies, rounds);
+        let (c, st) = (&self.contacts, &self.stepped);
+        let me = st.rank_here();
+        let own = (0..c.len()).filter(|&a| Some(st.rank_of(a)) == me).map(|a| (c.key[a], c.r[a]));
+        self.gathered = crate::whole::gather_contacts(st, own, rounds);
     }
     fn stepped_bodies(&self) -> Option<(usize, usize)> {
         self.stepped.counts()

@@ -104,7 +104,9 @@ pub fn share<const D: usize>(
 /// bodies stepped here from the shares of their contacts' impulses ([`share`];
 /// `own`: the contacts solved here, as [`share`] takes them), then every rank's
 /// V⁺ at the boundary of the bodies it stepped, with their energies
-/// ([`Stepped::pack`], one all-gather), and the node sets at V⁺ (the residual).
+/// ([`Stepped::pack`], one all-gather, which also adds up the contacts solved on
+/// each rank: [`Stepped::contacts_total`]), and the node sets at V⁺ (the
+/// residual).
 pub fn finish<const D: usize>(
     st: &mut Stepped,
     bodies: &mut [crate::body::FeBody],
@@ -112,12 +114,17 @@ pub fn finish<const D: usize>(
     own: impl Iterator<Item = (u32, FeSide<D>, Option<FeSide<D>>, [f64; D])>,
     rounds: &dyn Rounds,
 ) {
-    let shares = share(st, sets, own, rounds);
+    let own: Vec<_> = own.collect();
+    let shares = share(st, sets, own.iter().copied(), rounds);
     crate::nodes::velocities_from(bodies, sets, shares.iter().map(|s| (s.side, s.sign, s.p)), st.mask());
-    let mut mine = Vec::new();
+    // (the contacts solved here first: their count over the ranks is the history's)
+    let mut mine = vec![own.len() as f64];
     st.pack(bodies, &mut mine);
-    let all: Vec<f64> = rounds.all_gather(&mine).concat();
+    let per_rank = rounds.all_gather(&mine);
+    let total = per_rank.iter().map(|m| m.first().map_or(0, |&n| n as usize)).sum();
+    let all: Vec<f64> = per_rank.iter().flat_map(|m| m.iter().skip(1).copied()).collect();
     st.unpack(bodies, &all);
+    st.set_contacts_total(total);
     crate::nodes::sets_at_velocities(bodies, sets);
 }
 

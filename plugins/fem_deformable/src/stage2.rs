@@ -73,6 +73,9 @@ pub struct Deformables2 {
     pub stepped: crate::stepped::Stepped,
     /// The contacts this MPI rank solves, stepped in part ([`crate::solved::Solved`]).
     pub solved: crate::solved::Solved<FeContacts2>,
+    /// Every rank's contacts on rank 0 for the saved state, gathered on MPI ranks
+    /// ([`crate::whole::gather_contacts`]).
+    pub gathered: Option<Vec<(crate::nodes::FeKey, [f64; 2])>>,
 }
 
 impl Deformables2 {

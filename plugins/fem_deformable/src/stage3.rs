@@ -56,6 +56,9 @@ pub struct Deformables3 {
     pub stepped: crate::stepped::Stepped,
     /// The contacts this MPI rank solves, stepped in part ([`crate::solved::Solved`]).
     pub solved: crate::solved::Solved<FeContacts3>,
+    /// Every rank's contacts on rank 0 for the saved state, gathered on MPI ranks
+    /// ([`crate::whole::gather_contacts`]).
+    pub gathered: Option<Vec<(crate::nodes::FeKey, [f64; 3])>>,
 }
 
 /// The rigid bodies' M̂⁻¹ as the sweep reads them.

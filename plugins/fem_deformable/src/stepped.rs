@@ -112,6 +112,9 @@ pub struct Stepped {
     rank: Vec<u32>,
     /// A failure in the step in progress on this rank ([`Self::fail`]).
     failed: bool,
+    /// The family's contacts over the ranks, after the exchange of a step
+    /// stepped in part ([`crate::impulses::finish`]).
+    total: Option<usize>,
 }
 
 impl Stepped {
@@ -121,6 +124,7 @@ impl Stepped {
         self.on = None;
         self.held = true;
         self.failed = false;
+        self.total = None;
         self.energy_known = false;
         self.mine.clear();
         self.mine.resize(n, false);
@@ -376,6 +380,17 @@ impl Stepped {
     /// stepped in part.
     pub fn sender_of(&self, b: usize) -> Option<u32> {
         self.sender.get(b).copied()
+    }
+
+    /// The family's contacts over the ranks (the history's count), after the
+    /// exchange of a step stepped in part.
+    pub fn contacts_total(&self) -> Option<usize> {
+        self.total
+    }
+
+    /// [`Self::contacts_total`], from the exchange.
+    pub fn set_contacts_total(&mut self, n: usize) {
+        self.total = Some(n);
     }
 
     /// Every body's energies after the step, as their senders computed them

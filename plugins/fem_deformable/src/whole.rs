@@ -11,6 +11,7 @@
 //! load every rank holds every body whole.
 
 use crate::body::FeBody;
+use crate::nodes::FeKey;
 use crate::stepped::Stepped;
 
 /// After [`Stepped::decide`] in part: a body whose stepping rank changed gets its
@@ -56,6 +57,40 @@ pub fn gather_whole(st: &Stepped, bodies: &mut [FeBody], rounds: &dyn nscdd::dd:
     for m in rounds.exchange(&peers, &out) {
         take_whole(bodies, &m, |_| me == 0);
     }
+}
+
+/// [`nscdd::dd::Attached::gather_whole`]'s contacts: every rank's contacts of the
+/// last step (`own`: the contacts it solved, (key, impulse) each) on rank 0, in
+/// key order (the saved state's); `None` elsewhere and outside a step stepped in
+/// part.
+pub fn gather_contacts<const N: usize>(
+    st: &Stepped,
+    own: impl Iterator<Item = (FeKey, [f64; N])>,
+    rounds: &dyn nscdd::dd::Rounds,
+) -> Option<Vec<(FeKey, [f64; N])>> {
+    let (me, ranks) = st.ranks()?;
+    let mine: Vec<(FeKey, [f64; N])> = own.collect();
+    let (peers, out): (Vec<u32>, Vec<Vec<f64>>) = match me {
+        0 => ((1..ranks).collect(), vec![Vec::new(); ranks as usize - 1]),
+        _ => {
+            let m = mine
+                .iter()
+                .flat_map(|(k, r)| [k.0, k.1, k.2, k.3].map(f64::from).into_iter().chain(*r));
+            (vec![0], vec![m.collect()])
+        }
+    };
+    let got = rounds.exchange(&peers, &out);
+    (me == 0).then(|| {
+        let mut all = mine;
+        for m in &got {
+            all.extend(m.chunks_exact(4 + N).map(|x| {
+                let k = (x[0] as u32, x[1] as u32, x[2] as u32, x[3] as u32);
+                (k, std::array::from_fn(|q| x[4 + q]))
+            }));
+        }
+        all.sort_unstable_by_key(|x| x.0);
+        all
+    })
 }
 
 /// Bodies' whole states (body, u, V each) into `bodies`, those `take` says.
@@ -145,5 +180,25 @@ mod tests {
         gather_whole(&s0, &mut at0, &rounds);
         assert_eq!(rounds.sent.borrow().last(), Some(&(vec![1], vec![vec![]])));
         assert_eq!((&at0[0].u[..], &at0[0].v[..]), (&whole[..10], &whole[10..]));
+    }
+
+    /// Every rank's contacts on rank 0, in key order, for the saved state.
+    #[test]
+    fn every_ranks_contacts_gathered_on_rank_0_in_key_order() {
+        let rank_of = |a: usize| u32::from(a == 1);
+        let rounds = AllRanks::new(2, &rank_of, vec![(0, None), (1, None)]);
+        let (s0, s1) = (rounds.decide(0, 2), rounds.decide(1, 2));
+        let at1 = gather_contacts(&s1, [((1, 3, 0, 0), [0.5, 0.25])].into_iter(), &rounds);
+        assert_eq!(at1, None);
+        let sent = rounds.sent.borrow().last().cloned().unwrap();
+        assert_eq!(sent, (vec![0], vec![vec![1.0, 3.0, 0.0, 0.0, 0.5, 0.25]]));
+        *rounds.replies.borrow_mut() = sent.1;
+        let own0 = [((2, 0, 0, 0), [1.0, 0.0]), ((0, 7, 0, 0), [2.0, 0.0])];
+        let at0 = gather_contacts(&s0, own0.into_iter(), &rounds).unwrap();
+        let keys: Vec<FeKey> = at0.iter().map(|x| x.0).collect();
+        assert_eq!(keys, [(0, 7, 0, 0), (1, 3, 0, 0), (2, 0, 0, 0)]);
+        assert_eq!(at0[1].1, [0.5, 0.25]);
+        // outside a step stepped in part: nothing gathered
+        assert_eq!(gather_contacts::<2>(&Stepped::default(), std::iter::empty(), &rounds), None);
     }
 }
