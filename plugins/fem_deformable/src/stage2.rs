@@ -331,9 +331,10 @@ impl Deformables2 {
         crate::nodes::velocities_after(&mut self.bodies, &self.sets, impulses, self.stepped.mask());
     }
 
-    /// u⁺ = u⁻ + h((1 − θ)V⁻ + θV⁺) ([`update_bodies`]).
+    /// u⁺ = u⁻ + h((1 − θ)V⁻ + θV⁺) ([`update_stepped`]: on MPI ranks the
+    /// bodies stepped elsewhere at their boundary only).
     pub fn update(&mut self, h: f64, theta: f64, step: u64) -> Result<(), Diverged> {
-        update_bodies(&mut self.bodies, h, theta, step)
+        update_stepped(&mut self.bodies, h, theta, step, self.stepped.mask())
     }
 
     /// Natural-map residual ‖F(r)‖/‖q‖ of the whole step's problem: the world's
@@ -397,12 +398,39 @@ pub fn free_velocities(bodies: &mut [FeBody], h: f64, theta: f64, stepped: Optio
 /// u⁺ = u⁻ + h((1 − θ)V⁻ + θV⁺) of every deformable body; the divergence check
 /// names the body and node.
 pub fn update_bodies(bodies: &mut [FeBody], h: f64, theta: f64, step: u64) -> Result<(), Diverged> {
+    update_stepped(bodies, h, theta, step, None)
+}
+
+/// [`update_bodies`], at their boundary nodes only for the bodies `stepped` says
+/// this MPI rank does not step (`None`: all stepped): all it holds of them is
+/// their boundary ([`crate::whole`]).
+pub fn update_stepped(bodies: &mut [FeBody], h: f64, theta: f64, step: u64, stepped: Option<&[bool]>) -> Result<(), Diverged> {
     for (bi, b) in bodies.iter_mut().enumerate() {
-        for i in 0..b.u.len() {
+        let (d, n) = (b.dim(), b.u.len());
+        // u⁺ at dof i, whether u⁺ and V⁺ are finite there
+        let at = |b: &mut FeBody, i: usize| {
             b.u[i] = b.u_next(i, h, theta);
+            b.u[i].is_finite() && b.v[i].is_finite()
+        };
+        let mut bad = None;
+        if stepped.is_none_or(|m| m[bi]) {
+            for i in 0..n {
+                if !at(b, i) && bad.is_none() {
+                    bad = Some(i);
+                }
+            }
+        } else {
+            // (a body stepped elsewhere: its boundary's degrees of freedom)
+            for q in 0..b.mesh.boundary.len() {
+                let k = b.mesh.boundary[q] as usize;
+                for i in d * k..d * k + d {
+                    if !at(b, i) && bad.is_none() {
+                        bad = Some(i);
+                    }
+                }
+            }
         }
-        if let Some(i) = (0..b.u.len()).find(|&i| !(b.u[i].is_finite() && b.v[i].is_finite())) {
-            let d = b.dim();
+        if let Some(i) = bad {
             let name = b.name.as_deref().map(|n| format!(" (`{n}`)")).unwrap_or_default();
             return Err(Diverged {
                 step,

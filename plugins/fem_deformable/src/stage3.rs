@@ -9,7 +9,7 @@
 
 use crate::body::FeBody;
 use crate::contact3::*;
-use crate::stage2::{free_velocities, law_output, node_target, update_bodies, FeTimes};
+use crate::stage2::{free_velocities, law_output, node_target, FeTimes};
 use nscdd::dim::coulomb3 as coulomb;
 use nscdd::dim::d3::{tangents, Block3};
 use nscdd::engine::{ContactStage, Diverged};
@@ -341,7 +341,7 @@ impl Deformables3 {
 
     /// u⁺ = u⁻ + h((1 − θ)V⁻ + θV⁺).
     pub fn update(&mut self, h: f64, theta: f64, step: u64) -> Result<(), Diverged> {
-        update_bodies(&mut self.bodies, h, theta, step)
+        crate::stage2::update_stepped(&mut self.bodies, h, theta, step, self.stepped.mask())
     }
 
     /// Natural-map residual ‖F(r)‖/‖q‖ of the whole step's problem (rigid and
