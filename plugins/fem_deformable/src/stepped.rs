@@ -14,11 +14,12 @@
 //! (positions, V⁻ and the impulses are the same on every rank), but builds again
 //! with their numbers only the contacts it solves ([`crate::solved::Solved`]),
 //! and only the parts of its own subdomains; another rank's subdomain gets a
-//! shell part (its entities, and its contacts' indices, which receive their
-//! impulses from the rank solving them). After the write-back, the rank stepping
-//! a body sends its V⁺ to every rank ([`Stepped::pack`], [`Stepped::unpack`])
-//! with the body's energies after the step (the history's columns, each body's
-//! computed once). Each rank's residual reads only the contacts it solved (the
+//! shell part made from its rank's description ([`crate::shells`]). After the
+//! write-back, the rank stepping a body gets the impulses of its contacts solved
+//! elsewhere ([`crate::impulses`]), computes V⁺ and sends it at the body's
+//! boundary to every rank ([`Stepped::pack`], [`Stepped::unpack`]) with the
+//! body's energies after the step (the history's columns, each body's computed
+//! once); the body's whole state stays with it ([`crate::whole`]). Each rank's residual reads only the contacts it solved (the
 //! family's sums per subdomain, [`nscdd::dd::Attached::residual_parts_in`]). A
 //! body not stepped here builds no G (its contacts' W_αα and parts are never used
 //! here), and once it has gone [`RELEASE_AFTER`] steps unstepped here its columns
