@@ -342,7 +342,7 @@ impl Stepped {
     /// Every rank's [`Self::pack`] (rank order): the V⁺ of the bodies not stepped
     /// here at their boundary nodes (all that detection, the contacts and the
     /// position update there read of them; the rest of their state is their
-    /// stepping rank's, [`Self::hand_over`], [`Self::gather_whole`]), every body's
+    /// stepping rank's, [`crate::whole::hand_over`], [`crate::whole::gather_whole`]), every body's
     /// energies.
     pub fn unpack(&mut self, bodies: &mut [FeBody], all: &[f64]) {
         self.energy.clear();
