@@ -159,11 +159,11 @@ pub trait Attached<F: Family> {
     /// numbers only a solved contact needs (its bodies' free velocities, W_αα,
     /// u_free): its contact list and points must not depend on them. A family that
     /// then does on this rank only the work of the contacts solved here (and of its
-    /// bodies without contact, shared among the ranks) returns true: the ranks
-    /// then exchange what one computed for another's contacts
-    /// ([`Self::pack_solved`], [`Self::unpack_solved`]) before [`Self::split`], and
-    /// after its [`Self::write_back`] the results ([`Self::share_stepped`]),
-    /// before [`Self::residual_parts`]. It still gives
+    /// bodies without contact, shared among the ranks) returns true: it exchanges
+    /// in this call, through [`SolvedOn::rounds`], what one rank computed for
+    /// another's contacts (a deformable body's columns of M̂⁻¹ at its contact nodes,
+    /// from the one rank stepping it), and after its [`Self::write_back`] the
+    /// results ([`Self::share_stepped`]), before [`Self::residual_parts`]. It still gives
     /// every contact and a part for every subdomain, the same on every rank (their
     /// order and packed results are those of one process); the parts of other
     /// ranks' subdomains are never prepared nor swept here (they may be shells,
@@ -172,18 +172,6 @@ pub trait Attached<F: Family> {
     fn solved_on(&mut self, _w: &F::World, _on: Option<&SolvedOn<'_>>) -> bool {
         false
     }
-    /// After [`Self::solved_on`] returned true, before [`Self::split`]: what other
-    /// ranks need of what this rank computed for its contacts (a deformable body
-    /// stepped here whose contacts other ranks solve too: its columns of M̂⁻¹ at
-    /// its contact nodes and its free velocity there), as (rank, message) in
-    /// ascending ranks, appended to `out`. The relation must be symmetric in each
-    /// step: a rank listed here lists this rank too (a message may be empty). The
-    /// messages go point to point.
-    fn pack_solved(&self, _out: &mut Vec<(u32, Vec<f64>)>) {}
-    /// The messages of [`Self::pack_solved`] from the ranks this rank listed, as
-    /// (rank, message) in the same order; the family then builds what its parts
-    /// need. Called on every rank [`Self::solved_on`] returned true on.
-    fn unpack_solved(&mut self, _w: &F::World, _from: &[(u32, Vec<f64>)]) {}
     /// After [`Self::write_back`] of a step [`Self::solved_on`] returned true for,
     /// on every rank (collective): the family's rounds that finish the step (the
     /// deformable bodies: the impulses of a body's contacts solved elsewhere to the

@@ -386,7 +386,6 @@ impl<D: Family> NscddOf<D> {
         // the distributed repartition when contacts are held per rank)
         let build = self.ranks.as_mut().map(|rs| rs.assign(&owner, ns, repart && !self.local.now));
         rank_solved::solved_on(w, fams, (&self.fam_owner, self.ranks.as_mut()), &mut self.fam_stepped);
-        rank_solved::share_solved(w, fams, &self.fam_stepped, self.ranks.as_mut());
         let fo = FamilyOwners {
             fams: &*fams,
             owner: &self.fam_owner,

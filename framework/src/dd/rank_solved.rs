@@ -85,24 +85,6 @@ pub(super) fn share_stepped<D: Family>(fams: &mut [&mut dyn Attached<D>], on: &[
     }
 }
 
-/// After [`solved_on`], before the families' split: each family stepped in part
-/// (`on`) sends what other ranks' parts need to those ranks
-/// ([`Attached::pack_solved`], one point-to-point round per family) and takes what
-/// it receives ([`Attached::unpack_solved`]).
-pub(super) fn share_solved<D: Family>(w: &D::World, fams: &mut [&mut dyn Attached<D>], on: &[bool], ranks: Option<&mut RankState>) {
-    let Some(rs) = ranks else { return };
-    let rounds = RankRounds(std::cell::RefCell::new(rs));
-    for (fam, _) in fams.iter_mut().zip(on).filter(|x| *x.1) {
-        let mut out = Vec::new();
-        fam.pack_solved(&mut out);
-        let peers: Vec<u32> = out.iter().map(|x| x.0).collect();
-        let send: Vec<Vec<f64>> = out.into_iter().map(|x| x.1).collect();
-        let inbox = rounds.exchange(&peers, &send);
-        let from: Vec<(u32, Vec<f64>)> = peers.into_iter().zip(inbox).collect();
-        fam.unpack_solved(w, &from);
-    }
-}
-
 /// No contact on any rank: the families' V⁺ is their V_free (each family stepped
 /// in part then shares it, [`share_stepped`]).
 pub(super) fn write_back_alone<D: Family>(w: &mut D::World, fams: &mut [&mut dyn Attached<D>], on: &[bool], ranks: Option<&mut RankState>) {

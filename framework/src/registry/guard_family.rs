@@ -164,12 +164,6 @@ impl<D: Dim> Attached<Rigid<D>> for GuardedFamily<D> {
     fn solved_on(&mut self, w: &World<D>, on: Option<&SolvedOn<'_>>) -> bool {
         self.guard.call(|| self.inner.solved_on(w, on))
     }
-    fn pack_solved(&self, out: &mut Vec<(u32, Vec<f64>)>) {
-        self.guard.call(|| self.inner.pack_solved(out))
-    }
-    fn unpack_solved(&mut self, w: &World<D>, from: &[(u32, Vec<f64>)]) {
-        self.guard.call(|| self.inner.unpack_solved(w, from))
-    }
     fn share_stepped(&mut self, rounds: &dyn crate::dd::Rounds) {
         self.guard.call(|| self.inner.share_stepped(rounds))
     }

@@ -145,27 +145,20 @@ impl Attached<Rigid3> for Deformables3 {
             self.stepped.fail();
         }
         // stepped in part, the contacts are built once the other ranks' columns of
-        // the bodies not stepped here have come ([`Self::unpack_solved`])
+        // the bodies not stepped here have come ([`crate::solved::share_columns`])
         match part {
             true => self.fill_step(),
             false => self.build_contacts(w),
         }
-        // the other ranks' subdomains, and the node counts of the bodies stepped here
+        // the other ranks' subdomains, the node counts of the bodies stepped here, the
+        // columns of the bodies several ranks solve; then the contacts solved here
         if let Some(on) = on.filter(|_| part) {
             let c = &self.contacts;
-            crate::solved::rounds_after(&self.stepped, &self.sets, (c.len(), round_sides(c)), on, &mut self.solved);
+            let (st, sets) = (&self.stepped, &mut self.sets);
+            crate::solved::rounds_after(st, sets, (c.len(), round_sides(c)), on, &mut self.solved);
+            self.build_list(w);
         }
         part
-    }
-    /// The bodies stepped here whose contacts other ranks solve too: their free
-    /// velocity and G at their contact nodes.
-    fn pack_solved(&self, out: &mut Vec<(u32, Vec<f64>)>) {
-        crate::solved::pack_solved(&self.stepped, &self.sets, &self.solved.asked, out);
-    }
-    /// The other ranks' bodies of contacts solved here, then the contacts solved here.
-    fn unpack_solved(&mut self, w: &World3, from: &[(u32, Vec<f64>)]) {
-        crate::solved::unpack_solved(&self.stepped, &mut self.sets, from);
-        self.build_list(w);
     }
     fn points(&self, out: &mut Vec<[f64; 3]>) {
         out.extend_from_slice(&self.contacts.point);

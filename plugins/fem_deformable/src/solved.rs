@@ -4,8 +4,9 @@
 //! ([`crate::stepped`]), a rank builds again with their numbers only the contacts
 //! it solves ([`Solved`]); a body whose contacts several ranks solve is stepped by
 //! one of them, which sends the others its free velocity at its contact nodes and
-//! the rows of G their contacts read ([`pack_solved`], [`unpack_solved`], through
-//! [`nscdd::dd::Attached::pack_solved`]).
+//! the rows of G their contacts read ([`share_columns`]: [`pack_solved`],
+//! [`unpack_solved`], one point-to-point round in
+//! [`nscdd::dd::Attached::solved_on`]).
 
 use crate::nodes::{FeSide, NodeSet};
 use crate::stepped::Stepped;
@@ -104,12 +105,13 @@ pub fn rounds_before<const D: usize>(
     ask_nodes(st, nodes, on.rounds)
 }
 
-/// [`nscdd::dd::Attached::solved_on`]'s round once the sets are filled, stepped
+/// [`nscdd::dd::Attached::solved_on`]'s rounds once the sets are filled, stepped
 /// in part: the other ranks' subdomains and the node counts of the bodies every
-/// rank steps ([`crate::shells::share`]), into `solved`.
+/// rank steps ([`crate::shells::share`]), into `solved`, then the columns of the
+/// bodies several ranks solve ([`share_columns`]).
 pub fn rounds_after<const D: usize, Cs>(
     st: &Stepped,
-    sets: &[NodeSet<D>],
+    sets: &mut [NodeSet<D>],
     (n, sides): (usize, impl Fn(usize) -> Sides<D>),
     on: &SolvedOn<'_>,
     solved: &mut Solved<Cs>,
@@ -121,6 +123,7 @@ pub fn rounds_after<const D: usize, Cs>(
     let filled = sets.iter().enumerate().filter(|(b, s)| st.steps(*b) && !s.is_empty());
     let stepped: Vec<(u32, u32)> = filled.map(|(b, s)| (b as u32, s.len() as u32)).collect();
     (solved.shells, solved.set_lens) = crate::shells::share(on, n, bodies, &stepped);
+    share_columns(st, sets, &solved.asked, on.rounds);
 }
 
 /// The contact nodes of the bodies this rank steps whose contacts other ranks
@@ -154,8 +157,8 @@ pub fn shared_nodes<Cs>(stepped: &Stepped, solved: &Solved<Cs>, raw: impl Iterat
 /// its contact nodes, its free velocity there, and the rows of G of the nodes the
 /// receiver asked for: [`NodeSet::pack_received`]), in a message to each of those
 /// ranks; an empty message to the rank stepping a body whose contacts this rank
-/// solves (the relation is symmetric, as [`nscdd::dd::Attached::pack_solved`]
-/// needs). `asked`: [`ask_nodes`]'s.
+/// solves (the relation is symmetric, as [`Rounds::exchange`] needs). `asked`:
+/// [`ask_nodes`]'s.
 pub fn pack_solved<const D: usize>(stepped: &Stepped, sets: &[NodeSet<D>], asked: &Asked, out: &mut Vec<(u32, Vec<f64>)>) {
     let Some(me) = stepped.rank_here() else {
         return;
@@ -210,6 +213,19 @@ pub fn unpack_solved<const D: usize>(stepped: &Stepped, sets: &mut [NodeSet<D>],
     for (_, set) in sets.iter_mut().enumerate().filter(|(b, _)| stepped.receives(*b) && !got[*b]) {
         set.forget_g();
     }
+}
+
+/// The bodies stepped here whose contacts other ranks solve too: their contact
+/// nodes, free velocity there and the rows of G asked for, to those ranks
+/// ([`pack_solved`]); the same of the bodies stepped elsewhere whose contacts this
+/// rank solves, from their stepping ranks ([`unpack_solved`]). One
+/// point-to-point round.
+pub fn share_columns<const D: usize>(st: &Stepped, sets: &mut [NodeSet<D>], asked: &Asked, rounds: &dyn Rounds) {
+    let mut out = Vec::new();
+    pack_solved(st, sets, asked, &mut out);
+    let (peers, send): (Vec<u32>, Vec<Vec<f64>>) = out.into_iter().unzip();
+    let from: Vec<(u32, Vec<f64>)> = peers.iter().copied().zip(rounds.exchange(&peers, &send)).collect();
+    unpack_solved(st, sets, &from);
 }
 
 /// The contacts this rank solves in a step stepped in part ([`Stepped::solved`]):
