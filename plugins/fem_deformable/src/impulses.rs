@@ -65,10 +65,8 @@ pub fn share<const D: usize>(
             }
         }
     }
-    let peers: Vec<u32> = to.keys().copied().collect();
-    let out: Vec<Vec<f64>> = to.into_values().collect();
     let len = 4 + 3 * D;
-    for m in rounds.exchange(&peers, &out) {
+    for (_, m) in crate::solved::exchange_with(rounds, to) {
         for x in m.chunks_exact(len) {
             let body = x[2] as u32;
             let Some(set) = sets.get(body as usize).filter(|_| st.steps(body as usize)) else {

@@ -38,6 +38,14 @@ pub(crate) fn rounds_with(stepped: &Stepped, me: u32, mut fill: impl FnMut(u32, 
     to
 }
 
+/// One point-to-point round of the messages `to` (by rank, ascending: a
+/// symmetric relation, [`Rounds::exchange`]); returns (rank, its message) each.
+pub fn exchange_with(rounds: &dyn Rounds, to: BTreeMap<u32, Vec<f64>>) -> Vec<(u32, Vec<f64>)> {
+    let (peers, out): (Vec<u32>, Vec<Vec<f64>>) = to.into_iter().unzip();
+    let inbox = rounds.exchange(&peers, &out);
+    peers.into_iter().zip(inbox).collect()
+}
+
 /// The first round for the bodies whose contacts several ranks solve (after
 /// [`Stepped::decide`], before the free velocities): each rank solving some of a
 /// body's contacts without stepping it sends the rank stepping it the body's
@@ -61,9 +69,7 @@ pub fn ask_nodes(stepped: &Stepped, sides: impl Iterator<Item = (u32, u32)>, rou
             m.extend(mine[lo..hi].iter().map(|x| f64::from(x.1)));
         }
     });
-    let peers: Vec<u32> = to.keys().copied().collect();
-    let out: Vec<Vec<f64>> = to.into_values().collect();
-    for (&r, m) in peers.iter().zip(rounds.exchange(&peers, &out)) {
+    for (r, m) in exchange_with(rounds, to) {
         // (body, count, its nodes) each
         let mut i = 0;
         while let (Some(&b), Some(&n)) = (m.get(i), m.get(i + 1)) {
@@ -223,8 +229,7 @@ pub fn unpack_solved<const D: usize>(stepped: &Stepped, sets: &mut [NodeSet<D>],
 pub fn share_columns<const D: usize>(st: &Stepped, sets: &mut [NodeSet<D>], asked: &Asked, rounds: &dyn Rounds) {
     let mut out = Vec::new();
     pack_solved(st, sets, asked, &mut out);
-    let (peers, send): (Vec<u32>, Vec<Vec<f64>>) = out.into_iter().unzip();
-    let from: Vec<(u32, Vec<f64>)> = peers.iter().copied().zip(rounds.exchange(&peers, &send)).collect();
+    let from = exchange_with(rounds, out.into_iter().collect());
     unpack_solved(st, sets, &from);
 }
 

@@ -32,9 +32,7 @@ pub fn hand_over(st: &Stepped, bodies: &mut [FeBody], rounds: &dyn nscdd::dd::Ro
             to.entry(p).or_default();
         }
     }
-    let peers: Vec<u32> = to.keys().copied().collect();
-    let out: Vec<Vec<f64>> = to.into_values().collect();
-    for m in rounds.exchange(&peers, &out) {
+    for (_, m) in crate::solved::exchange_with(rounds, to) {
         take_whole(bodies, &m, |b| st.sender_of(b) == Some(me));
     }
 }
