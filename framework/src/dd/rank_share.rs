@@ -56,14 +56,17 @@ impl RankState {
     /// The attached families' parts of the other ranks' subdomains: their packed
     /// results ([`super::LocalPart::pack`]) from each subdomain's rank to every rank
     /// (one all-gather): a family, held whole on every rank, writes back every part.
-    /// Nothing without parts (the same on every rank: they hold the same families).
+    /// Nothing without parts or packed values (the same on every rank: they hold
+    /// the same families).
     /// Collective.
     fn share_parts<D: Family>(&mut self, d: &mut Decomposition<D>) {
-        if d.subs.iter().all(|s| s.parts.0.is_empty()) {
+        let len = |s: &super::Subdomain<D>| s.parts.0.iter().map(|(_, p)| p.packed_len()).sum::<usize>();
+        // (every rank sees every subdomain's lengths the same, as the all-gather's
+        // counts need: none of them, no round)
+        if d.subs.iter().all(|s| len(s) == 0) {
             return;
         }
         let me = self.cluster.rank();
-        let len = |s: &super::Subdomain<D>| s.parts.0.iter().map(|(_, p)| p.packed_len()).sum::<usize>();
         self.send.clear();
         for s in d.subs.iter().filter(|s| self.rank_of[s.id as usize] == me) {
             for (_, p) in &s.parts.0 {

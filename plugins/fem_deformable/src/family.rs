@@ -309,6 +309,7 @@ macro_rules! scene_family {
             }
             fn load_state(&mut self, state: &serde_json::Value) -> Result<(), String> {
                 self.stepped = Default::default();
+                self.warm.loaded();
                 load(&mut self.bodies, &mut self.contacts, state)
             }
             fn local_problem(&self, w: &World<$dim>) -> Option<nscdd::fc::FamilyShare> {

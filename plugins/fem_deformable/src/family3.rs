@@ -21,12 +21,10 @@ pub struct FePart3 {
     contacts: FeContacts3,
     /// Index of each local contact in the family's contact set.
     global: Vec<u32>,
-    /// A part of another rank's subdomain, stepped in part: its entities and its
-    /// contacts' indices only, which receive their impulses ([`LocalPart::unpack`])
-    /// for [`Attached::write_back`].
-    shell: bool,
-    /// A shell's contacts' impulses, received.
-    r_in: Vec<[f64; 3]>,
+    /// A part of another rank's subdomain, stepped in part, of this many
+    /// contacts: its entities and its count only (what the gluing reads of it;
+    /// its contacts stay on their rank, [`crate::warm`]).
+    shell: Option<u32>,
 }
 
 impl FePart3 {
@@ -41,7 +39,7 @@ impl FePart3 {
 
 impl LocalPart<Rigid3> for FePart3 {
     fn len(&self) -> usize {
-        self.global.len()
+        self.shell.map_or(self.global.len(), |n| n as usize)
     }
     fn entities(&self) -> &[u32] {
         &self.fe
@@ -95,21 +93,15 @@ impl LocalPart<Rigid3> for FePart3 {
             }
         }
     }
-    /// The impulses (the other ranks' families need no other number of a contact:
-    /// each rank's residual reads its own subdomains' contacts).
-    fn pack(&self, out: &mut Vec<f64>) {
-        out.extend(self.contacts.r.iter().flatten());
-    }
+    /// Nothing: a family stepped in part (on MPI ranks, where parts are shared)
+    /// needs no number of another rank's contacts (each rank's residual reads its
+    /// own subdomains' contacts, the warm starts come from the ranks stepping the
+    /// bodies: [`crate::warm`]).
+    fn pack(&self, _out: &mut Vec<f64>) {}
     fn packed_len(&self) -> usize {
-        3 * self.global.len()
+        0
     }
-    fn unpack(&mut self, values: &[f64]) {
-        let r = values.chunks_exact(3).map(|x| std::array::from_fn(|q| x[q]));
-        match self.shell {
-            true => self.r_in = r.collect(),
-            false => self.contacts.r.iter_mut().zip(r).for_each(|(a, b)| *a = b),
-        }
-    }
+    fn unpack(&mut self, _values: &[f64]) {}
     fn as_any(&self) -> &dyn Any {
         self
     }
@@ -136,7 +128,8 @@ impl Attached<Rigid3> for Deformables3 {
         // the whole states handed over, the nodes of the bodies stepped elsewhere asked
         if let Some(on) = on.filter(|_| part) {
             let (c, st, sets) = (&self.contacts, &self.stepped, &self.sets);
-            self.solved.asked = crate::solved::rounds_before(st, &mut self.bodies, sets, (c.len(), round_sides(c)), on);
+            let bw = (&mut self.bodies[..], &mut self.warm);
+            self.solved.asked = crate::solved::rounds_before(st, bw, sets, (c.len(), round_sides(c)), on);
         }
         // (a large body this rank steps first is assembled here: if that fails, no
         // body is stepped here and the step's end reports it)
@@ -154,8 +147,8 @@ impl Attached<Rigid3> for Deformables3 {
         // columns of the bodies several ranks solve; then the contacts solved here
         if let Some(on) = on.filter(|_| part) {
             let c = &self.contacts;
-            let (st, sets) = (&self.stepped, &mut self.sets);
-            crate::solved::rounds_after(st, sets, (c.len(), round_sides(c)), on, &mut self.solved);
+            let (st, sw) = (&self.stepped, (&mut self.sets[..], &mut self.warm));
+            crate::solved::rounds_after(st, sw, (c.len(), round_sides(c)), on, &mut self.solved);
             self.build_list(w);
         }
         part
@@ -205,12 +198,10 @@ impl Attached<Rigid3> for Deformables3 {
                 }
             }
         });
-        if let Some(o) = own {
-            let others = by_subdomain(owner, |a| !o[a]);
-            parts.extend(crate::shells::make(&self.solved.shells, &others, copy, |fe, global| FePart3 {
+        if own.is_some() {
+            parts.extend(crate::shells::make(&self.solved.shells, copy, |fe, n| FePart3 {
                 fe,
-                global,
-                shell: true,
+                shell: Some(n),
                 ..Default::default()
             }));
             parts.sort_by_key(|x| x.0);
@@ -224,10 +215,7 @@ impl Attached<Rigid3> for Deformables3 {
         for (_, p) in parts {
             let Some(p) = p.as_any().downcast_ref::<FePart3>() else { continue };
             for (l, &g) in p.global.iter().enumerate() {
-                match p.shell {
-                    true => self.contacts.r[g as usize] = p.r_in[l],
-                    false => self.contacts.results_from(g as usize, &p.contacts, l),
-                }
+                self.contacts.results_from(g as usize, &p.contacts, l);
             }
         }
         // stepped in part, V⁺ comes once the impulses of the bodies' contacts solved
@@ -260,9 +248,10 @@ impl Attached<Rigid3> for Deformables3 {
         let me = st.rank_here();
         let own = (0..c.len()).filter(|&a| Some(st.rank_of(a)) == me);
         let own: Vec<_> = own
-            .map(|a| (a as u32, c.cand[a], c.anta[a].fe(), global(&c.frame[a], c.r[a])))
+            .map(|a| (a as u32, c.cand[a], c.anta[a].fe(), global(&c.frame[a], c.r[a]), (c.key[a], c.r[a])))
             .collect();
-        crate::impulses::finish(&mut self.stepped, &mut self.bodies, &mut self.sets, own.into_iter(), rounds);
+        let sw = (&mut self.sets[..], &mut self.warm);
+        crate::impulses::finish(&mut self.stepped, &mut self.bodies, sw, own.into_iter(), rounds);
     }
     /// The bodies stepped elsewhere whole, every rank's contacts (the saved state).
     fn gather_whole(&mut self, rounds: &dyn nscdd::dd::Rounds) {

@@ -8,9 +8,10 @@
 //! own contacts' in the one-process order (the contacts in the family's order,
 //! the candidate side before the antagonist): V⁺ is the one-process number.
 
-use crate::nodes::{FeSide, NodeSet};
+use crate::nodes::{FeKey, FeSide, NodeSet};
 use crate::stepped::Stepped;
 use nscdd::dd::Rounds;
+use std::collections::BTreeMap;
 
 /// One side's share of a contact's impulse: the contact's place in the family's
 /// order, which side (0: candidate, 1: antagonist), the side, its sign and the
@@ -24,26 +25,39 @@ pub struct Share<const D: usize> {
     pub p: [f64; D],
 }
 
-/// The shares of the contacts solved here (`contacts`: (place, candidate,
-/// deformable antagonist, P), in the family's order) on the bodies other ranks
-/// step go to those ranks; returns the shares on the bodies stepped here, this
-/// rank's and those received, in the one-process order. `sets`: the node sets
-/// (the sides' set indices; a set of a body stepped here holds every node the
-/// other ranks' contacts touch, [`crate::solved::shared_nodes`]).
+/// A contact solved here, as [`share`] takes it: its place in the family's
+/// order, its candidate side, its deformable antagonist side, its impulse P
+/// (global), and its key and r (local: its next warm start, [`crate::warm`]).
+pub type Solved<const D: usize> = (u32, FeSide<D>, Option<FeSide<D>>, [f64; D], (FeKey, [f64; D]));
+
+/// The shares of the contacts solved here (`contacts`, in the family's order)
+/// on the bodies other ranks step go to those ranks, with the (key, r) of those
+/// whose candidate body another rank steps ([`crate::warm`]); returns the
+/// shares on the bodies stepped here, this rank's and those received, in the
+/// one-process order, and the (key, r) of the contacts of the bodies stepped
+/// here. `sets`: the node sets (the sides' set indices; a set of a body stepped
+/// here holds every node the other ranks' contacts touch,
+/// [`crate::solved::shared_nodes`]).
 pub fn share<const D: usize>(
     st: &Stepped,
     sets: &[NodeSet<D>],
-    contacts: impl Iterator<Item = (u32, FeSide<D>, Option<FeSide<D>>, [f64; D])>,
+    contacts: impl Iterator<Item = Solved<D>>,
     rounds: &dyn Rounds,
-) -> Vec<Share<D>> {
+) -> (Vec<Share<D>>, Vec<(FeKey, [f64; D])>) {
     let Some(me) = st.rank_here() else {
-        return Vec::new();
+        return Default::default();
     };
-    let mut here = Vec::new();
+    let (mut here, mut warm) = (Vec::new(), Vec::new());
     // (the ranks solving some contacts of a body stepped here, or stepping a body
     // some of whose contacts are solved here: the symmetric relation of the columns)
     let mut to = crate::solved::rounds_with(st, me, |_, _, _| {});
-    for (at, cand, anta, p) in contacts {
+    let mut front: BTreeMap<u32, Vec<f64>> = BTreeMap::new();
+    for (at, cand, anta, p, (key, r)) in contacts {
+        match st.sender_of(cand.body as usize).unwrap_or(me) {
+            q if q == me => warm.push((key, r)),
+            q if r != [0.0; D] && to.contains_key(&q) => crate::warm::pack(key, r, front.entry(q).or_default()),
+            _ => {}
+        }
         for (which, side, sign) in [(0, Some(cand), 1.0), (1, anta, -1.0)] {
             let Some(side) = side else { continue };
             let q = st.sender_of(side.body as usize).unwrap_or(me);
@@ -66,7 +80,10 @@ pub fn share<const D: usize>(
         }
     }
     let len = 4 + 3 * D;
+    crate::warm::with_front(&mut to, front);
     for (_, m) in crate::solved::exchange_with(rounds, to) {
+        let (got, m) = crate::warm::split_front(&m);
+        warm.extend(crate::warm::unpack::<D>(got));
         for x in m.chunks_exact(len) {
             let body = x[2] as u32;
             let Some(set) = sets.get(body as usize).filter(|_| st.steps(body as usize)) else {
@@ -95,12 +112,13 @@ pub fn share<const D: usize>(
         }
     }
     here.sort_by_key(|s| (s.at, s.which));
-    here
+    (here, warm)
 }
 
 /// [`nscdd::dd::Attached::share_stepped`] of the deformable bodies: V⁺ of the
 /// bodies stepped here from the shares of their contacts' impulses ([`share`];
-/// `own`: the contacts solved here, as [`share`] takes them), then every rank's
+/// `own`: the contacts solved here, as [`share`] takes them), the next step's
+/// warm starts of their contacts into `warm`, then every rank's
 /// V⁺ at the boundary of the bodies it stepped, with their energies
 /// ([`Stepped::pack`], one all-gather, which also adds up the contacts solved on
 /// each rank: [`Stepped::contacts_total`]), and the node sets at V⁺ (the
@@ -108,12 +126,13 @@ pub fn share<const D: usize>(
 pub fn finish<const D: usize>(
     st: &mut Stepped,
     bodies: &mut [crate::body::FeBody],
-    sets: &mut [NodeSet<D>],
-    own: impl Iterator<Item = (u32, FeSide<D>, Option<FeSide<D>>, [f64; D])>,
+    (sets, warm): (&mut [NodeSet<D>], &mut crate::warm::Warm<D>),
+    own: impl Iterator<Item = Solved<D>>,
     rounds: &dyn Rounds,
 ) {
     let own: Vec<_> = own.collect();
-    let shares = share(st, sets, own.iter().copied(), rounds);
+    let (shares, held) = share(st, sets, own.iter().copied(), rounds);
+    warm.set(held.into_iter());
     crate::nodes::velocities_from(bodies, sets, shares.iter().map(|s| (s.side, s.sign, s.p)), st.mask());
     // (the contacts solved here first: their count over the ranks is the history's)
     let mut mine = vec![own.len() as f64];
@@ -151,17 +170,27 @@ mod tests {
             w: [0.25, 0.75],
         };
         // rank 1: its contact's candidate side on body 1 stays, the antagonist's goes
-        let own1 = [(1, FeSide::node(1, 0), Some(seg), [1.0, 2.0])];
-        let here1 = share(&s1, &sets, own1.into_iter(), &rounds);
+        let key1 = ((1, 5, 1 << 31, 0), [0.5, 0.0]);
+        let own1 = [(1, FeSide::node(1, 0), Some(seg), [1.0, 2.0], key1)];
+        let (here1, warm1) = share(&s1, &sets, own1.into_iter(), &rounds);
         assert_eq!(here1.iter().map(|s| (s.at, s.which)).collect::<Vec<_>>(), [(1, 0)]);
+        assert_eq!(warm1, [key1]);
         let sent = rounds.sent.borrow().last().cloned().unwrap();
-        // (place 1, antagonist, body 0, sign −1, nodes 8 and 9, weights, P)
-        assert_eq!(sent, (vec![0], vec![vec![1.0, 1.0, 0.0, -1.0, 8.0, 9.0, 0.25, 0.75, 1.0, 2.0]]));
+        // (no warm start: place 1, antagonist, body 0, sign −1, nodes 8 and 9, weights, P)
+        assert_eq!(
+            sent,
+            (vec![0], vec![vec![0.0, 1.0, 1.0, 0.0, -1.0, 8.0, 9.0, 0.25, 0.75, 1.0, 2.0]])
+        );
         // rank 0 receives it and merges it between its contacts 0 and 2
         *rounds.replies.borrow_mut() = sent.1.clone();
-        let own0 = [(0, FeSide::node(0, 0), None, [3.0, 4.0]), (2, FeSide::node(0, 0), None, [5.0, 6.0])];
-        let here0 = share(&s0, &sets, own0.into_iter(), &rounds);
-        assert_eq!(rounds.sent.borrow().last().cloned().unwrap(), (vec![1], vec![vec![]]));
+        let key = |a: u32| ((0, 3, 7, a), [1.0, 0.0]);
+        let own0 = [
+            (0, FeSide::node(0, 0), None, [3.0, 4.0], key(0)),
+            (2, FeSide::node(0, 0), None, [5.0, 6.0], key(2)),
+        ];
+        let (here0, warm0) = share(&s0, &sets, own0.into_iter(), &rounds);
+        assert_eq!(warm0, [key(0), key(2)]);
+        assert_eq!(rounds.sent.borrow().last().cloned().unwrap(), (vec![1], vec![vec![0.0]]));
         let got: Vec<(u32, u32, f64)> = here0.iter().map(|s| (s.at, s.which, s.sign)).collect();
         assert_eq!(got, [(0, 0, 1.0), (1, 1, -1.0), (2, 0, 1.0)]);
         assert_eq!(here0[1].side, seg);

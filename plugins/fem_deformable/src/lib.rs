@@ -25,6 +25,7 @@ pub mod solved;
 pub mod stage2;
 pub mod stage3;
 pub mod stepped;
+pub mod warm;
 pub mod whole;
 
 use nscdd::dim::{D2, D3};

@@ -3,8 +3,8 @@
 //! part ([`crate::stepped`]), a rank makes full parts of its own subdomains only;
 //! the framework still needs every subdomain's entity copies (the deformable
 //! bodies' multiplicities and interface) and its copies of the world's rigid
-//! bodies (theirs), and a part's count of contacts (the impulses it sends,
-//! [`nscdd::dd::LocalPart::pack`]). Each rank describes its own subdomains
+//! bodies (theirs), and a part's count of contacts ([`nscdd::dd::LocalPart::len`]).
+//! Each rank describes its own subdomains
 //! ([`Shell`]: the entities and the rigid antagonists in the order its split makes
 //! their copies, and the contacts), the ranks all-gather the descriptions
 //! ([`share`], in [`nscdd::dd::Attached::solved_on`]), and a rank makes the other
@@ -79,27 +79,16 @@ pub fn share(
 }
 
 /// The shell parts of the other ranks' subdomains `shells` ([`share`]), each
-/// made by `part(entities, global)`, its copies of the world's rigid bodies asked
-/// of `copy` (the framework's, [`nscdd::dd::Attached::split`]) in its rank's
-/// order. `global`: its contacts' places in the family's list (from `others`,
-/// the (subdomain, contact) of the contacts solved elsewhere, ascending), where
-/// their impulses go back ([`nscdd::dd::LocalPart::unpack`]).
-pub fn make<P>(
-    shells: &[Shell],
-    others: &[(u32, u32)],
-    copy: &mut dyn FnMut(u32, u32) -> u32,
-    part: impl Fn(Vec<u32>, Vec<u32>) -> P,
-) -> Vec<(u32, P)> {
+/// made by `part(entities, contacts)` (its count of contacts), its copies of the
+/// world's rigid bodies asked of `copy` (the framework's,
+/// [`nscdd::dd::Attached::split`]) in its rank's order.
+pub fn make<P>(shells: &[Shell], copy: &mut dyn FnMut(u32, u32) -> u32, part: impl Fn(Vec<u32>, u32) -> P) -> Vec<(u32, P)> {
     let mut out = Vec::with_capacity(shells.len());
     for sh in shells {
         for &g in &sh.rigid {
             copy(sh.sub, g);
         }
-        let lo = others.partition_point(|x| x.0 < sh.sub);
-        let hi = others.partition_point(|x| x.0 <= sh.sub);
-        let global: Vec<u32> = others[lo..hi].iter().map(|x| x.1).collect();
-        debug_assert_eq!(global.len(), sh.contacts as usize, "subdomain {}'s contacts", sh.sub);
-        out.push((sh.sub, part(sh.entities.clone(), global)));
+        out.push((sh.sub, part(sh.entities.clone(), sh.contacts)));
     }
     out
 }

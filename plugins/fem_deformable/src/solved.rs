@@ -10,6 +10,7 @@
 
 use crate::nodes::{FeSide, NodeSet};
 use crate::stepped::Stepped;
+use crate::warm::Warm;
 use nscdd::dd::{Rounds, SolvedOn};
 use std::collections::BTreeMap;
 
@@ -96,12 +97,12 @@ pub type Sides<const D: usize> = (FeSide<D>, Option<FeSide<D>>, Option<u32>);
 /// contacts of the family's list.
 pub fn rounds_before<const D: usize>(
     st: &Stepped,
-    bodies: &mut [crate::body::FeBody],
+    (bodies, warm): (&mut [crate::body::FeBody], &mut Warm<D>),
     sets: &[NodeSet<D>],
     (n, sides): (usize, impl Fn(usize) -> Sides<D>),
     on: &SolvedOn<'_>,
 ) -> Asked {
-    crate::whole::hand_over(st, bodies, on.rounds);
+    crate::whole::hand_over(st, bodies, warm, on.rounds);
     let own = (0..n).filter(|&a| st.rank_of(a) == on.rank);
     let fe = own.flat_map(|a| {
         let (c, f, _) = sides(a);
@@ -114,10 +115,11 @@ pub fn rounds_before<const D: usize>(
 /// [`nscdd::dd::Attached::solved_on`]'s rounds once the sets are filled, stepped
 /// in part: the other ranks' subdomains and the node counts of the bodies every
 /// rank steps ([`crate::shells::share`]), into `solved`, then the columns of the
-/// bodies several ranks solve ([`share_columns`]).
+/// bodies several ranks solve, with their contacts' warm starts
+/// ([`share_columns`]).
 pub fn rounds_after<const D: usize, Cs>(
     st: &Stepped,
-    sets: &mut [NodeSet<D>],
+    (sets, warm): (&mut [NodeSet<D>], &mut Warm<D>),
     (n, sides): (usize, impl Fn(usize) -> Sides<D>),
     on: &SolvedOn<'_>,
     solved: &mut Solved<Cs>,
@@ -129,7 +131,7 @@ pub fn rounds_after<const D: usize, Cs>(
     let filled = sets.iter().enumerate().filter(|(b, s)| st.steps(*b) && !s.is_empty());
     let stepped: Vec<(u32, u32)> = filled.map(|(b, s)| (b as u32, s.len() as u32)).collect();
     (solved.shells, solved.set_lens) = crate::shells::share(on, n, bodies, &stepped);
-    share_columns(st, sets, &solved.asked, on.rounds);
+    share_columns(st, (sets, warm), &solved.asked, on.rounds);
 }
 
 /// The contact nodes of the bodies this rank steps whose contacts other ranks
@@ -223,21 +225,38 @@ pub fn unpack_solved<const D: usize>(stepped: &Stepped, sets: &mut [NodeSet<D>],
 
 /// The bodies stepped here whose contacts other ranks solve too: their contact
 /// nodes, free velocity there and the rows of G asked for, to those ranks
-/// ([`pack_solved`]); the same of the bodies stepped elsewhere whose contacts this
-/// rank solves, from their stepping ranks ([`unpack_solved`]). One
-/// point-to-point round.
-pub fn share_columns<const D: usize>(st: &Stepped, sets: &mut [NodeSet<D>], asked: &Asked, rounds: &dyn Rounds) {
+/// ([`pack_solved`]), after the last step's impulses of their contacts at the
+/// nodes asked for (their warm starts, [`crate::warm`]); the same of the bodies
+/// stepped elsewhere whose contacts this rank solves, from their stepping ranks
+/// ([`unpack_solved`]). One point-to-point round.
+pub fn share_columns<const D: usize>(st: &Stepped, (sets, warm): (&mut [NodeSet<D>], &mut Warm<D>), asked: &Asked, rounds: &dyn Rounds) {
     let mut out = Vec::new();
     pack_solved(st, sets, asked, &mut out);
-    let from = exchange_with(rounds, out.into_iter().collect());
+    let mut to: BTreeMap<u32, Vec<f64>> = out.into_iter().collect();
+    if let Some(me) = st.rank_here() {
+        let front = rounds_with(st, me, |r, b, m| {
+            if st.sends(b as usize) {
+                let at = asked.binary_search_by_key(&(b, r), |x| (x.0, x.1));
+                let nodes = at.map_or(&[][..], |p| &asked[p].2[..]);
+                warm.pack_body(b, |k| nodes.binary_search(&k).is_ok(), m);
+            }
+        });
+        crate::warm::with_front(&mut to, front);
+    }
+    let mut from = exchange_with(rounds, to);
+    for (_, m) in from.iter_mut() {
+        let (got, rest) = crate::warm::split_front(m);
+        warm.add(got);
+        *m = rest.to_vec();
+    }
     unpack_solved(st, sets, &from);
 }
 
 /// The contacts this rank solves in a step stepped in part ([`Stepped::solved`]):
 /// built again after the partition with their numbers (W_αα, u_free, targets),
 /// while the family's list keeps every contact as one process has it (keys,
-/// sides, frames and, after the step, every impulse: [`crate::family2`]'s parts
-/// of other ranks' subdomains receive them).
+/// sides, frames, points: the partition's and the rounds'; the impulses of those
+/// solved elsewhere stay on their ranks, [`crate::warm`]).
 #[derive(Default)]
 pub struct Solved<Cs> {
     /// Each raw contact's index in the family's list (`u32::MAX`: dropped), from

@@ -59,6 +59,9 @@ pub struct Deformables3 {
     /// Every rank's contacts on rank 0 for the saved state, gathered on MPI ranks
     /// ([`crate::whole::gather_contacts`]).
     pub gathered: Option<Vec<(crate::nodes::FeKey, [f64; 3])>>,
+    /// The last step's impulses of the contacts this rank may solve, on MPI ranks
+    /// ([`crate::warm`]).
+    pub warm: crate::warm::Warm<3>,
 }
 
 /// The rigid bodies' M̂⁻¹ as the sweep reads them.
@@ -132,13 +135,18 @@ impl Deformables3 {
     /// W_αα, ū, warm start), stepped in part only those solved here.
     pub fn build_list(&mut self, w: &World3) {
         let (h, theta) = (w.time.h, w.time.theta);
+        // (stepped in part, the contacts solved here start from the impulses kept by
+        // the ranks that stepped their bodies: [`crate::warm`])
+        let own = self.stepped.solved();
+        let from_warm = own.is_some() && !self.warm.from_list;
         self.prev.clear();
-        self.prev
-            .extend(self.contacts.key.iter().copied().zip(self.contacts.r.iter().copied()));
-        self.prev.sort_unstable_by_key(|x| x.0);
+        if !from_warm {
+            let kr = self.contacts.key.iter().copied().zip(self.contacts.r.iter().copied());
+            self.prev.extend(kr);
+            self.prev.sort_unstable_by_key(|x| x.0);
+        }
         // stepped in part, after the partition: only the contacts solved here, into
         // `solved` (the family's list, built before it, keeps every contact)
-        let own = self.stepped.solved();
         let mut c = match own {
             None => std::mem::take(&mut self.contacts),
             Some(_) => std::mem::take(&mut self.solved.list),
@@ -197,6 +205,7 @@ impl Deformables3 {
             let key = (rc.body, cand_key, key_j, feature);
             let r = match self.prev.binary_search_by_key(&key, |x| x.0) {
                 Ok(p) => self.prev[p].1,
+                Err(_) if from_warm => self.warm.r_of(&key),
                 Err(_) => [0.0; 3],
             };
             if own.is_none() {

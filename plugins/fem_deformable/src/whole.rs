@@ -13,14 +13,17 @@
 use crate::body::FeBody;
 use crate::nodes::FeKey;
 use crate::stepped::Stepped;
+use crate::warm::Warm;
+use std::collections::BTreeMap;
 
 /// After [`Stepped::decide`] in part: a body whose stepping rank changed gets its
 /// whole state (u, V) from the rank that stepped it in the last step (the only
-/// one holding it whole since, [`Stepped::unpack`]), point to point.
-pub fn hand_over(st: &Stepped, bodies: &mut [FeBody], rounds: &dyn nscdd::dd::Rounds) {
+/// one holding it whole since, [`Stepped::unpack`]), with the last step's
+/// impulses of its contacts ([`crate::warm`]), point to point.
+pub fn hand_over<const N: usize>(st: &Stepped, bodies: &mut [FeBody], warm: &mut Warm<N>, rounds: &dyn nscdd::dd::Rounds) {
     let Some(me) = st.rank_here() else { return };
     let moved = |b: &usize| st.prev_sender(*b).is_some_and(|p| Some(p) != st.sender_of(*b));
-    let mut to: std::collections::BTreeMap<u32, Vec<f64>> = Default::default();
+    let (mut to, mut front): (BTreeMap<u32, Vec<f64>>, BTreeMap<u32, Vec<f64>>) = Default::default();
     for b in (0..bodies.len()).filter(moved) {
         let (p, q) = (st.prev_sender(b), st.sender_of(b));
         let (Some(p), Some(q)) = (p, q) else { continue };
@@ -28,12 +31,16 @@ pub fn hand_over(st: &Stepped, bodies: &mut [FeBody], rounds: &dyn nscdd::dd::Ro
             let m = to.entry(q).or_default();
             m.push(b as f64);
             m.extend(bodies[b].u.iter().chain(&bodies[b].v));
+            warm.pack_body(b as u32, |_| true, front.entry(q).or_default());
         } else if q == me {
             to.entry(p).or_default();
         }
     }
+    crate::warm::with_front(&mut to, front);
     for (_, m) in crate::solved::exchange_with(rounds, to) {
-        take_whole(bodies, &m, |b| st.sender_of(b) == Some(me));
+        let (got, m) = crate::warm::split_front(&m);
+        warm.add(got);
+        take_whole(bodies, m, |b| st.sender_of(b) == Some(me));
     }
 }
 
@@ -144,7 +151,8 @@ mod tests {
         decide(&mut s0, 0);
         decide(&mut s1, 1);
         // the first step after a load: the state is whole everywhere, nothing handed over
-        hand_over(&s1, &mut bodies, &rounds);
+        let (mut w0, mut w1) = (Warm::<2>::default(), Warm::<2>::default());
+        hand_over(&s1, &mut bodies, &mut w1, &rounds);
         assert_eq!(rounds.sent.borrow().last(), Some(&(vec![], vec![])));
         // rank 0's V⁺ at the four boundary nodes, and the energies
         let mut msg = vec![0.0];
@@ -161,15 +169,20 @@ mod tests {
         let whole: Vec<f64> = (0..20).map(f64::from).collect();
         bodies[0].u.copy_from_slice(&whole[..10]);
         bodies[0].v.copy_from_slice(&whole[10..]);
-        hand_over(&s0, &mut bodies, &rounds);
+        // (with the last step's impulse of its contact at node 2, [`crate::warm`])
+        w0.set([((0, 2, 5, 0), [0.5, 0.25])].into_iter());
+        hand_over(&s0, &mut bodies, &mut w0, &rounds);
         let mut expect = vec![0.0];
         expect.extend(&whole);
-        assert_eq!(rounds.sent.borrow().last(), Some(&(vec![1], vec![expect.clone()])));
+        let mut handed = vec![6.0, 0.0, 2.0, 5.0, 0.0, 0.5, 0.25];
+        handed.extend(&expect);
+        assert_eq!(rounds.sent.borrow().last(), Some(&(vec![1], vec![handed.clone()])));
         let mut got = vec![square()];
-        *rounds.replies.borrow_mut() = vec![expect.clone()];
-        hand_over(&s1, &mut got, &rounds);
-        assert_eq!(rounds.sent.borrow().last(), Some(&(vec![0], vec![vec![]])));
+        *rounds.replies.borrow_mut() = vec![handed];
+        hand_over(&s1, &mut got, &mut w1, &rounds);
+        assert_eq!(rounds.sent.borrow().last(), Some(&(vec![0], vec![vec![0.0]])));
         assert_eq!((&got[0].u[..], &got[0].v[..]), (&whole[..10], &whole[10..]));
+        assert_eq!(w1.r_of(&(0, 2, 5, 0)), [0.5, 0.25]);
         // before an output, rank 1 sends the bodies it stepped to rank 0
         gather_whole(&s1, &mut got, &rounds);
         assert_eq!(rounds.sent.borrow().last(), Some(&(vec![0], vec![expect.clone()])));
