@@ -125,6 +125,20 @@ pub struct RawFe {
     pub point: [f64; 2],
 }
 
+impl RawFe {
+    /// The contact's key ([`crate::nodes::FeKey`]: body, node, antagonist — a
+    /// rigid body's global id or `1 << 31 |` a deformable body —, segment), once
+    /// its rigid antagonist is named by global id; the family's contacts are in
+    /// key order (`detect_step`), the same whatever part of the world a rank
+    /// holds.
+    pub fn key(&self) -> crate::nodes::FeKey {
+        match self.anta {
+            RawAnta::Rigid(g) => (self.body, self.node, g, 0),
+            RawAnta::Segment { body, seg, .. } => (self.body, self.node, 1 << 31 | body, seg),
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum RawAnta {
     /// A rigid body: its slot in the world from `detect`, its global id once the

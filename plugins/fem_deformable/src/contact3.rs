@@ -137,6 +137,24 @@ pub struct RawFe3 {
     pub point: [f64; 3],
 }
 
+impl RawFe3 {
+    /// The contact's key ([`crate::nodes::FeKey`]: body, node or `1 << 31 |` a
+    /// face, antagonist — a rigid body's global id or `1 << 31 |` a deformable
+    /// body —, face), once its rigid antagonist is named by global id; the
+    /// family's contacts are in key order (`detect_step`), the same whatever part
+    /// of the world a rank holds.
+    pub fn key(&self) -> crate::nodes::FeKey {
+        let cand = match self.cand {
+            RawCand3::Node(node) => node,
+            RawCand3::Face { face, .. } => 1 << 31 | face,
+        };
+        match self.anta {
+            RawAnta3::Rigid(g) => (self.body, cand, g, 0),
+            RawAnta3::Face { body, face, .. } => (self.body, cand, 1 << 31 | body, face),
+        }
+    }
+}
+
 /// The candidate side found by detection.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum RawCand3 {

@@ -108,6 +108,9 @@ impl Deformables2 {
             _ => None,
         });
         crate::family::rigid_by_global(w, rigid, &mut self.rigid_free);
+        // (in key order: the order of the family's contacts, whatever order
+        // detection finds them in)
+        self.raw.sort_by_key(|rc| rc.key());
         self.times.detect = t.elapsed().as_secs_f64();
     }
 
