@@ -113,6 +113,30 @@ pub fn rigid_delassus(n: [f64; 2], arm: [f64; 2], im: [f64; 3]) -> [f64; 3] {
     nscdd::dim::d2::delassus(&f, [0.0; 3], im)
 }
 
+/// The lever arm (normal, tangential) of a rigid body at `x` for a contact at
+/// `point` with normal `n`, t = (−n_y, n_x).
+pub fn rigid_arm(n: [f64; 2], point: [f64; 2], x: [f64; 2]) -> [f64; 2] {
+    let t = [-n[1], n[0]];
+    let d = [point[0] - x[0], point[1] - x[1]];
+    [d[0] * n[1] - d[1] * n[0], d[0] * t[1] - d[1] * t[0]]
+}
+
+/// Whether a raw contact (its rigid antagonist named by global id) can move
+/// along its normal: its node, or its antagonist (W_αα's rigid share, or the
+/// segment's nodes). A contact of two fixed sides is dropped at detection, so
+/// its nodes join no node set.
+pub fn mobile(w: &World2, bodies: &[crate::body::FeBody], rc: &RawFe) -> bool {
+    let n = rc.n;
+    let moves = match rc.anta {
+        RawAnta::Rigid(g) => {
+            let ju = crate::family::slot(w, g);
+            rigid_delassus(n, rigid_arm(n, rc.point, w.bodies.pos[ju]), w.bodies.inv_mass[ju])[0] > 0.0
+        }
+        RawAnta::Segment { body, a, b, xi, .. } => bodies[body as usize].mobile(&[a, b], &[1.0 - xi, xi], &n),
+    };
+    moves || bodies[rc.body as usize].mobile(&[rc.node], &[1.0], &n)
+}
+
 /// A contact found by detection, before the node sets exist.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RawFe {

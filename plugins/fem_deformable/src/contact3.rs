@@ -126,6 +126,29 @@ pub fn rigid_delassus(b: &Basis, d: [f64; 3], inv_m: [f64; 3], inv_i: &Sym3) -> 
     nscdd::dim::d3::delassus(&f, [0.0; 3], &[0.0; 6], inv_m, inv_i)
 }
 
+/// Whether a raw contact (its rigid antagonist named by global id) can move
+/// along its normal: its candidate side, or its antagonist (W_αα's rigid share,
+/// or the face's nodes). A contact of two fixed sides is dropped at detection,
+/// so its nodes join no node set.
+pub fn mobile(w: &World3, bodies: &[FeBody], rc: &RawFe3) -> bool {
+    let n = &rc.n;
+    let cand = match rc.cand {
+        RawCand3::Node(node) => bodies[rc.body as usize].mobile(&[node], &[1.0], n),
+        RawCand3::Face { nodes, w: wts, .. } => bodies[rc.body as usize].mobile(&nodes, &wts, n),
+    };
+    cand || match rc.anta {
+        RawAnta3::Rigid(g) => {
+            let ju = crate::family::slot(w, g);
+            let x = w.bodies.pos[ju];
+            let d = [rc.point[0] - x[0], rc.point[1] - x[1], rc.point[2] - x[2]];
+            let (t1, t2) = nscdd::dim::d3::tangents(rc.n);
+            let im = &w.bodies.inv_mass[ju];
+            rigid_delassus(&[rc.n, t1, t2], d, im.m, &im.i)[0] > 0.0
+        }
+        RawAnta3::Face { body, nodes, w: wts, .. } => bodies[body as usize].mobile(&nodes, &wts, n),
+    }
+}
+
 /// A contact found by detection, before the node sets exist.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RawFe3 {

@@ -26,7 +26,7 @@ use std::time::Instant;
 /// An antagonist side: the side, its local velocities at the beginning of the step
 /// and free, its material, its key and its feature, and whether an impulse along
 /// the normal moves it.
-type AntaSide = (Anta, [f64; 2], [f64; 2], u16, u32, u32, bool);
+type AntaSide = (Anta, [f64; 2], [f64; 2], u16);
 
 /// Seconds per stage of the deformable part of the last step (the benchmark's
 /// split).
@@ -109,7 +109,9 @@ impl Deformables2 {
         });
         crate::family::rigid_by_global(w, rigid, &mut self.rigid_free);
         // (in key order: the order of the family's contacts, whatever order
-        // detection finds them in)
+        // detection finds them in; those that cannot move dropped)
+        let bodies = &self.bodies;
+        self.raw.retain(|rc| crate::contact2::mobile(w, bodies, rc));
         self.raw.sort_by_key(|rc| rc.key());
         self.times.detect = t.elapsed().as_secs_f64();
     }
@@ -192,16 +194,13 @@ impl Deformables2 {
             let vb_i = local(n, [body.v_begin[2 * rc.node as usize], body.v_begin[2 * rc.node as usize + 1]]);
             let vf_i = local(n, set.v[k as usize]);
             let mut wb = set.delassus(&cand, n);
-            let (anta, ub_j, uf_j, mat_j, key_j, feature, moves) = self.antagonist(w, rc, n, &v_begin, &mut wb);
-            // W_αα > 0, known on every rank (the columns only where the body is stepped)
-            if !(moves || body.mobile(&[rc.node], &[1.0], &n)) {
-                continue;
-            }
+            // (W_αα > 0: a contact of two fixed sides was dropped at detection)
+            let (anta, ub_j, uf_j, mat_j) = self.antagonist(w, rc, n, &v_begin, &mut wb);
             let Some(law) = w.law(body.material, mat_j) else { continue };
             let u_begin = [vb_i[0] - ub_j[0], vb_i[1] - ub_j[1]];
             let u_free = [vf_i[0] - uf_j[0], vf_i[1] - uf_j[1]];
             let lo = law_output(law, rc.gap, u_begin[0], u_free[0], (h, theta, w.step));
-            let key = (rc.body, rc.node, key_j, feature);
+            let key = rc.key();
             let r = match self.prev.binary_search_by_key(&key, |x| x.0) {
                 Ok(p) => self.prev[p].1,
                 Err(_) if from_warm => self.warm.r_of(&key),
@@ -258,31 +257,25 @@ impl Deformables2 {
     }
 
     /// The antagonist side of a raw contact: the side, its local velocities at the
-    /// beginning of the step and free, its material, its key and feature; adds its
+    /// beginning of the step and free, its material; adds its
     /// share of W_αα to `wb`.
     fn antagonist(&self, w: &World2, rc: &RawFe, n: [f64; 2], v_begin: &[[f64; 3]], wb: &mut [f64; 3]) -> AntaSide {
         match rc.anta {
             RawAnta::Rigid(g) => {
                 let ju = crate::family::slot(w, g);
-                let t = [-n[1], n[0]];
-                let dd = [rc.point[0] - w.bodies.pos[ju][0], rc.point[1] - w.bodies.pos[ju][1]];
-                let arm = [dd[0] * n[1] - dd[1] * n[0], dd[0] * t[1] - dd[1] * t[0]];
+                let arm = rigid_arm(n, rc.point, w.bodies.pos[ju]);
                 let wr = rigid_delassus(n, arm, w.bodies.inv_mass[ju]);
                 for q in 0..3 {
                     wb[q] += wr[q];
                 }
-                let moves = wr[0] > 0.0;
                 (
                     Anta::Rigid { body: g, arm },
                     rigid_local(n, arm, v_begin[ju]),
                     rigid_local(n, arm, free_of(&self.rigid_free, g)),
                     w.bodies.material[ju],
-                    g,
-                    0,
-                    moves,
                 )
             }
-            RawAnta::Segment { body: ob, seg, a, b, xi } => {
+            RawAnta::Segment { body: ob, a, b, xi, .. } => {
                 let os = &self.sets[ob as usize];
                 let ka = os.nodes.binary_search(&a).unwrap() as u32;
                 let kb = os.nodes.binary_search(&b).unwrap() as u32;
@@ -299,15 +292,7 @@ impl Deformables2 {
                 let vb = |x: u32| [other.v_begin[2 * x as usize], other.v_begin[2 * x as usize + 1]];
                 let (va, vbb) = (vb(a), vb(b));
                 let vbeg = [(1.0 - xi) * va[0] + xi * vbb[0], (1.0 - xi) * va[1] + xi * vbb[1]];
-                (
-                    Anta::Fe(side),
-                    local(n, vbeg),
-                    local(n, os.side_velocity(&side)),
-                    other.material,
-                    1 << 31 | ob,
-                    seg,
-                    other.mobile(&[a, b], &[1.0 - xi, xi], &n),
-                )
+                (Anta::Fe(side), local(n, vbeg), local(n, os.side_velocity(&side)), other.material)
             }
         }
     }

@@ -28,7 +28,7 @@ fn vb3(b: &FeBody, k: u32) -> [f64; 3] {
 /// An antagonist side: the side, its local velocities at the beginning of the step
 /// and free, its material, its key and its feature, and whether an impulse along
 /// the normal moves it.
-type AntaSide3 = (Anta3, [f64; 3], [f64; 3], u16, u32, u32, bool);
+type AntaSide3 = (Anta3, [f64; 3], [f64; 3], u16);
 
 /// The deformable bodies of a 3D scene and their contacts.
 #[derive(Default)]
@@ -95,7 +95,9 @@ impl Deformables3 {
         });
         crate::family::rigid_by_global(w, rigid, &mut self.rigid_free);
         // (in key order: the order of the family's contacts, whatever order
-        // detection finds them in)
+        // detection finds them in; those that cannot move dropped)
+        let bodies = &self.bodies;
+        self.raw.retain(|rc| crate::contact3::mobile(w, bodies, rc));
         self.raw.sort_by_key(|rc| rc.key());
         self.times.detect = t.elapsed().as_secs_f64();
     }
@@ -168,17 +170,12 @@ impl Deformables3 {
             let bi = rc.body as usize;
             let set = &self.sets[bi];
             let body = &self.bodies[bi];
-            let (cand, vbi, cand_key, cand_moves) = match rc.cand {
+            let (cand, vbi) = match rc.cand {
                 RawCand3::Node(node) => {
                     let k = set.nodes.binary_search(&node).unwrap() as u32;
-                    (
-                        FeSide3::node(rc.body, k),
-                        vb3(body, node),
-                        node,
-                        body.mobile(&[node], &[1.0], &rc.n),
-                    )
+                    (FeSide3::node(rc.body, k), vb3(body, node))
                 }
-                RawCand3::Face { face, nodes: f, w: wts } => {
+                RawCand3::Face { nodes: f, w: wts, .. } => {
                     let k = f.map(|x| set.nodes.binary_search(&x).unwrap() as u32);
                     let mut v = [0.0; 3];
                     for (q, &node) in f.iter().enumerate() {
@@ -187,8 +184,7 @@ impl Deformables3 {
                             v[c] += wts[q] * vn[c];
                         }
                     }
-                    let moves = body.mobile(&f, &wts, &rc.n);
-                    (FeSide3 { body: rc.body, k, w: wts }, v, 1 << 31 | face, moves)
+                    (FeSide3 { body: rc.body, k, w: wts }, v)
                 }
             };
             let (t1, t2) = tangents(rc.n);
@@ -196,16 +192,13 @@ impl Deformables3 {
             let ub_i = local(&basis, vbi);
             let uf_i = local(&basis, set.side_velocity(&cand));
             let mut wb = project(&basis, &set.side_block(&cand));
-            let (anta, ub_j, uf_j, mat_j, key_j, feature, moves) = self.antagonist(w, rc, &basis, &v_begin, &mut wb);
-            // W_αα > 0, known on every rank (the columns only where the body is stepped)
-            if !(moves || cand_moves) {
-                continue;
-            }
+            // (W_αα > 0: a contact of two fixed sides was dropped at detection)
+            let (anta, ub_j, uf_j, mat_j) = self.antagonist(w, rc, &basis, &v_begin, &mut wb);
             let Some(law) = w.law(body.material, mat_j) else { continue };
             let u_begin: [f64; 3] = std::array::from_fn(|q| ub_i[q] - ub_j[q]);
             let u_free: [f64; 3] = std::array::from_fn(|q| uf_i[q] - uf_j[q]);
             let lo = law_output(law, rc.gap, u_begin[0], u_free[0], (h, theta, w.step));
-            let key = (rc.body, cand_key, key_j, feature);
+            let key = rc.key();
             let r = match self.prev.binary_search_by_key(&key, |x| x.0) {
                 Ok(p) => self.prev[p].1,
                 Err(_) if from_warm => self.warm.r_of(&key),
@@ -269,7 +262,7 @@ impl Deformables3 {
     }
 
     /// The antagonist side of a raw contact: the side, its local velocities at the
-    /// beginning of the step and free, its material, its key and feature; adds its
+    /// beginning of the step and free, its material; adds its
     /// share of W_αα to `wb`.
     fn antagonist(&self, w: &World3, rc: &RawFe3, basis: &Basis, v_begin: &[[f64; 6]], wb: &mut [f64; 6]) -> AntaSide3 {
         let basis = *basis;
@@ -282,22 +275,18 @@ impl Deformables3 {
                 for q in 0..6 {
                     wb[q] += wr[q];
                 }
-                let moves = wr[0] > 0.0;
                 (
                     Anta3::Rigid { body: g, d },
                     rigid_local(&basis, d, &v_begin[ju]),
                     rigid_local(&basis, d, &free_of(&self.rigid_free, g)),
                     w.bodies.material[ju],
-                    g,
-                    0,
-                    moves,
                 )
             }
             RawAnta3::Face {
                 body: ob,
-                face,
                 nodes: f,
                 w: wts,
+                ..
             } => {
                 let os = &self.sets[ob as usize];
                 let kk = f.map(|x| os.nodes.binary_search(&x).unwrap() as u32);
@@ -319,9 +308,6 @@ impl Deformables3 {
                     local(&basis, vbeg),
                     local(&basis, os.side_velocity(&side)),
                     other.material,
-                    1 << 31 | ob,
-                    face,
-                    other.mobile(&f, &wts, &rc.n),
                 )
             }
         }

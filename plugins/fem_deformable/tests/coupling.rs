@@ -299,3 +299,59 @@ fn exported_coupled_problem_is_the_solved_one() {
         }
     }
 }
+
+/// A block fixed at its base, which lies within the alert distance of a fixed
+/// floor, under a disk: the base's contacts with the floor cannot move (both
+/// sides fixed) and are dropped at detection, so the block's node set holds the
+/// disk's contact nodes only (the set a rank stepping the block fills from its
+/// own contacts, whatever rank detects the base's).
+#[test]
+fn contacts_of_two_fixed_sides_are_dropped_at_detection() {
+    let text = r#"
+[time]
+step = 1e-3
+steps = 1
+[solver]
+tolerance = 1e-8
+max_sweeps = 10000
+[detection]
+alert = 0.01
+[[materials]]
+name = "soil"
+density = 2000.0
+[[materials]]
+name = "stone"
+density = 2500.0
+[[laws]]
+materials = ["soil", "stone"]
+friction = 0.5
+[[laws]]
+materials = ["stone", "stone"]
+friction = 0.5
+[[bodies]]
+shape = "halfplane"
+material = "stone"
+position = [0.0, 0.0]
+fixed = true
+[[bodies]]
+shape = "disk"
+material = "stone"
+radius = 0.1
+position = [0.5, 0.6005]
+[[deformable]]
+material = "soil"
+young = 1e6
+poisson = 0.3
+fix = ["bottom"]
+mesh = { rectangle = { origin = [0.0, 0.001], size = [1.0, 0.5], cells = [10, 5] } }
+"#;
+    let mut s = scene(text);
+    let rep = s.step().unwrap();
+    assert!(rep.solve.converged);
+    let body = &s.fe.bodies[0];
+    let y = |k: u32| body.mesh.x0[2 * k as usize + 1];
+    let nodes = &s.fe.sets[0].nodes;
+    assert!(!nodes.is_empty(), "the disk's contact nodes");
+    assert!(nodes.iter().all(|&k| y(k) > 0.4), "only the top's nodes: {nodes:?}");
+    assert_eq!(s.fe.contacts.len(), nodes.len());
+}
