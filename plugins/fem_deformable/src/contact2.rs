@@ -121,20 +121,25 @@ pub fn rigid_arm(n: [f64; 2], point: [f64; 2], x: [f64; 2]) -> [f64; 2] {
     [d[0] * n[1] - d[1] * n[0], d[0] * t[1] - d[1] * t[0]]
 }
 
-/// Whether a raw contact (its rigid antagonist named by global id) can move
-/// along its normal: its node, or its antagonist (W_αα's rigid share, or the
-/// segment's nodes). A contact of two fixed sides is dropped at detection, so
-/// its nodes join no node set.
-pub fn mobile(w: &World2, bodies: &[crate::body::FeBody], rc: &RawFe) -> bool {
-    let n = rc.n;
-    let moves = match rc.anta {
+/// Whether a raw contact (its rigid antagonist named by global id) is kept: a
+/// law for its materials, and a side that can move along its normal (its node,
+/// or its antagonist: W_αα's rigid share, or the segment's nodes). A contact of
+/// two fixed sides is dropped at detection, so its nodes join no node set, and
+/// every contact kept is built ([`crate::solved::Solved`]).
+pub fn kept(w: &World2, bodies: &[crate::body::FeBody], rc: &RawFe) -> bool {
+    let (n, body) = (rc.n, &bodies[rc.body as usize]);
+    let (moves, material) = match rc.anta {
         RawAnta::Rigid(g) => {
             let ju = crate::family::slot(w, g);
-            rigid_delassus(n, rigid_arm(n, rc.point, w.bodies.pos[ju]), w.bodies.inv_mass[ju])[0] > 0.0
+            let wr = rigid_delassus(n, rigid_arm(n, rc.point, w.bodies.pos[ju]), w.bodies.inv_mass[ju]);
+            (wr[0] > 0.0, w.bodies.material[ju])
         }
-        RawAnta::Segment { body, a, b, xi, .. } => bodies[body as usize].mobile(&[a, b], &[1.0 - xi, xi], &n),
+        RawAnta::Segment { body: ob, a, b, xi, .. } => {
+            let other = &bodies[ob as usize];
+            (other.mobile(&[a, b], &[1.0 - xi, xi], &n), other.material)
+        }
     };
-    moves || bodies[rc.body as usize].mobile(&[rc.node], &[1.0], &n)
+    w.law(body.material, material).is_some() && (moves || body.mobile(&[rc.node], &[1.0], &n))
 }
 
 /// A contact found by detection, before the node sets exist.
@@ -150,6 +155,16 @@ pub struct RawFe {
 }
 
 impl RawFe {
+    /// Its sides for the rounds of a step stepped in part
+    /// ([`crate::solved::Sides`]).
+    pub fn sides(&self) -> crate::solved::Sides<2> {
+        let cand = (self.body, [self.node; 2]);
+        match self.anta {
+            RawAnta::Rigid(g) => (cand, None, Some(g)),
+            RawAnta::Segment { body, a, b, .. } => (cand, Some((body, [a, b])), None),
+        }
+    }
+
     /// The contact's key ([`crate::nodes::FeKey`]: body, node, antagonist — a
     /// rigid body's global id or `1 << 31 |` a deformable body —, segment), once
     /// its rigid antagonist is named by global id; the family's contacts are in

@@ -126,27 +126,34 @@ pub fn rigid_delassus(b: &Basis, d: [f64; 3], inv_m: [f64; 3], inv_i: &Sym3) -> 
     nscdd::dim::d3::delassus(&f, [0.0; 3], &[0.0; 6], inv_m, inv_i)
 }
 
-/// Whether a raw contact (its rigid antagonist named by global id) can move
-/// along its normal: its candidate side, or its antagonist (W_αα's rigid share,
-/// or the face's nodes). A contact of two fixed sides is dropped at detection,
-/// so its nodes join no node set.
-pub fn mobile(w: &World3, bodies: &[FeBody], rc: &RawFe3) -> bool {
-    let n = &rc.n;
+/// Whether a raw contact (its rigid antagonist named by global id) is kept: a
+/// law for its materials, and a side that can move along its normal (its
+/// candidate side, or its antagonist: W_αα's rigid share, or the face's nodes).
+/// A contact of two fixed sides is dropped at detection, so its nodes join no
+/// node set, and every contact kept is built ([`crate::solved::Solved`]).
+pub fn kept(w: &World3, bodies: &[FeBody], rc: &RawFe3) -> bool {
+    let (n, body) = (&rc.n, &bodies[rc.body as usize]);
     let cand = match rc.cand {
-        RawCand3::Node(node) => bodies[rc.body as usize].mobile(&[node], &[1.0], n),
-        RawCand3::Face { nodes, w: wts, .. } => bodies[rc.body as usize].mobile(&nodes, &wts, n),
+        RawCand3::Node(node) => body.mobile(&[node], &[1.0], n),
+        RawCand3::Face { nodes, w: wts, .. } => body.mobile(&nodes, &wts, n),
     };
-    cand || match rc.anta {
+    let (moves, material) = match rc.anta {
         RawAnta3::Rigid(g) => {
             let ju = crate::family::slot(w, g);
             let x = w.bodies.pos[ju];
             let d = [rc.point[0] - x[0], rc.point[1] - x[1], rc.point[2] - x[2]];
             let (t1, t2) = nscdd::dim::d3::tangents(rc.n);
             let im = &w.bodies.inv_mass[ju];
-            rigid_delassus(&[rc.n, t1, t2], d, im.m, &im.i)[0] > 0.0
+            (rigid_delassus(&[rc.n, t1, t2], d, im.m, &im.i)[0] > 0.0, w.bodies.material[ju])
         }
-        RawAnta3::Face { body, nodes, w: wts, .. } => bodies[body as usize].mobile(&nodes, &wts, n),
-    }
+        RawAnta3::Face {
+            body: ob, nodes, w: wts, ..
+        } => {
+            let other = &bodies[ob as usize];
+            (other.mobile(&nodes, &wts, n), other.material)
+        }
+    };
+    w.law(body.material, material).is_some() && (cand || moves)
 }
 
 /// A contact found by detection, before the node sets exist.
@@ -161,6 +168,19 @@ pub struct RawFe3 {
 }
 
 impl RawFe3 {
+    /// Its sides for the rounds of a step stepped in part
+    /// ([`crate::solved::Sides`]).
+    pub fn sides(&self) -> crate::solved::Sides<3> {
+        let cand = match self.cand {
+            RawCand3::Node(node) => (self.body, [node; 3]),
+            RawCand3::Face { nodes, .. } => (self.body, nodes),
+        };
+        match self.anta {
+            RawAnta3::Rigid(g) => (cand, None, Some(g)),
+            RawAnta3::Face { body, nodes, .. } => (cand, Some((body, nodes)), None),
+        }
+    }
+
     /// The contact's key ([`crate::nodes::FeKey`]: body, node or `1 << 31 |` a
     /// face, antagonist — a rigid body's global id or `1 << 31 |` a deformable
     /// body —, face), once its rigid antagonist is named by global id; the

@@ -277,7 +277,7 @@ macro_rules! scene_family {
                 <$stage>::update(self, w.time.h, w.time.theta, w.step)
             }
             fn contacts(&self) -> usize {
-                self.contacts.len()
+                self.stepped.contacts_total().unwrap_or(self.contacts.len())
             }
             fn history_columns(&self) -> Vec<String> {
                 [
@@ -290,8 +290,7 @@ macro_rules! scene_family {
                 .to_vec()
             }
             fn history_values(&self, out: &mut Vec<f64>) {
-                let contacts = self.stepped.contacts_total().unwrap_or(self.contacts.len());
-                history_values(&self.bodies, contacts, self.stepped.energies(), out)
+                history_values(&self.bodies, self.contacts(), self.stepped.energies(), out)
             }
             fn write_frame(&mut self, dir: &Path, frame: u32, t: f64) -> std::io::Result<()> {
                 write_frame(&self.bodies, "deformable", &mut self.frames, dir, frame, t)

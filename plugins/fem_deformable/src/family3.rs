@@ -19,7 +19,8 @@ pub struct FePart3 {
     fe: Vec<u32>,
     sets: Vec<NodeSet3>,
     contacts: FeContacts3,
-    /// Index of each local contact in the family's contact set.
+    /// Index of each local contact in the family's list (stepped in part, the list
+    /// of the contacts solved here: [`crate::solved::Solved`]).
     global: Vec<u32>,
     /// A part of another rank's subdomain, stepped in part, of this many
     /// contacts: its entities and its count only (what the gluing reads of it;
@@ -113,23 +114,23 @@ impl Attached<Rigid3> for Deformables3 {
     fn after_free_velocity(&mut self, w: &World3) {
         self.detect_step(w);
     }
-    /// The contact list and points, no body stepped yet (no solve).
-    fn build(&mut self, w: &mut World3) {
+    /// Nothing is built before the partition: the family's contacts are its raw
+    /// contacts, kept and sorted by detection ([`crate::solved::Solved`]); no body
+    /// stepped yet.
+    fn build(&mut self, _w: &mut World3) {
         self.stepped.hold(self.bodies.len());
-        self.build_contacts(w);
     }
     /// The bodies of the contacts solved here ([`crate::stepped`]): their free
     /// velocities, and the contacts built again with their numbers.
     fn solved_on(&mut self, w: &World3, on: Option<&SolvedOn<'_>>) -> bool {
-        let c = &self.contacts;
-        let sides = (0..c.len()).map(|a| (c.cand[a].body, c.anta[a].fe().map(|s| s.body)));
+        let sides = self.raw.iter().map(|rc| rc.sides()).map(|(c, f, _)| (c.0, f.map(|s| s.0)));
         let part = self.stepped.decide(self.bodies.len(), on, sides, (w.time.h, w.time.theta));
         self.stepped.release(&mut self.bodies, &mut self.sets);
         // the whole states handed over, the nodes of the bodies stepped elsewhere asked
         if let Some(on) = on.filter(|_| part) {
-            let (c, st, sets) = (&self.contacts, &self.stepped, &self.sets);
+            let (raw, st) = (&self.raw, &self.stepped);
             let bw = (&mut self.bodies[..], &mut self.warm);
-            self.solved.asked = crate::solved::rounds_before(st, bw, sets, (c.len(), round_sides(c)), on);
+            self.solved.asked = crate::solved::rounds_before(st, bw, (raw.len(), |a| raw[a].sides()), on);
         }
         // (a large body this rank steps first is assembled here: if that fails, no
         // body is stepped here and the step's end reports it)
@@ -146,15 +147,14 @@ impl Attached<Rigid3> for Deformables3 {
         // the other ranks' subdomains, the node counts of the bodies stepped here, the
         // columns of the bodies several ranks solve; then the contacts solved here
         if let Some(on) = on.filter(|_| part) {
-            let c = &self.contacts;
-            let (st, sw) = (&self.stepped, (&mut self.sets[..], &mut self.warm));
-            crate::solved::rounds_after(st, sw, (c.len(), round_sides(c)), on, &mut self.solved);
+            let (raw, st, sw) = (&self.raw, &self.stepped, (&mut self.sets[..], &mut self.warm));
+            crate::solved::rounds_after(st, sw, (raw.len(), |a| raw[a].sides()), on, &mut self.solved);
             self.build_list(w);
         }
         part
     }
     fn points(&self, out: &mut Vec<[f64; 3]>) {
-        out.extend_from_slice(&self.contacts.point);
+        out.extend(self.raw.iter().map(|rc| rc.point));
     }
     fn n_entities(&self) -> usize {
         self.bodies.len()
@@ -172,7 +172,7 @@ impl Attached<Rigid3> for Deformables3 {
         }
     }
     fn split(&self, _w: &World3, owner: &[u32], copy: &mut dyn FnMut(u32, u32) -> u32) -> Vec<(u32, Box<dyn LocalPart<Rigid3>>)> {
-        let c = &self.contacts;
+        let (c, in_part) = (&self.contacts, self.stepped.solved().is_some());
         // stepped in part: the contacts solved here come from their own list, the
         // other ranks' subdomains are shells made from their ranks' descriptions
         // ([`crate::shells`], [`FePart3::shell`])
@@ -181,21 +181,20 @@ impl Attached<Rigid3> for Deformables3 {
         let pairs = by_subdomain(owner, |a| own.is_none_or(|o| o[a]));
         let mut parts = split_pairs(&pairs, self.bodies.len(), make, |s, part: &mut FePart3, contacts, entity| {
             for &a in contacts {
-                let a = a as usize;
-                let mut cand = c.cand[a];
+                let Some((src, l)) = self.solved.place(c, in_part, a as usize) else {
+                    continue;
+                };
+                let mut cand = src.cand[l];
                 cand.body = entity(part, cand.body);
-                let anta = match c.anta[a] {
+                let anta = match src.anta[l] {
                     Anta3::Rigid { body, d } => Anta3::Rigid { body: copy(s, body), d },
                     Anta3::Fe(mut side) => {
                         side.body = entity(part, side.body);
                         Anta3::Fe(side)
                     }
                 };
-                part.global.push(a as u32);
-                match own {
-                    Some(_) => part.contacts.push_from(&self.solved.list, self.solved.of[a] as usize, cand, anta),
-                    None => part.contacts.push_from(c, a, cand, anta),
-                }
+                part.global.push(l as u32);
+                part.contacts.push_from(src, l, cand, anta);
             }
         });
         if own.is_some() {
@@ -214,8 +213,13 @@ impl Attached<Rigid3> for Deformables3 {
     fn write_back(&mut self, _w: &mut World3, parts: &[(u32, &dyn LocalPart<Rigid3>)]) {
         for (_, p) in parts {
             let Some(p) = p.as_any().downcast_ref::<FePart3>() else { continue };
+            // (stepped in part, the contacts solved here: `global` indexes their list)
+            let list = match self.stepped.solved() {
+                Some(_) => &mut self.solved.list,
+                None => &mut self.contacts,
+            };
             for (l, &g) in p.global.iter().enumerate() {
-                self.contacts.results_from(g as usize, &p.contacts, l);
+                list.results_from(g as usize, &p.contacts, l);
             }
         }
         // stepped in part, V⁺ comes once the impulses of the bodies' contacts solved
@@ -244,11 +248,10 @@ impl Attached<Rigid3> for Deformables3 {
     /// V⁺ of the bodies stepped here, their contacts' impulses solved elsewhere
     /// received ([`crate::impulses`]), and V⁺ at every body's boundary shared.
     fn share_stepped(&mut self, rounds: &dyn nscdd::dd::Rounds) {
-        let (c, st) = (&self.contacts, &self.stepped);
-        let me = st.rank_here();
-        let own = (0..c.len()).filter(|&a| Some(st.rank_of(a)) == me);
-        let own: Vec<_> = own
-            .map(|a| (a as u32, c.cand[a], c.anta[a].fe(), global(&c.frame[a], c.r[a]), (c.key[a], c.r[a])))
+        // (the contacts solved here, at their places among the family's)
+        let (c, at) = (&self.solved.list, &self.solved.at);
+        let own: Vec<_> = (0..c.len())
+            .map(|l| (at[l], c.cand[l], c.anta[l].fe(), global(&c.frame[l], c.r[l]), (c.key[l], c.r[l])))
             .collect();
         let sw = (&mut self.sets[..], &mut self.warm);
         crate::impulses::finish(&mut self.stepped, &mut self.bodies, sw, own.into_iter(), rounds);
@@ -256,27 +259,14 @@ impl Attached<Rigid3> for Deformables3 {
     /// The bodies stepped elsewhere whole, every rank's contacts (the saved state).
     fn gather_whole(&mut self, rounds: &dyn nscdd::dd::Rounds) {
         crate::whole::gather_whole(&self.stepped, &mut self.bodies, rounds);
-        let (c, st) = (&self.contacts, &self.stepped);
-        let me = st.rank_here();
-        let own = (0..c.len()).filter(|&a| Some(st.rank_of(a)) == me).map(|a| (c.key[a], c.r[a]));
-        self.gathered = crate::whole::gather_contacts(st, own, rounds);
+        let c = &self.solved.list;
+        let own = c.key.iter().copied().zip(c.r.iter().copied());
+        self.gathered = crate::whole::gather_contacts(&self.stepped, own, rounds);
     }
     fn stepped_bodies(&self) -> Option<(usize, usize)> {
         self.stepped.counts()
     }
     fn built_bodies(&self) -> Option<usize> {
         self.stepped.built(&self.bodies)
-    }
-}
-
-/// Each contact's sides for the rounds of a step stepped in part
-/// ([`crate::solved::Sides`]).
-fn round_sides(c: &FeContacts3) -> impl Fn(usize) -> crate::solved::Sides<3> + '_ {
-    |a| {
-        let rigid = match c.anta[a] {
-            Anta3::Rigid { body, .. } => Some(body),
-            _ => None,
-        };
-        (c.cand[a], c.anta[a].fe(), rigid)
     }
 }

@@ -8,7 +8,7 @@
 //! [`unpack_solved`], one point-to-point round in
 //! [`nscdd::dd::Attached::solved_on`]).
 
-use crate::nodes::{FeSide, NodeSet};
+use crate::nodes::NodeSet;
 use crate::stepped::Stepped;
 use crate::warm::Warm;
 use nscdd::dd::{Rounds, SolvedOn};
@@ -85,10 +85,14 @@ pub fn ask_nodes(stepped: &Stepped, sides: impl Iterator<Item = (u32, u32)>, rou
     asked
 }
 
+/// One deformable side of a contact: the body and the mesh nodes it reads (a
+/// single node repeated).
+pub type Side<const D: usize> = (u32, [u32; D]);
+
 /// A contact's sides for the rounds of a step stepped in part: its candidate
 /// side, its deformable antagonist side if any, its rigid antagonist (global id)
 /// if any.
-pub type Sides<const D: usize> = (FeSide<D>, Option<FeSide<D>>, Option<u32>);
+pub type Sides<const D: usize> = (Side<D>, Option<Side<D>>, Option<u32>);
 
 /// [`nscdd::dd::Attached::solved_on`]'s rounds before the free velocities,
 /// stepped in part: the whole states handed over ([`crate::whole::hand_over`]),
@@ -98,7 +102,6 @@ pub type Sides<const D: usize> = (FeSide<D>, Option<FeSide<D>>, Option<u32>);
 pub fn rounds_before<const D: usize>(
     st: &Stepped,
     (bodies, warm): (&mut [crate::body::FeBody], &mut Warm<D>),
-    sets: &[NodeSet<D>],
     (n, sides): (usize, impl Fn(usize) -> Sides<D>),
     on: &SolvedOn<'_>,
 ) -> Asked {
@@ -108,7 +111,7 @@ pub fn rounds_before<const D: usize>(
         let (c, f, _) = sides(a);
         std::iter::once(c).chain(f)
     });
-    let nodes = fe.flat_map(|s| s.k.map(|k| (s.body, sets[s.body as usize].nodes[k as usize])));
+    let nodes = fe.flat_map(|(b, ks)| ks.map(|k| (b, k)));
     ask_nodes(st, nodes, on.rounds)
 }
 
@@ -126,7 +129,7 @@ pub fn rounds_after<const D: usize, Cs>(
 ) {
     let bodies = |a: usize| {
         let (c, f, r) = sides(a);
-        (c.body, f.map(|s| s.body), r)
+        (c.0, f.map(|s| s.0), r)
     };
     let filled = sets.iter().enumerate().filter(|(b, s)| st.steps(*b) && !s.is_empty());
     let stepped: Vec<(u32, u32)> = filled.map(|(b, s)| (b as u32, s.len() as u32)).collect();
@@ -135,15 +138,15 @@ pub fn rounds_after<const D: usize, Cs>(
 }
 
 /// The contact nodes of the bodies this rank steps whose contacts other ranks
-/// solve too: the nodes of the raw contacts solved here or dropped by the build
-/// (`raw`: (raw contact, body, node) of every side), and those the other ranks
+/// solve too: the nodes of the contacts solved here (`raw`: (contact, body,
+/// node) of every side of the family's contacts), and those the other ranks
 /// asked ([`ask_nodes`]), into `nodes` (each body's sorted nodes). The others'
 /// entries stay.
 pub fn shared_nodes<Cs>(stepped: &Stepped, solved: &Solved<Cs>, raw: impl Iterator<Item = (usize, u32, u32)>, nodes: &mut [Vec<u32>]) {
     let Some(own) = stepped.solved() else {
         return;
     };
-    let here = |i: usize| solved.raw_at.get(i).is_none_or(|&a| a == u32::MAX || own[a as usize]);
+    let here = |i: usize| own.get(i).is_some_and(|&o| o);
     let mut pairs: Vec<(u32, u32)> = raw
         .filter(|&(i, b, _)| stepped.sends(b as usize) && here(i))
         .map(|x| (x.1, x.2))
@@ -252,21 +255,19 @@ pub fn share_columns<const D: usize>(st: &Stepped, (sets, warm): (&mut [NodeSet<
     unpack_solved(st, sets, &from);
 }
 
-/// The contacts this rank solves in a step stepped in part ([`Stepped::solved`]):
-/// built again after the partition with their numbers (W_αα, u_free, targets),
-/// while the family's list keeps every contact as one process has it (keys,
-/// sides, frames, points: the partition's and the rounds'; the impulses of those
-/// solved elsewhere stay on their ranks, [`crate::warm`]).
+/// The contacts this rank solves in a step stepped in part ([`Stepped::solved`]),
+/// built after the partition with their numbers (W_αα, u_free, targets). The
+/// family's contacts are its raw contacts (kept by detection, in key order: their
+/// points are the partition's, [`nscdd::dd::Attached::points`]); a rank builds
+/// only those it solves, and the impulses of those solved elsewhere stay on
+/// their ranks ([`crate::warm`]).
 #[derive(Default)]
 pub struct Solved<Cs> {
-    /// Each raw contact's index in the family's list (`u32::MAX`: dropped), from
-    /// the build of the whole list.
-    pub raw_at: Vec<u32>,
     /// The contacts solved here.
     pub list: Cs,
-    /// Their indices in the family's list (ascending).
+    /// Their indices among the family's contacts (ascending).
     pub at: Vec<u32>,
-    /// Per contact of the family's list, its index in `list` (`u32::MAX`: solved
+    /// Per contact of the family, its index in `list` (`u32::MAX`: solved
     /// elsewhere).
     pub of: Vec<u32>,
     /// What the other ranks asked of the bodies stepped here ([`ask_nodes`]).
@@ -299,28 +300,26 @@ impl<Cs> Solved<Cs> {
         }
     }
 
-    /// A build's contacts `c` (`n`: their count): the family's list `list` (`own`
-    /// false: every contact), or the contacts solved here, one for each of `at`.
-    pub fn keep(&mut self, c: Cs, list: &mut Cs, own: bool, n: impl Fn(&Cs) -> usize) {
-        debug_assert!(!own || self.at.len() == n(&c), "the contacts solved here built again");
+    /// A build's contacts `c`: the family's list `list` (`own` false: every
+    /// contact, one process), or the contacts solved here, one for each of `at`,
+    /// among the family's `n` contacts.
+    pub fn keep(&mut self, c: Cs, list: &mut Cs, own: bool, n: usize) {
         match own {
             false => *list = c,
             true => {
                 self.list = c;
-                self.index(n(list));
+                self.index(n);
             }
         }
     }
 
-    /// Whether raw contact `i` is to be built again here (`own`: the family's
-    /// contacts solved here), its list index recorded in `at` if so.
-    pub fn again(&mut self, i: usize, own: &[bool]) -> bool {
-        match self.raw_at.get(i) {
-            Some(&a) if a != u32::MAX && own[a as usize] => {
-                self.at.push(a);
-                true
-            }
-            _ => false,
+    /// Contact `a`'s place in `list` and that list: the contacts solved here
+    /// (stepped in part) or the family's `whole` list; `None` if `a` is solved
+    /// elsewhere.
+    pub fn place<'a>(&'a self, whole: &'a Cs, part: bool, a: usize) -> Option<(&'a Cs, usize)> {
+        match part {
+            false => Some((whole, a)),
+            true => self.of.get(a).filter(|&&l| l != u32::MAX).map(|&l| (&self.list, l as usize)),
         }
     }
 }
@@ -330,22 +329,21 @@ mod tests {
     use super::*;
     use crate::stepped::AllRanks;
 
-    /// The contacts solved here are built again from the raw contacts kept in the
-    /// family's list.
+    /// The contacts solved here (the family's 0 and 2 of 3) and their places.
     #[test]
     fn the_contacts_solved_here_and_their_places() {
-        // raw contacts 0, 2, 3 are the list's 0, 1, 2 (raw 1 dropped); list 1 is
-        // solved elsewhere
-        let mut sv = Solved::<()> {
-            raw_at: vec![0, u32::MAX, 1, 2],
+        let mut sv = Solved::<&str> {
+            at: vec![0, 2],
             ..Default::default()
         };
-        let own = [true, false, true];
-        let again: Vec<bool> = (0..4).map(|i| sv.again(i, &own)).collect();
-        assert_eq!(again, [true, false, false, true]);
-        assert_eq!(sv.at, [0, 2]);
-        sv.index(3);
+        let mut whole = "whole";
+        sv.keep("part", &mut whole, true, 3);
         assert_eq!(sv.of, [0, u32::MAX, 1]);
+        assert_eq!(sv.place(&whole, true, 2), Some((&"part", 1)));
+        assert_eq!(sv.place(&whole, true, 1), None);
+        assert_eq!(sv.place(&whole, false, 1), Some((&"whole", 1)));
+        sv.keep("all", &mut whole, false, 3);
+        assert_eq!(whole, "all");
     }
 
     /// A body whose contacts ranks 0 (two) and 1 (one) solve, on 3 ranks: rank 0

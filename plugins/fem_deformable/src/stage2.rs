@@ -60,7 +60,7 @@ pub struct Deformables2 {
     pub sets: Vec<NodeSet>,
     pub alert: f64,
     pub times: FeTimes,
-    raw: Vec<RawFe>,
+    pub(crate) raw: Vec<RawFe>,
     prev: Vec<(FeKey, [f64; 2])>,
     /// A failure inside the step (a refactorization), reported after it.
     pub error: Option<String>,
@@ -109,9 +109,10 @@ impl Deformables2 {
         });
         crate::family::rigid_by_global(w, rigid, &mut self.rigid_free);
         // (in key order: the order of the family's contacts, whatever order
-        // detection finds them in; those that cannot move dropped)
+        // detection finds them in; those that cannot move dropped, every one kept
+        // built: the family's contacts)
         let bodies = &self.bodies;
-        self.raw.retain(|rc| crate::contact2::mobile(w, bodies, rc));
+        self.raw.retain(|rc| crate::contact2::kept(w, bodies, rc));
         self.raw.sort_by_key(|rc| rc.key());
         self.times.detect = t.elapsed().as_secs_f64();
     }
@@ -165,20 +166,16 @@ impl Deformables2 {
             self.prev.sort_unstable_by_key(|x| x.0);
         }
         // stepped in part, after the partition: only the contacts solved here, into
-        // `solved` (the family's list, built before it, keeps every contact)
+        // `solved` (the family's contacts are the raw ones, [`crate::solved::Solved`])
         let mut c = match own {
             None => std::mem::take(&mut self.contacts),
             Some(_) => std::mem::take(&mut self.solved.list),
         };
         c.clear();
         self.solved.at.clear();
-        if own.is_none() {
-            self.solved.raw_at.clear();
-            self.solved.raw_at.resize(self.raw.len(), u32::MAX);
-        }
         let v_begin = w.velocity_begin();
         for (i, rc) in self.raw.iter().enumerate() {
-            if own.is_some_and(|o| !self.solved.again(i, o)) {
+            if own.is_some_and(|o| !o[i]) {
                 continue;
             }
             let bi = rc.body as usize;
@@ -196,6 +193,7 @@ impl Deformables2 {
             let mut wb = set.delassus(&cand, n);
             // (W_αα > 0: a contact of two fixed sides was dropped at detection)
             let (anta, ub_j, uf_j, mat_j) = self.antagonist(w, rc, n, &v_begin, &mut wb);
+            // (a law for every contact kept by detection, [`crate::contact2::kept`])
             let Some(law) = w.law(body.material, mat_j) else { continue };
             let u_begin = [vb_i[0] - ub_j[0], vb_i[1] - ub_j[1]];
             let u_free = [vf_i[0] - uf_j[0], vf_i[1] - uf_j[1]];
@@ -206,9 +204,7 @@ impl Deformables2 {
                 Err(_) if from_warm => self.warm.r_of(&key),
                 Err(_) => [0.0, 0.0],
             };
-            if own.is_none() {
-                self.solved.raw_at[i] = c.len() as u32;
-            }
+            self.solved.at.push(i as u32);
             c.cand.push(cand);
             c.anta.push(anta);
             c.frame.push(n);
@@ -226,7 +222,7 @@ impl Deformables2 {
             c.point.push(rc.point);
             c.key.push(key);
         }
-        self.solved.keep(c, &mut self.contacts, own.is_some(), FeContacts2::len);
+        self.solved.keep(c, &mut self.contacts, own.is_some(), self.raw.len());
     }
 
     /// The contact nodes of each body (sorted, unique) and their node sets (G blocks,
@@ -348,11 +344,15 @@ impl Deformables2 {
         self.residual_parts_of(vel, at, 0..self.contacts.len())
     }
 
-    /// [`Self::residual_parts`] of the contacts `contacts` only.
+    /// [`Self::residual_parts`] of the contacts `contacts` only (the family's
+    /// indices; stepped in part, those solved here: [`crate::solved::Solved`]).
     pub fn residual_parts_of(&self, vel: &[[f64; 3]], at: impl Fn(u32) -> usize, contacts: impl Iterator<Item = usize>) -> (f64, f64) {
-        let c = &self.contacts;
+        let part = self.stepped.solved().is_some();
         let (mut f2, mut q2) = (0.0, 0.0);
         for a in contacts {
+            let Some((c, a)) = self.solved.place(&self.contacts, part, a) else {
+                continue;
+            };
             let t = c.target[a];
             let anta = c.anta[a].rigid_at(&at);
             let mut u = local_velocity(&self.sets, vel, c.cand[a], anta, c.frame[a]);

@@ -43,7 +43,7 @@ pub struct Deformables3 {
     pub sets: Vec<NodeSet3>,
     pub alert: f64,
     pub times: FeTimes,
-    raw: Vec<RawFe3>,
+    pub(crate) raw: Vec<RawFe3>,
     prev: Vec<(FeKey, [f64; 3])>,
     /// A failure inside the step (a refactorization), reported after it.
     pub error: Option<String>,
@@ -95,9 +95,10 @@ impl Deformables3 {
         });
         crate::family::rigid_by_global(w, rigid, &mut self.rigid_free);
         // (in key order: the order of the family's contacts, whatever order
-        // detection finds them in; those that cannot move dropped)
+        // detection finds them in; those that cannot move dropped, every one kept
+        // built: the family's contacts)
         let bodies = &self.bodies;
-        self.raw.retain(|rc| crate::contact3::mobile(w, bodies, rc));
+        self.raw.retain(|rc| crate::contact3::kept(w, bodies, rc));
         self.raw.sort_by_key(|rc| rc.key());
         self.times.detect = t.elapsed().as_secs_f64();
     }
@@ -151,20 +152,16 @@ impl Deformables3 {
             self.prev.sort_unstable_by_key(|x| x.0);
         }
         // stepped in part, after the partition: only the contacts solved here, into
-        // `solved` (the family's list, built before it, keeps every contact)
+        // `solved` (the family's contacts are the raw ones, [`crate::solved::Solved`])
         let mut c = match own {
             None => std::mem::take(&mut self.contacts),
             Some(_) => std::mem::take(&mut self.solved.list),
         };
         c.clear();
         self.solved.at.clear();
-        if own.is_none() {
-            self.solved.raw_at.clear();
-            self.solved.raw_at.resize(self.raw.len(), u32::MAX);
-        }
         let v_begin = w.velocity_begin();
         for (i, rc) in self.raw.iter().enumerate() {
-            if own.is_some_and(|o| !self.solved.again(i, o)) {
+            if own.is_some_and(|o| !o[i]) {
                 continue;
             }
             let bi = rc.body as usize;
@@ -194,6 +191,7 @@ impl Deformables3 {
             let mut wb = project(&basis, &set.side_block(&cand));
             // (W_αα > 0: a contact of two fixed sides was dropped at detection)
             let (anta, ub_j, uf_j, mat_j) = self.antagonist(w, rc, &basis, &v_begin, &mut wb);
+            // (a law for every contact kept by detection, [`crate::contact3::kept`])
             let Some(law) = w.law(body.material, mat_j) else { continue };
             let u_begin: [f64; 3] = std::array::from_fn(|q| ub_i[q] - ub_j[q]);
             let u_free: [f64; 3] = std::array::from_fn(|q| uf_i[q] - uf_j[q]);
@@ -204,9 +202,7 @@ impl Deformables3 {
                 Err(_) if from_warm => self.warm.r_of(&key),
                 Err(_) => [0.0; 3],
             };
-            if own.is_none() {
-                self.solved.raw_at[i] = c.len() as u32;
-            }
+            self.solved.at.push(i as u32);
             c.cand.push(cand);
             c.anta.push(anta);
             c.frame.push(basis);
@@ -224,7 +220,7 @@ impl Deformables3 {
             c.point.push(rc.point);
             c.key.push(key);
         }
-        self.solved.keep(c, &mut self.contacts, own.is_some(), FeContacts3::len);
+        self.solved.keep(c, &mut self.contacts, own.is_some(), self.raw.len());
     }
 
     /// The contact nodes of each body (sorted, unique) and their node sets (G blocks,
@@ -356,11 +352,15 @@ impl Deformables3 {
         self.residual_parts_of(vel, at, 0..self.contacts.len())
     }
 
-    /// [`Self::residual_parts`] of the contacts `contacts` only.
+    /// [`Self::residual_parts`] of the contacts `contacts` only (the family's
+    /// indices; stepped in part, those solved here: [`crate::solved::Solved`]).
     pub fn residual_parts_of(&self, vel: &[[f64; 6]], at: impl Fn(u32) -> usize, contacts: impl Iterator<Item = usize>) -> (f64, f64) {
-        let c = &self.contacts;
+        let part = self.stepped.solved().is_some();
         let (mut f2, mut q2) = (0.0, 0.0);
         for a in contacts {
+            let Some((c, a)) = self.solved.place(&self.contacts, part, a) else {
+                continue;
+            };
             let t = c.target[a];
             let anta = c.anta[a].rigid_at(&at);
             let mut u = local_velocity(&self.sets, vel, c.cand[a], anta, &c.frame[a]);
