@@ -1,12 +1,13 @@
 //! The contacts one MPI rank solves, and the columns of M̂⁻¹ it sends or receives
 //! for them (docs/SCALING.md, "The contacts solved per rank" and "A body whose
 //! contacts several ranks solve, stepped by one"). In a step stepped in part
-//! ([`crate::stepped`]), a rank builds again with their numbers only the contacts
-//! it solves ([`Solved`]); a body whose contacts several ranks solve is stepped by
+//! ([`crate::stepped`]), a rank builds only the contacts it solves
+//! ([`Solved`]); a body whose contacts several ranks solve is stepped by
 //! one of them, which sends the others its free velocity at its contact nodes and
 //! the rows of G their contacts read ([`share_columns`]: [`pack_solved`],
 //! [`unpack_solved`], one point-to-point round in
-//! [`nscdd::dd::Attached::solved_on`]).
+//! [`nscdd::dd::Attached::solved_on`], with the contacts' warm starts,
+//! [`crate::warm`]).
 
 use crate::nodes::NodeSet;
 use crate::stepped::Stepped;

@@ -10,9 +10,9 @@
 //! those rows of G from it, point to point, for its W_αα, u_free and parts
 //! ([`crate::solved`]). A body without contact is stepped
 //! by the rank that checked it at load ([`crate::scene::checked_by`]). Every rank
-//! still detects every contact and builds the family's list of every contact
-//! (positions, V⁻ and the impulses are the same on every rank), but builds again
-//! with their numbers only the contacts it solves ([`crate::solved::Solved`]),
+//! still detects every contact (the family's contacts, kept and sorted by
+//! detection: their points are the partition's), but builds only the contacts
+//! it solves ([`crate::solved::Solved`]),
 //! and only the parts of its own subdomains; another rank's subdomain gets a
 //! shell part made from its rank's description ([`crate::shells`]). After the
 //! write-back, the rank stepping a body gets the impulses of its contacts solved
