@@ -15,7 +15,9 @@ use mpi_common::*;
 /// history (but its timings), every rank stepping some deformable bodies and the
 /// ranks fewer together than every rank all of them (`family_bodies_stepped`
 /// against `family_bodies` in `ranks.json`: `body_steps`, every step stepped in
-/// part). The ranks run with the environment `env`; their outputs are in
+/// part), and each deformable contact held by one rank a step (`family_contacts`,
+/// against the one-process history). The ranks run with the environment `env`;
+/// their outputs are in
 /// `{tag}_ranks{n}`. Returns the one-process `final.json`.
 fn stepped_on_ranks(
     dir: &std::path::Path,
@@ -48,8 +50,27 @@ fn stepped_on_ranks(
             all.iter().all(|&a| a == body_steps) && stepped.iter().sum::<u64>() == body_steps,
             "{tag}, {n} ranks: deformable bodies stepped {stepped:?} of {all:?}"
         );
+        // each contact held by one rank a step, the one solving it
+        // (`Attached::keep_own`)
+        let held = per_rank_count(&out, "family_contacts");
+        assert_eq!(
+            held.iter().sum::<u64>(),
+            contacts_over_steps(&one),
+            "{tag}, {n} ranks: deformable contacts held {held:?}"
+        );
     }
     reference
+}
+
+/// The deformable contacts of every step of a run, summed (its history).
+fn contacts_over_steps(out: &std::path::Path) -> u64 {
+    let h = std::fs::read_to_string(out.join("history.csv")).expect("history.csv");
+    let mut lines = h.lines();
+    let head: Vec<&str> = lines.next().expect("header").split(',').collect();
+    let col = head.iter().position(|c| *c == "deformable_contacts").expect("deformable_contacts");
+    lines
+        .map(|l| l.split(',').nth(col).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0) as u64)
+        .sum()
 }
 
 /// The deformable bodies' frames (`deformable*.vtu`) and the checkpoint of `one`

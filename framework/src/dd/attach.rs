@@ -185,6 +185,18 @@ pub trait Attached<F: Family> {
     /// steps read of the bodies it does not step). The default: nothing (the state
     /// is the same on every rank).
     fn gather_whole(&mut self, _rounds: &dyn Rounds) {}
+    /// On MPI ranks with contacts held per rank ([`super::local`]), each step after
+    /// [`Self::build`] and [`Self::points`] (and after a repartition's new grid):
+    /// `own(p)` says whether a contact point p lies in a cell of this rank's
+    /// subdomains of the family (edge cells unbounded), whose contacts this rank
+    /// solves. A family that then keeps only those contacts (its list, points,
+    /// [`Self::solved_on`] and [`Self::split`] cover them only, as a rank's rigid
+    /// contacts) returns true, and the framework reads its points again. Its
+    /// contacts' subdomains are the cells of their points, so no other rank
+    /// needs them. The default: false (every contact kept on every rank).
+    fn keep_own(&mut self, _own: &dyn Fn([f64; 3]) -> bool) -> bool {
+        false
+    }
     /// (its bodies stepped here, its bodies) in a step stepped in part (`ranks.json`).
     fn stepped_bodies(&self) -> Option<(usize, usize)> {
         None

@@ -163,6 +163,8 @@ pub struct NscddOf<D: Family> {
     fam_owner: Vec<Vec<u32>>,
     /// The attached families' contact points (this step), one range per family.
     fam_points: Vec<[f64; 3]>,
+    /// The families' contacts over the ranks (before [`Self::keep_own`]).
+    fam_total: usize,
     fam_ranges: Vec<std::ops::Range<usize>>,
     /// Which attached families are stepped in part on this rank this step
     /// ([`Attached::solved_on`]).
@@ -224,6 +226,7 @@ impl<D: Family> NscddOf<D> {
             by_model: false,
             fam_owner: Vec::new(),
             fam_points: Vec::new(),
+            fam_total: 0,
             fam_ranges: Vec::new(),
             fam_stepped: Vec::new(),
             held_ok: None,
@@ -380,7 +383,7 @@ impl<D: Family> NscddOf<D> {
         if repart {
             self.grid = Some(grid.clone());
             let total = self.local.new_grid.take().map_or(nc, |(_, t)| t);
-            self.grid_empty = total + self.fam_points.len() == 0;
+            self.grid_empty = total + self.fam_total == 0;
         }
         // several processes: each builds only the subdomains of its rank (chosen by
         // the distributed repartition when contacts are held per rank)
@@ -457,6 +460,41 @@ impl<D: Family> NscddOf<D> {
             let a = self.fam_points.len();
             f.points(&mut self.fam_points);
             self.fam_ranges.push(a..self.fam_points.len());
+        }
+    }
+
+    /// With contacts held per rank: each family told which of its contact points
+    /// are this rank's (the cells of its subdomains in the step's grid, the new
+    /// one after a repartition, [`Attached::keep_own`]); the points read again
+    /// if one keeps only those. `fam_total` keeps every rank's count (the same
+    /// on every rank: a family's points are whole before); the points held
+    /// counted in `ranks.json` (`family_contacts`).
+    fn keep_own(&mut self, fams: &mut [&mut dyn Attached<D>]) {
+        self.fam_total = self.fam_points.len();
+        self.keep_own_points(fams);
+        if let Some(rs) = self.ranks.as_mut() {
+            rs.totals.family_contacts += self.fam_points.len() as u64;
+        }
+    }
+
+    /// [`Self::keep_own`]'s calls, with contacts held per rank.
+    fn keep_own_points(&mut self, fams: &mut [&mut dyn Attached<D>]) {
+        let (Some(rs), true) = (self.ranks.as_ref(), self.local.now) else {
+            return;
+        };
+        let grid = match (&self.local.new_grid, &self.grid) {
+            (Some((g, _)), _) | (None, Some(g)) => g,
+            (None, None) => return,
+        };
+        let (me, by_model) = (rs.cluster.rank(), self.by_model);
+        let mut kept = false;
+        for (f, fam) in fams.iter_mut().enumerate() {
+            let base = if by_model { (f + 1) * grid.len() } else { 0 };
+            let own = |p: [f64; 3]| rs.rank_of.get(base + grid.cell_of(p) as usize) == Some(&me);
+            kept |= fam.keep_own(&own);
+        }
+        if kept {
+            self.family_points(fams);
         }
     }
 

@@ -22,9 +22,11 @@ use super::ranks::RankState;
 /// summed over the steps stepped in part (`family_bodies_stepped`,
 /// `family_bodies`, [`super::Attached::solved_on`]), and of those the bodies whose
 /// data only their stepping ranks need it held (`family_bodies_built`, a
-/// deformable body's M, K and factors: [`super::Attached::built_bodies`]).
+/// deformable body's M, K and factors: [`super::Attached::built_bodies`]); the
+/// families' contacts it held, summed over the steps (`family_contacts`: each
+/// rank its own with contacts held per rank, [`super::Attached::keep_own`]).
 pub fn totals_json(st: &mut RankState) -> String {
-    const H: usize = 26;
+    const H: usize = 27;
     let p = st.cluster.size() as usize;
     let t = &st.totals;
     let (wait_wall, wait_cpu) = st.cluster.waited();
@@ -56,6 +58,7 @@ pub fn totals_json(st: &mut RankState) -> String {
         t.family_bodies_stepped as f64,
         t.family_bodies as f64,
         t.family_bodies_built as f64,
+        t.family_contacts as f64,
         t.peers.len() as f64,
     ];
     mine.extend(t.peers.iter().map(|&x| x as f64));
@@ -96,6 +99,7 @@ pub fn totals_json(st: &mut RankState) -> String {
                 "family_bodies_stepped": x[22] as u64,
                 "family_bodies": x[23] as u64,
                 "family_bodies_built": x[24] as u64,
+                "family_contacts": x[25] as u64,
                 "peers": peers,
                 "last_subdomains": subs,
             })

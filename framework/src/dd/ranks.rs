@@ -104,6 +104,9 @@ pub struct RankTotals {
     /// The attached families' bodies whose data only their stepping ranks need
     /// this rank held, summed over the same steps ([`super::Attached::built_bodies`]).
     pub family_bodies_built: u64,
+    /// The attached families' contacts this rank held, summed over the steps
+    /// ([`super::Attached::keep_own`]).
+    pub family_contacts: u64,
 }
 
 /// The multi-process state of an NSCDD solver.

@@ -35,6 +35,7 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
         }
         self.dd.family_points(self.fams);
         self.dd.repartition_local(w);
+        self.dd.keep_own(self.fams);
         let mut rep = std::mem::take(&mut self.dd.pending);
         self.dd.partition(w, self.fams, &mut rep);
         self.dd.pending = rep;

@@ -170,6 +170,9 @@ impl<D: Dim> Attached<Rigid<D>> for GuardedFamily<D> {
     fn gather_whole(&mut self, rounds: &dyn crate::dd::Rounds) {
         self.guard.call(|| self.inner.gather_whole(rounds))
     }
+    fn keep_own(&mut self, own: &dyn Fn([f64; 3]) -> bool) -> bool {
+        self.guard.call(|| self.inner.keep_own(own))
+    }
     fn stepped_bodies(&self) -> Option<(usize, usize)> {
         self.guard.call(|| self.inner.stepped_bodies())
     }

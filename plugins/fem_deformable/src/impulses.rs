@@ -3,32 +3,33 @@
 //! impulses sent to the stepping rank"). After the sweeps each rank holds the
 //! impulses of the contacts it solved; a body stepped elsewhere gets, from each
 //! rank solving some of its contacts, the shares of those impulses on its side
-//! (the side's nodes and weights, the impulse P and its sign), point to point, in
-//! [`nscdd::dd::Attached::share_stepped`]. The rank stepping it adds them to its
-//! own contacts' in the one-process order (the contacts in the family's order,
-//! the candidate side before the antagonist): V⁺ is the one-process number.
+//! (the contact's key, the side's nodes and weights, the impulse P and its
+//! sign), point to point, in [`nscdd::dd::Attached::share_stepped`]. The rank
+//! stepping it adds them to its own contacts' in the one-process order (the
+//! contacts in key order, the family's, the candidate side before the
+//! antagonist): V⁺ is the one-process number.
 
 use crate::nodes::{FeKey, FeSide, NodeSet};
 use crate::stepped::Stepped;
 use nscdd::dd::Rounds;
 use std::collections::BTreeMap;
 
-/// One side's share of a contact's impulse: the contact's place in the family's
-/// order, which side (0: candidate, 1: antagonist), the side, its sign and the
-/// global impulse P on the candidate.
+/// One side's share of a contact's impulse: the contact's key (its place in the
+/// family's order), which side (0: candidate, 1: antagonist), the side, its sign
+/// and the global impulse P on the candidate.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Share<const D: usize> {
-    pub at: u32,
+    pub key: FeKey,
     pub which: u32,
     pub side: FeSide<D>,
     pub sign: f64,
     pub p: [f64; D],
 }
 
-/// A contact solved here, as [`share`] takes it: its place in the family's
-/// order, its candidate side, its deformable antagonist side, its impulse P
-/// (global), and its key and r (local: its next warm start, [`crate::warm`]).
-pub type Solved<const D: usize> = (u32, FeSide<D>, Option<FeSide<D>>, [f64; D], (FeKey, [f64; D]));
+/// A contact solved here, as [`share`] takes it: its candidate side, its
+/// deformable antagonist side, its impulse P (global), and its key (its place in
+/// the family's order) and r (local: its next warm start, [`crate::warm`]).
+pub type Solved<const D: usize> = (FeSide<D>, Option<FeSide<D>>, [f64; D], (FeKey, [f64; D]));
 
 /// The shares of the contacts solved here (`contacts`, in the family's order)
 /// on the bodies other ranks step go to those ranks, with the (key, r) of those
@@ -52,7 +53,7 @@ pub fn share<const D: usize>(
     // some of whose contacts are solved here: the symmetric relation of the columns)
     let mut to = crate::solved::rounds_with(st, me, |_, _, _| {});
     let mut front: BTreeMap<u32, Vec<f64>> = BTreeMap::new();
-    for (at, cand, anta, p, (key, r)) in contacts {
+    for (cand, anta, p, (key, r)) in contacts {
         match st.sender_of(cand.body as usize).unwrap_or(me) {
             q if q == me => warm.push((key, r)),
             q if r != [0.0; D] && to.contains_key(&q) => crate::warm::pack(key, r, front.entry(q).or_default()),
@@ -62,10 +63,11 @@ pub fn share<const D: usize>(
             let Some(side) = side else { continue };
             let q = st.sender_of(side.body as usize).unwrap_or(me);
             if q == me {
-                here.push(Share { at, which, side, sign, p });
+                here.push(Share { key, which, side, sign, p });
             } else if let Some(m) = to.get_mut(&q) {
-                // (place, which, body, sign, the side's D nodes and weights, P)
-                m.extend([f64::from(at), f64::from(which), f64::from(side.body), sign]);
+                // (key, which, body, sign, the side's D nodes and weights, P)
+                m.extend([key.0, key.1, key.2, key.3, which, side.body].map(f64::from));
+                m.push(sign);
                 let set = &sets[side.body as usize];
                 m.extend(side.k.map(|k| f64::from(set.nodes[k as usize])));
                 m.extend(side.w);
@@ -79,39 +81,40 @@ pub fn share<const D: usize>(
             }
         }
     }
-    let len = 4 + 3 * D;
+    let len = 7 + 3 * D;
     crate::warm::with_front(&mut to, front);
     for (_, m) in crate::solved::exchange_with(rounds, to) {
         let (got, m) = crate::warm::split_front(&m);
         warm.extend(crate::warm::unpack::<D>(got));
         for x in m.chunks_exact(len) {
-            let body = x[2] as u32;
+            let body = x[5] as u32;
             let Some(set) = sets.get(body as usize).filter(|_| st.steps(body as usize)) else {
                 continue;
             };
+            let (nodes, w, p) = (&x[7..7 + D], &x[7 + D..7 + 2 * D], &x[7 + 2 * D..]);
             let k = std::array::from_fn(|q| {
-                let found = set.nodes.binary_search(&(x[4 + q] as u32));
+                let found = set.nodes.binary_search(&(nodes[q] as u32));
                 debug_assert!(
                     found.is_ok(),
                     "body {body}: node {} of a contact solved elsewhere not in its set",
-                    x[4 + q]
+                    nodes[q]
                 );
                 found.map_or(0, |k| k as u32)
             });
             here.push(Share {
-                at: x[0] as u32,
-                which: x[1] as u32,
+                key: (x[0] as u32, x[1] as u32, x[2] as u32, x[3] as u32),
+                which: x[4] as u32,
                 side: FeSide {
                     body,
                     k,
-                    w: std::array::from_fn(|q| x[4 + D + q]),
+                    w: std::array::from_fn(|q| w[q]),
                 },
-                sign: x[3],
-                p: std::array::from_fn(|q| x[4 + 2 * D + q]),
+                sign: x[6],
+                p: std::array::from_fn(|q| p[q]),
             });
         }
     }
-    here.sort_by_key(|s| (s.at, s.which));
+    here.sort_by_key(|s| (s.key, s.which));
     (here, warm)
 }
 
@@ -150,10 +153,10 @@ mod tests {
     use super::*;
     use crate::stepped::AllRanks;
 
-    /// Body 0's contacts 0 and 2 are solved on rank 0, which steps it, contact 1
-    /// (body 1 on body 0's segment) on rank 1, which steps body 1: rank 1 sends the
-    /// antagonist side's share to rank 0, which merges it between its own two in
-    /// the family's order.
+    /// Body 0's two contacts (on rigid bodies) are solved on rank 0, which steps
+    /// it, the contact of body 1 on body 0's segment on rank 1, which steps body
+    /// 1: rank 1 sends the antagonist side's share to rank 0, which merges it
+    /// with its own two in key order (the family's).
     #[test]
     fn a_body_stepped_here_gets_the_shares_of_its_contacts_solved_elsewhere() {
         let rank_of = |a: usize| u32::from(a == 1);
@@ -171,29 +174,27 @@ mod tests {
         };
         // rank 1: its contact's candidate side on body 1 stays, the antagonist's goes
         let key1 = ((1, 5, 1 << 31, 0), [0.5, 0.0]);
-        let own1 = [(1, FeSide::node(1, 0), Some(seg), [1.0, 2.0], key1)];
+        let own1 = [(FeSide::node(1, 0), Some(seg), [1.0, 2.0], key1)];
         let (here1, warm1) = share(&s1, &sets, own1.into_iter(), &rounds);
-        assert_eq!(here1.iter().map(|s| (s.at, s.which)).collect::<Vec<_>>(), [(1, 0)]);
+        assert_eq!(here1.iter().map(|s| (s.key, s.which)).collect::<Vec<_>>(), [(key1.0, 0)]);
         assert_eq!(warm1, [key1]);
         let sent = rounds.sent.borrow().last().cloned().unwrap();
-        // (no warm start: place 1, antagonist, body 0, sign −1, nodes 8 and 9, weights, P)
-        assert_eq!(
-            sent,
-            (vec![0], vec![vec![0.0, 1.0, 1.0, 0.0, -1.0, 8.0, 9.0, 0.25, 0.75, 1.0, 2.0]])
-        );
-        // rank 0 receives it and merges it between its contacts 0 and 2
+        // (no warm start: the key, antagonist, body 0, sign −1, nodes 8 and 9, weights, P)
+        let msg = vec![0.0, 1.0, 5.0, 2147483648.0, 0.0, 1.0, 0.0, -1.0, 8.0, 9.0, 0.25, 0.75, 1.0, 2.0];
+        assert_eq!(sent, (vec![0], vec![msg]));
+        // rank 0 receives it and merges it with its two contacts in key order
         *rounds.replies.borrow_mut() = sent.1.clone();
-        let key = |a: u32| ((0, 3, 7, a), [1.0, 0.0]);
+        let key = |n: u32| ((0, n, 7, 0), [1.0, 0.0]);
         let own0 = [
-            (0, FeSide::node(0, 0), None, [3.0, 4.0], key(0)),
-            (2, FeSide::node(0, 0), None, [5.0, 6.0], key(2)),
+            (FeSide::node(0, 0), None, [3.0, 4.0], key(3)),
+            (FeSide::node(0, 0), None, [5.0, 6.0], key(4)),
         ];
         let (here0, warm0) = share(&s0, &sets, own0.into_iter(), &rounds);
-        assert_eq!(warm0, [key(0), key(2)]);
+        assert_eq!(warm0, [key(3), key(4)]);
         assert_eq!(rounds.sent.borrow().last().cloned().unwrap(), (vec![1], vec![vec![0.0]]));
-        let got: Vec<(u32, u32, f64)> = here0.iter().map(|s| (s.at, s.which, s.sign)).collect();
-        assert_eq!(got, [(0, 0, 1.0), (1, 1, -1.0), (2, 0, 1.0)]);
-        assert_eq!(here0[1].side, seg);
-        assert_eq!(here0[1].p, [1.0, 2.0]);
+        let got: Vec<(FeKey, u32, f64)> = here0.iter().map(|s| (s.key, s.which, s.sign)).collect();
+        assert_eq!(got, [(key(3).0, 0, 1.0), (key(4).0, 0, 1.0), (key1.0, 1, -1.0)]);
+        assert_eq!(here0[2].side, seg);
+        assert_eq!(here0[2].p, [1.0, 2.0]);
     }
 }
