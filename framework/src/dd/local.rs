@@ -27,6 +27,7 @@
 //! single process takes with all the contacts, so results stay bitwise those of one
 //! process.
 
+use super::attach::Attached;
 use super::cells::{cells_of, CellIndex};
 use super::family::Family;
 use super::partition::{Grid, OwnerOf};
@@ -318,6 +319,41 @@ impl<D: Family> super::NscddOf<D> {
         self.local.held = true;
         self.local.whole_store = true;
         self.local.owned.start_held::<D>(w, rs, grid);
+    }
+
+    /// With contacts held per rank: each family told which of its contact points
+    /// are this rank's (the cells of its subdomains in the step's grid, the new
+    /// one after a repartition, [`Attached::keep_own`]); the points read again
+    /// if one keeps only those. `fam_total` keeps every rank's count (the same
+    /// on every rank: a family's points are whole before); the points held
+    /// counted in `ranks.json` (`family_contacts`).
+    pub(super) fn keep_own(&mut self, fams: &mut [&mut dyn Attached<D>]) {
+        self.fam_total = self.fam_points.len();
+        self.keep_own_points(fams);
+        if let Some(rs) = self.ranks.as_mut() {
+            rs.totals.family_contacts += self.fam_points.len() as u64;
+        }
+    }
+
+    /// [`Self::keep_own`]'s calls, with contacts held per rank.
+    fn keep_own_points(&mut self, fams: &mut [&mut dyn Attached<D>]) {
+        let (Some(rs), true) = (self.ranks.as_ref(), self.local.now) else {
+            return;
+        };
+        let grid = match (&self.local.new_grid, &self.grid) {
+            (Some((g, _)), _) | (None, Some(g)) => g,
+            (None, None) => return,
+        };
+        let (me, by_model) = (rs.cluster.rank(), self.by_model);
+        let mut kept = false;
+        for (f, fam) in fams.iter_mut().enumerate() {
+            let base = if by_model { (f + 1) * grid.len() } else { 0 };
+            let own = |p: [f64; 3]| rs.rank_of.get(base + grid.cell_of(p) as usize) == Some(&me);
+            kept |= fam.keep_own(&own);
+        }
+        if kept {
+            self.family_points(fams);
+        }
     }
 
     /// Whether this step re-partitions over a new grid.
