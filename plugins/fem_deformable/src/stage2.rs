@@ -192,7 +192,7 @@ impl Deformables2 {
             let vf_i = local(n, set.v[k as usize]);
             let mut wb = set.delassus(&cand, n);
             // (W_αα > 0: a contact of two fixed sides was dropped at detection)
-            let (anta, ub_j, uf_j, mat_j) = self.antagonist(w, rc, n, &v_begin, &mut wb);
+            let (anta, ub_j, uf_j, mat_j) = self.antagonist(w, rc, n, v_begin, &mut wb);
             // (a law for every contact kept by detection, [`crate::contact2::kept`])
             let Some(law) = w.law(body.material, mat_j) else { continue };
             let u_begin = [vb_i[0] - ub_j[0], vb_i[1] - ub_j[1]];

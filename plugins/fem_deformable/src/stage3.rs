@@ -190,7 +190,7 @@ impl Deformables3 {
             let uf_i = local(&basis, set.side_velocity(&cand));
             let mut wb = project(&basis, &set.side_block(&cand));
             // (W_αα > 0: a contact of two fixed sides was dropped at detection)
-            let (anta, ub_j, uf_j, mat_j) = self.antagonist(w, rc, &basis, &v_begin, &mut wb);
+            let (anta, ub_j, uf_j, mat_j) = self.antagonist(w, rc, &basis, v_begin, &mut wb);
             // (a law for every contact kept by detection, [`crate::contact3::kept`])
             let Some(law) = w.law(body.material, mat_j) else { continue };
             let u_begin: [f64; 3] = std::array::from_fn(|q| ub_i[q] - ub_j[q]);
