@@ -29,7 +29,7 @@ pub struct Share<const D: usize> {
 /// A contact solved here, as [`share`] takes it: its candidate side, its
 /// deformable antagonist side, its impulse P (global), and its key (its place in
 /// the family's order) and r (local: its next warm start, [`crate::warm`]).
-pub type Solved<const D: usize> = (FeSide<D>, Option<FeSide<D>>, [f64; D], (FeKey, [f64; D]));
+pub type Own<const D: usize> = (FeSide<D>, Option<FeSide<D>>, [f64; D], (FeKey, [f64; D]));
 
 /// The shares of the contacts solved here (`contacts`, in the family's order)
 /// on the bodies other ranks step go to those ranks, with the (key, r) of those
@@ -42,7 +42,7 @@ pub type Solved<const D: usize> = (FeSide<D>, Option<FeSide<D>>, [f64; D], (FeKe
 pub fn share<const D: usize>(
     st: &Stepped,
     sets: &[NodeSet<D>],
-    contacts: impl Iterator<Item = Solved<D>>,
+    contacts: impl Iterator<Item = Own<D>>,
     rounds: &dyn Rounds,
 ) -> (Vec<Share<D>>, Vec<(FeKey, [f64; D])>) {
     let Some(me) = st.rank_here() else {
@@ -130,7 +130,7 @@ pub fn finish<const D: usize>(
     st: &mut Stepped,
     bodies: &mut [crate::body::FeBody],
     (sets, warm): (&mut [NodeSet<D>], &mut crate::warm::Warm<D>),
-    own: impl Iterator<Item = Solved<D>>,
+    own: impl Iterator<Item = Own<D>>,
     rounds: &dyn Rounds,
 ) {
     let own: Vec<_> = own.collect();

@@ -197,9 +197,10 @@ pub fn pack_solved<const D: usize>(stepped: &Stepped, sets: &[NodeSet<D>], asked
 /// The messages of [`pack_solved`]: the bodies whose contacts this rank solves
 /// without stepping them get their sender's contact nodes, free velocity and G
 /// ([`NodeSet::set_received`]).
-pub fn unpack_solved<const D: usize>(stepped: &Stepped, sets: &mut [NodeSet<D>], from: &[(u32, Vec<f64>)]) {
+pub fn unpack_solved<const D: usize>(stepped: &Stepped, sets: &mut [NodeSet<D>], from: &[(u32, impl AsRef<[f64]>)]) {
     let mut got = vec![false; sets.len()];
     for (_, all) in from {
+        let all = all.as_ref();
         let mut i = 0;
         // (body, n, n nodes, v: D n, m, m nodes, their m D rows of D n values) each
         while let (Some(&b), Some(&n)) = (all.get(i), all.get(i + 1)) {
@@ -248,13 +249,16 @@ pub fn share_columns<const D: usize>(st: &Stepped, (sets, warm): (&mut [NodeSet<
         });
         crate::warm::with_front(&mut to, front);
     }
-    let mut from = exchange_with(rounds, to);
-    for (_, m) in from.iter_mut() {
-        let (got, rest) = crate::warm::split_front(m);
-        warm.add(got);
-        *m = rest.to_vec();
-    }
-    unpack_solved(st, sets, &from);
+    let from = exchange_with(rounds, to);
+    let rest: Vec<(u32, &[f64])> = from
+        .iter()
+        .map(|(r, m)| {
+            let (got, rest) = crate::warm::split_front(m);
+            warm.add(got);
+            (*r, rest)
+        })
+        .collect();
+    unpack_solved(st, sets, &rest);
 }
 
 /// The contacts this rank solves in a step stepped in part ([`Stepped::solved`]),
@@ -403,7 +407,7 @@ mod tests {
         let mut v = Vec::new();
         f0.pack(&[], &mut v);
         assert!(v.is_empty());
-        unpack_solved(&s1, &mut got, &[(0, vec![])]);
+        unpack_solved(&s1, &mut got, &[(0, Vec::<f64>::new())]);
         assert_eq!(got[0].v, [[0.0, 0.0]; 2]);
         assert_eq!(got[0].block(0, 0), [[0.0; 2]; 2]);
     }

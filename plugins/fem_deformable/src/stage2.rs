@@ -24,8 +24,7 @@ use nscdd::world::World2;
 use std::time::Instant;
 
 /// An antagonist side: the side, its local velocities at the beginning of the step
-/// and free, its material, its key and its feature, and whether an impulse along
-/// the normal moves it.
+/// and free, its material.
 type AntaSide = (Anta, [f64; 2], [f64; 2], u16);
 
 /// Seconds per stage of the deformable part of the last step (the benchmark's

@@ -26,8 +26,7 @@ fn vb3(b: &FeBody, k: u32) -> [f64; 3] {
 }
 
 /// An antagonist side: the side, its local velocities at the beginning of the step
-/// and free, its material, its key and its feature, and whether an impulse along
-/// the normal moves it.
+/// and free, its material.
 type AntaSide3 = (Anta3, [f64; 3], [f64; 3], u16);
 
 /// The deformable bodies of a 3D scene and their contacts.

@@ -103,7 +103,7 @@ pub fn pack<const N: usize>(k: FeKey, r: [f64; N], m: &mut Vec<f64>) {
 
 /// The entries of `m` (whole entries only).
 pub fn unpack<const N: usize>(m: &[f64]) -> impl Iterator<Item = (FeKey, [f64; N])> + '_ {
-    m.chunks_exact(4 + N).map(|x| {
+    m.chunks_exact(Warm::<N>::LEN).map(|x| {
         let k = (x[0] as u32, x[1] as u32, x[2] as u32, x[3] as u32);
         (k, std::array::from_fn(|q| x[4 + q]))
     })
