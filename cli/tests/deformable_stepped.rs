@@ -16,7 +16,8 @@ use mpi_common::*;
 /// ranks fewer together than every rank all of them (`family_bodies_stepped`
 /// against `family_bodies` in `ranks.json`: `body_steps`, every step stepped in
 /// part), and each deformable contact held by one rank a step (`family_contacts`,
-/// against the one-process history). The ranks run with the environment `env`;
+/// against the one-process history), detected by fewer than every rank
+/// (`family_detected`). The ranks run with the environment `env`;
 /// their outputs are in
 /// `{tag}_ranks{n}`. Returns the one-process `final.json`.
 fn stepped_on_ranks(
@@ -53,10 +54,18 @@ fn stepped_on_ranks(
         // each contact held by one rank a step, the one solving it
         // (`Attached::keep_own`)
         let held = per_rank_count(&out, "family_contacts");
+        let total = contacts_over_steps(&one);
         assert_eq!(
             held.iter().sum::<u64>(),
-            contacts_over_steps(&one),
+            total,
             "{tag}, {n} ranks: deformable contacts held {held:?}"
+        );
+        // and found by each rank's detection in its own cells between repartitions
+        // (`Attached::after_free_velocity_own`; a repartition step detects whole)
+        let found: u64 = per_rank_count(&out, "family_detected").iter().sum();
+        assert!(
+            found >= total && found < n as u64 * total,
+            "{tag}, {n} ranks: {found} deformable contacts detected, {total} in one process"
         );
     }
     reference

@@ -95,6 +95,25 @@ pub trait LocalPart<F: Family>: Any + Send {
     fn as_any(&self) -> &dyn Any;
 }
 
+/// The cells of this rank's subdomains of a family on a step that keeps the last
+/// grid ([`Attached::after_free_velocity_own`]).
+pub struct OwnCells<'a> {
+    /// Their boxes `[lo, hi]` (z = 0 in 2D; the grid's edge cells unbounded,
+    /// closed: a point on a shared face may be another rank's), for skipping what
+    /// meets none of them.
+    pub boxes: &'a [[[f64; 3]; 2]],
+    /// Whether the point p (z = 0 in 2D) lies in one of them: the exact test,
+    /// [`Attached::keep_own`]'s.
+    pub of: &'a dyn Fn([f64; 3]) -> bool,
+}
+
+impl OwnCells<'_> {
+    /// Whether the box `[lo, hi]` (first `n` coordinates) meets one of the boxes.
+    pub fn meets(&self, n: usize, lo: &[f64], hi: &[f64]) -> bool {
+        self.boxes.iter().any(|b| (0..n).all(|k| lo[k] <= b[1][k] && b[0][k] <= hi[k]))
+    }
+}
+
 /// A body family beside the world's rigid bodies, solved by the NSCDD stage (module
 /// docs). The step calls, in order: [`Self::after_free_velocity`], [`Self::build`],
 /// [`Self::points`], [`Self::split`] (then the parts' `prepare` and `warm_start`),
@@ -195,6 +214,18 @@ pub trait Attached<F: Family> {
     /// contacts' subdomains are the cells of their points, so no other rank
     /// needs them. The default: false (every contact kept on every rank).
     fn keep_own(&mut self, _own: &dyn Fn([f64; 3]) -> bool) -> bool {
+        false
+    }
+    /// On MPI ranks with contacts held per rank, on a step that keeps the last
+    /// grid (no repartition), in place of [`Self::after_free_velocity`]: the same,
+    /// with detection limited to the contacts whose point ([`Self::points`]) is
+    /// this rank's ([`OwnCells`]). A family that does so returns true (its
+    /// [`Self::keep_own`] then keeps them all); it must find exactly the contacts
+    /// of its whole detection that [`Self::keep_own`] would keep, in the same
+    /// order. The default: false, and [`Self::after_free_velocity`] is called
+    /// (whole detection, then [`Self::keep_own`]). A repartition step detects
+    /// whole: its grid comes from every contact's point.
+    fn after_free_velocity_own(&mut self, _w: &F::World, _own: &OwnCells<'_>) -> bool {
         false
     }
     /// (its bodies stepped here, its bodies) in a step stepped in part (`ranks.json`).

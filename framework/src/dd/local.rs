@@ -324,13 +324,20 @@ impl<D: Family> super::NscddOf<D> {
     /// With contacts held per rank: each family told which of its contact points
     /// are this rank's (the cells of its subdomains in the step's grid, the new
     /// one after a repartition, [`Attached::keep_own`]); the points read again
-    /// if one keeps only those. `fam_total` keeps every rank's count (the same
-    /// on every rank: a family's points are whole before); the points held
-    /// counted in `ranks.json` (`family_contacts`).
+    /// if one keeps only those. On a repartition step `fam_total` keeps every
+    /// rank's count (the same on every rank: a family detects whole then, and its
+    /// points are whole before; other steps may detect per rank,
+    /// [`Attached::after_free_velocity_own`]); the points held
+    /// counted in `ranks.json` (`family_contacts`), and those detected
+    /// (`family_detected`).
     pub(super) fn keep_own(&mut self, fams: &mut [&mut dyn Attached<D>]) {
-        self.fam_total = self.fam_points.len();
+        if self.repartitions() {
+            self.fam_total = self.fam_points.len();
+        }
+        let detected = self.fam_points.len() as u64;
         self.keep_own_points(fams);
         if let Some(rs) = self.ranks.as_mut() {
+            rs.totals.family_detected += detected;
             rs.totals.family_contacts += self.fam_points.len() as u64;
         }
     }
@@ -354,6 +361,22 @@ impl<D: Family> super::NscddOf<D> {
         if kept {
             self.family_points(fams);
         }
+    }
+
+    /// With contacts held per rank, on a step that keeps the last grid: family
+    /// f's own cells' boxes ([`super::OwnCells::boxes`]) with the test of a point,
+    /// for its detection in the rank's region ([`Attached::after_free_velocity_own`]).
+    pub(super) fn own_cells(&self, f: usize) -> Option<(Vec<[[f64; 3]; 2]>, impl Fn([f64; 3]) -> bool + '_)> {
+        let (Some(rs), Some(grid), true) = (self.ranks.as_ref(), self.grid.as_ref(), self.local.now) else {
+            return None;
+        };
+        if self.repartitions() {
+            return None;
+        }
+        let base = if self.by_model { (f + 1) * grid.len() } else { 0 };
+        let me = rs.cluster.rank();
+        let boxes = cells_of(grid, rs.rank_of.get(base..)?, me);
+        Some((boxes, move |p| rs.rank_of.get(base + grid.cell_of(p) as usize) == Some(&me)))
     }
 
     /// Whether this step re-partitions over a new grid.

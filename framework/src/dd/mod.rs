@@ -81,7 +81,7 @@ pub mod team;
 pub mod transport;
 
 use crate::model::ContactKey;
-pub use attach::{Attached, EntityInfo, LocalPart, Rounds, SolvedOn};
+pub use attach::{Attached, EntityInfo, LocalPart, OwnCells, Rounds, SolvedOn};
 pub use census::Census;
 pub use cluster::{Cluster, Solo};
 pub use config::{Balance, DdConfig};
@@ -163,7 +163,8 @@ pub struct NscddOf<D: Family> {
     fam_owner: Vec<Vec<u32>>,
     /// The attached families' contact points (this step), one range per family.
     fam_points: Vec<[f64; 3]>,
-    /// The families' contacts over the ranks (before [`Self::keep_own`]).
+    /// The families' contacts over the ranks on a repartition step (before
+    /// [`Self::keep_own`]).
     fam_total: usize,
     fam_ranges: Vec<std::ops::Range<usize>>,
     /// Which attached families are stepped in part on this rank this step

@@ -24,9 +24,11 @@ use super::ranks::RankState;
 /// data only their stepping ranks need it held (`family_bodies_built`, a
 /// deformable body's M, K and factors: [`super::Attached::built_bodies`]); the
 /// families' contacts it held, summed over the steps (`family_contacts`: each
-/// rank its own with contacts held per rank, [`super::Attached::keep_own`]).
+/// rank its own with contacts held per rank, [`super::Attached::keep_own`]), and
+/// those its families' detection found (`family_detected`: between repartitions
+/// a rank's own, [`super::Attached::after_free_velocity_own`]).
 pub fn totals_json(st: &mut RankState) -> String {
-    const H: usize = 27;
+    const H: usize = 28;
     let p = st.cluster.size() as usize;
     let t = &st.totals;
     let (wait_wall, wait_cpu) = st.cluster.waited();
@@ -59,6 +61,7 @@ pub fn totals_json(st: &mut RankState) -> String {
         t.family_bodies as f64,
         t.family_bodies_built as f64,
         t.family_contacts as f64,
+        t.family_detected as f64,
         t.peers.len() as f64,
     ];
     mine.extend(t.peers.iter().map(|&x| x as f64));
@@ -100,6 +103,7 @@ pub fn totals_json(st: &mut RankState) -> String {
                 "family_bodies": x[23] as u64,
                 "family_bodies_built": x[24] as u64,
                 "family_contacts": x[25] as u64,
+                "family_detected": x[26] as u64,
                 "peers": peers,
                 "last_subdomains": subs,
             })

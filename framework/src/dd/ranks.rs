@@ -107,6 +107,9 @@ pub struct RankTotals {
     /// The attached families' contacts this rank held, summed over the steps
     /// ([`super::Attached::keep_own`]).
     pub family_contacts: u64,
+    /// The attached families' contacts their detection found on this rank,
+    /// summed over the steps ([`super::Attached::after_free_velocity_own`]).
+    pub family_detected: u64,
 }
 
 /// The multi-process state of an NSCDD solver.

@@ -25,8 +25,13 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
     }
     fn after_free_velocity(&mut self, w: &D::World) {
         D::velocities(w, &mut self.dd.v_free);
-        for f in self.fams.iter_mut() {
-            f.after_free_velocity(w);
+        // (with contacts held per rank, between repartitions, a family may detect
+        // in this rank's cells only)
+        for (k, f) in self.fams.iter_mut().enumerate() {
+            let own = |(boxes, of): (Vec<_>, _)| f.after_free_velocity_own(w, &super::OwnCells { boxes: &boxes, of: &of });
+            if !self.dd.own_cells(k).is_some_and(own) {
+                f.after_free_velocity(w);
+            }
         }
     }
     fn prepare(&mut self, w: &mut D::World) {

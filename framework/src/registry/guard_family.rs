@@ -173,6 +173,9 @@ impl<D: Dim> Attached<Rigid<D>> for GuardedFamily<D> {
     fn keep_own(&mut self, own: &dyn Fn([f64; 3]) -> bool) -> bool {
         self.guard.call(|| self.inner.keep_own(own))
     }
+    fn after_free_velocity_own(&mut self, w: &World<D>, own: &crate::dd::OwnCells<'_>) -> bool {
+        self.guard.call(|| self.inner.after_free_velocity_own(w, own))
+    }
     fn stepped_bodies(&self) -> Option<(usize, usize)> {
         self.guard.call(|| self.inner.stepped_bodies())
     }

@@ -17,6 +17,7 @@
 
 use crate::nodes::FeContacts;
 pub use crate::nodes::FeKey;
+use nscdd::dd::OwnCells;
 use nscdd::dim::d2::Block2;
 use nscdd::world::World2;
 
@@ -152,9 +153,18 @@ pub struct RawFe {
     pub n: [f64; 2],
     pub gap: f64,
     pub point: [f64; 2],
+    /// The candidate node's position: the contact's point for the partition
+    /// ([`nscdd::dd::Attached::points`]), known before the antagonist is searched
+    /// (detection in a rank's cells tests it first).
+    pub at: [f64; 2],
 }
 
 impl RawFe {
+    /// [`Self::at`] with z = 0.
+    pub fn at3(&self) -> [f64; 3] {
+        [self.at[0], self.at[1], 0.0]
+    }
+
     /// Its sides for the rounds of a step stepped in part
     /// ([`crate::solved::Sides`]).
     pub fn sides(&self) -> crate::solved::Sides<2> {
@@ -193,12 +203,18 @@ pub enum RawAnta {
 }
 
 /// Finds node contacts of every deformable body with the rigid bodies of `w`
-/// and with the segments of the other deformable bodies, within `alert`.
-pub fn detect(w: &World2, fe: &[crate::body::FeBody], alert: f64, out: &mut Vec<RawFe>) {
+/// and with the segments of the other deformable bodies, within `alert`; with
+/// `own`, those of the nodes in this rank's cells only (a body whose box meets
+/// none of them skipped whole).
+pub fn detect(w: &World2, fe: &[crate::body::FeBody], alert: f64, own: Option<&OwnCells<'_>>, out: &mut Vec<RawFe>) {
     out.clear();
     let boxes: Vec<[f64; 4]> = fe.iter().map(|b| bounds(b)).collect();
+    let not_own = |p: [f64; 2]| own.is_some_and(|o| !(o.of)([p[0], p[1], 0.0]));
     for (fb, body) in fe.iter().enumerate() {
         let bb = boxes[fb];
+        if own.is_some_and(|o| !o.meets(2, &bb[..2], &bb[2..])) {
+            continue;
+        }
         for rb in 0..w.bodies.len() {
             let s = w.bodies.shape[rb];
             let store = &w.shapes[s.kind as usize];
@@ -213,7 +229,7 @@ pub fn detect(w: &World2, fe: &[crate::body::FeBody], alert: f64, out: &mut Vec<
             for &k in &body.mesh.boundary {
                 let p = body.position(k as usize);
                 let p = [p[0], p[1]];
-                if p[0] < a.min[0] - alert || p[0] > a.max[0] + alert || p[1] < a.min[1] - alert || p[1] > a.max[1] + alert {
+                if not_own(p) || p[0] < a.min[0] - alert || p[0] > a.max[0] + alert || p[1] < a.min[1] - alert || p[1] > a.max[1] + alert {
                     continue;
                 }
                 if let Some(pc) = store.point_contact(s.index, x, rot, p, [0.0; 2]) {
@@ -225,6 +241,7 @@ pub fn detect(w: &World2, fe: &[crate::body::FeBody], alert: f64, out: &mut Vec<
                             n: pc.normal,
                             gap: pc.gap,
                             point: pc.point,
+                            at: p,
                         });
                     }
                 }
@@ -242,7 +259,7 @@ pub fn detect(w: &World2, fe: &[crate::body::FeBody], alert: f64, out: &mut Vec<
             for &k in &body.mesh.boundary {
                 let p = body.position(k as usize);
                 let p = [p[0], p[1]];
-                if p[0] < o[0] - alert || p[0] > o[2] + alert || p[1] < o[1] - alert || p[1] > o[3] + alert {
+                if not_own(p) || p[0] < o[0] - alert || p[0] > o[2] + alert || p[1] < o[1] - alert || p[1] > o[3] + alert {
                     continue;
                 }
                 if let Some(mut c) = nearest_segment(other, p, alert) {
@@ -256,6 +273,7 @@ pub fn detect(w: &World2, fe: &[crate::body::FeBody], alert: f64, out: &mut Vec<
                         n: c.1,
                         gap: c.2,
                         point: c.3,
+                        at: p,
                     });
                 }
             }

@@ -26,6 +26,7 @@
 use crate::body::FeBody;
 pub use crate::nodes::FeKey;
 use crate::nodes::{FeContacts, FeSide, NodeSet};
+use nscdd::dd::OwnCells;
 use nscdd::dim::coulomb3::{self as coulomb, Sym3};
 use nscdd::dim::d3::cross;
 use nscdd::dim::d3::{point_velocity, Block3, Frame3};
@@ -165,6 +166,10 @@ pub struct RawFe3 {
     pub n: [f64; 3],
     pub gap: f64,
     pub point: [f64; 3],
+    /// The candidate's point: its node's position, or its face's point at the
+    /// weights; the contact's point for the partition
+    /// ([`nscdd::dd::Attached::points`]; detection in a rank's cells tests it).
+    pub at: [f64; 3],
 }
 
 impl RawFe3 {
@@ -326,12 +331,20 @@ impl SurfaceGrid {
 /// (about two boundary edges wide) that each rigid body's box meets, after a grid
 /// built once per body and step; boundary nodes × faces for each pair of
 /// deformable bodies whose boxes meet.
-pub fn detect(w: &World3, fe: &[FeBody], alert: f64, out: &mut Vec<RawFe3>) {
+///
+/// With `own`, only the contacts whose candidate point ([`RawFe3::at`]) lies in
+/// this rank's cells (a body whose box meets none of them skipped whole; a face
+/// contact chosen among all the faces first, as whole detection chooses it).
+pub fn detect(w: &World3, fe: &[FeBody], alert: f64, own: Option<&OwnCells<'_>>, out: &mut Vec<RawFe3>) {
     out.clear();
     let boxes: Vec<Bounds> = fe.iter().map(bounds).collect();
     let mut near: Vec<u32> = vec![];
+    let is_own = |p: [f64; 3]| own.is_none_or(|o| (o.of)(p));
     for (fb, body) in fe.iter().enumerate() {
         let bb = boxes[fb];
+        if own.is_some_and(|o| !o.meets(3, &bb.0, &bb.1)) {
+            continue;
+        }
         let mut grid: Option<SurfaceGrid> = None;
         for rb in 0..w.bodies.len() {
             let s = w.bodies.shape[rb];
@@ -378,18 +391,19 @@ pub fn detect(w: &World3, fe: &[FeBody], alert: f64, out: &mut Vec<RawFe3>) {
                         n: fc.normal,
                         gap: fc.gap,
                         point: fc.point,
+                        at: std::array::from_fn(|c| (0..3).map(|k| fc.bary[k] * tri[k][c]).sum()),
                     };
                     if best.is_none_or(|b| fc.gap < b.gap) {
                         best = Some(rc);
                     }
                 }
-                out.extend(best);
+                out.extend(best.filter(|b| is_own(b.at)));
                 continue;
             }
             grid.near(&ab, alert, false, &mut near);
             for &k in &near {
                 let p = body.position(k as usize);
-                if !inside(p, &ab, alert) {
+                if !inside(p, &ab, alert) || !is_own(p) {
                     continue;
                 }
                 if let Some(pc) = store.point_contact(s.index, x, q, p, body.mesh.node_normal[k as usize]) {
@@ -401,18 +415,20 @@ pub fn detect(w: &World3, fe: &[FeBody], alert: f64, out: &mut Vec<RawFe3>) {
                             n: pc.normal,
                             gap: pc.gap,
                             point: pc.point,
+                            at: p,
                         });
                     }
                 }
             }
         }
-        fe_pairs(w, fe, &boxes, fb, alert, out);
+        fe_pairs(w, fe, (&boxes, fb, alert), &is_own, out);
     }
 }
 
 /// Node contacts of deformable body `fb`'s boundary nodes with the boundary faces of
 /// the deformable bodies after it whose boxes meet its own.
-fn fe_pairs(w: &World3, fe: &[FeBody], boxes: &[Bounds], fb: usize, alert: f64, out: &mut Vec<RawFe3>) {
+/// `own`: whether a node's position is this rank's.
+fn fe_pairs(w: &World3, fe: &[FeBody], (boxes, fb, alert): (&[Bounds], usize, f64), own: &dyn Fn([f64; 3]) -> bool, out: &mut Vec<RawFe3>) {
     let (body, bb) = (&fe[fb], boxes[fb]);
     for (ob, other) in fe.iter().enumerate().skip(fb + 1) {
         let o = boxes[ob];
@@ -421,7 +437,7 @@ fn fe_pairs(w: &World3, fe: &[FeBody], boxes: &[Bounds], fb: usize, alert: f64, 
         }
         for &k in &body.mesh.boundary {
             let p = body.position(k as usize);
-            if !inside(p, &o, alert) {
+            if !inside(p, &o, alert) || !own(p) {
                 continue;
             }
             if let Some((face, nodes, wts, n, gap, q)) = nearest_face(other, p, alert) {
@@ -437,6 +453,7 @@ fn fe_pairs(w: &World3, fe: &[FeBody], boxes: &[Bounds], fb: usize, alert: f64, 
                     n,
                     gap,
                     point: q,
+                    at: p,
                 });
             }
         }

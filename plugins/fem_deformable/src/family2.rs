@@ -15,7 +15,7 @@
 
 use crate::contact2::*;
 use crate::stage2::{self, Deformables2};
-use nscdd::dd::{Attached, EntityInfo, LocalPart, Rigid2, SolvedOn};
+use nscdd::dd::{Attached, EntityInfo, LocalPart, OwnCells, Rigid2, SolvedOn};
 use nscdd::dim::coulomb2 as coulomb;
 use nscdd::dim::d2::Block2;
 use nscdd::norms::Sums;
@@ -108,7 +108,13 @@ impl Attached<Rigid2> for Deformables2 {
     /// Detection only: the free velocities come after the partition
     /// ([`Self::solved_on`]).
     fn after_free_velocity(&mut self, w: &World2) {
-        self.detect_step(w);
+        self.detect_step(w, None);
+    }
+    /// Detection of the contacts of the candidate nodes (or faces) in this rank's
+    /// cells only: their points ([`Self::points`]) are the candidates' own.
+    fn after_free_velocity_own(&mut self, w: &World2, own: &OwnCells<'_>) -> bool {
+        self.detect_step(w, Some(own));
+        true
     }
     /// Nothing is built before the partition: the family's contacts are its raw
     /// contacts, kept and sorted by detection ([`crate::solved::Solved`]); no body
@@ -150,7 +156,7 @@ impl Attached<Rigid2> for Deformables2 {
         part
     }
     fn points(&self, out: &mut Vec<[f64; 3]>) {
-        out.extend(self.raw.iter().map(|rc| [rc.point[0], rc.point[1], 0.0]));
+        out.extend(self.raw.iter().map(|rc| rc.at3()));
     }
     fn n_entities(&self) -> usize {
         self.bodies.len()
@@ -262,7 +268,7 @@ impl Attached<Rigid2> for Deformables2 {
     /// contacts it solves; their nodes alone fill its node sets, the others'
     /// come through the rounds, [`crate::solved`]).
     fn keep_own(&mut self, own: &dyn Fn([f64; 3]) -> bool) -> bool {
-        self.raw.retain(|rc| own([rc.point[0], rc.point[1], 0.0]));
+        self.raw.retain(|rc| own(rc.at3()));
         true
     }
     fn stepped_bodies(&self) -> Option<(usize, usize)> {

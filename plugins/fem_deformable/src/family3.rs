@@ -5,7 +5,7 @@
 use crate::contact3::*;
 use crate::family2::{by_subdomain, split_pairs};
 use crate::stage3::{self, Deformables3};
-use nscdd::dd::{Attached, EntityInfo, LocalPart, Rigid3, SolvedOn};
+use nscdd::dd::{Attached, EntityInfo, LocalPart, OwnCells, Rigid3, SolvedOn};
 use nscdd::dim::coulomb3 as coulomb;
 use nscdd::dim::d3::{Block3, InvMass3};
 use nscdd::norms::Sums;
@@ -112,7 +112,13 @@ impl Attached<Rigid3> for Deformables3 {
     /// Detection only: the free velocities come after the partition
     /// ([`Self::solved_on`]).
     fn after_free_velocity(&mut self, w: &World3) {
-        self.detect_step(w);
+        self.detect_step(w, None);
+    }
+    /// Detection of the contacts of the candidate nodes (or faces) in this rank's
+    /// cells only: their points ([`Self::points`]) are the candidates' own.
+    fn after_free_velocity_own(&mut self, w: &World3, own: &OwnCells<'_>) -> bool {
+        self.detect_step(w, Some(own));
+        true
     }
     /// Nothing is built before the partition: the family's contacts are its raw
     /// contacts, kept and sorted by detection ([`crate::solved::Solved`]); no body
@@ -154,7 +160,7 @@ impl Attached<Rigid3> for Deformables3 {
         part
     }
     fn points(&self, out: &mut Vec<[f64; 3]>) {
-        out.extend(self.raw.iter().map(|rc| rc.point));
+        out.extend(self.raw.iter().map(|rc| rc.at));
     }
     fn n_entities(&self) -> usize {
         self.bodies.len()
@@ -266,7 +272,7 @@ impl Attached<Rigid3> for Deformables3 {
     /// contacts it solves; their nodes alone fill its node sets, the others'
     /// come through the rounds, [`crate::solved`]).
     fn keep_own(&mut self, own: &dyn Fn([f64; 3]) -> bool) -> bool {
-        self.raw.retain(|rc| own(rc.point));
+        self.raw.retain(|rc| own(rc.at));
         true
     }
     fn stepped_bodies(&self) -> Option<(usize, usize)> {

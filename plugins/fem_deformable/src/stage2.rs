@@ -94,14 +94,15 @@ impl Deformables2 {
     /// Detection and the free velocities (factoring M̂ first if h or θ changed):
     /// the one-domain stage.
     pub fn begin_step(&mut self, w: &World2) -> Result<(), String> {
-        self.detect_step(w);
+        self.detect_step(w, None);
         self.free_step(w)
     }
 
-    /// Detection, and the V_free of the rigid antagonists.
-    pub fn detect_step(&mut self, w: &World2) {
+    /// Detection (with `own`, in this rank's cells only: [`nscdd::dd::OwnCells`]),
+    /// and the V_free of the rigid antagonists.
+    pub fn detect_step(&mut self, w: &World2, own: Option<&nscdd::dd::OwnCells<'_>>) {
         let t = Instant::now();
-        detect(w, &self.bodies, self.alert, &mut self.raw);
+        detect(w, &self.bodies, self.alert, own, &mut self.raw);
         let rigid = self.raw.iter_mut().filter_map(|rc| match &mut rc.anta {
             RawAnta::Rigid(j) => Some(j),
             _ => None,
