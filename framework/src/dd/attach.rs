@@ -216,15 +216,17 @@ pub trait Attached<F: Family> {
     fn keep_own(&mut self, _own: &dyn Fn([f64; 3]) -> bool) -> bool {
         false
     }
-    /// On MPI ranks with contacts held per rank, on a step that keeps the last
-    /// grid (no repartition), in place of [`Self::after_free_velocity`]: the same,
-    /// with detection limited to the contacts whose point ([`Self::points`]) is
-    /// this rank's ([`OwnCells`]). A family that does so returns true (its
-    /// [`Self::keep_own`] then keeps them all); it must find exactly the contacts
-    /// of its whole detection that [`Self::keep_own`] would keep, in the same
-    /// order. The default: false, and [`Self::after_free_velocity`] is called
-    /// (whole detection, then [`Self::keep_own`]). A repartition step detects
-    /// whole: its grid comes from every contact's point.
+    /// On MPI ranks with contacts held per rank, in place of
+    /// [`Self::after_free_velocity`]: the same, with detection limited to the
+    /// contacts whose point ([`Self::points`]) lies in this rank's cells of the
+    /// last grid ([`OwnCells`]). A family that does so returns true: it must find
+    /// exactly the contacts of its whole detection that [`Self::keep_own`] would
+    /// keep, in the same order. On a repartition step the framework merges every
+    /// rank's points into the new grid, then calls it again with the new grid's
+    /// cells (so it must be repeatable: detection again, in other cells), and the
+    /// second call's contacts are the step's; on other steps [`Self::keep_own`] is
+    /// not called. The default: false, and [`Self::after_free_velocity`] is called
+    /// (whole detection, the same on every rank, then [`Self::keep_own`]).
     fn after_free_velocity_own(&mut self, _w: &F::World, _own: &OwnCells<'_>) -> bool {
         false
     }

@@ -83,6 +83,9 @@ pub trait Family: Sized + Send + Sync + Default + Clone + std::fmt::Debug + 'sta
     /// as the world holds).
     fn velocities(w: &Self::World, out: &mut Vec<Self::V>);
     fn set_vel(w: &mut Self::World, g: usize, v: Self::V);
+    /// The held bodies' velocities swapped with `v` (by slot, as many; another
+    /// length, as empty: nothing).
+    fn swap_velocities(w: &mut Self::World, v: &mut [Self::V]);
     /// The global ids of contact `a` of the world's contacts.
     fn contact_bodies(w: &Self::World, a: usize) -> [u32; 2];
     /// The step's visiting order of the contacts (empty: storage order).
@@ -281,6 +284,12 @@ impl<D: Dim> Family for Rigid<D> {
     fn velocities(w: &Self::World, out: &mut Vec<Self::V>) {
         out.clear();
         out.extend_from_slice(&w.bodies.vel);
+    }
+    fn swap_velocities(w: &mut Self::World, v: &mut [Self::V]) {
+        debug_assert!(v.is_empty() || v.len() == w.bodies.vel.len(), "velocities by slot");
+        if v.len() == w.bodies.vel.len() {
+            w.bodies.vel.swap_with_slice(v);
+        }
     }
     /// (a body the world does not hold is not stepped here: nothing to write)
     fn set_vel(w: &mut Self::World, g: usize, v: Self::V) {

@@ -27,7 +27,6 @@
 //! single process takes with all the contacts, so results stay bitwise those of one
 //! process.
 
-use super::attach::Attached;
 use super::cells::{cells_of, CellIndex};
 use super::family::Family;
 use super::partition::{Grid, OwnerOf};
@@ -321,64 +320,6 @@ impl<D: Family> super::NscddOf<D> {
         self.local.owned.start_held::<D>(w, rs, grid);
     }
 
-    /// With contacts held per rank: each family told which of its contact points
-    /// are this rank's (the cells of its subdomains in the step's grid, the new
-    /// one after a repartition, [`Attached::keep_own`]); the points read again
-    /// if one keeps only those. On a repartition step `fam_total` keeps every
-    /// rank's count (the same on every rank: a family detects whole then, and its
-    /// points are whole before; other steps may detect per rank,
-    /// [`Attached::after_free_velocity_own`]); the points held
-    /// counted in `ranks.json` (`family_contacts`), and those detected
-    /// (`family_detected`).
-    pub(super) fn keep_own(&mut self, fams: &mut [&mut dyn Attached<D>]) {
-        if self.repartitions() {
-            self.fam_total = self.fam_points.len();
-        }
-        let detected = self.fam_points.len() as u64;
-        self.keep_own_points(fams);
-        if let Some(rs) = self.ranks.as_mut() {
-            rs.totals.family_detected += detected;
-            rs.totals.family_contacts += self.fam_points.len() as u64;
-        }
-    }
-
-    /// [`Self::keep_own`]'s calls, with contacts held per rank.
-    fn keep_own_points(&mut self, fams: &mut [&mut dyn Attached<D>]) {
-        let (Some(rs), true) = (self.ranks.as_ref(), self.local.now) else {
-            return;
-        };
-        let grid = match (&self.local.new_grid, &self.grid) {
-            (Some((g, _)), _) | (None, Some(g)) => g,
-            (None, None) => return,
-        };
-        let (me, by_model) = (rs.cluster.rank(), self.by_model);
-        let mut kept = false;
-        for (f, fam) in fams.iter_mut().enumerate() {
-            let base = if by_model { (f + 1) * grid.len() } else { 0 };
-            let own = |p: [f64; 3]| rs.rank_of.get(base + grid.cell_of(p) as usize) == Some(&me);
-            kept |= fam.keep_own(&own);
-        }
-        if kept {
-            self.family_points(fams);
-        }
-    }
-
-    /// With contacts held per rank, on a step that keeps the last grid: family
-    /// f's own cells' boxes ([`super::OwnCells::boxes`]) with the test of a point,
-    /// for its detection in the rank's region ([`Attached::after_free_velocity_own`]).
-    pub(super) fn own_cells(&self, f: usize) -> Option<(Vec<[[f64; 3]; 2]>, impl Fn([f64; 3]) -> bool + '_)> {
-        let (Some(rs), Some(grid), true) = (self.ranks.as_ref(), self.grid.as_ref(), self.local.now) else {
-            return None;
-        };
-        if self.repartitions() {
-            return None;
-        }
-        let base = if self.by_model { (f + 1) * grid.len() } else { 0 };
-        let me = rs.cluster.rank();
-        let boxes = cells_of(grid, rs.rank_of.get(base..)?, me);
-        Some((boxes, move |p| rs.rank_of.get(base + grid.cell_of(p) as usize) == Some(&me)))
-    }
-
     /// Whether this step re-partitions over a new grid.
     pub(super) fn repartitions(&self) -> bool {
         self.repartitions_at(self.steps)
@@ -458,12 +399,17 @@ impl<D: Family> super::NscddOf<D> {
         let s = &self.settings;
         let c = D::contacts(w);
         let nc = D::len(c);
-        // the attached families' contact points (every rank's, the same) counted
-        // once, by rank 0; `total`: the world's contacts
-        let fam: &[[f64; 3]] = if rs.cluster.rank() == 0 { &self.fam_points } else { &[] };
+        // the attached families' contact points: those detected in the rank's
+        // cells each rank's own, those detected whole (every rank's, the same)
+        // counted once, by rank 0; `total`: the contacts
+        let rank0 = rs.cluster.rank() == 0;
+        let fam: Vec<[f64; 3]> = (self.fam_ranges.iter().enumerate())
+            .filter(|(f, _)| rank0 || self.fam_own.get(*f) == Some(&true))
+            .flat_map(|(_, r)| self.fam_points[r.clone()].iter().copied())
+            .collect();
         let points = || (0..nc).map(|a| D::point(c, a)).chain(fam.iter().copied());
         let (lo, hi) = Grid::bounds(points());
-        let mine: Vec<f64> = lo.iter().chain(&hi).copied().chain([nc as f64]).collect();
+        let mine: Vec<f64> = lo.iter().chain(&hi).copied().chain([(nc + fam.len()) as f64]).collect();
         let (_, all) = rs.all_gather_any(&mine);
         let (mut glo, mut ghi, mut total) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3], 0usize);
         for x in all.chunks_exact(7) {

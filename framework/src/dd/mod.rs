@@ -52,6 +52,7 @@ pub mod first_part;
 pub mod gluing;
 mod grid;
 mod local;
+mod local_families;
 #[cfg(feature = "mpi")]
 pub mod mpi;
 mod owned;
@@ -170,6 +171,9 @@ pub struct NscddOf<D: Family> {
     /// Which attached families are stepped in part on this rank this step
     /// ([`Attached::solved_on`]).
     fam_stepped: Vec<bool>,
+    /// Which attached families detected in this rank's cells only this step
+    /// ([`Attached::after_free_velocity_own`]).
+    fam_own: Vec<bool>,
     /// Whether the steps may hold bodies and contacts per rank ([`local`],
     /// [`owned`]): rigid bodies alone, or attached families that name the world
     /// bodies they touch; by model, with at least as many grid cells as ranks.
@@ -230,6 +234,7 @@ impl<D: Family> NscddOf<D> {
             fam_total: 0,
             fam_ranges: Vec::new(),
             fam_stepped: Vec::new(),
+            fam_own: Vec::new(),
             held_ok: None,
             sums_per_sub: None,
             pending: DdStepReport::default(),
@@ -383,8 +388,8 @@ impl<D: Family> NscddOf<D> {
         });
         if repart {
             self.grid = Some(grid.clone());
-            let total = self.local.new_grid.take().map_or(nc, |(_, t)| t);
-            self.grid_empty = total + self.fam_total == 0;
+            let total = self.local.new_grid.take().map_or(nc + self.fam_total, |(_, t)| t);
+            self.grid_empty = total == 0;
         }
         // several processes: each builds only the subdomains of its rank (chosen by
         // the distributed repartition when contacts are held per rank)

@@ -25,14 +25,18 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
     }
     fn after_free_velocity(&mut self, w: &D::World) {
         D::velocities(w, &mut self.dd.v_free);
-        // (with contacts held per rank, between repartitions, a family may detect
-        // in this rank's cells only)
+        // (with contacts held per rank a family may detect in this rank's cells
+        // only: the last grid's)
+        let mut fam_own = std::mem::take(&mut self.dd.fam_own);
+        fam_own.clear();
         for (k, f) in self.fams.iter_mut().enumerate() {
             let own = |(boxes, of): (Vec<_>, _)| f.after_free_velocity_own(w, &super::OwnCells { boxes: &boxes, of: &of });
-            if !self.dd.own_cells(k).is_some_and(own) {
+            fam_own.push(self.dd.own_cells(k, None).is_some_and(own));
+            if !fam_own[k] {
                 f.after_free_velocity(w);
             }
         }
+        self.dd.fam_own = fam_own;
     }
     fn prepare(&mut self, w: &mut D::World) {
         for f in self.fams.iter_mut() {
@@ -40,7 +44,7 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
         }
         self.dd.family_points(self.fams);
         self.dd.repartition_local(w);
-        self.dd.keep_own(self.fams);
+        self.dd.keep_own(w, self.fams);
         let mut rep = std::mem::take(&mut self.dd.pending);
         self.dd.partition(w, self.fams, &mut rep);
         self.dd.pending = rep;
