@@ -60,17 +60,8 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
     fn after_integrate(&mut self, w: &mut D::World, moved: Result<(), usize>) -> Result<(), usize> {
         let moved = moved.map_err(|k| D::global(w, k));
         if self.dd.local.now && !self.fams.is_empty() {
-            // the families' reach for the next step (their positions not yet updated);
-            // by geometry none of a family detecting in the rank's cells: its rigid
-            // antagonists are in the halo, their copies in the subdomains of the rigid
-            // contacts, which the limited shells describe (by model its subdomains are
-            // its own, whose rigid copies they do not: the bodies near it stay held
-            // by every rank)
-            let by_model = self.dd.by_model;
-            let fams: Vec<&dyn Attached<D>> = (self.fams.iter().enumerate())
-                .filter(|(k, _)| by_model || self.dd.fam_own.get(*k) != Some(&true))
-                .map(|(_, f)| &**f as &dyn Attached<D>)
-                .collect();
+            // the families' reach for the next step (their positions not yet updated)
+            let fams: Vec<&dyn Attached<D>> = self.fams.iter().map(|f| &**f as &dyn Attached<D>).collect();
             let mut reach = Vec::new();
             super::attach::reach_of(w, &fams, &mut reach);
             self.dd.local.owned.set_reach(reach);
