@@ -170,7 +170,9 @@ pub trait Attached<F: Family> {
     /// are. Called when the mode is decided (before the first step, also in one
     /// process) and after each step's [`Self::write_back`] of a step held per rank
     /// (the family's positions not yet updated: the boxes must cover that update),
-    /// the same boxes on every rank. The default: none.
+    /// the same boxes on every rank; not after a step in which the family detected
+    /// in the rank's cells ([`Self::after_free_velocity_own`]): its rigid
+    /// antagonists are then in the rank's halo. The default: none.
     fn reach(&self, _w: &F::World, _out: &mut Vec<[[f64; 3]; 2]>) {}
     /// Each step of the NSCDD stage, after the partition and before [`Self::split`]:
     /// where its contacts ([`Self::points`] order) are solved ([`SolvedOn`]; `None`

@@ -399,15 +399,18 @@ impl<D: Family> NscddOf<D> {
             fams: &*fams,
             owner: &self.fam_owner,
         };
-        let (local, families) = (&self.local, !fams.is_empty());
-        let mut shells = |subs: &mut [Subdomain<D>]| {
+        let local = &self.local;
+        let mut shells = |subs: &mut [Subdomain<D>], first: Option<&[u32]>| {
             let rs = self.ranks.as_mut().expect("ranks");
-            match start.as_ref().and_then(|(asked, _)| shells::near_of::<D>(local, w, asked)) {
-                Some(near) => rs.fill_shells_near(subs, &near, families),
-                None => rs.fill_shells(subs),
+            match (start.as_ref().and_then(|(asked, _)| shells::near_of::<D>(local, w, asked)), first) {
+                (Some(near), None) => rs.fill_shells_near(subs, &near),
+                (Some(near), Some(first)) => return rs.route_family_copies(subs, &near, first),
+                (None, None) => rs.fill_shells(subs),
+                (None, Some(_)) => {}
             }
+            Vec::new()
         };
-        let shells = self.local.now.then_some(&mut shells as &mut dyn FnMut(&mut [Subdomain<D>]));
+        let shells = self.local.now.then_some(&mut shells as partition::Shells<'_, D>);
         self.last = partition::decompose_owned::<D>(w, &self.v_free, grid, owner, ns, &self.store, build.as_deref(), &fo, shells);
         // contacts held per rank: the other ranks' F_Γ are not kept up to date here
         // (the copies' starting velocities hold F_Γ and the warm starts, families'

@@ -147,8 +147,12 @@ impl<D: Family> Default for Decomposition<D> {
 }
 
 /// Fills the other ranks' subdomains with their bodies, or those near this rank
-/// (contacts held per rank, [`super::shells`]).
-pub type Shells<'a, D> = &'a mut dyn FnMut(&mut [Subdomain<D>]);
+/// (contacts held per rank, [`super::shells`]): called with `None` before the
+/// attached families' split, then with `Some(first)` after it (`first[s]`:
+/// subdomain s's copies before the split), when the families' copies of this
+/// rank's subdomains go to the limited shells; returns the copies that adds
+/// (body, subdomain, local id).
+pub type Shells<'a, D> = &'a mut dyn FnMut(&mut [Subdomain<D>], Option<&[u32]>) -> Vec<(u32, u32, u32)>;
 
 /// Every body copy of a decomposition as (body, subdomain), sorted: each body's
 /// subdomains, ascending.
@@ -193,16 +197,21 @@ pub fn decompose_owned<D: Family>(
     let built = |s: u32| build.is_none_or(|b| b[s as usize]);
     let (mut subs, mut copy_of) = split_contacts::<D>(w, &owner, ns);
     let shelled = shells.is_some();
-    if let Some(fill) = shells {
+    let mut shells = shells;
+    if let Some(fill) = shells.as_mut() {
         // contacts held per rank: the other ranks' subdomains get their bodies only
-        fill(&mut subs);
+        fill(&mut subs, None);
         for sub in subs.iter().filter(|s| !built(s.id)) {
             for (l, &g) in sub.body_global.iter().enumerate() {
                 copy_of.push((g, sub.id, l as u32));
             }
         }
     }
+    let first: Vec<u32> = subs.iter().map(|s| s.body_global.len() as u32).collect();
     let ent_copies = split_families(w, &mut subs, &mut copy_of, fam);
+    if let Some(fill) = shells.as_mut() {
+        copy_of.extend(fill(&mut subs, Some(&first)));
+    }
     // copies grouped by body, in subdomain order; each copy's multiplicity
     copy_of.sort_unstable_by_key(|e| (e.0, e.1));
     let mult = multiplicities(&mut subs, &copy_of);
@@ -310,10 +319,10 @@ fn split_families<D: Family>(
                 stamp[k] = s;
                 local[k] = sub.body_global.len() as u32;
                 sub.body_global.push(g);
-                // (a limited shell: the copy's local id on the subdomain's rank)
-                if let Some(n) = sub.shell_len.as_mut() {
-                    sub.shell_local.push(*n);
-                    *n += 1;
+                // (a limited shell: the copy's local id on the subdomain's rank comes
+                // with the family copies routed after the split)
+                if sub.limited_shell {
+                    sub.shell_local.push(u32::MAX);
                 }
                 copy_of.push((g, s, local[k]));
             }

@@ -33,7 +33,8 @@ impl RankState {
         for s in d.subs.iter_mut().filter(|s| self.rank_of[s.id as usize] != me) {
             s.vel.resize(s.body_global.len(), D::V::default());
             for (l, g) in s.body_global.iter().enumerate() {
-                if active.is_none_or(|a| a.binary_search(g).is_ok()) {
+                // (a copy no route named: none, `RankState::route_family_copies`)
+                if active.is_none_or(|a| a.binary_search(g).is_ok()) && s.remote_id(l as u32) != u32::MAX {
                     asks.push((s.id, s.remote_id(l as u32)));
                     here.push((s.id, l as u32));
                 }

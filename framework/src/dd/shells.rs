@@ -124,19 +124,18 @@ impl RankState {
     }
 
     /// The other ranks' subdomains limited to the bodies this rank may need, from
-    /// their ranks point to point (module docs); with `families` (attached body
-    /// families, which copy their bodies into every subdomain after this), each
-    /// shell's number of bodies on its rank too ([`Subdomain::shell_len`]).
-    /// Collective.
-    pub(super) fn fill_shells_near<D: Family>(&mut self, subs: &mut [Subdomain<D>], near: &Near, families: bool) {
+    /// their ranks point to point (module docs; the attached families' copies
+    /// come after their split, [`Self::route_family_copies`]). Collective.
+    pub(super) fn fill_shells_near<D: Family>(&mut self, subs: &mut [Subdomain<D>], near: &Near) {
         // each own subdomain's bodies (subdomain, local id, body) to the ranks that may need them
         let own: Vec<&Subdomain<D>> = subs.iter().filter(|s| self.is_own(s.id)).collect();
-        let (got, _) = self.route(own.into_iter(), near, false, |s, l, g, o| {
+        let (got, _) = self.route(own.into_iter(), near, (false, &|_| 0), |s, l, g, o| {
             o.extend([f64::from(s.id), l as f64, f64::from(g)]);
         });
         for sub in subs.iter_mut().filter(|s| !self.is_own(s.id)) {
             sub.body_global.clear();
             sub.shell_local.clear();
+            sub.limited_shell = true;
         }
         // a rank's subdomains in ascending id, each in its local order
         for x in got.iter().flat_map(|m| m.chunks_exact(3)) {
@@ -146,30 +145,61 @@ impl RankState {
         }
         self.totals.shell_bodies += got.iter().map(|m| m.len() as u64 / 3).sum::<u64>();
         self.totals.limited_shells += 1;
-        if families {
-            let lens = self.per_subdomain(subs.len(), 1, |s, out| out.push(subs[s].body_global.len() as f64));
-            for (sub, &n) in subs.iter_mut().zip(&lens) {
-                sub.shell_len = (!self.is_own(sub.id)).then_some(n as u32);
-            }
-        }
     }
 
-    /// Each copy of `subs` (this rank's subdomains) to the ranks that may need its
-    /// body ([`Near::targets`]), as `pack(subdomain, local id, body, out)` appends
-    /// it, point to point; returns what the other ranks sent this one and, with
-    /// `to_me`, this rank's own part. Collective.
+    /// After the attached families' split: their copies of this rank's subdomains
+    /// (those past `first[s]`) to the ranks that may need their bodies, by the rule
+    /// of [`Self::fill_shells_near`], point to point. A copy a family made into a
+    /// limited shell here gets its id on the subdomain's rank; one it did not
+    /// make (its family copies only what this rank holds) is added. Returns the
+    /// copies added (body, subdomain, local id). So a rank needs no family to copy
+    /// the same bodies in the same order as the subdomain's rank. Collective.
+    pub(super) fn route_family_copies<D: Family>(&mut self, subs: &mut [Subdomain<D>], near: &Near, first: &[u32]) -> Vec<(u32, u32, u32)> {
+        let own: Vec<&Subdomain<D>> = subs.iter().filter(|s| self.is_own(s.id)).collect();
+        let from = |s: &Subdomain<D>| first.get(s.id as usize).map_or(0, |&f| f as usize);
+        let (got, _) = self.route(own.into_iter(), near, (false, &from), |s, l, g, o| {
+            o.extend([f64::from(s.id), l as f64, f64::from(g)]);
+        });
+        let mut added = Vec::new();
+        for x in got.iter().flat_map(|m| m.chunks_exact(3)) {
+            let (s, l, g) = (x[0] as u32, x[1] as u32, x[2] as u32);
+            let (Some(sub), Some(&f)) = (subs.get_mut(s as usize), first.get(s as usize)) else {
+                continue;
+            };
+            let f = (f as usize).min(sub.body_global.len());
+            match sub.body_global[f..].iter().position(|&b| b == g) {
+                Some(k) => sub.shell_local[f + k] = l,
+                None => {
+                    added.push((g, s, sub.body_global.len() as u32));
+                    sub.body_global.push(g);
+                    sub.shell_local.push(l);
+                }
+            }
+        }
+        self.totals.shell_bodies += added.len() as u64;
+        debug_assert!(
+            subs.iter().all(|s| !s.shell_local.contains(&u32::MAX)),
+            "a family copied into a limited shell a body its subdomain's rank did not route here"
+        );
+        added
+    }
+
+    /// Each copy of `subs` (this rank's subdomains; from local id `from(s)` on) to
+    /// the ranks that may need its body ([`Near::targets`]), as `pack(subdomain,
+    /// local id, body, out)` appends it, point to point; returns what the other
+    /// ranks sent this one and, with `to_me`, this rank's own part. Collective.
     fn route<'s, D: Family>(
         &mut self,
         subs: impl Iterator<Item = &'s Subdomain<D>>,
         near: &Near,
-        to_me: bool,
+        (to_me, from): (bool, &dyn Fn(&Subdomain<D>) -> usize),
         mut pack: impl FnMut(&Subdomain<D>, usize, u32, &mut Vec<f64>),
     ) -> (Vec<Vec<f64>>, Vec<f64>) {
         let (me, np) = (self.cluster.rank(), self.cluster.size() as usize);
         let mut out: Vec<Vec<f64>> = vec![Vec::new(); np];
         let mut to: Vec<u32> = Vec::new();
         for s in subs {
-            for (l, &g) in s.body_global.iter().enumerate() {
+            for (l, &g) in s.body_global.iter().enumerate().skip(from(s)) {
                 near.targets::<D>(g, np, &mut to);
                 for &q in to.iter().filter(|&&q| to_me || q != me) {
                     pack(s, l, g, &mut out[q as usize]);
@@ -196,7 +226,7 @@ impl RankState {
         let me = self.cluster.rank();
         let old_rank_of = std::mem::take(&mut self.old_rank_of);
         let old_own = last.subs.iter().filter(|s| old_rank_of.get(s.id as usize) == Some(&me));
-        let (got, mine) = self.route(old_own, near, true, |s, _, g, o| {
+        let (got, mine) = self.route(old_own, near, (true, &|_| 0), |s, _, g, o| {
             let kept = store.get(g, s.id);
             o.extend([f64::from(s.id), f64::from(g), f64::from(u8::from(kept.is_some()))]);
             o.extend_from_slice(kept.unwrap_or_default().as_ref());

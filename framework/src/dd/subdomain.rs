@@ -46,11 +46,10 @@ pub struct Subdomain<D: Family> {
     /// ([`super::shells`]): each body's local id on the subdomain's rank. Empty when
     /// the ids are those of the subdomain's rank ([`Subdomain::remote_id`]).
     pub shell_local: Vec<u32>,
-    /// A limited shell with attached families: the number of the subdomain's
-    /// bodies on its rank so far, the local id there of the next body a family's
-    /// contact copies into it (every rank copies the same bodies in the same order:
-    /// they are stepped by every rank, [`super::Attached::held_everywhere`]).
-    pub shell_len: Option<u32>,
+    /// A limited shell ([`super::shells`]): the attached families' copies made
+    /// into it get their ids on the subdomain's rank ([`Self::shell_local`]) from
+    /// the routing after the split (`RankState::route_family_copies`).
+    pub limited_shell: bool,
     /// Copy velocities V_E.
     pub vel: Vec<D::V>,
     /// Copy M̂_E⁻¹ = m M̂⁻¹.

@@ -177,7 +177,7 @@ impl Attached<Rigid3> for Deformables3 {
             weight: 1.0 / n.max(1) as f64,
         }
     }
-    fn split(&self, _w: &World3, owner: &[u32], copy: &mut dyn FnMut(u32, u32) -> u32) -> Vec<(u32, Box<dyn LocalPart<Rigid3>>)> {
+    fn split(&self, w: &World3, owner: &[u32], copy: &mut dyn FnMut(u32, u32) -> u32) -> Vec<(u32, Box<dyn LocalPart<Rigid3>>)> {
         let (c, in_part) = (&self.contacts, self.stepped.solved().is_some());
         // stepped in part: the contacts solved here come from their own list, the
         // other ranks' subdomains are shells made from their ranks' descriptions
@@ -204,7 +204,8 @@ impl Attached<Rigid3> for Deformables3 {
             }
         });
         if own.is_some() {
-            parts.extend(crate::shells::make(&self.solved.shells, copy, |fe, n| FePart3 {
+            let held = |g: u32| w.ids.slot(g).is_some();
+            parts.extend(crate::shells::make(&self.solved.shells, held, copy, |fe, n| FePart3 {
                 fe,
                 shell: Some(n),
                 ..Default::default()
@@ -244,7 +245,9 @@ impl Attached<Rigid3> for Deformables3 {
         let at = |g| crate::family::slot(w, g);
         Some(self.residual_parts_of(&w.bodies.vel, at, contacts.iter().map(|&a| a as usize)))
     }
-    /// None by id: the world bodies near the deformable bodies ([`Self::reach`]).
+    /// None by id: the world bodies near the deformable bodies ([`Self::reach`],
+    /// asked only before the first step: the family then detects in each rank's
+    /// cells, [`Self::after_free_velocity_own`]).
     fn held_everywhere(&self) -> Option<Vec<u32>> {
         Some(Vec::new())
     }

@@ -80,12 +80,18 @@ pub fn share(
 
 /// The shell parts of the other ranks' subdomains `shells` ([`share`]), each
 /// made by `part(entities, contacts)` (its count of contacts), its copies of the
-/// world's rigid bodies asked of `copy` (the framework's,
-/// [`nscdd::dd::Attached::split`]) in its rank's order.
-pub fn make<P>(shells: &[Shell], copy: &mut dyn FnMut(u32, u32) -> u32, part: impl Fn(Vec<u32>, u32) -> P) -> Vec<(u32, P)> {
+/// world's rigid bodies this rank holds (`held`: those it steps; the framework
+/// gives each its id on the subdomain's rank) asked of `copy` (the framework's,
+/// [`nscdd::dd::Attached::split`]).
+pub fn make<P>(
+    shells: &[Shell],
+    held: impl Fn(u32) -> bool,
+    copy: &mut dyn FnMut(u32, u32) -> u32,
+    part: impl Fn(Vec<u32>, u32) -> P,
+) -> Vec<(u32, P)> {
     let mut out = Vec::with_capacity(shells.len());
     for sh in shells {
-        for &g in &sh.rigid {
+        for &g in sh.rigid.iter().filter(|&&g| held(g)) {
             copy(sh.sub, g);
         }
         out.push((sh.sub, part(sh.entities.clone(), sh.contacts)));
