@@ -399,12 +399,14 @@ impl<D: Family> NscddOf<D> {
             fams: &*fams,
             owner: &self.fam_owner,
         };
-        let local = &self.local;
+        let (local, families) = (&self.local, !fams.is_empty());
         let mut shells = |subs: &mut [Subdomain<D>], first: Option<&[u32]>| {
             let rs = self.ranks.as_mut().expect("ranks");
+            // (the families' copies routed after their split: none without families)
             match (start.as_ref().and_then(|(asked, _)| shells::near_of::<D>(local, w, asked)), first) {
                 (Some(near), None) => rs.fill_shells_near(subs, &near),
-                (Some(near), Some(first)) => return rs.route_family_copies(subs, &near, first),
+                (Some(near), Some(first)) if families => return rs.route_family_copies(subs, &near, first),
+                (Some(_), Some(_)) => {}
                 (None, None) => rs.fill_shells(subs),
                 (None, Some(_)) => {}
             }
