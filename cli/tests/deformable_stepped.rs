@@ -61,7 +61,8 @@ fn stepped_on_ranks(
             "{tag}, {n} ranks: deformable contacts held {held:?}"
         );
         // and found by each rank's detection in its own cells between repartitions
-        // (`Attached::after_free_velocity_own`; a repartition step detects whole)
+        // (`Attached::after_free_velocity_own`; a repartition step in the old cells,
+        // then in the new ones; a fresh run's first step in a provisional grid's)
         let found: u64 = per_rank_count(&out, "family_detected").iter().sum();
         assert!(
             found >= total && found < n as u64 * total,
@@ -125,6 +126,22 @@ fn deformable_bodies_are_stepped_per_rank() {
     let hybrid = dir.join("hybrid");
     ok(&mpirun(&[(2, args(&s2, &hybrid, &["--threads", "2"]))]), "2 ranks of 2 threads");
     assert!(final_json(&hybrid) == reference, "2 ranks of 2 threads end elsewhere");
+    // the centralized scheme (whole shells: the family detects whole and keeps its
+    // reach, `OwnCells` being for the decentralized scheme's limited shells)
+    let central = dir.join("central");
+    ok(
+        &mpirun(&[(2, args(&s2, &central, &["--scheme", "centralized"]))]),
+        "2 ranks, centralized",
+    );
+    let one_central = dir.join("one_central");
+    ok(
+        &nscdd(&args(&s2, &one_central, &["--scheme", "centralized"])),
+        "centralized in one process",
+    );
+    assert!(
+        final_json(&central) == final_json(&one_central),
+        "2 ranks, centralized, end elsewhere"
+    );
     // a state written by 2 ranks between repartitions restarts on 4 ranks (and
     // at a repartition, step 35)
     let first = write(&dir, "first.toml", &BLOCKS.replace("steps = 60", "steps = 33"));

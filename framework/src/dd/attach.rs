@@ -155,7 +155,9 @@ pub trait Attached<F: Family> {
     /// (ascending global ids; those it may touch as it moves come from
     /// [`Self::reach`]), which every rank then holds and steps as it does a
     /// fixed or driven body (bitwise the same state wherever it is held), so that
-    /// the family, held whole on every rank, builds the same contacts everywhere.
+    /// the family, held whole on every rank, builds the same contacts everywhere
+    /// (a family detecting in each rank's cells, [`Self::after_free_velocity_own`],
+    /// needs only the rank's halo).
     /// It reads a world body through its slot ([`Family::held_slot`]). `None` (the
     /// default): the family may touch any world body, and its scenes run on ranks
     /// with every body and contact held on every rank.
@@ -225,8 +227,10 @@ pub trait Attached<F: Family> {
     /// exactly the contacts of its whole detection that [`Self::keep_own`] would
     /// keep, in the same order. On a repartition step the framework merges every
     /// rank's points into the new grid, then calls it again with the new grid's
-    /// cells (so it must be repeatable: detection again, in other cells), and the
-    /// second call's contacts are the step's; on other steps [`Self::keep_own`] is
+    /// cells, after [`Self::build`] and [`Self::points`] (so it must be repeatable,
+    /// and leave the family as its build would: detection again, in other cells,
+    /// the world's velocities back at V_free for it), and the second call's
+    /// contacts are the step's; with the decentralized scheme only; on other steps [`Self::keep_own`] is
     /// not called. The default: false, and [`Self::after_free_velocity`] is called
     /// (whole detection, the same on every rank, then [`Self::keep_own`]).
     fn after_free_velocity_own(&mut self, _w: &F::World, _own: &OwnCells<'_>) -> bool {

@@ -80,7 +80,11 @@ impl<D: Family> super::NscddOf<D> {
     /// repartition step the old regions), for its detection in the rank's cells
     /// ([`Attached::after_free_velocity_own`]).
     pub(super) fn own_cells<'a>(&'a self, f: usize, grid: Option<&'a Grid>) -> Option<(Vec<CellBox>, impl Fn([f64; 3]) -> bool + 'a)> {
-        let (Some(rs), Some(grid), true) = (self.ranks.as_ref(), grid.or(self.grid.as_ref()), self.local.now) else {
+        // (the decentralized scheme only: its limited shells take a family's copies
+        // by routing, `RankState::route_family_copies`; the centralized one's whole
+        // shells need every rank to copy the same bodies, which the reach gives)
+        let decentralized = self.settings.scheme == super::Scheme::Decentralized;
+        let (Some(rs), Some(grid), true) = (self.ranks.as_ref(), grid.or(self.grid.as_ref()), self.local.now && decentralized) else {
             return None;
         };
         let base = if self.by_model { (f + 1) * grid.len() } else { 0 };

@@ -164,8 +164,9 @@ pub struct NscddOf<D: Family> {
     fam_owner: Vec<Vec<u32>>,
     /// The attached families' contact points (this step), one range per family.
     fam_points: Vec<[f64; 3]>,
-    /// The families' contacts over the ranks on a repartition step (before
-    /// [`Self::keep_own`]).
+    /// The families' contacts (before [`Self::keep_own`]): over the ranks when
+    /// they detect whole; read only then (a distributed repartition counts its
+    /// own, [`Self::repartition_local`]).
     fam_total: usize,
     fam_ranges: Vec<std::ops::Range<usize>>,
     /// Which attached families are stepped in part on this rank this step

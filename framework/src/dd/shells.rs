@@ -163,9 +163,13 @@ impl RankState {
         let mut added = Vec::new();
         for x in got.iter().flat_map(|m| m.chunks_exact(3)) {
             let (s, l, g) = (x[0] as u32, x[1] as u32, x[2] as u32);
+            // (another rank's limited shell only: its messages name no other)
             let (Some(sub), Some(&f)) = (subs.get_mut(s as usize), first.get(s as usize)) else {
                 continue;
             };
+            if !sub.limited_shell || sub.shell_local.len() != sub.body_global.len() {
+                continue;
+            }
             let f = (f as usize).min(sub.body_global.len());
             match sub.body_global[f..].iter().position(|&b| b == g) {
                 Some(k) => sub.shell_local[f + k] = l,
@@ -401,7 +405,8 @@ pub(super) fn copy_counts<D: Family>(
         let (mut asks, mut bodies) = (Vec::new(), Vec::new());
         for (s, sub) in d.subs.iter().enumerate().filter(|(s, _)| !own(*s)) {
             for (l, &g) in sub.body_global.iter().enumerate() {
-                if held.binary_search(&g).is_ok() {
+                // (a copy no route named: none, [`RankState::route_family_copies`])
+                if held.binary_search(&g).is_ok() && sub.remote_id(l as u32) != u32::MAX {
                     asks.push((s as u32, sub.remote_id(l as u32)));
                     bodies.push(g);
                 }

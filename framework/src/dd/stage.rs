@@ -61,9 +61,9 @@ impl<D: Family> ContactStage<D::World> for Stage<'_, '_, D> {
         let moved = moved.map_err(|k| D::global(w, k));
         if self.dd.local.now && !self.fams.is_empty() {
             // the families' reach for the next step (their positions not yet updated);
-            // none of a family detecting in the rank's cells: its rigid antagonists
-            // are in the rank's halo, their copies routed to the shells as the rigid
-            // contacts' are (`RankState::route_family_copies`)
+            // none of a family detecting in the rank's cells (decentralized only):
+            // its rigid antagonists are in the rank's halo, their copies routed to the
+            // limited shells as the rigid contacts' are (`RankState::route_family_copies`)
             let own = &self.dd.fam_own;
             let fams: Vec<&dyn Attached<D>> = (self.fams.iter().enumerate())
                 .filter(|(k, _)| own.get(*k) != Some(&true))

@@ -242,8 +242,9 @@ impl Attached<Rigid2> for Deformables2 {
         Some(self.residual_parts_of(&w.bodies.vel, at, contacts.iter().map(|&a| a as usize)))
     }
     /// None by id: the world bodies near the deformable bodies ([`Self::reach`],
-    /// asked only before the first step: the family then detects in each rank's
-    /// cells, [`Self::after_free_velocity_own`]).
+    /// asked before the first step and after a step that detected whole: with the
+    /// decentralized scheme the family detects in each rank's cells,
+    /// [`Self::after_free_velocity_own`], and its antagonists are in their halos).
     fn held_everywhere(&self) -> Option<Vec<u32>> {
         Some(Vec::new())
     }
