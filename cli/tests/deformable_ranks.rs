@@ -34,13 +34,7 @@ fn bodies(fin: &str) -> u64 {
 
 /// The most deformable contacts of a step in `out`'s history.
 fn most_fe_contacts(out: &std::path::Path) -> f64 {
-    let h = std::fs::read_to_string(out.join("history.csv")).expect("history.csv");
-    let mut lines = h.lines();
-    let head: Vec<&str> = lines.next().expect("header").split(',').collect();
-    let k = head.iter().position(|c| *c == "deformable_contacts").expect("deformable_contacts");
-    lines
-        .map(|l| l.split(',').nth(k).and_then(|x| x.parse().ok()).unwrap_or(0.0))
-        .fold(0.0, f64::max)
+    common::history_column(out, "deformable_contacts").into_iter().fold(0.0, f64::max)
 }
 
 /// Runs `scene` (`steps` steps, a grid of `cells` cells) in one process and on each

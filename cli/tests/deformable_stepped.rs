@@ -74,12 +74,9 @@ fn stepped_on_ranks(
 
 /// The deformable contacts of every step of a run, summed (its history).
 fn contacts_over_steps(out: &std::path::Path) -> u64 {
-    let h = std::fs::read_to_string(out.join("history.csv")).expect("history.csv");
-    let mut lines = h.lines();
-    let head: Vec<&str> = lines.next().expect("header").split(',').collect();
-    let col = head.iter().position(|c| *c == "deformable_contacts").expect("deformable_contacts");
-    lines
-        .map(|l| l.split(',').nth(col).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0) as u64)
+    common::history_column(out, "deformable_contacts")
+        .into_iter()
+        .map(|x| x as u64)
         .sum()
 }
 

@@ -54,6 +54,12 @@ impl<D: Dim> Clone for DetectorTable<D> {
     }
 }
 
+/// Whether the box `[lo, hi]` (first `n` coordinates) meets one of `boxes`
+/// (closed boxes, bounds may be infinite).
+pub fn boxes_meet(boxes: &[[[f64; 3]; 2]], n: usize, lo: &[f64], hi: &[f64]) -> bool {
+    boxes.iter().any(|b| (0..n).all(|k| lo[k] <= b[1][k] && b[0][k] <= hi[k]))
+}
+
 /// A part of space for [`Detector::detect`]: a union of axis-aligned boxes (bounds
 /// may be infinite; coordinates past the dimension ignored), and pairs of bodies
 /// kept wherever they are (sorted, `[i, j]` with i < j).
@@ -66,7 +72,7 @@ pub struct Region {
 impl Region {
     /// Whether the box `[lo, hi]` (first `n` coordinates) meets one of the boxes.
     pub fn meets(&self, n: usize, lo: &[f64], hi: &[f64]) -> bool {
-        self.boxes.iter().any(|b| (0..n).all(|k| lo[k] <= b[1][k] && b[0][k] <= hi[k]))
+        boxes_meet(&self.boxes, n, lo, hi)
     }
     /// Whether the intersection of two boxes (`min`, `max`, first `n` coordinates),
     /// each grown by `alert`, meets one of the boxes: the test a pair passes to be

@@ -67,6 +67,18 @@ pub fn run_scene(dir: &Path, name: &str, scene: &str, flags: &[&str]) -> PathBuf
     out
 }
 
+/// Column `name` of `out`'s history.csv, a value per step (0 where one does not
+/// parse).
+pub fn history_column(out: &Path, name: &str) -> Vec<f64> {
+    let h = std::fs::read_to_string(out.join("history.csv")).expect("history.csv");
+    let mut lines = h.lines();
+    let head: Vec<&str> = lines.next().expect("header").split(',').collect();
+    let k = head.iter().position(|c| *c == name).unwrap_or_else(|| panic!("no column {name}"));
+    lines
+        .map(|l| l.split(',').nth(k).and_then(|x| x.parse().ok()).unwrap_or(0.0))
+        .collect()
+}
+
 /// Every column of `out`'s history.csv but the timings (`t_*`), the header and
 /// each row.
 pub fn history_physics(out: &Path) -> Vec<String> {

@@ -110,7 +110,7 @@ pub struct OwnCells<'a> {
 impl OwnCells<'_> {
     /// Whether the box `[lo, hi]` (first `n` coordinates) meets one of the boxes.
     pub fn meets(&self, n: usize, lo: &[f64], hi: &[f64]) -> bool {
-        self.boxes.iter().any(|b| (0..n).all(|k| lo[k] <= b[1][k] && b[0][k] <= hi[k]))
+        crate::detect::boxes_meet(self.boxes, n, lo, hi)
     }
 }
 
@@ -230,8 +230,8 @@ pub trait Attached<F: Family> {
     /// cells, after [`Self::build`] and [`Self::points`] (so it must be repeatable,
     /// and leave the family as its build would: detection again, in other cells,
     /// the world's velocities back at V_free for it), and the second call's
-    /// contacts are the step's; with the decentralized scheme only; on other steps [`Self::keep_own`] is
-    /// not called. The default: false, and [`Self::after_free_velocity`] is called
+    /// contacts are the step's; with the decentralized scheme only; on other
+    /// steps [`Self::keep_own`] is not called. The default: false, and [`Self::after_free_velocity`] is called
     /// (whole detection, the same on every rank, then [`Self::keep_own`]).
     fn after_free_velocity_own(&mut self, _w: &F::World, _own: &OwnCells<'_>) -> bool {
         false

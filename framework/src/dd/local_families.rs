@@ -37,7 +37,7 @@ impl<D: Family> super::NscddOf<D> {
             return 0;
         }
         let new_grid = self.local.new_grid.as_ref().map(|g| &g.0);
-        let (mut kept, mut again) = (false, 0);
+        let mut kept = false;
         // (detected again as at the free velocity: the world's velocities V_free,
         // not yet warm-started)
         let redetect = new_grid.is_some() && self.fam_own.contains(&true);
@@ -56,9 +56,6 @@ impl<D: Family> super::NscddOf<D> {
                 (true, true) => {
                     let found = fam.after_free_velocity_own(w, &super::OwnCells { boxes: &boxes, of: &own });
                     debug_assert!(found, "a family that detects in a rank's cells does so again");
-                    let mut n = Vec::new();
-                    fam.points(&mut n);
-                    again += n.len() as u64;
                     kept = true;
                 }
                 (false, _) => kept |= fam.keep_own(&own),
@@ -71,7 +68,14 @@ impl<D: Family> super::NscddOf<D> {
         if kept {
             self.family_points(fams);
         }
-        again
+        // (the second detection's contacts: the points read again)
+        match redetect {
+            true => (self.fam_ranges.iter().zip(&self.fam_own))
+                .filter(|x| *x.1)
+                .map(|x| x.0.len() as u64)
+                .sum(),
+            false => 0,
+        }
     }
 
     /// With contacts held per rank: family f's own cells' boxes

@@ -407,9 +407,8 @@ impl<D: Family> NscddOf<D> {
             match (start.as_ref().and_then(|(asked, _)| shells::near_of::<D>(local, w, asked)), first) {
                 (Some(near), None) => rs.fill_shells_near(subs, &near),
                 (Some(near), Some(first)) if families => return rs.route_family_copies(subs, &near, first),
-                (Some(_), Some(_)) => {}
                 (None, None) => rs.fill_shells(subs),
-                (None, Some(_)) => {}
+                (_, Some(_)) => {}
             }
             Vec::new()
         };
