@@ -114,6 +114,36 @@ impl OwnCells<'_> {
     }
 }
 
+/// Every rank's cells of a family's subdomains in a step's grid (edge cells
+/// unbounded, each grown by 10⁻⁶ of a cell, as [`OwnCells`]' boxes): which ranks
+/// detect where ([`Attached::share_stepped`], [`Attached::new_cells`]).
+pub struct RankCells<'a> {
+    /// `meeting(n, lo, hi, f)` calls `f` with the rank of every cell whose box
+    /// meets `[lo, hi]` (first `n` coordinates; a rank once per cell, so maybe
+    /// several times).
+    pub meeting: &'a dyn Fn(usize, &[f64], &[f64], &mut dyn FnMut(u32)),
+    /// This rank and the number of ranks.
+    pub rank: u32,
+    pub ranks: u32,
+}
+
+impl RankCells<'_> {
+    /// [`Self::meeting`].
+    pub fn ranks_meeting(&self, n: usize, lo: &[f64], hi: &[f64], mut f: impl FnMut(u32)) {
+        (self.meeting)(n, lo, hi, &mut f);
+    }
+}
+
+/// Runs `f` with the [`RankCells`] of `index` (this rank `rank` of `ranks`).
+pub(super) fn with_cells<R>(index: &super::cells::CellIndex, (rank, ranks): (u32, u32), f: impl FnOnce(&RankCells<'_>) -> R) -> R {
+    let meeting = |n: usize, lo: &[f64], hi: &[f64], g: &mut dyn FnMut(u32)| index.ranks_meeting(n, lo, hi, g);
+    f(&RankCells {
+        meeting: &meeting,
+        rank,
+        ranks,
+    })
+}
+
 /// A body family beside the world's rigid bodies, solved by the NSCDD stage (module
 /// docs). The step calls, in order: [`Self::after_free_velocity`], [`Self::build`],
 /// [`Self::points`], [`Self::split`] (then the parts' `prepare` and `warm_start`),
@@ -200,8 +230,17 @@ pub trait Attached<F: Family> {
     /// deformable bodies: the impulses of a body's contacts solved elsewhere to the
     /// rank stepping it, its V⁺ computed there and sent at its boundary), after
     /// which what the family's residual, outputs and position update read is the
-    /// same on every rank.
-    fn share_stepped(&mut self, _rounds: &dyn Rounds) {}
+    /// same on every rank. `next`: every rank's cells in which the family's next
+    /// detection runs when it detects in each rank's cells
+    /// ([`Self::after_free_velocity_own`], this step's grid, decentralized scheme),
+    /// so that a rank needs only what reaches its cells; `None`: the next detection
+    /// may read the family whole on every rank.
+    fn share_stepped(&mut self, _rounds: &dyn Rounds, _next: Option<&RankCells<'_>>) {}
+    /// On a repartition step, for a family that detected in this rank's cells of
+    /// the last grid ([`Self::after_free_velocity_own`]), before it detects again
+    /// in the new ones (collective): every rank's new cells, so that what a rank
+    /// now needs there of the family and lacks is sent to it. The default: nothing.
+    fn new_cells(&mut self, _cells: &RankCells<'_>, _rounds: &dyn Rounds) {}
     /// On MPI ranks, before the outputs read the family's state (an output frame, a
     /// saved state): what rank 0 lacks of it, sent there (collective: every rank
     /// calls it; a family stepped in part may hold on a rank only what its next
@@ -311,7 +350,11 @@ impl<F: Family> std::fmt::Debug for Parts<F> {
 pub(super) fn write_back_families<D: Family>(
     d: &super::partition::Decomposition<D>,
     w: &mut D::World,
-    (fams, stepped, owner): (&mut [&mut dyn Attached<D>], &[bool], &[Vec<u32>]),
+    (fams, stepped, owner): (
+        &mut [&mut dyn Attached<D>],
+        (&[bool], &[Option<super::cells::CellIndex>]),
+        &[Vec<u32>],
+    ),
     mut ranks: Option<&mut super::ranks::RankState>,
 ) -> f64 {
     for (f, fam) in fams.iter_mut().enumerate() {

@@ -4,7 +4,7 @@
 //! whole and keeps its own ([`Attached::keep_own`]).
 
 use super::attach::Attached;
-use super::cells::cells_of;
+use super::cells::{cells_of, CellIndex};
 use super::family::Family;
 use super::partition::Grid;
 
@@ -24,6 +24,10 @@ impl<D: Family> super::NscddOf<D> {
         self.fam_total = self.fam_points.len();
         let detected = self.fam_points.len() as u64;
         let again = self.keep_own_points(w, fams);
+        // (every rank's cells of the step's grid, for the families' next detection)
+        let grid = self.local.new_grid.as_ref().map(|g| &g.0);
+        let cells = (0..fams.len()).map(|f| self.family_cells(f, grid)).collect();
+        self.fam_cells = cells;
         if let Some(rs) = self.ranks.as_mut() {
             rs.totals.family_detected += detected + again;
             rs.totals.family_contacts += self.fam_points.len() as u64;
@@ -47,6 +51,11 @@ impl<D: Family> super::NscddOf<D> {
         };
         D::swap_velocities(w, &mut v);
         for (f, fam) in fams.iter_mut().enumerate() {
+            // (what each rank lacks of the family in its new cells sent to it first)
+            if let (Some(index), Some(rs)) = (redetect.then(|| self.family_cells(f, new_grid)).flatten(), self.ranks.as_mut()) {
+                let rank = (rs.cluster.rank(), rs.cluster.size());
+                super::attach::with_cells(&index, rank, |c| super::with_rounds(rs, |r| fam.new_cells(c, r)));
+            }
             let Some((boxes, own)) = self.own_cells(f, new_grid) else {
                 continue;
             };
@@ -78,17 +87,35 @@ impl<D: Family> super::NscddOf<D> {
         }
     }
 
+    /// Whether a family may detect in each rank's cells this step: contacts held
+    /// per rank, the decentralized scheme only (its limited shells take a family's
+    /// copies by routing, `RankState::route_family_copies`; the centralized one's
+    /// whole shells need every rank to copy the same bodies, which the reach gives).
+    fn cells_per_rank(&self) -> bool {
+        self.ranks.is_some() && self.local.now && self.settings.scheme == super::Scheme::Decentralized
+    }
+
+    /// Every rank's cells of family f in the step's grid (`grid`, after a
+    /// repartition, else the last one), when it detected in this rank's cells
+    /// this step ([`Attached::after_free_velocity_own`]).
+    fn family_cells(&self, f: usize, grid: Option<&Grid>) -> Option<CellIndex> {
+        let (Some(rs), Some(grid)) = (self.ranks.as_ref(), grid.or(self.grid.as_ref())) else {
+            return None;
+        };
+        if !self.cells_per_rank() || self.fam_own.get(f) != Some(&true) {
+            return None;
+        }
+        let base = if self.by_model { (f + 1) * grid.len() } else { 0 };
+        Some(CellIndex::new(grid, rs.rank_of.get(base..base + grid.len())?))
+    }
+
     /// With contacts held per rank: family f's own cells' boxes
     /// ([`super::OwnCells::boxes`]) with the test of a point, in the step's grid
     /// (`grid`, after a repartition), else the last one (the step's, or on a
     /// repartition step the old regions), for its detection in the rank's cells
     /// ([`Attached::after_free_velocity_own`]).
     pub(super) fn own_cells<'a>(&'a self, f: usize, grid: Option<&'a Grid>) -> Option<(Vec<CellBox>, impl Fn([f64; 3]) -> bool + 'a)> {
-        // (the decentralized scheme only: its limited shells take a family's copies
-        // by routing, `RankState::route_family_copies`; the centralized one's whole
-        // shells need every rank to copy the same bodies, which the reach gives)
-        let decentralized = self.settings.scheme == super::Scheme::Decentralized;
-        let (Some(rs), Some(grid), true) = (self.ranks.as_ref(), grid.or(self.grid.as_ref()), self.local.now && decentralized) else {
+        let (Some(rs), Some(grid), true) = (self.ranks.as_ref(), grid.or(self.grid.as_ref()), self.cells_per_rank()) else {
             return None;
         };
         let base = if self.by_model { (f + 1) * grid.len() } else { 0 };

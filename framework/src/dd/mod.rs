@@ -82,7 +82,7 @@ pub mod team;
 pub mod transport;
 
 use crate::model::ContactKey;
-pub use attach::{Attached, EntityInfo, LocalPart, OwnCells, Rounds, SolvedOn};
+pub use attach::{Attached, EntityInfo, LocalPart, OwnCells, RankCells, Rounds, SolvedOn};
 pub use census::Census;
 pub use cluster::{Cluster, Solo};
 pub use config::{Balance, DdConfig};
@@ -175,6 +175,8 @@ pub struct NscddOf<D: Family> {
     /// Which attached families detected in this rank's cells only this step
     /// ([`Attached::after_free_velocity_own`]).
     fam_own: Vec<bool>,
+    /// Every rank's cells of each family detecting in them: its next detection's.
+    fam_cells: Vec<Option<cells::CellIndex>>,
     /// Whether the steps may hold bodies and contacts per rank ([`local`],
     /// [`owned`]): rigid bodies alone, or attached families that name the world
     /// bodies they touch; by model, with at least as many grid cells as ranks.
@@ -236,6 +238,7 @@ impl<D: Family> NscddOf<D> {
             fam_ranges: Vec::new(),
             fam_stepped: Vec::new(),
             fam_own: Vec::new(),
+            fam_cells: Vec::new(),
             held_ok: None,
             sums_per_sub: None,
             pending: DdStepReport::default(),
@@ -499,7 +502,7 @@ impl<D: Family> NscddOf<D> {
         if total == 0 {
             rep.solve.converged = true;
             self.store.keep(&d.subs);
-            rank_solved::write_back_alone(w, fams, &self.fam_stepped, self.ranks.as_mut());
+            rank_solved::write_back_alone(w, fams, (&self.fam_stepped, &self.fam_cells), self.ranks.as_mut());
             return;
         }
         let per = set.sweeps_per_gluing.max(1);
@@ -566,7 +569,8 @@ impl<D: Family> NscddOf<D> {
             None => attach::write_back(d, w),
         }
         self.store.keep(&d.subs);
-        rep.solve.residual = attach::write_back_families(d, w, (fams, &self.fam_stepped, &self.fam_owner), self.ranks.as_mut());
+        let on = (&self.fam_stepped[..], &self.fam_cells[..]);
+        rep.solve.residual = attach::write_back_families(d, w, (fams, on, &self.fam_owner), self.ranks.as_mut());
         self.local.body_sub.clear();
         if let (true, false, Some(rs)) = (self.local.now, self.local.skip_view, self.ranks.as_mut()) {
             self.local.body_sub = shells::body_subdomains(rs, d, D::n_bodies(w));

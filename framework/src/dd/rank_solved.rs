@@ -7,7 +7,8 @@
 //! computed ([`Attached::share_stepped`], the family's rounds), so that what its
 //! residual, outputs and position update read is the same on every rank again.
 
-use super::attach::Attached;
+use super::attach::{with_cells, Attached};
+use super::cells::CellIndex;
 use super::family::Family;
 use super::ranks::RankState;
 
@@ -34,6 +35,11 @@ pub trait Rounds {
     /// comes back in the same place. The relation is symmetric (a peer lists this
     /// rank in the same round; a message may be empty).
     fn exchange(&self, peers: &[u32], out: &[Vec<f64>]) -> Vec<Vec<f64>>;
+    /// Values to ranks that need not expect them: `to` = (rank, values), each rank
+    /// once, not this one. Returns (rank, values) of every rank that sent this one
+    /// something, ascending (collective: one all-to-all of the lengths, then one
+    /// point-to-point round with the ranks sent to or receiving from this one).
+    fn send(&self, to: Vec<(u32, Vec<f64>)>) -> Vec<(u32, Vec<f64>)>;
 }
 
 /// Runs `f` with the [`Rounds`] of the ranks `rs` (a family's collective rounds
@@ -68,15 +74,32 @@ impl Rounds for RankRounds<'_> {
         }
         inbox
     }
+    fn send(&self, to: Vec<(u32, Vec<f64>)>) -> Vec<(u32, Vec<f64>)> {
+        let rs = &mut *self.0.borrow_mut();
+        let mut out = vec![Vec::new(); rs.cluster.size() as usize];
+        for (r, m) in to {
+            out[r as usize] = m;
+        }
+        let (peers, inbox) = rs.send_ranks(out);
+        peers.into_iter().zip(inbox).filter(|x| !x.1.is_empty()).collect()
+    }
 }
 
 /// After the families' write-back: each family stepped in part (`on`) runs its
-/// rounds ([`Attached::share_stepped`]; collective: `on` is the same on every
-/// rank).
-pub(super) fn share_stepped<D: Family>(fams: &mut [&mut dyn Attached<D>], on: &[bool], mut ranks: Option<&mut RankState>) {
-    for (fam, _) in fams.iter_mut().zip(on).filter(|x| *x.1) {
+/// rounds ([`Attached::share_stepped`], with every rank's cells of its next
+/// detection, `cells`; collective: `on` is the same on every rank).
+pub(super) fn share_stepped<D: Family>(
+    fams: &mut [&mut dyn Attached<D>],
+    (on, cells): (&[bool], &[Option<CellIndex>]),
+    mut ranks: Option<&mut RankState>,
+) {
+    for (f, (fam, _)) in fams.iter_mut().zip(on).enumerate().filter(|x| *x.1 .1) {
         let Some(rs) = ranks.as_deref_mut() else { return };
-        with_rounds(rs, |r| fam.share_stepped(r));
+        let rank = (rs.cluster.rank(), rs.cluster.size());
+        match cells.get(f).and_then(Option::as_ref) {
+            Some(index) => with_cells(index, rank, |c| with_rounds(rs, |r| fam.share_stepped(r, Some(c)))),
+            None => with_rounds(rs, |r| fam.share_stepped(r, None)),
+        }
         if let Some((here, n)) = fam.stepped_bodies() {
             rs.totals.family_bodies_stepped += here as u64;
             rs.totals.family_bodies += n as u64;
@@ -87,7 +110,12 @@ pub(super) fn share_stepped<D: Family>(fams: &mut [&mut dyn Attached<D>], on: &[
 
 /// No contact on any rank: the families' V⁺ is their V_free (each family stepped
 /// in part then shares it, [`share_stepped`]).
-pub(super) fn write_back_alone<D: Family>(w: &mut D::World, fams: &mut [&mut dyn Attached<D>], on: &[bool], ranks: Option<&mut RankState>) {
+pub(super) fn write_back_alone<D: Family>(
+    w: &mut D::World,
+    fams: &mut [&mut dyn Attached<D>],
+    on: (&[bool], &[Option<CellIndex>]),
+    ranks: Option<&mut RankState>,
+) {
     for fam in fams.iter_mut() {
         fam.write_back(w, &[]);
     }

@@ -164,8 +164,11 @@ impl<D: Dim> Attached<Rigid<D>> for GuardedFamily<D> {
     fn solved_on(&mut self, w: &World<D>, on: Option<&SolvedOn<'_>>) -> bool {
         self.guard.call(|| self.inner.solved_on(w, on))
     }
-    fn share_stepped(&mut self, rounds: &dyn crate::dd::Rounds) {
-        self.guard.call(|| self.inner.share_stepped(rounds))
+    fn share_stepped(&mut self, rounds: &dyn crate::dd::Rounds, next: Option<&crate::dd::RankCells<'_>>) {
+        self.guard.call(|| self.inner.share_stepped(rounds, next))
+    }
+    fn new_cells(&mut self, cells: &crate::dd::RankCells<'_>, rounds: &dyn crate::dd::Rounds) {
+        self.guard.call(|| self.inner.new_cells(cells, rounds))
     }
     fn gather_whole(&mut self, rounds: &dyn crate::dd::Rounds) {
         self.guard.call(|| self.inner.gather_whole(rounds))

@@ -206,9 +206,13 @@ pub enum RawAnta {
 /// and with the segments of the other deformable bodies, within `alert`; with
 /// `own`, those of the nodes in this rank's cells only (a body whose box meets
 /// none of them skipped whole).
-pub fn detect(w: &World2, fe: &[crate::body::FeBody], alert: f64, own: Option<&OwnCells<'_>>, out: &mut Vec<RawFe>) {
+pub fn detect(w: &World2, fe: &[crate::body::FeBody], alert: f64, own: Option<&OwnCells<'_>>, held: Option<&[bool]>, out: &mut Vec<RawFe>) {
     out.clear();
-    let boxes: Vec<[f64; 4]> = fe.iter().map(|b| bounds(b)).collect();
+    // (a body this rank holds stale, [`crate::near`]: an empty box, which meets none)
+    let empty = [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY];
+    let boxes: Vec<[f64; 4]> = (fe.iter().enumerate())
+        .map(|(k, b)| if held.is_none_or(|h| h[k]) { bounds(b) } else { empty })
+        .collect();
     let not_own = |p: [f64; 2]| own.is_some_and(|o| !(o.of)([p[0], p[1], 0.0]));
     for (fb, body) in fe.iter().enumerate() {
         let bb = boxes[fb];

@@ -335,9 +335,13 @@ impl SurfaceGrid {
 /// With `own`, only the contacts whose candidate point ([`RawFe3::at`]) lies in
 /// this rank's cells (a body whose box meets none of them skipped whole; a face
 /// contact chosen among all the faces first, as whole detection chooses it).
-pub fn detect(w: &World3, fe: &[FeBody], alert: f64, own: Option<&OwnCells<'_>>, out: &mut Vec<RawFe3>) {
+pub fn detect(w: &World3, fe: &[FeBody], alert: f64, own: Option<&OwnCells<'_>>, held: Option<&[bool]>, out: &mut Vec<RawFe3>) {
     out.clear();
-    let boxes: Vec<Bounds> = fe.iter().map(bounds).collect();
+    // (a body this rank holds stale, [`crate::near`]: an empty box, which meets none)
+    let empty = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    let boxes: Vec<Bounds> = (fe.iter().enumerate())
+        .map(|(k, b)| if held.is_none_or(|h| h[k]) { bounds(b) } else { empty })
+        .collect();
     let mut near: Vec<u32> = vec![];
     let is_own = |p: [f64; 3]| own.is_none_or(|o| (o.of)(p));
     for (fb, body) in fe.iter().enumerate() {

@@ -130,7 +130,7 @@ impl Attached<Rigid2> for Deformables2 {
         self.stepped.release(&mut self.bodies, &mut self.sets);
         // the whole states handed over, the nodes of the bodies stepped elsewhere asked
         if let Some(on) = on.filter(|_| part) {
-            let (raw, st) = (&self.raw, &self.stepped);
+            let (raw, st) = (&self.raw, &mut self.stepped);
             let bw = (&mut self.bodies[..], &mut self.warm);
             self.solved.asked = crate::solved::rounds_before(st, bw, (raw.len(), |a| raw[a].sides()), on);
         }
@@ -252,14 +252,21 @@ impl Attached<Rigid2> for Deformables2 {
         crate::family::reach(&self.bodies, w.time.h, self.alert, out);
     }
     /// V⁺ of the bodies stepped here, their contacts' impulses solved elsewhere
-    /// received ([`crate::impulses`]), and V⁺ at every body's boundary shared.
-    fn share_stepped(&mut self, rounds: &dyn nscdd::dd::Rounds) {
+    /// received ([`crate::impulses`]), and V⁺ at a body's boundary sent to the
+    /// ranks near it ([`crate::near`]).
+    fn share_stepped(&mut self, rounds: &dyn nscdd::dd::Rounds, next: Option<&nscdd::dd::RankCells<'_>>) {
         let c = &self.solved.list;
         let own: Vec<_> = (0..c.len())
             .map(|l| (c.cand[l], c.anta[l].fe(), global(c.frame[l], c.r[l]), (c.key[l], c.r[l])))
             .collect();
         let sw = (&mut self.sets[..], &mut self.warm);
-        crate::impulses::finish(&mut self.stepped, &mut self.bodies, sw, own.into_iter(), rounds);
+        let ba = (&mut self.bodies[..], self.alert);
+        crate::impulses::finish(&mut self.stepped, ba, sw, own.into_iter(), (rounds, next));
+    }
+    /// A repartition step's new cells: the boundary of the bodies stepped here
+    /// last to the ranks now near them that lack it ([`crate::near::new_cells`]).
+    fn new_cells(&mut self, cells: &nscdd::dd::RankCells<'_>, rounds: &dyn nscdd::dd::Rounds) {
+        crate::near::new_cells(&mut self.stepped, &mut self.bodies, self.alert, cells, rounds);
     }
     /// The bodies stepped elsewhere whole, every rank's contacts (the saved state).
     fn gather_whole(&mut self, rounds: &dyn nscdd::dd::Rounds) {

@@ -11,7 +11,7 @@
 
 use crate::nodes::{FeKey, FeSide, NodeSet};
 use crate::stepped::Stepped;
-use nscdd::dd::Rounds;
+use nscdd::dd::{RankCells, Rounds};
 use std::collections::BTreeMap;
 
 /// One side's share of a contact's impulse: the contact's key (its place in the
@@ -121,30 +121,22 @@ pub fn share<const D: usize>(
 /// [`nscdd::dd::Attached::share_stepped`] of the deformable bodies: V⁺ of the
 /// bodies stepped here from the shares of their contacts' impulses ([`share`];
 /// `own`: the contacts solved here, as [`share`] takes them), the next step's
-/// warm starts of their contacts into `warm`, then every rank's
-/// V⁺ at the boundary of the bodies it stepped, with their energies
-/// ([`Stepped::pack`], one all-gather, which also adds up the contacts solved on
-/// each rank: [`Stepped::contacts_total`]), and the node sets at V⁺ (the
-/// residual).
+/// warm starts of their contacts into `warm`, then their V⁺ at their boundary to
+/// the ranks near them (`next`: the cells of the next detection) with their
+/// energies and the contacts solved here to rank 0 ([`crate::near::share`]),
+/// and the node sets at V⁺ (the residual).
 pub fn finish<const D: usize>(
     st: &mut Stepped,
-    bodies: &mut [crate::body::FeBody],
+    (bodies, alert): (&mut [crate::body::FeBody], f64),
     (sets, warm): (&mut [NodeSet<D>], &mut crate::warm::Warm<D>),
     own: impl Iterator<Item = Own<D>>,
-    rounds: &dyn Rounds,
+    (rounds, next): (&dyn Rounds, Option<&RankCells<'_>>),
 ) {
     let own: Vec<_> = own.collect();
     let (shares, held) = share(st, sets, own.iter().copied(), rounds);
     warm.set(held.into_iter());
     crate::nodes::velocities_from(bodies, sets, shares.iter().map(|s| (s.side, s.sign, s.p)), st.mask());
-    // (the contacts solved here first: their count over the ranks is the history's)
-    let mut mine = vec![own.len() as f64];
-    st.pack(bodies, &mut mine);
-    let per_rank = rounds.all_gather(&mine);
-    let total = per_rank.iter().map(|m| m.first().map_or(0, |&n| n as usize)).sum();
-    let all: Vec<f64> = per_rank.iter().flat_map(|m| m.iter().skip(1).copied()).collect();
-    st.unpack(bodies, &all);
-    st.set_contacts_total(total);
+    crate::near::share(st, bodies, (own.len(), alert), next, rounds);
     crate::nodes::sets_at_velocities(bodies, sets);
 }
 

@@ -15,6 +15,7 @@ pub mod family3;
 pub mod impulses;
 pub mod matrices;
 pub mod mesh;
+pub mod near;
 pub mod nodes;
 pub mod output;
 pub mod problem;

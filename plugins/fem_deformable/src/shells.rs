@@ -145,6 +145,9 @@ mod tests {
         fn exchange(&self, _peers: &[u32], _out: &[Vec<f64>]) -> Vec<Vec<f64>> {
             unreachable!()
         }
+        fn send(&self, _to: Vec<(u32, Vec<f64>)>) -> Vec<(u32, Vec<f64>)> {
+            unreachable!()
+        }
     }
 
     /// Rank 0 solves three contacts in subdomains 0 (body 2 on body 1, body 2 on

@@ -101,7 +101,7 @@ pub type Sides<const D: usize> = (Side<D>, Option<Side<D>>, Option<u32>);
 /// touch asked of their stepping ranks ([`ask_nodes`]). `sides(a)`: the `n`
 /// contacts of the family's list.
 pub fn rounds_before<const D: usize>(
-    st: &Stepped,
+    st: &mut Stepped,
     (bodies, warm): (&mut [crate::body::FeBody], &mut Warm<D>),
     (n, sides): (usize, impl Fn(usize) -> Sides<D>),
     on: &SolvedOn<'_>,
@@ -113,7 +113,7 @@ pub fn rounds_before<const D: usize>(
         std::iter::once(c).chain(f)
     });
     let nodes = fe.flat_map(|(b, ks)| ks.map(|k| (b, k)));
-    ask_nodes(st, nodes, on.rounds)
+    ask_nodes(&*st, nodes, on.rounds)
 }
 
 /// [`nscdd::dd::Attached::solved_on`]'s rounds once the sets are filled, stepped
@@ -398,15 +398,13 @@ mod tests {
         assert_eq!(got[0].block(1, 1), two.block(1, 1));
         assert_eq!(got[0].block(0, 0), [[0.0; 2]; 2]);
         // rank 0 fails in the step (its body's assembly): it steps nothing, sends
-        // nothing of the body and no V⁺, but still exchanges with rank 1 (an empty
+        // nothing of the body and no V⁺ (it steps none: [`crate::near::share`]), but
+        // still exchanges with rank 1 (an empty
         // message), whose set then reads no G and zero velocities
         let mut f0 = decide_on(0);
         f0.fail();
         assert!(!f0.steps(0) && !f0.sends(0) && f0.mask() == Some(&[false][..]));
         assert_eq!(packed(&f0, &asked), [(1, vec![])]);
-        let mut v = Vec::new();
-        f0.pack(&[], &mut v);
-        assert!(v.is_empty());
         unpack_solved(&s1, &mut got, &[(0, Vec::<f64>::new())]);
         assert_eq!(got[0].v, [[0.0, 0.0]; 2]);
         assert_eq!(got[0].block(0, 0), [[0.0; 2]; 2]);

@@ -102,7 +102,8 @@ impl Deformables2 {
     /// and the V_free of the rigid antagonists.
     pub fn detect_step(&mut self, w: &World2, own: Option<&nscdd::dd::OwnCells<'_>>) {
         let t = Instant::now();
-        detect(w, &self.bodies, self.alert, own, &mut self.raw);
+        let held = crate::near::held_for(&self.stepped.near, own.is_some(), &mut self.error);
+        detect(w, &self.bodies, self.alert, own, held, &mut self.raw);
         let rigid = self.raw.iter_mut().filter_map(|rc| match &mut rc.anta {
             RawAnta::Rigid(j) => Some(j),
             _ => None,
@@ -120,7 +121,7 @@ impl Deformables2 {
     /// The free velocities of the bodies this rank steps ([`crate::stepped`]).
     pub fn free_step(&mut self, w: &World2) -> Result<(), String> {
         let detect = self.times.detect;
-        self.times = free_velocities(&mut self.bodies, w.time.h, w.time.theta, self.stepped.mask())?;
+        self.times = free_velocities(&mut self.bodies, w.time.h, w.time.theta, self.stepped.masks())?;
         self.times.detect = detect;
         Ok(())
     }
@@ -327,7 +328,7 @@ impl Deformables2 {
     /// u⁺ = u⁻ + h((1 − θ)V⁻ + θV⁺) ([`update_stepped`]: on MPI ranks the
     /// bodies stepped elsewhere at their boundary only).
     pub fn update(&mut self, h: f64, theta: f64, step: u64) -> Result<(), Diverged> {
-        update_stepped(&mut self.bodies, h, theta, step, self.stepped.mask())
+        update_stepped(&mut self.bodies, h, theta, step, self.stepped.masks())
     }
 
     /// Natural-map residual ‖F(r)‖/‖q‖ of the whole step's problem: the world's
@@ -368,7 +369,7 @@ impl Deformables2 {
 /// Factors M̂ of the bodies `stepped` (`None`: all) if h or θ changed or their
 /// factors were released (assembling M and K first if they were), then their free
 /// velocity (the others keep V⁻ only); the times of both stages.
-pub fn free_velocities(bodies: &mut [FeBody], h: f64, theta: f64, stepped: Option<&[bool]>) -> Result<FeTimes, String> {
+pub fn free_velocities(bodies: &mut [FeBody], h: f64, theta: f64, (stepped, held): Masks<'_>) -> Result<FeTimes, String> {
     let t0 = Instant::now();
     for (bi, b) in bodies.iter_mut().enumerate() {
         if stepped.is_none_or(|m| m[bi]) {
@@ -380,7 +381,7 @@ pub fn free_velocities(bodies: &mut [FeBody], h: f64, theta: f64, stepped: Optio
     for (bi, b) in bodies.iter_mut().enumerate() {
         if stepped.is_none_or(|m| m[bi]) {
             b.free_velocity(h, theta);
-        } else {
+        } else if held.is_none_or(|m| m[bi]) {
             // (V⁻ kept; V_free is not needed here: [`crate::stepped`])
             b.v_begin.clone_from(&b.v);
         }
@@ -395,13 +396,18 @@ pub fn free_velocities(bodies: &mut [FeBody], h: f64, theta: f64, stepped: Optio
 /// u⁺ = u⁻ + h((1 − θ)V⁻ + θV⁺) of every deformable body; the divergence check
 /// names the body and node.
 pub fn update_bodies(bodies: &mut [FeBody], h: f64, theta: f64, step: u64) -> Result<(), Diverged> {
-    update_stepped(bodies, h, theta, step, None)
+    update_stepped(bodies, h, theta, step, (None, None))
 }
+
+/// The bodies an MPI rank steps and those whose boundary it holds current
+/// ([`crate::stepped::Stepped::masks`]; `None`: every body).
+pub type Masks<'a> = (Option<&'a [bool]>, Option<&'a [bool]>);
 
 /// [`update_bodies`], at their boundary nodes only for the bodies `stepped` says
 /// this MPI rank does not step (`None`: all stepped): all it holds of them is
-/// their boundary ([`crate::whole`]).
-pub fn update_stepped(bodies: &mut [FeBody], h: f64, theta: f64, step: u64, stepped: Option<&[bool]>) -> Result<(), Diverged> {
+/// their boundary ([`crate::whole`]); not at all for those `held` says it holds
+/// stale ([`crate::near`]).
+pub fn update_stepped(bodies: &mut [FeBody], h: f64, theta: f64, step: u64, (stepped, held): Masks<'_>) -> Result<(), Diverged> {
     for (bi, b) in bodies.iter_mut().enumerate() {
         let (d, n) = (b.dim(), b.u.len());
         // u⁺ at dof i, whether u⁺ and V⁺ are finite there
@@ -416,8 +422,9 @@ pub fn update_stepped(bodies: &mut [FeBody], h: f64, theta: f64, step: u64, step
                     bad = Some(i);
                 }
             }
-        } else {
-            // (a body stepped elsewhere: its boundary's degrees of freedom)
+        } else if held.is_none_or(|m| m[bi]) {
+            // (a body stepped elsewhere: its boundary's degrees of freedom; none of
+            // one held stale here, [`crate::near`])
             for q in 0..b.mesh.boundary.len() {
                 let k = b.mesh.boundary[q] as usize;
                 for i in d * k..d * k + d {

@@ -88,7 +88,8 @@ impl Deformables3 {
     /// and the V_free of the rigid antagonists.
     pub fn detect_step(&mut self, w: &World3, own: Option<&nscdd::dd::OwnCells<'_>>) {
         let t = Instant::now();
-        detect(w, &self.bodies, self.alert, own, &mut self.raw);
+        let held = crate::near::held_for(&self.stepped.near, own.is_some(), &mut self.error);
+        detect(w, &self.bodies, self.alert, own, held, &mut self.raw);
         let rigid = self.raw.iter_mut().filter_map(|rc| match &mut rc.anta {
             RawAnta3::Rigid(j) => Some(j),
             _ => None,
@@ -106,7 +107,7 @@ impl Deformables3 {
     /// The free velocities of the bodies this rank steps ([`crate::stepped`]).
     pub fn free_step(&mut self, w: &World3) -> Result<(), String> {
         let detect = self.times.detect;
-        self.times = free_velocities(&mut self.bodies, w.time.h, w.time.theta, self.stepped.mask())?;
+        self.times = free_velocities(&mut self.bodies, w.time.h, w.time.theta, self.stepped.masks())?;
         self.times.detect = detect;
         Ok(())
     }
@@ -335,7 +336,7 @@ impl Deformables3 {
 
     /// u⁺ = u⁻ + h((1 − θ)V⁻ + θV⁺).
     pub fn update(&mut self, h: f64, theta: f64, step: u64) -> Result<(), Diverged> {
-        crate::stage2::update_stepped(&mut self.bodies, h, theta, step, self.stepped.mask())
+        crate::stage2::update_stepped(&mut self.bodies, h, theta, step, self.stepped.masks())
     }
 
     /// Natural-map residual ‖F(r)‖/‖q‖ of the whole step's problem (rigid and

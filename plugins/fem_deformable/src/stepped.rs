@@ -17,9 +17,9 @@
 //! shell part made from its rank's description ([`crate::shells`]). After the
 //! write-back, the rank stepping a body gets the impulses of its contacts solved
 //! elsewhere ([`crate::impulses`]), computes V⁺ and sends it at the body's
-//! boundary to every rank ([`Stepped::pack`], [`Stepped::unpack`]) with the
-//! body's energies after the step (the history's columns, each body's computed
-//! once); the body's whole state stays with it ([`crate::whole`]). Each rank's residual reads only the contacts it solved (the
+//! boundary to the ranks whose cells it is near ([`crate::near`]), and the
+//! body's energies after the step to rank 0 (the history's columns, each body's
+//! computed once); the body's whole state stays with it ([`crate::whole`]). Each rank's residual reads only the contacts it solved (the
 //! family's sums per subdomain, [`nscdd::dd::Attached::residual_parts_in`]). A
 //! body not stepped here builds no G (its contacts' W_αα and parts are never used
 //! here), and once it has gone [`RELEASE_AFTER`] steps unstepped here its columns
@@ -113,6 +113,8 @@ pub struct Stepped {
     rank: Vec<u32>,
     /// A failure in the step in progress on this rank ([`Self::fail`]).
     failed: bool,
+    /// Which ranks hold each body's boundary current ([`crate::near`]).
+    pub near: crate::near::Near,
     /// The family's contacts over the ranks, after the exchange of a step
     /// stepped in part ([`crate::impulses::finish`]).
     total: Option<usize>,
@@ -251,6 +253,12 @@ impl Stepped {
         (self.held || self.failed || self.on.is_some()).then_some(&self.mine[..])
     }
 
+    /// [`Self::mask`] and the bodies whose boundary this rank holds current
+    /// ([`crate::near::Near::held`]).
+    pub fn masks(&self) -> crate::stage2::Masks<'_> {
+        (self.mask(), self.near.held())
+    }
+
     /// Whether this rank solves each contact of the family's list, stepped in part
     /// (after [`Self::decide`]; `None`: all of them, in one process and before the
     /// partition).
@@ -260,7 +268,7 @@ impl Stepped {
 
     /// A failure in the step on this rank after [`Self::decide`] (the assembly or
     /// factorization of a body it steps; the step's end reports it): no body is
-    /// stepped here any more and nothing of them is sent ([`Self::pack`],
+    /// stepped here any more and nothing of them is sent ([`crate::near::share`],
     /// [`crate::solved::pack_solved`]), but this rank still exchanges (empty
     /// messages) with the ranks it would have, so that none waits for it.
     pub fn fail(&mut self) {
@@ -320,50 +328,19 @@ impl Stepped {
         self.on.map(|_| (self.mine.iter().filter(|&&x| x).count(), self.mine.len()))
     }
 
-    /// The bodies this rank sends: (body, its V⁺ at its boundary nodes, its
-    /// energies after the step) each, the energies at u⁺ ([`FeBody::u_next`], the
-    /// position update's arithmetic).
-    pub fn pack(&self, bodies: &[FeBody], out: &mut Vec<f64>) {
-        let Some((rank, _)) = self.on.filter(|_| !self.failed) else {
-            return;
-        };
-        let (h, theta) = self.ht;
-        let mut u_next = Vec::new();
-        for (b, body) in bodies.iter().enumerate().filter(|(b, _)| self.sender[*b] == rank) {
-            out.push(b as f64);
-            let d = body.dim();
-            out.extend(body.mesh.boundary.iter().flat_map(|&k| &body.v[d * k as usize..d * k as usize + d]));
-            u_next.clear();
-            u_next.extend((0..body.u.len()).map(|i| body.u_next(i, h, theta)));
-            out.extend(body.energies(&u_next, &body.v));
-        }
+    /// (h, θ) of the step in progress, in part.
+    pub fn ht(&self) -> (f64, f64) {
+        self.ht
     }
 
-    /// Every rank's [`Self::pack`] (rank order): the V⁺ of the bodies not stepped
-    /// here at their boundary nodes (all that detection, the contacts and the
-    /// position update there read of them; the rest of their state is their
-    /// stepping rank's, [`crate::whole::hand_over`], [`crate::whole::gather_whole`]), every body's
-    /// energies.
-    pub fn unpack(&mut self, bodies: &mut [FeBody], all: &[f64]) {
-        self.energy.clear();
-        self.energy.resize(bodies.len(), [f64::NAN; 3]);
-        let mut i = 0;
-        while let Some(&b) = all.get(i) {
-            let Some(body) = bodies.get_mut(b as usize) else { return };
-            let (d, nb) = (body.dim(), body.mesh.boundary.len());
-            let n = d * nb;
-            let (Some(v), Some(e)) = (all.get(i + 1..i + 1 + n), all.get(i + 1 + n..i + 4 + n)) else {
-                return;
-            };
-            if !self.steps(b as usize) {
-                for (&k, x) in body.mesh.boundary.iter().zip(v.chunks_exact(d)) {
-                    body.v[d * k as usize..d * k as usize + d].copy_from_slice(x);
-                }
-            }
-            self.energy[b as usize] = [e[0], e[1], e[2]];
-            i += 4 + n;
-        }
+    /// After the bodies' V⁺ were shared ([`crate::near::share`]): every body's
+    /// energies after the step, as their stepping ranks computed them (on rank 0;
+    /// elsewhere those of the bodies stepped here), and the contacts over the
+    /// ranks (on rank 0; elsewhere this rank's).
+    pub fn after_share(&mut self, energy: Vec<[f64; 3]>, total: usize) {
+        self.energy = energy;
         self.energy_known = true;
+        self.total = Some(total);
     }
 
     /// The last step's stepping rank of body `b` (`None`: the state was whole on
@@ -383,19 +360,14 @@ impl Stepped {
         self.sender.get(b).copied()
     }
 
-    /// The family's contacts over the ranks (the history's count), after the
-    /// exchange of a step stepped in part.
+    /// The family's contacts over the ranks (the history's count, on rank 0),
+    /// after the exchange of a step stepped in part.
     pub fn contacts_total(&self) -> Option<usize> {
         self.total
     }
 
-    /// [`Self::contacts_total`], from the exchange.
-    pub fn set_contacts_total(&mut self, n: usize) {
-        self.total = Some(n);
-    }
-
     /// Every body's energies after the step, as their senders computed them
-    /// ([`Self::pack`]); `None` unless the step in progress was stepped in part and
+    /// ([`Self::after_share`]; on rank 0); `None` unless the step in progress was stepped in part and
     /// exchanged.
     pub fn energies(&self) -> Option<&[[f64; 3]]> {
         self.energy_known.then_some(&self.energy[..])
@@ -473,6 +445,12 @@ impl nscdd::dd::Rounds for AllRanks<'_> {
         (0..peers.len())
             .map(|i| r.get_mut(i).map(std::mem::take).unwrap_or_default())
             .collect()
+    }
+    /// (`replies[r]`: what rank r sends, if not empty)
+    fn send(&self, to: Vec<(u32, Vec<f64>)>) -> Vec<(u32, Vec<f64>)> {
+        self.sent.borrow_mut().push(to.into_iter().unzip());
+        let got = std::mem::take(&mut *self.replies.borrow_mut());
+        (0..).zip(got).filter(|x| !x.1.is_empty()).collect()
     }
 }
 

@@ -18,9 +18,10 @@ use std::collections::BTreeMap;
 
 /// After [`Stepped::decide`] in part: a body whose stepping rank changed gets its
 /// whole state (u, V) from the rank that stepped it in the last step (the only
-/// one holding it whole since, [`Stepped::unpack`]), with the last step's
-/// impulses of its contacts ([`crate::warm`]), point to point.
-pub fn hand_over<const N: usize>(st: &Stepped, bodies: &mut [FeBody], warm: &mut Warm<N>, rounds: &dyn nscdd::dd::Rounds) {
+/// one holding it whole since, [`crate::near::share`]), with the last step's
+/// impulses of its contacts ([`crate::warm`]) and the ranks holding its boundary
+/// current ([`crate::near::Near::holders`]), point to point.
+pub fn hand_over<const N: usize>(st: &mut Stepped, bodies: &mut [FeBody], warm: &mut Warm<N>, rounds: &dyn nscdd::dd::Rounds) {
     let Some(me) = st.rank_here() else { return };
     let moved = |b: &usize| st.prev_sender(*b).is_some_and(|p| Some(p) != st.sender_of(*b));
     let (mut to, mut front): (BTreeMap<u32, Vec<f64>>, BTreeMap<u32, Vec<f64>>) = Default::default();
@@ -30,6 +31,10 @@ pub fn hand_over<const N: usize>(st: &Stepped, bodies: &mut [FeBody], warm: &mut
         if p == me {
             let m = to.entry(q).or_default();
             m.push(b as f64);
+            // (its holders: their count, −1 for every rank)
+            let held = st.near.holders(b);
+            m.push(held.map_or(-1.0, |h| h.len() as f64));
+            m.extend(held.unwrap_or_default().iter().map(|&r| f64::from(r)));
             m.extend(bodies[b].u.iter().chain(&bodies[b].v));
             warm.pack_body(b as u32, |_| true, front.entry(q).or_default());
         } else if q == me {
@@ -37,10 +42,22 @@ pub fn hand_over<const N: usize>(st: &Stepped, bodies: &mut [FeBody], warm: &mut
         }
     }
     crate::warm::with_front(&mut to, front);
-    for (_, m) in crate::solved::exchange_with(rounds, to) {
-        let (got, m) = crate::warm::split_front(&m);
+    let n = bodies.len();
+    for (from, m) in crate::solved::exchange_with(rounds, to) {
+        let (got, mut m) = crate::warm::split_front(&m);
         warm.add(got);
-        take_whole(bodies, m, |b| st.sender_of(b) == Some(me));
+        while let (Some(&b), Some(&k)) = (m.first(), m.get(1)) {
+            let (k, len) = (k.max(0.0) as usize, bodies.get(b as usize).map_or(0, |x| 2 * x.u.len()));
+            let (Some(held), Some(x)) = (m.get(2..2 + k), m.get(2 + k..2 + k + len)) else {
+                break;
+            };
+            if st.sender_of(b as usize) == Some(me) {
+                take_whole(bodies, b as usize, x);
+                let held = (m[1] >= 0.0).then(|| held.iter().map(|&r| r as u32).collect());
+                st.near.take_holders(n, b as usize, from, held);
+            }
+            m = &m[2 + k + len..];
+        }
     }
 }
 
@@ -59,8 +76,14 @@ pub fn gather_whole(st: &Stepped, bodies: &mut [FeBody], rounds: &dyn nscdd::dd:
             (vec![0], vec![m])
         }
     };
-    for m in rounds.exchange(&peers, &out) {
-        take_whole(bodies, &m, |_| me == 0);
+    for m in rounds.exchange(&peers, &out).iter().filter(|_| me == 0) {
+        let mut i = 0;
+        while let Some(&b) = m.get(i) {
+            let len = bodies.get(b as usize).map_or(0, |x| 2 * x.u.len());
+            let Some(x) = m.get(i + 1..i + 1 + len) else { return };
+            take_whole(bodies, b as usize, x);
+            i += 1 + len;
+        }
     }
 }
 
@@ -98,42 +121,39 @@ pub fn gather_contacts<const N: usize>(
     })
 }
 
-/// Bodies' whole states (body, u, V each) into `bodies`, those `take` says.
-fn take_whole(bodies: &mut [FeBody], m: &[f64], take: impl Fn(usize) -> bool) {
-    let mut i = 0;
-    while let Some(&b) = m.get(i) {
-        let Some(body) = bodies.get_mut(b as usize) else { return };
-        let n = body.u.len();
-        let Some(x) = m.get(i + 1..i + 1 + 2 * n) else { return };
-        if take(b as usize) {
-            body.u.copy_from_slice(&x[..n]);
-            body.v.copy_from_slice(&x[n..]);
-        }
-        i += 1 + 2 * n;
+/// Body `b`'s whole state (u, V: `x`) into `bodies`.
+fn take_whole(bodies: &mut [FeBody], b: usize, x: &[f64]) {
+    let Some(body) = bodies.get_mut(b) else { return };
+    let n = body.u.len();
+    if x.len() == 2 * n {
+        body.u.copy_from_slice(&x[..n]);
+        body.v.copy_from_slice(&x[n..]);
     }
+}
+
+/// A square of four triangles around an interior node (node 4), without M and K
+/// (unit tests).
+#[cfg(test)]
+pub(crate) fn square() -> FeBody {
+    let raw = crate::python::RawMesh {
+        dim: 2,
+        points: vec![0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0, 0.5, 0.5],
+        cells: vec![0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4],
+    };
+    let el = crate::body::Elastic {
+        young: 1e6,
+        poisson: 0.3,
+        density: 1e3,
+        plane_stress: false,
+        rayleigh: [0.0; 2],
+    };
+    FeBody::light(None, crate::mesh::Mesh::new(raw).unwrap(), el, 0)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::stepped::AllRanks;
-
-    /// A square of four triangles around an interior node (node 4).
-    fn square() -> FeBody {
-        let raw = crate::python::RawMesh {
-            dim: 2,
-            points: vec![0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0, 0.5, 0.5],
-            cells: vec![0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4],
-        };
-        let el = crate::body::Elastic {
-            young: 1e6,
-            poisson: 0.3,
-            density: 1e3,
-            plane_stress: false,
-            rayleigh: [0.0; 2],
-        };
-        FeBody::light(None, crate::mesh::Mesh::new(raw).unwrap(), el, 0)
-    }
 
     /// A body stepped by rank 0, then by rank 1, seen from rank 1: it takes the
     /// body's V⁺ at its boundary only, then its whole state from rank 0 when it
@@ -152,15 +172,16 @@ mod tests {
         decide(&mut s1, 1);
         // the first step after a load: the state is whole everywhere, nothing handed over
         let (mut w0, mut w1) = (Warm::<2>::default(), Warm::<2>::default());
-        hand_over(&s1, &mut bodies, &mut w1, &rounds);
+        hand_over(&mut s1, &mut bodies, &mut w1, &rounds);
         assert_eq!(rounds.sent.borrow().last(), Some(&(vec![], vec![])));
-        // rank 0's V⁺ at the four boundary nodes, and the energies
-        let mut msg = vec![0.0];
+        // rank 0's V⁺ at the four boundary nodes (to every rank: no cells given)
+        let mut msg = vec![0.0, 0.0];
         msg.extend((1..=8).map(f64::from));
-        msg.extend([0.5, 0.25, 0.0]);
-        s1.unpack(&mut bodies, &msg);
+        *rounds.replies.borrow_mut() = vec![msg];
+        crate::near::share(&mut s1, &mut bodies, (0, 0.1), None, &rounds);
         assert_eq!(bodies[0].v, [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 0.0, 0.0]);
-        assert_eq!(s1.energies(), Some(&[[0.5, 0.25, 0.0]][..]));
+        // (rank 1 steps nothing: rank 0 gets its count of contacts, no energies)
+        assert_eq!(rounds.sent.borrow().last(), Some(&(vec![0], vec![vec![0.0, 0.0]])));
         // the contact moves to rank 1: rank 0 sends the whole state, rank 1 takes it
         on_rank.set(1);
         decide(&mut s0, 0);
@@ -171,15 +192,16 @@ mod tests {
         bodies[0].v.copy_from_slice(&whole[10..]);
         // (with the last step's impulse of its contact at node 2, [`crate::warm`])
         w0.set([((0, 2, 5, 0), [0.5, 0.25])].into_iter());
-        hand_over(&s0, &mut bodies, &mut w0, &rounds);
+        hand_over(&mut s0, &mut bodies, &mut w0, &rounds);
         let mut expect = vec![0.0];
         expect.extend(&whole);
-        let mut handed = vec![6.0, 0.0, 2.0, 5.0, 0.0, 0.5, 0.25];
-        handed.extend(&expect);
+        // (the body, its holders: −1, every rank; its state)
+        let mut handed = vec![6.0, 0.0, 2.0, 5.0, 0.0, 0.5, 0.25, 0.0, -1.0];
+        handed.extend(&whole);
         assert_eq!(rounds.sent.borrow().last(), Some(&(vec![1], vec![handed.clone()])));
         let mut got = vec![square()];
         *rounds.replies.borrow_mut() = vec![handed];
-        hand_over(&s1, &mut got, &mut w1, &rounds);
+        hand_over(&mut s1, &mut got, &mut w1, &rounds);
         assert_eq!(rounds.sent.borrow().last(), Some(&(vec![0], vec![vec![0.0]])));
         assert_eq!((&got[0].u[..], &got[0].v[..]), (&whole[..10], &whole[10..]));
         assert_eq!(w1.r_of(&(0, 2, 5, 0)), [0.5, 0.25]);

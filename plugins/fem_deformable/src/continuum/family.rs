@@ -104,7 +104,7 @@ impl<D: Dim, const N: usize> Continuum<D, N> {
                 set.g.clear();
             }
         }
-        crate::stage2::free_velocities(&mut self.bodies, w.time.h, w.time.theta, None)?;
+        crate::stage2::free_velocities(&mut self.bodies, w.time.h, w.time.theta, (None, None))?;
         let begin = w.velocity_begin();
         self.grain_begin.clear();
         self.grain_free.clear();
