@@ -17,7 +17,8 @@ use mpi_common::*;
 /// against `family_bodies` in `ranks.json`: `body_steps`, every step stepped in
 /// part), and each deformable contact held by one rank a step (`family_contacts`,
 /// against the one-process history), detected by fewer than every rank
-/// (`family_detected`). The ranks run with the environment `env`;
+/// (`family_detected`), each body held current by the ranks near it only
+/// (`family_bodies_near`). The ranks run with the environment `env`;
 /// their outputs are in
 /// `{tag}_ranks{n}`. Returns the one-process `final.json`.
 fn stepped_on_ranks(
@@ -50,6 +51,15 @@ fn stepped_on_ranks(
         assert!(
             all.iter().all(|&a| a == body_steps) && stepped.iter().sum::<u64>() == body_steps,
             "{tag}, {n} ranks: deformable bodies stepped {stepped:?} of {all:?}"
+        );
+        // each body's boundary held current where the next detection reads it
+        // (`fem_deformable::near`): by every rank stepping it, by every rank at most
+        let near = per_rank_count(&out, "family_bodies_near");
+        // (and not by every rank: some ranks' cells are far from some bodies)
+        let fewer = near.iter().sum::<u64>() < n as u64 * body_steps;
+        assert!(
+            near.iter().zip(&stepped).all(|(&h, &s)| s <= h && h <= body_steps) && fewer,
+            "{tag}, {n} ranks: deformable bodies held current {near:?}, stepped {stepped:?}"
         );
         // each contact held by one rank a step, the one solving it
         // (`Attached::keep_own`)

@@ -284,6 +284,11 @@ pub trait Attached<F: Family> {
     fn built_bodies(&self) -> Option<usize> {
         None
     }
+    /// After [`Self::share_stepped`]: its bodies whose state this rank holds
+    /// current for its next detection (`ranks.json`; `None`: every body).
+    fn near_bodies(&self) -> Option<usize> {
+        None
+    }
 }
 
 /// The world bodies that `fams` read or touch ([`Attached::held_everywhere`]),

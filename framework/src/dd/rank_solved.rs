@@ -105,6 +105,7 @@ pub(super) fn share_stepped<D: Family>(
             rs.totals.family_bodies += n as u64;
         }
         rs.totals.family_bodies_built += fam.built_bodies().unwrap_or(0) as u64;
+        rs.totals.family_bodies_near += fam.near_bodies().or(fam.stepped_bodies().map(|x| x.1)).unwrap_or(0) as u64;
     }
 }
 

@@ -26,9 +26,12 @@ use super::ranks::RankState;
 /// families' contacts it held, summed over the steps (`family_contacts`: each
 /// rank its own with contacts held per rank, [`super::Attached::keep_own`]), and
 /// those its families' detection found (`family_detected`: between repartitions
-/// a rank's own, [`super::Attached::after_free_velocity_own`]).
+/// a rank's own, [`super::Attached::after_free_velocity_own`]), and the
+/// families' bodies whose boundary it held current after each step
+/// (`family_bodies_near`: with detection per rank the bodies near its cells,
+/// [`super::Attached::near_bodies`]).
 pub fn totals_json(st: &mut RankState) -> String {
-    const H: usize = 28;
+    const H: usize = 29;
     let p = st.cluster.size() as usize;
     let t = &st.totals;
     let (wait_wall, wait_cpu) = st.cluster.waited();
@@ -62,6 +65,7 @@ pub fn totals_json(st: &mut RankState) -> String {
         t.family_bodies_built as f64,
         t.family_contacts as f64,
         t.family_detected as f64,
+        t.family_bodies_near as f64,
         t.peers.len() as f64,
     ];
     mine.extend(t.peers.iter().map(|&x| x as f64));
@@ -104,6 +108,7 @@ pub fn totals_json(st: &mut RankState) -> String {
                 "family_bodies_built": x[24] as u64,
                 "family_contacts": x[25] as u64,
                 "family_detected": x[26] as u64,
+                "family_bodies_near": x[27] as u64,
                 "peers": peers,
                 "last_subdomains": subs,
             })

@@ -110,6 +110,9 @@ pub struct RankTotals {
     /// The attached families' contacts their detection found on this rank,
     /// summed over the steps ([`super::Attached::after_free_velocity_own`]).
     pub family_detected: u64,
+    /// The attached families' bodies whose boundary this rank held current after
+    /// each step stepped in part ([`super::Attached::near_bodies`]).
+    pub family_bodies_near: u64,
 }
 
 /// The multi-process state of an NSCDD solver.

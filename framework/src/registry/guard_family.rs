@@ -179,6 +179,9 @@ impl<D: Dim> Attached<Rigid<D>> for GuardedFamily<D> {
     fn after_free_velocity_own(&mut self, w: &World<D>, own: &crate::dd::OwnCells<'_>) -> bool {
         self.guard.call(|| self.inner.after_free_velocity_own(w, own))
     }
+    fn near_bodies(&self) -> Option<usize> {
+        self.guard.call(|| self.inner.near_bodies())
+    }
     fn stepped_bodies(&self) -> Option<(usize, usize)> {
         self.guard.call(|| self.inner.stepped_bodies())
     }

@@ -288,6 +288,9 @@ impl Attached<Rigid2> for Deformables2 {
     fn built_bodies(&self) -> Option<usize> {
         self.stepped.built(&self.bodies)
     }
+    fn near_bodies(&self) -> Option<usize> {
+        self.stepped.near.held().map(|h| h.iter().filter(|&&x| x).count())
+    }
 }
 
 impl FePart2 {

@@ -292,4 +292,7 @@ impl Attached<Rigid3> for Deformables3 {
     fn built_bodies(&self) -> Option<usize> {
         self.stepped.built(&self.bodies)
     }
+    fn near_bodies(&self) -> Option<usize> {
+        self.stepped.near.held().map(|h| h.iter().filter(|&&x| x).count())
+    }
 }

@@ -232,7 +232,7 @@ pub fn unpack_solved<const D: usize>(stepped: &Stepped, sets: &mut [NodeSet<D>],
 /// The bodies stepped here whose contacts other ranks solve too: their contact
 /// nodes, free velocity there and the rows of G asked for, to those ranks
 /// ([`pack_solved`]), after the last step's impulses of their contacts at the
-/// nodes asked for (their warm starts, [`crate::warm`]); the same of the bodies
+/// nodes asked for and on their faces (their warm starts, [`crate::warm`]); the same of the bodies
 /// stepped elsewhere whose contacts this rank solves, from their stepping ranks
 /// ([`unpack_solved`]). One point-to-point round.
 pub fn share_columns<const D: usize>(st: &Stepped, (sets, warm): (&mut [NodeSet<D>], &mut Warm<D>), asked: &Asked, rounds: &dyn Rounds) {
@@ -244,7 +244,9 @@ pub fn share_columns<const D: usize>(st: &Stepped, (sets, warm): (&mut [NodeSet<
             if st.sends(b as usize) {
                 let at = asked.binary_search_by_key(&(b, r), |x| (x.0, x.1));
                 let nodes = at.map_or(&[][..], |p| &asked[p].2[..]);
-                warm.pack_body(b, |k| nodes.binary_search(&k).is_ok(), m);
+                // (a 3D face candidate's, `1 << 31 |` its face, always: its nodes are
+                // not named; the receiver finds what it solves by key)
+                warm.pack_body(b, |k| k & 1 << 31 != 0 || nodes.binary_search(&k).is_ok(), m);
             }
         });
         crate::warm::with_front(&mut to, front);
