@@ -197,7 +197,7 @@ impl FeBody {
         self.mesh.dim
     }
     pub fn n_dofs(&self) -> usize {
-        self.u.len()
+        self.mesh.x0.len()
     }
     /// Nonzeros of M̂ (both triangles).
     pub fn nnz(&self) -> usize {
@@ -367,6 +367,25 @@ impl FeBody {
             .iter()
             .zip(w)
             .any(|(&k, &wq)| wq != 0.0 && (0..d).any(|c| n[c] != 0.0 && !self.fixed[d * k as usize + c]))
+    }
+
+    /// Drops the state u, V, V⁻ and V_free (a body whose boundary an MPI rank
+    /// holds stale, [`crate::near`]): its mesh, material and matrices stay.
+    pub fn release_state(&mut self) {
+        for x in [&mut self.u, &mut self.v, &mut self.v_begin, &mut self.v_free] {
+            *x = Vec::new();
+        }
+    }
+
+    /// The state made again where released ([`Self::release_state`]), at zero: a
+    /// body whose boundary or whole state an MPI rank receives.
+    pub fn ensure_state(&mut self) {
+        let n = self.n_dofs();
+        for x in [&mut self.u, &mut self.v, &mut self.v_begin, &mut self.v_free] {
+            if x.len() != n {
+                *x = vec![0.0; n];
+            }
+        }
     }
 
     /// Drops every cached column and their memory (a body this MPI rank no longer

@@ -183,7 +183,7 @@ fn load<C: Copy, A: Copy, F: Copy, B: Copy, const N: usize>(
         ));
     }
     for (i, (b, sb)) in bodies.iter().zip(&s.bodies).enumerate() {
-        let n = b.u.len();
+        let n = b.n_dofs();
         if sb.displacement.len() != n || sb.velocity.len() != n {
             return Err(format!(
                 "deformable body {i} has {n} degrees of freedom in the scene, {} in the state: a restart needs the scene that wrote it",
@@ -198,6 +198,7 @@ fn load<C: Copy, A: Copy, F: Copy, B: Copy, const N: usize>(
         return Err(format!("contact {k}: the impulse must be {N} finite numbers"));
     }
     for (b, sb) in bodies.iter_mut().zip(s.bodies) {
+        b.ensure_state();
         b.u = sb.displacement;
         b.v = sb.velocity;
     }

@@ -9,9 +9,12 @@
 //! its boundary only to the ranks whose cells (of the step's grid: the next
 //! detection's) that box meets, at the positions of the next step (u⁺,
 //! [`FeBody::u_next`], the position update's arithmetic) ([`share`]); a rank
-//! receiving nothing of a body marks it stale and leaves it out of its detection
-//! and position update ([`Near::held`]). A rank that held a body stale gets its
-//! boundary's u and V⁻ with its V⁺, so the stepping rank keeps, per body, the
+//! receiving nothing of a body marks it stale, leaves it out of its detection
+//! and position update ([`Near::held`]) and drops its state (u, V, V⁻, V_free:
+//! [`FeBody::release_state`]; its mesh, material and matrices stay). A rank that
+//! held a body stale gets its boundary's u and V⁻ with its V⁺ (its interior left
+//! at zero: only the rank stepping a body holds it whole, [`crate::whole`]), so
+//! the stepping rank keeps, per body, the
 //! ranks holding it current ([`Near`]; handed over with the body's whole state,
 //! [`crate::whole::hand_over`]). On a repartition step the last stepping rank
 //! sends the boundary (u, V) to the ranks whose new cells the box meets and
@@ -200,6 +203,11 @@ pub fn share(st: &mut Stepped, bodies: &mut [FeBody], (contacts, alert): (usize,
             let stale = m[i + 1] != 0.0;
             let len = d * nb * if stale { 3 } else { 1 };
             let x = &m[i + 2..i + 2 + len];
+            debug_assert!(
+                stale || body.u.len() == body.n_dofs(),
+                "body {b}'s V⁺ alone, its state not held here"
+            );
+            body.ensure_state();
             let bd = &body.mesh.boundary;
             if stale {
                 set_boundary(d, bd, &mut body.u, &x[..d * nb]);
@@ -209,6 +217,10 @@ pub fn share(st: &mut Stepped, bodies: &mut [FeBody], (contacts, alert): (usize,
             here[b] = true;
             i += 2 + len;
         }
+    }
+    // (what a rank holds of a body stale: its mesh, material and matrices)
+    for (b, _) in here.iter().enumerate().filter(|x| !*x.1) {
+        bodies[b].release_state();
     }
     st.near.here = here;
     st.after_share(energy, total);
@@ -246,6 +258,7 @@ pub fn new_cells(st: &mut Stepped, bodies: &mut [FeBody], alert: f64, cells: &Ra
             let body = &mut bodies[b];
             let (d, nb) = (body.dim(), body.mesh.boundary.len());
             let x = &m[i + 1..i + 1 + 2 * d * nb];
+            body.ensure_state();
             set_boundary(d, &body.mesh.boundary, &mut body.u, &x[..d * nb]);
             set_boundary(d, &body.mesh.boundary, &mut body.v, &x[d * nb..]);
             st.near.here[b] = true;
@@ -316,6 +329,7 @@ mod tests {
         let mut at2 = vec![square()];
         share(&mut s2, &mut at2, (0, 0.1), Some(&cells(2)), &rounds);
         assert_eq!(s2.near.held(), Some(&[false][..]));
+        assert!(at2[0].u.is_empty() && at2[0].v.is_empty(), "its state dropped there");
         assert_eq!(rounds.sent.borrow().last().cloned().unwrap(), (vec![0], vec![vec![0.0, 0.0]]));
         // moved to 1.5 ≤ x ≤ 2.5: rank 1 holds it, rank 2 gets u and V⁻ too
         (0..5).for_each(|k| bodies[0].u[2 * k] = 1.5);

@@ -157,13 +157,13 @@ pub fn spec_of(i: usize, e: &toml::Table) -> Result<DeformableSpec, EntryError> 
 
 /// Builds the deformable bodies of a scene's `[[deformable]]` entries, factored
 /// for the scene's h and θ (mesh files are relative to the scene's folder). Loaded
-/// for a run on P MPI ranks (`cx.ranks`), rank r assembles and factors, of the
-/// large bodies ([`crate::stepped::RELEASE_MIN_BYTES`]), only the bodies i with
-/// ⌊i P / N⌋ = r (N bodies: a contiguous share, as the subdomains of a rank are),
-/// to check them; it holds every body's mesh and state, and assembles and factors
-/// a large body (the same numbers) when it first steps it ([`crate::stepped`]: a
-/// large body it does not step is dropped, factors first). No rank assembles
-/// every large body at load, nor holds every large body's matrices; a large
+/// for a run on P MPI ranks (`cx.ranks`), rank r assembles and factors only the
+/// bodies i with ⌊i P / N⌋ = r (N bodies: a contiguous share, as the subdomains
+/// of a rank are), to check them; it holds every body's mesh and state, and
+/// assembles and factors a body (the same numbers) when it first steps it
+/// ([`crate::stepped`]: a large body, [`crate::stepped::RELEASE_MIN_BYTES`], it
+/// does not step is dropped, factors first; a smaller one is kept once made).
+/// No rank assembles every body at load, nor holds every body's matrices; a
 /// body's error is reported by the rank that checks it.
 pub fn bodies_from<D: nscdd::dim::Dim>(
     entries: &[toml::Table],
@@ -197,8 +197,8 @@ pub fn bodies_from<D: nscdd::dim::Dim>(
         if large {
             b.allow_release();
         }
-        // (a large body on ranks: assembled by the rank checking it only)
-        if !large || cx.ranks.is_none_or(|(me, p)| checked_by(i, entries.len(), p) == me) {
+        // (on ranks: assembled by the rank checking it only)
+        if cx.ranks.is_none_or(|(me, p)| checked_by(i, entries.len(), p) == me) {
             b.ensure_matrices().map_err(|m| at("mesh", m))?;
             b.factorize(time.h, time.theta).map_err(|m| at("", m))?;
         }

@@ -47,7 +47,7 @@ pub fn hand_over<const N: usize>(st: &mut Stepped, bodies: &mut [FeBody], warm: 
         let (got, mut m) = crate::warm::split_front(&m);
         warm.add(got);
         while let (Some(&b), Some(&k)) = (m.first(), m.get(1)) {
-            let (k, len) = (k.max(0.0) as usize, bodies.get(b as usize).map_or(0, |x| 2 * x.u.len()));
+            let (k, len) = (k.max(0.0) as usize, bodies.get(b as usize).map_or(0, |x| 2 * x.n_dofs()));
             let (Some(held), Some(x)) = (m.get(2..2 + k), m.get(2 + k..2 + k + len)) else {
                 break;
             };
@@ -79,7 +79,7 @@ pub fn gather_whole(st: &Stepped, bodies: &mut [FeBody], rounds: &dyn nscdd::dd:
     for m in rounds.exchange(&peers, &out).iter().filter(|_| me == 0) {
         let mut i = 0;
         while let Some(&b) = m.get(i) {
-            let len = bodies.get(b as usize).map_or(0, |x| 2 * x.u.len());
+            let len = bodies.get(b as usize).map_or(0, |x| 2 * x.n_dofs());
             let Some(x) = m.get(i + 1..i + 1 + len) else { return };
             take_whole(bodies, b as usize, x);
             i += 1 + len;
@@ -124,8 +124,9 @@ pub fn gather_contacts<const N: usize>(
 /// Body `b`'s whole state (u, V: `x`) into `bodies`.
 fn take_whole(bodies: &mut [FeBody], b: usize, x: &[f64]) {
     let Some(body) = bodies.get_mut(b) else { return };
-    let n = body.u.len();
+    let n = body.n_dofs();
     if x.len() == 2 * n {
+        body.ensure_state();
         body.u.copy_from_slice(&x[..n]);
         body.v.copy_from_slice(&x[n..]);
     }
