@@ -114,6 +114,14 @@ impl OwnCells<'_> {
     }
 }
 
+/// `f(n, lo, hi, g)`: `g` called with the rank of every cell whose box meets
+/// `[lo, hi]` ([`RankCells::meeting`]).
+pub type Meeting<'m> = dyn Fn(usize, &[f64], &[f64], &mut dyn FnMut(u32)) + 'm;
+
+/// Which families are stepped in part this step, and every rank's cells of the
+/// next detection of those detecting in each rank's cells.
+pub(super) type SteppedOn<'a> = (&'a [bool], &'a [Option<super::cells::CellIndex>]);
+
 /// Every rank's cells of a family's subdomains in a step's grid (edge cells
 /// unbounded, each grown by 10⁻⁶ of a cell, as [`OwnCells`]' boxes): which ranks
 /// detect where ([`Attached::share_stepped`], [`Attached::new_cells`]).
@@ -121,7 +129,7 @@ pub struct RankCells<'a> {
     /// `meeting(n, lo, hi, f)` calls `f` with the rank of every cell whose box
     /// meets `[lo, hi]` (first `n` coordinates; a rank once per cell, so maybe
     /// several times).
-    pub meeting: &'a dyn Fn(usize, &[f64], &[f64], &mut dyn FnMut(u32)),
+    pub meeting: &'a Meeting<'a>,
     /// This rank and the number of ranks.
     pub rank: u32,
     pub ranks: u32,
@@ -355,11 +363,7 @@ impl<F: Family> std::fmt::Debug for Parts<F> {
 pub(super) fn write_back_families<D: Family>(
     d: &super::partition::Decomposition<D>,
     w: &mut D::World,
-    (fams, stepped, owner): (
-        &mut [&mut dyn Attached<D>],
-        (&[bool], &[Option<super::cells::CellIndex>]),
-        &[Vec<u32>],
-    ),
+    (fams, stepped, owner): (&mut [&mut dyn Attached<D>], SteppedOn<'_>, &[Vec<u32>]),
     mut ranks: Option<&mut super::ranks::RankState>,
 ) -> f64 {
     for (f, fam) in fams.iter_mut().enumerate() {

@@ -7,8 +7,7 @@
 //! computed ([`Attached::share_stepped`], the family's rounds), so that what its
 //! residual, outputs and position update read is the same on every rank again.
 
-use super::attach::{with_cells, Attached};
-use super::cells::CellIndex;
+use super::attach::{with_cells, Attached, SteppedOn};
 use super::family::Family;
 use super::ranks::RankState;
 
@@ -88,11 +87,7 @@ impl Rounds for RankRounds<'_> {
 /// After the families' write-back: each family stepped in part (`on`) runs its
 /// rounds ([`Attached::share_stepped`], with every rank's cells of its next
 /// detection, `cells`; collective: `on` is the same on every rank).
-pub(super) fn share_stepped<D: Family>(
-    fams: &mut [&mut dyn Attached<D>],
-    (on, cells): (&[bool], &[Option<CellIndex>]),
-    mut ranks: Option<&mut RankState>,
-) {
+pub(super) fn share_stepped<D: Family>(fams: &mut [&mut dyn Attached<D>], (on, cells): SteppedOn<'_>, mut ranks: Option<&mut RankState>) {
     for (f, (fam, _)) in fams.iter_mut().zip(on).enumerate().filter(|x| *x.1 .1) {
         let Some(rs) = ranks.as_deref_mut() else { return };
         let rank = (rs.cluster.rank(), rs.cluster.size());
@@ -114,7 +109,7 @@ pub(super) fn share_stepped<D: Family>(
 pub(super) fn write_back_alone<D: Family>(
     w: &mut D::World,
     fams: &mut [&mut dyn Attached<D>],
-    on: (&[bool], &[Option<CellIndex>]),
+    on: SteppedOn<'_>,
     ranks: Option<&mut RankState>,
 ) {
     for fam in fams.iter_mut() {

@@ -188,21 +188,25 @@ pub fn share(st: &mut Stepped, bodies: &mut [FeBody], (contacts, alert): (usize,
     let mut here: Vec<bool> = (0..n).map(|b| st.steps(b)).collect();
     let mut total = contacts;
     for (_, m) in rounds.send(to.into_iter().collect()) {
-        let mut i = 0;
+        let mut rest = &m[..];
         if me == 0 {
-            total += m[0] as usize;
-            for x in m[2..].chunks_exact(4).take(m[1] as usize) {
-                energy[x[0] as usize] = [x[1], x[2], x[3]];
+            // (the header: the sender's contacts, then (body, energies) of its bodies)
+            let (Some(&c), Some(&k)) = (m.first(), m.get(1)) else { continue };
+            let Some(es) = m.get(2..2 + 4 * k as usize) else { continue };
+            total += c as usize;
+            for x in es.chunks_exact(4) {
+                if let Some(e) = energy.get_mut(x[0] as usize) {
+                    *e = [x[1], x[2], x[3]];
+                }
             }
-            i = 2 + 4 * m[1] as usize;
+            rest = &m[2 + es.len()..];
         }
-        while let Some(&b) = m.get(i) {
+        while let (Some(&b), Some(&kind)) = (rest.first(), rest.get(1)) {
             let b = b as usize;
-            let body = &mut bodies[b];
-            let (d, nb) = (body.dim(), body.mesh.boundary.len());
-            let stale = m[i + 1] != 0.0;
+            let Some(body) = bodies.get_mut(b) else { break };
+            let (d, nb, stale) = (body.dim(), body.mesh.boundary.len(), kind != 0.0);
             let len = d * nb * if stale { 3 } else { 1 };
-            let x = &m[i + 2..i + 2 + len];
+            let Some(x) = rest.get(2..2 + len) else { break };
             debug_assert!(
                 stale || body.u.len() == body.n_dofs(),
                 "body {b}'s V⁺ alone, its state not held here"
@@ -215,7 +219,7 @@ pub fn share(st: &mut Stepped, bodies: &mut [FeBody], (contacts, alert): (usize,
             }
             set_boundary(d, bd, &mut body.v, &x[len - d * nb..]);
             here[b] = true;
-            i += 2 + len;
+            rest = &rest[2 + len..];
         }
     }
     // (what a rank holds of a body stale: its mesh, material and matrices)
@@ -252,17 +256,17 @@ pub fn new_cells(st: &mut Stepped, bodies: &mut [FeBody], alert: f64, cells: &Ra
         }
     }
     for (_, m) in rounds.send(to.into_iter().collect()) {
-        let mut i = 0;
-        while let Some(&b) = m.get(i) {
+        let mut rest = &m[..];
+        while let Some(&b) = rest.first() {
             let b = b as usize;
-            let body = &mut bodies[b];
+            let Some(body) = bodies.get_mut(b) else { break };
             let (d, nb) = (body.dim(), body.mesh.boundary.len());
-            let x = &m[i + 1..i + 1 + 2 * d * nb];
+            let Some(x) = rest.get(1..1 + 2 * d * nb) else { break };
             body.ensure_state();
             set_boundary(d, &body.mesh.boundary, &mut body.u, &x[..d * nb]);
             set_boundary(d, &body.mesh.boundary, &mut body.v, &x[d * nb..]);
             st.near.here[b] = true;
-            i += 1 + 2 * d * nb;
+            rest = &rest[1 + 2 * d * nb..];
         }
     }
 }
