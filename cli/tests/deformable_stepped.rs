@@ -190,16 +190,20 @@ fn bodies_dropped_where_not_stepped_give_the_same_results() {
     let s2 = write(&dir, "blocks.toml", BLOCKS);
     let soon = [("NSCDD_FE_RELEASE", "0 2 5")];
     let reference = stepped_on_ranks(&dir, "released", (&s2, 4 * 60), &[2, 4], &soon);
-    for n in [2, 4] {
+    // every body small (below 10¹² bytes): its M and K dropped only where it is far
+    // from the rank's cells (`fem_deformable::near`), after 5 idle steps
+    let far = [("NSCDD_FE_RELEASE", "1e12 2 5")];
+    assert!(stepped_on_ranks(&dir, "far", (&s2, 4 * 60), &[4], &far) == reference);
+    for (tag, n) in [("released", 2), ("released", 4), ("far", 4)] {
         // each rank held the matrices of fewer bodies than all of them, and of no
         // fewer than it stepped
-        let out = dir.join(format!("released_ranks{n}"));
+        let out = dir.join(format!("{tag}_ranks{n}"));
         let built = per_rank_count(&out, "family_bodies_built");
         let stepped = per_rank_count(&out, "family_bodies_stepped");
         let all = per_rank_count(&out, "family_bodies");
         assert!(
             built.iter().zip(&stepped).zip(&all).all(|((&b, &s), &a)| s <= b && b < a),
-            "{n} ranks: matrices held {built:?}, bodies stepped {stepped:?} of {all:?}"
+            "{tag}, {n} ranks: matrices held {built:?}, bodies stepped {stepped:?} of {all:?}"
         );
     }
     // a state of 2 ranks restarted on 3 (every body loaded light where not checked)

@@ -162,7 +162,8 @@ pub fn spec_of(i: usize, e: &toml::Table) -> Result<DeformableSpec, EntryError> 
 /// of a rank are), to check them; it holds every body's mesh and state, and
 /// assembles and factors a body (the same numbers) when it first steps it
 /// ([`crate::stepped`]: a large body, [`crate::stepped::RELEASE_MIN_BYTES`], it
-/// does not step is dropped, factors first; a smaller one is kept once made).
+/// does not step is dropped, factors first; a smaller one is kept once made,
+/// unless it is far from the rank's cells).
 /// No rank assembles every body at load, nor holds every body's matrices; a
 /// body's error is reported by the rank that checks it.
 pub fn bodies_from<D: nscdd::dim::Dim>(
@@ -193,10 +194,8 @@ pub fn bodies_from<D: nscdd::dim::Dim>(
         };
         let mut b = build_with(&spec, materials, dim, dir, &mut check, Assembly::Deferred).map_err(|(k, m)| at(k, m))?;
         b.set_gravity(&cx.world.gravity.as_ref()[..dim]);
-        let large = large(dim, b.mesh.n_nodes() as f64);
-        if large {
-            b.allow_release();
-        }
+        // (its M, K and F_ext = M g are made from its mesh, material and gravity)
+        b.allow_release();
         // (on ranks: assembled by the rank checking it only)
         if cx.ranks.is_none_or(|(me, p)| checked_by(i, entries.len(), p) == me) {
             b.ensure_matrices().map_err(|m| at("mesh", m))?;
@@ -212,6 +211,12 @@ pub fn bodies_from<D: nscdd::dim::Dim>(
 /// `NSCDD_FE_RELEASE`'s size, [`crate::stepped::release_rule`]).
 fn large(dim: usize, nodes: f64) -> bool {
     matrices_bytes(dim, nodes) >= crate::stepped::release_rule().0
+}
+
+/// Whether body `b` is large ([`large`]): a rank drops its factors and matrices
+/// when it does not step it ([`crate::stepped::Stepped::release`]).
+pub fn is_large(b: &FeBody) -> bool {
+    large(b.dim(), b.mesh.n_nodes() as f64)
 }
 
 /// The rank of `ranks` that checks body `b` of `n` at load ([`bodies_from`]) and

@@ -25,12 +25,13 @@
 //! here), and once it has gone [`RELEASE_AFTER`] steps unstepped here its columns
 //! of M̂⁻¹ and its G are dropped, with the factors of its M̂ if it is large
 //! ([`RELEASE_MIN_BYTES`]), and after [`RELEASE_MATRICES_AFTER`] a large body's
-//! M and K (memory per rank; stepped again, it assembles, factors and solves them
-//! anew, the same numbers). Loaded on ranks, a rank holds the matrices of the
-//! large bodies it checked at load only ([`crate::scene::bodies_from`]): the
-//! factors of one it does not step at the first step are dropped then (its M and
-//! K [`RELEASE_MATRICES_AFTER`] − [`RELEASE_AFTER`] steps later), and a large body
-//! it steps without them is assembled and factored there
+//! M and K, or a smaller body's if it is far from the rank's cells
+//! ([`crate::near`]) (memory per rank; stepped again, it assembles, factors and
+//! solves them anew, the same numbers). Loaded on ranks, a rank holds the
+//! matrices of the bodies it checked at load only ([`crate::scene::bodies_from`]):
+//! the factors of a large one it does not step at the first step are dropped
+//! then (its M and K [`RELEASE_MATRICES_AFTER`] − [`RELEASE_AFTER`] steps later),
+//! and a body it steps without them is assembled and factored there
 //! ([`crate::stage2::free_velocities`]).
 
 use crate::body::FeBody;
@@ -48,8 +49,10 @@ pub const RELEASE_MATRICES_AFTER: u32 = 100;
 
 /// The size of a body's M, K and factors ([`crate::scene::matrices_bytes`]'s
 /// estimate) from which a rank drops them when it does not step the body: a
-/// smaller body keeps them once made (only its columns and G are dropped), since
-/// making them again costs more time than they hold memory (docs/SCALING.md,
+/// smaller body keeps them once made (only its columns and G are dropped) unless
+/// it is also far from the rank's cells ([`crate::near`]) after
+/// [`RELEASE_MATRICES_AFTER`] steps, since making them again costs more time
+/// than they hold memory (docs/SCALING.md,
 /// "M̂'s factors, M and K held where a body is stepped": 2D bodies of fewer than
 /// about 13 000 nodes, 3D bodies of fewer than about 1 200).
 pub const RELEASE_MIN_BYTES: f64 = 16.0 * 1024.0 * 1024.0;
@@ -234,12 +237,16 @@ impl Stepped {
     }
 
     /// Drops the columns and G of [`Self::to_release`]'s bodies, and the factors of
-    /// M̂ (and M and K, as it says) of those large enough ([`FeBody::is_releasable`]:
-    /// [`RELEASE_MIN_BYTES`]).
+    /// M̂ (and M and K, as it says) of those large enough
+    /// ([`crate::scene::is_large`]: [`RELEASE_MIN_BYTES`]); a smaller body's M,
+    /// K and factors go only when it says so and the body is far from this
+    /// rank's cells ([`crate::near::Near::holds`]: held stale).
     pub fn release<const D: usize>(&self, bodies: &mut [FeBody], sets: &mut [NodeSet<D>]) {
         for &(b, matrices) in &self.release {
             let body = &mut bodies[b as usize];
-            match (body.is_releasable(), matrices) {
+            let far = !self.near.holds(b as usize);
+            match (crate::scene::is_large(body), matrices) {
+                (false, true) if far => body.release_matrices(),
                 (false, _) => body.release_columns(),
                 (true, false) => body.release_factor(),
                 (true, true) => body.release_matrices(),

@@ -123,8 +123,8 @@ fn a_released_factor_is_made_again_with_the_same_numbers() {
 /// Loaded for a run on MPI ranks (`FamilyContext::ranks`), a large body
 /// (`stepped::RELEASE_MIN_BYTES`) is assembled and factored only by the rank
 /// checking it (⌊i P / N⌋); any other rank assembles and factors it, the same
-/// numbers, when it steps it. A small body is assembled everywhere and kept; loaded
-/// for one process, every body is.
+/// numbers, when it steps it. So is a small body (kept once made); loaded for one
+/// process, every body is.
 #[test]
 fn large_bodies_loaded_on_ranks_hold_no_matrices() {
     // 131 × 101 nodes: M, K and factors of about 17 MB
@@ -152,8 +152,9 @@ fn large_bodies_loaded_on_ranks_hold_no_matrices() {
         };
         nscdd_fem_deformable::scene::bodies_from(entries, &cx).unwrap().remove(0)
     };
-    let small_on_1 = load(&small, Some((1, 2)));
-    assert!(small_on_1.is_factored() && !small_on_1.is_releasable());
+    let (small_on_0, small_on_1) = (load(&small, Some((0, 2))), load(&small, Some((1, 2))));
+    assert!(small_on_0.is_factored() && !nscdd_fem_deformable::scene::is_large(&small_on_0));
+    assert!(!small_on_1.is_factored() && !small_on_1.has_matrices());
     let mut one = load(&entries, None);
     assert!(one.is_factored() && one.has_matrices() && one.is_releasable());
     let nodes = [0u32, 3, 7, 20, 31];
