@@ -255,6 +255,13 @@ pub trait Attached<F: Family> {
     /// steps read of the bodies it does not step). The default: nothing (the state
     /// is the same on every rank).
     fn gather_whole(&mut self, _rounds: &dyn Rounds) {}
+    /// With `output.vtk` on MPI ranks: whether every rank writes the family's
+    /// frame files of what it holds whole (its `write_frame` called on every rank,
+    /// without [`Self::gather_whole`] before it; rank 0 alone writes the series).
+    /// The default: false (rank 0 writes the frames, after the gather).
+    fn frames_per_rank(&self) -> bool {
+        false
+    }
     /// On MPI ranks with contacts held per rank ([`super::local`]), each step after
     /// [`Self::build`] and [`Self::points`] (and after a repartition's new grid):
     /// `own(p)` says whether a contact point p lies in a cell of this rank's

@@ -173,6 +173,9 @@ impl<D: Dim> Attached<Rigid<D>> for GuardedFamily<D> {
     fn gather_whole(&mut self, rounds: &dyn crate::dd::Rounds) {
         self.guard.call(|| self.inner.gather_whole(rounds))
     }
+    fn frames_per_rank(&self) -> bool {
+        self.guard.call(|| self.inner.frames_per_rank())
+    }
     fn keep_own(&mut self, own: &dyn Fn([f64; 3]) -> bool) -> bool {
         self.guard.call(|| self.inner.keep_own(own))
     }

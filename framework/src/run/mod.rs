@@ -194,12 +194,15 @@ pub(crate) fn write_rank_totals<D: crate::dd::Family>(dd: &mut Option<crate::dd:
 }
 
 /// On MPI ranks, before an output reads the families' state: what rank 0 lacks of
-/// it, sent there ([`crate::dd::Attached::gather_whole`]; collective).
-pub(crate) fn gather_families<D: Dim>(dd: &mut Option<NscddOf<Rigid<D>>>, families: &mut [Box<dyn SceneFamily<D>>]) {
+/// it, sent there ([`crate::dd::Attached::gather_whole`]; collective); before a
+/// frame (`frame`), not of a family whose ranks write their own frame files
+/// ([`crate::dd::Attached::frames_per_rank`]).
+pub(crate) fn gather_families<D: Dim>(dd: &mut Option<NscddOf<Rigid<D>>>, families: &mut [Box<dyn SceneFamily<D>>], frame: bool) {
     let Some(rs) = dd.as_mut().and_then(|n| n.ranks_mut()) else {
         return;
     };
-    crate::dd::with_rounds(rs, |r| families.iter_mut().for_each(|f| f.gather_whole(r)));
+    let fams = families.iter_mut().filter(|f| !(frame && f.frames_per_rank()));
+    crate::dd::with_rounds(rs, |r| fams.for_each(|f| f.gather_whole(r)));
 }
 
 /// Writes the state on rank 0. Collective on MPI ranks (F_Γ is gathered from every
@@ -213,7 +216,7 @@ pub(crate) fn save_state<D: Dim>(
     families: &mut [Box<dyn SceneFamily<D>>],
     dd: &mut Option<NscddOf<Rigid<D>>>,
 ) -> Result<(), RunError> {
-    gather_families(dd, families);
+    gather_families(dd, families, false);
     let families = &*families;
     // bodies held per rank: every body's record from its owner; contacts held per
     // rank: every rank's, in key order

@@ -131,10 +131,14 @@ impl<D: Dim> Runner<D> {
             }
         }
         if scene.output.vtk {
-            crate::run::gather_families(&mut self.dd, &mut scene.families);
-        }
-        if self.vtk {
-            for f in scene.families.iter_mut() {
+            crate::run::gather_families(&mut self.dd, &mut scene.families, true);
+            // (rank 0, and every rank for a family whose ranks write their own files)
+            let ranks = self.dd.as_mut().and_then(|n| n.ranks_mut()).is_some();
+            for f in scene.families.iter_mut().filter(|f| self.vtk || (ranks && f.frames_per_rank())) {
+                if !self.vtk {
+                    // (the folder rank 0 makes, maybe not yet)
+                    std::fs::create_dir_all(dir)?;
+                }
                 f.write_frame(dir, self.frame, w.t)?;
             }
         }

@@ -32,7 +32,9 @@ impl FamilyKind<D2> for DeformableKind {
     fn load(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D2>) -> Result<Box<dyn SceneFamily<D2>>, EntryError> {
         let bodies = crate::scene::bodies_from(entries, cx)?;
         crate::scene::refuse_compliant(&bodies, cx.world)?;
-        Ok(Box::new(Deformables2::new(bodies, cx.world.alert)))
+        let mut fe = Deformables2::new(bodies, cx.world.alert);
+        fe.ranks = cx.ranks;
+        Ok(Box::new(fe))
     }
     fn load_boxes(
         &self,
@@ -48,7 +50,9 @@ impl FamilyKind<D3> for DeformableKind {
     fn load(&self, entries: &[toml::Table], cx: &FamilyContext<'_, D3>) -> Result<Box<dyn SceneFamily<D3>>, EntryError> {
         let bodies = crate::scene::bodies_from(entries, cx)?;
         crate::scene::refuse_compliant(&bodies, cx.world)?;
-        Ok(Box::new(Deformables3::new(bodies, cx.world.alert)))
+        let mut fe = Deformables3::new(bodies, cx.world.alert);
+        fe.ranks = cx.ranks;
+        Ok(Box::new(fe))
     }
     fn load_boxes(
         &self,
@@ -237,17 +241,16 @@ fn describe(bodies: &[FeBody]) -> String {
     format!("{n} deformable bod{} ({nodes} nodes)", if n == 1 { "y" } else { "ies" })
 }
 
-/// One VTK unstructured grid per body (`{prefix}{i}_{frame}.vtu`), the frame
-/// recorded for the `.pvd` series.
+/// One VTK unstructured grid per body (`{prefix}{i}_{frame}.vtu`) of the bodies
+/// `mine` says, the frame recorded for the `.pvd` series.
 pub(crate) fn write_frame(
     bodies: &[FeBody],
-    prefix: &str,
+    (prefix, mine): (&str, impl Fn(usize) -> bool),
     frames: &mut Vec<(f64, u32)>,
     dir: &Path,
-    frame: u32,
-    t: f64,
+    (frame, t): (u32, f64),
 ) -> std::io::Result<()> {
-    for (bi, b) in bodies.iter().enumerate() {
+    for (bi, b) in bodies.iter().enumerate().filter(|x| mine(x.0)) {
         let path = dir.join(format!("{prefix}{bi}_{frame:05}.vtu"));
         nscdd::output::write_atomic(&path, |tmp| std::fs::write(tmp, crate::output::vtu(b)))?;
     }
@@ -294,7 +297,10 @@ macro_rules! scene_family {
                 history_values(&self.bodies, self.contacts(), self.stepped.energies(), out)
             }
             fn write_frame(&mut self, dir: &Path, frame: u32, t: f64) -> std::io::Result<()> {
-                write_frame(&self.bodies, "deformable", &mut self.frames, dir, frame, t)
+                // (on MPI ranks each body by the rank holding it whole)
+                let (st, n, on) = (&self.stepped, self.bodies.len(), self.ranks);
+                let mine = |b: usize| st.writes_frame(b, n, on);
+                write_frame(&self.bodies, ("deformable", mine), &mut self.frames, dir, (frame, t))
             }
             fn finish(&mut self, dir: &Path) -> std::io::Result<()> {
                 crate::output::write_pvd(dir, self.bodies.len(), &self.frames)

@@ -78,6 +78,8 @@ pub struct Deformables2 {
     /// The last step's impulses of the contacts this rank may solve, on MPI ranks
     /// ([`crate::warm`]).
     pub warm: crate::warm::Warm<2>,
+    /// (this rank, ranks) of a run on MPI ranks, from the load.
+    pub ranks: Option<(u32, u32)>,
 }
 
 impl Deformables2 {

@@ -61,6 +61,8 @@ pub struct Deformables3 {
     /// The last step's impulses of the contacts this rank may solve, on MPI ranks
     /// ([`crate::warm`]).
     pub warm: crate::warm::Warm<3>,
+    /// (this rank, ranks) of a run on MPI ranks, from the load.
+    pub ranks: Option<(u32, u32)>,
 }
 
 /// The rigid bodies' M̂⁻¹ as the sweep reads them.

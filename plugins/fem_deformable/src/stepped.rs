@@ -350,6 +350,18 @@ impl Stepped {
         self.total = Some(total);
     }
 
+    /// Whether this rank writes body `b`'s frame files (of `n` bodies; `loaded`:
+    /// (this rank, ranks) of a run on MPI ranks): the rank that stepped it last,
+    /// which holds it whole, or before any step the rank that checked it at load
+    /// (every rank holds it whole then); in one process, every body.
+    pub fn writes_frame(&self, b: usize, n: usize, loaded: Option<(u32, u32)>) -> bool {
+        let Some((me, p)) = loaded else { return true };
+        match self.sender_of(b).filter(|_| self.on.is_some()) {
+            Some(s) => s == me,
+            None => crate::scene::checked_by(b, n, p) == me,
+        }
+    }
+
     /// The last step's stepping rank of body `b` (`None`: the state was whole on
     /// every rank, as after a load).
     pub fn prev_sender(&self, b: usize) -> Option<u32> {

@@ -555,7 +555,7 @@ impl<D: Dim, const N: usize> SceneFamily<D> for Continuum<D, N> {
         }
     }
     fn write_frame(&mut self, dir: &Path, frame: u32, t: f64) -> std::io::Result<()> {
-        crate::family::write_frame(&self.bodies, "continuum", &mut self.frames, dir, frame, t)
+        crate::family::write_frame(&self.bodies, ("continuum", |_| true), &mut self.frames, dir, (frame, t))
     }
     fn finish(&mut self, dir: &Path) -> std::io::Result<()> {
         crate::output::write_series(dir, "continuum", self.bodies.len(), &self.frames)
