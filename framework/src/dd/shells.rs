@@ -160,19 +160,22 @@ impl RankState {
         let (got, _) = self.route(own.into_iter(), near, (false, &from), |s, l, g, o| {
             o.extend([f64::from(s.id), l as f64, f64::from(g)]);
         });
+        // (another rank's limited shells only: its messages name no other; each
+        // family copy there by (subdomain, body))
+        let limited = |s: &Subdomain<D>| s.limited_shell && s.shell_local.len() == s.body_global.len();
+        let mut at: std::collections::HashMap<(u32, u32), usize> = Default::default();
+        for s in subs.iter().filter(|s| limited(s)) {
+            let f = from(s).min(s.body_global.len());
+            at.extend((f..s.body_global.len()).map(|k| ((s.id, s.body_global[k]), k)));
+        }
         let mut added = Vec::new();
         for x in got.iter().flat_map(|m| m.chunks_exact(3)) {
             let (s, l, g) = (x[0] as u32, x[1] as u32, x[2] as u32);
-            // (another rank's limited shell only: its messages name no other)
-            let (Some(sub), Some(&f)) = (subs.get_mut(s as usize), first.get(s as usize)) else {
+            let Some(sub) = subs.get_mut(s as usize).filter(|sub| limited(sub)) else {
                 continue;
             };
-            if !sub.limited_shell || sub.shell_local.len() != sub.body_global.len() {
-                continue;
-            }
-            let f = (f as usize).min(sub.body_global.len());
-            match sub.body_global[f..].iter().position(|&b| b == g) {
-                Some(k) => sub.shell_local[f + k] = l,
+            match at.get(&(s, g)) {
+                Some(&k) => sub.shell_local[k] = l,
                 None => {
                     added.push((g, s, sub.body_global.len() as u32));
                     sub.body_global.push(g);
