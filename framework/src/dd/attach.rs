@@ -236,9 +236,9 @@ pub trait Attached<F: Family> {
     /// After [`Self::write_back`] of a step [`Self::solved_on`] returned true for,
     /// on every rank (collective): the family's rounds that finish the step (the
     /// deformable bodies: the impulses of a body's contacts solved elsewhere to the
-    /// rank stepping it, its V⁺ computed there and sent at its boundary), after
-    /// which what the family's residual, outputs and position update read is the
-    /// same on every rank. `next`: every rank's cells in which the family's next
+    /// rank stepping it, its V⁺ computed there and sent at its boundary to the
+    /// ranks that read it), after which what the family's residual and position
+    /// update read on each rank is what one process reads there. `next`: every rank's cells in which the family's next
     /// detection runs when it detects in each rank's cells
     /// ([`Self::after_free_velocity_own`], this step's grid, decentralized scheme),
     /// so that a rank needs only what reaches its cells; `None`: the next detection

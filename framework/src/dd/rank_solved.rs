@@ -5,7 +5,8 @@
 //! that uses it does the work of its contacts' bodies on the ranks solving them
 //! only, and after its [`Attached::write_back`] the ranks exchange what each
 //! computed ([`Attached::share_stepped`], the family's rounds), so that what its
-//! residual, outputs and position update read is the same on every rank again.
+//! residual and position update read on each rank is what one process reads
+//! there.
 
 use super::attach::{with_cells, Attached, SteppedOn};
 use super::family::Family;

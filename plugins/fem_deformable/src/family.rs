@@ -278,6 +278,19 @@ macro_rules! scene_family {
                         message: e,
                     });
                 }
+                // (a body diverged on the rank stepping it: every rank stops here)
+                if let Some(b) = self.stepped.diverged.take() {
+                    let name = self.bodies[b as usize]
+                        .name
+                        .as_deref()
+                        .map(|n| format!(" (`{n}`)"))
+                        .unwrap_or_default();
+                    return Err(Diverged {
+                        step: w.step,
+                        body: b,
+                        message: format!("deformable body {b}{name} has a non-finite state (on the MPI rank stepping it)"),
+                    });
+                }
                 <$stage>::update(self, w.time.h, w.time.theta, w.step)
             }
             fn contacts(&self) -> usize {

@@ -272,9 +272,10 @@ impl Attached<Rigid3> for Deformables3 {
     fn new_cells(&mut self, cells: &nscdd::dd::RankCells<'_>, rounds: &dyn nscdd::dd::Rounds) {
         crate::near::new_cells(&mut self.stepped, &mut self.bodies, self.alert, cells, rounds);
     }
-    /// Each rank writes the frames of the bodies it holds whole.
+    /// Each rank writes the frames of the bodies it holds whole (loaded knowing
+    /// its rank: [`crate::stepped::Stepped::writes_frame`]).
     fn frames_per_rank(&self) -> bool {
-        true
+        self.ranks.is_some()
     }
     /// The bodies stepped elsewhere whole, every rank's contacts (the saved state).
     fn gather_whole(&mut self, rounds: &dyn nscdd::dd::Rounds) {

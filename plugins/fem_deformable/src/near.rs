@@ -40,11 +40,6 @@ pub struct Near {
 }
 
 impl Near {
-    /// After a load: every rank holds every body whole.
-    pub fn loaded(&mut self) {
-        *self = Near::default();
-    }
-
     /// Per body, whether this rank holds its boundary current (`None`: every one).
     pub fn held(&self) -> Option<&[bool]> {
         (!self.here.is_empty()).then_some(&self.here[..])
@@ -86,16 +81,17 @@ impl Near {
     }
 }
 
-/// The bodies a detection reads ([`Near::held`]; `own`: in this rank's cells);
-/// a detection of every body where some are held stale, which the framework
+/// The bodies a detection reads ([`Near::held`]; `own`: in this rank's cells).
+/// A detection of every body where some are held stale, which the framework
 /// never asks (the next detection's cells given to [`share`] are the step's),
-/// sets `error`, which stops the run after the step.
-pub fn held_for<'a>(near: &'a Near, own: bool, error: &mut Option<String>) -> Option<&'a [bool]> {
+/// is a bug: it panics, which stops every rank with the message (the plugin's
+/// guard and `MPI_Abort`), since only this rank knows.
+pub fn held_for(near: &Near, own: bool) -> Option<&[bool]> {
     let held = near.held();
-    if !own && held.is_some_and(|h| h.contains(&false)) && error.is_none() {
-        *error =
-            Some("internal error: a deformable detection of every body, after a step that sent each body only to the ranks near it".into());
-    }
+    assert!(
+        own || held.is_none_or(|h| !h.contains(&false)),
+        "internal error: a deformable detection of every body, after a step that sent each body only to the ranks near it"
+    );
     held
 }
 
@@ -125,6 +121,28 @@ fn ranks_near(body: &FeBody, u: impl Fn(usize) -> f64, alert: f64, cells: &RankC
     out
 }
 
+/// The ranks body `b` goes to after the step (but `me`, ascending): those whose
+/// cells (`next`) its box at `u_next` grown by `alert` meets ([`ranks_near`]),
+/// every rank without cells, and the ranks that solved its contacts (their
+/// residual reads its V⁺).
+fn targets(
+    st: &Stepped,
+    (b, body, u_next): (usize, &FeBody, &[f64]),
+    (next, alert): (Option<&RankCells<'_>>, f64),
+    (me, ranks): (u32, u32),
+) -> Vec<u32> {
+    let mut near = match next {
+        Some(cells) => ranks_near(body, |i| u_next[i], alert, cells),
+        None => (0..ranks).filter(|&q| q != me).collect(),
+    };
+    let lo = st.solvers().partition_point(|x| x.0 < b as u32);
+    let solvers = st.solvers()[lo..].iter().take_while(|x| x.0 == b as u32);
+    near.extend(solvers.map(|x| x.1).filter(|&q| q != me));
+    near.sort_unstable();
+    near.dedup();
+    near
+}
+
 /// Body `b`'s values at its boundary nodes (`x`: u, V or V⁻).
 fn boundary_of(body: &FeBody, x: &[f64], out: &mut Vec<f64>) {
     let d = body.dim();
@@ -139,8 +157,8 @@ fn set_boundary(body_dim: usize, boundary: &[u32], into: &mut [f64], x: &[f64]) 
 }
 
 /// After V⁺ of the bodies stepped here: each one's V⁺ at its boundary to the
-/// ranks near it ([`ranks_near`] in `next`, the cells of the next detection;
-/// every rank without), with its u and V⁻ there to those that held it stale;
+/// ranks near it (whose cells of the next detection, `next`, its box grown by
+/// `alert` meets; every rank without) and to those that solved its contacts, with its u and V⁻ there to those that held it stale;
 /// its energies after the step ([`FeBody::energies`] at u⁺) and this rank's
 /// count of `contacts` to rank 0 (the history's). Marks the bodies received
 /// here, and those stepped here, current ([`Near::held`]).
@@ -164,21 +182,22 @@ pub fn share(st: &mut Stepped, bodies: &mut [FeBody], (contacts, alert): (usize,
         head.push(b as f64);
         head.extend(energy[b]);
         head[1] += 1.0;
-        let near = match next {
-            Some(cells) => ranks_near(body, |i| u_next[i], alert, cells),
-            None => (0..ranks).filter(|&q| q != me).collect(),
-        };
+        // (a body with a non-finite value goes to every rank, which all stop at
+        // this step: [`Stepped::diverged`])
+        let bad = !u_next.iter().chain(&body.v).all(|x| x.is_finite());
+        let near = targets(st, (b, body, &u_next[..]), (next.filter(|_| !bad), alert), (me, ranks));
         for &q in &near {
             let m = to.entry(q).or_default();
             let stale = !st.near.holds_on(b, q);
-            m.extend([b as f64, f64::from(u8::from(stale))]);
-            if stale {
+            let kind = if bad { 2 } else { u8::from(stale) };
+            m.extend([b as f64, f64::from(kind)]);
+            if kind != 0 {
                 boundary_of(body, &body.u, m);
                 boundary_of(body, &body.v_begin, m);
             }
             boundary_of(body, &body.v, m);
         }
-        st.near.holders[b] = next.map(|_| near);
+        st.near.holders[b] = next.filter(|_| !bad).map(|_| near);
     }
     if me != 0 {
         let rest = to.remove(&0).unwrap_or_default();
@@ -205,6 +224,9 @@ pub fn share(st: &mut Stepped, bodies: &mut [FeBody], (contacts, alert): (usize,
             let b = b as usize;
             let Some(body) = bodies.get_mut(b) else { break };
             let (d, nb, stale) = (body.dim(), body.mesh.boundary.len(), kind != 0.0);
+            if kind == 2.0 {
+                st.diverged.get_or_insert(b as u32);
+            }
             let len = d * nb * if stale { 3 } else { 1 };
             let Some(x) = rest.get(2..2 + len) else { break };
             debug_assert!(
@@ -381,6 +403,33 @@ mod tests {
         assert_eq!(s0.near.holders(0), Some(&[1][..]));
     }
 
+    /// A body with a non-finite value (here at its interior node) goes to every
+    /// rank whatever the cells, marked so that each stops at this step.
+    #[test]
+    fn a_diverging_body_goes_to_every_rank_which_stops() {
+        let rank_of = |_: usize| 0;
+        let rounds = AllRanks::new(3, &rank_of, vec![(0, None)]);
+        let (mut s0, mut s2) = (rounds.decide(0, 1), rounds.decide(2, 1));
+        let meeting = |_: usize, lo: &[f64], hi: &[f64], f: &mut dyn FnMut(u32)| slabs(lo, hi, 0.0, f);
+        let cells = RankCells {
+            meeting: &meeting,
+            rank: 0,
+            ranks: 3,
+        };
+        let mut bodies = vec![square()];
+        bodies[0].v[8] = f64::NAN;
+        share(&mut s0, &mut bodies, (1, 0.1), Some(&cells), &rounds);
+        let (peers, msgs) = rounds.sent.borrow().last().cloned().unwrap();
+        assert_eq!(peers, [1, 2], "every rank, not only rank 1 near it");
+        assert_eq!(msgs[1][..2], [0.0, 2.0]);
+        assert_eq!(s0.near.holders(0), None);
+        *rounds.replies.borrow_mut() = vec![msgs[1].clone()];
+        let mut at2 = vec![square()];
+        assert_eq!(s2.diverged, None);
+        share(&mut s2, &mut at2, (0, 0.1), Some(&cells), &rounds);
+        assert_eq!(s2.diverged, Some(0));
+    }
+
     /// Without cells (the next detection reads every body) every rank gets every
     /// body, and stays current.
     #[test]
@@ -393,11 +442,9 @@ mod tests {
         let (peers, _) = rounds.sent.borrow().last().cloned().unwrap();
         assert_eq!(peers, [1, 2]);
         assert_eq!(s0.near.holders(0), None);
-        let mut error = None;
-        assert_eq!(held_for(&s0.near, false, &mut error), Some(&[true][..]));
-        assert!(error.is_none());
+        assert_eq!(held_for(&s0.near, false), Some(&[true][..]));
         s0.near.here[0] = false;
-        held_for(&s0.near, false, &mut error);
-        assert!(error.is_some_and(|e| e.contains("internal error")));
+        assert!(std::panic::catch_unwind(|| held_for(&s0.near, false)).is_err());
+        assert_eq!(held_for(&s0.near, true), Some(&[false][..]));
     }
 }

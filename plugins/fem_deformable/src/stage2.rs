@@ -104,7 +104,7 @@ impl Deformables2 {
     /// and the V_free of the rigid antagonists.
     pub fn detect_step(&mut self, w: &World2, own: Option<&nscdd::dd::OwnCells<'_>>) {
         let t = Instant::now();
-        let held = crate::near::held_for(&self.stepped.near, own.is_some(), &mut self.error);
+        let held = crate::near::held_for(&self.stepped.near, own.is_some());
         detect(w, &self.bodies, self.alert, own, held, &mut self.raw);
         let rigid = self.raw.iter_mut().filter_map(|rc| match &mut rc.anta {
             RawAnta::Rigid(j) => Some(j),

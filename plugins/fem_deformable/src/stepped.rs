@@ -92,7 +92,7 @@ pub struct Stepped {
     /// In part: (body, rank solving one of its contacts) of the bodies whose
     /// contacts several ranks solve, ascending, once each.
     solvers: Vec<(u32, u32)>,
-    /// Per body, in part: the rank whose V⁺ every rank takes.
+    /// Per body, in part: the rank stepping it, whose V⁺ the ranks near it take.
     sender: Vec<u32>,
     /// Per body, the last step's `sender` (empty: the state is whole on every
     /// rank, as after a load).
@@ -118,6 +118,10 @@ pub struct Stepped {
     failed: bool,
     /// Which ranks hold each body's boundary current ([`crate::near`]).
     pub near: crate::near::Near,
+    /// A body another rank stepped with a non-finite value in the step in
+    /// progress (its V⁺ came here with it, [`crate::near::share`]): the step's end
+    /// reports a divergence on every rank.
+    pub diverged: Option<u32>,
     /// The family's contacts over the ranks, after the exchange of a step
     /// stepped in part ([`crate::impulses::finish`]).
     total: Option<usize>,
@@ -128,6 +132,7 @@ impl Stepped {
     /// (no solve), until [`Self::decide`].
     pub fn hold(&mut self, n: usize) {
         self.on = None;
+        self.diverged = None;
         self.held = true;
         self.failed = false;
         self.total = None;
@@ -244,14 +249,20 @@ impl Stepped {
     pub fn release<const D: usize>(&self, bodies: &mut [FeBody], sets: &mut [NodeSet<D>]) {
         for &(b, matrices) in &self.release {
             let body = &mut bodies[b as usize];
-            let far = !self.near.holds(b as usize);
             match (crate::scene::is_large(body), matrices) {
-                (false, true) if far => body.release_matrices(),
                 (false, _) => body.release_columns(),
                 (true, false) => body.release_factor(),
                 (true, true) => body.release_matrices(),
             }
             sets[b as usize].release_g();
+        }
+        // (a small body idle that long, once it is far from this rank's cells)
+        let (_, _, matrices_after) = release_rule();
+        for (b, body) in bodies.iter_mut().enumerate() {
+            let idle = self.idle.get(b).is_some_and(|&i| i >= matrices_after);
+            if idle && body.has_matrices() && !self.near.holds(b) && !crate::scene::is_large(body) {
+                body.release_matrices();
+            }
         }
     }
 

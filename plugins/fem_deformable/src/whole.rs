@@ -1,14 +1,16 @@
 //! The whole state of the deformable bodies on MPI ranks (docs/SCALING.md,
 //! "Bodies held at their boundary where not stepped"). In a step stepped in part
 //! ([`crate::stepped`]) a rank that does not step a body receives its V⁺ at its
-//! boundary nodes only ([`Stepped::unpack`]): detection, the contacts, the
-//! reach and the position update there read nothing else of it. Its interior
-//! is then stale on that rank, and the rank stepping it is the only one holding
-//! it whole. So when a body's stepping rank changes, the last one hands its whole
-//! state (u, V) over to the new one ([`hand_over`], point to point, before the
-//! free velocities), and before an output frame or a saved state the ranks send
-//! rank 0 the whole state of the bodies they stepped ([`gather_whole`]). After a
-//! load every rank holds every body whole.
+//! boundary nodes only, and only if the body is near its cells
+//! ([`crate::near::share`]): detection, the contacts, the reach and the position
+//! update there read nothing else of it. Its interior is then stale on that
+//! rank, and the rank stepping it is the only one holding it whole. So when a
+//! body's stepping rank changes, the last one hands its whole state (u, V) over
+//! to the new one ([`hand_over`], point to point, before the free velocities),
+//! each rank writes the frame files of the bodies it holds whole
+//! ([`crate::stepped::Stepped::writes_frame`]), and before a saved state the
+//! ranks send rank 0 the whole state of the bodies they stepped
+//! ([`gather_whole`]). After a load every rank holds every body whole.
 
 use crate::body::FeBody;
 use crate::nodes::FeKey;
