@@ -258,6 +258,51 @@ pub(crate) fn write_frame(
     Ok(())
 }
 
+/// The [`nscdd::dd::Attached`] hooks of the deformable family on MPI ranks that
+/// read nothing of the dimension but the world's type (`$world`), the same in
+/// [`crate::family2`] and [`crate::family3`].
+macro_rules! rank_hooks {
+    ($world:ty) => {
+        /// None by id: the world bodies near the deformable bodies ([`Self::reach`],
+        /// asked before the first step and after a step that detected whole: with the
+        /// decentralized scheme the family detects in each rank's cells,
+        /// [`Self::after_free_velocity_own`], and its antagonists are in their halos).
+        fn held_everywhere(&self) -> Option<Vec<u32>> {
+            Some(Vec::new())
+        }
+        fn reach(&self, w: &$world, out: &mut Vec<[[f64; 3]; 2]>) {
+            crate::family::reach(&self.bodies, w.time.h, self.alert, out);
+        }
+        /// A repartition step's new cells: the boundary of the bodies stepped here
+        /// last to the ranks now near them that lack it ([`crate::near::new_cells`]).
+        fn new_cells(&mut self, cells: &nscdd::dd::RankCells<'_>, rounds: &dyn nscdd::dd::Rounds) {
+            crate::near::new_cells(&mut self.stepped, &mut self.bodies, self.alert, cells, rounds);
+        }
+        /// Each rank writes the frames of the bodies it holds whole (loaded knowing
+        /// its rank: [`crate::stepped::Stepped::writes_frame`]).
+        fn frames_per_rank(&self) -> bool {
+            self.ranks.is_some()
+        }
+        /// The bodies stepped elsewhere whole, every rank's contacts (the saved state).
+        fn gather_whole(&mut self, rounds: &dyn nscdd::dd::Rounds) {
+            crate::whole::gather_whole(&self.stepped, &mut self.bodies, rounds);
+            let c = &self.solved.list;
+            let own = c.key.iter().copied().zip(c.r.iter().copied());
+            self.gathered = crate::whole::gather_contacts(&self.stepped, own, rounds);
+        }
+        fn stepped_bodies(&self) -> Option<(usize, usize)> {
+            self.stepped.counts()
+        }
+        fn built_bodies(&self) -> Option<usize> {
+            self.stepped.built(&self.bodies)
+        }
+        fn near_bodies(&self) -> Option<usize> {
+            self.stepped.near.held().map(|h| h.iter().filter(|&&x| x).count())
+        }
+    };
+}
+pub(crate) use rank_hooks;
+
 macro_rules! scene_family {
     ($stage:ty, $dim:ty, $share:path) => {
         impl SceneFamily<$dim> for $stage {

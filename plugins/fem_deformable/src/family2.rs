@@ -241,16 +241,6 @@ impl Attached<Rigid2> for Deformables2 {
         let at = |g| crate::family::slot(w, g);
         Some(self.residual_parts_of(&w.bodies.vel, at, contacts.iter().map(|&a| a as usize)))
     }
-    /// None by id: the world bodies near the deformable bodies ([`Self::reach`],
-    /// asked before the first step and after a step that detected whole: with the
-    /// decentralized scheme the family detects in each rank's cells,
-    /// [`Self::after_free_velocity_own`], and its antagonists are in their halos).
-    fn held_everywhere(&self) -> Option<Vec<u32>> {
-        Some(Vec::new())
-    }
-    fn reach(&self, w: &World2, out: &mut Vec<[[f64; 3]; 2]>) {
-        crate::family::reach(&self.bodies, w.time.h, self.alert, out);
-    }
     /// V⁺ of the bodies stepped here, their contacts' impulses solved elsewhere
     /// received ([`crate::impulses`]), and V⁺ at a body's boundary sent to the
     /// ranks near it ([`crate::near`]).
@@ -263,23 +253,6 @@ impl Attached<Rigid2> for Deformables2 {
         let ba = (&mut self.bodies[..], self.alert);
         crate::impulses::finish(&mut self.stepped, ba, sw, own.into_iter(), (rounds, next));
     }
-    /// A repartition step's new cells: the boundary of the bodies stepped here
-    /// last to the ranks now near them that lack it ([`crate::near::new_cells`]).
-    fn new_cells(&mut self, cells: &nscdd::dd::RankCells<'_>, rounds: &dyn nscdd::dd::Rounds) {
-        crate::near::new_cells(&mut self.stepped, &mut self.bodies, self.alert, cells, rounds);
-    }
-    /// Each rank writes the frames of the bodies it holds whole (loaded knowing
-    /// its rank: [`crate::stepped::Stepped::writes_frame`]).
-    fn frames_per_rank(&self) -> bool {
-        self.ranks.is_some()
-    }
-    /// The bodies stepped elsewhere whole, every rank's contacts (the saved state).
-    fn gather_whole(&mut self, rounds: &dyn nscdd::dd::Rounds) {
-        crate::whole::gather_whole(&self.stepped, &mut self.bodies, rounds);
-        let c = &self.solved.list;
-        let own = c.key.iter().copied().zip(c.r.iter().copied());
-        self.gathered = crate::whole::gather_contacts(&self.stepped, own, rounds);
-    }
     /// Its contacts kept per rank: those whose point is this rank's (the
     /// contacts it solves; their nodes alone fill its node sets, the others'
     /// come through the rounds, [`crate::solved`]).
@@ -287,15 +260,7 @@ impl Attached<Rigid2> for Deformables2 {
         self.raw.retain(|rc| own(rc.at3()));
         true
     }
-    fn stepped_bodies(&self) -> Option<(usize, usize)> {
-        self.stepped.counts()
-    }
-    fn built_bodies(&self) -> Option<usize> {
-        self.stepped.built(&self.bodies)
-    }
-    fn near_bodies(&self) -> Option<usize> {
-        self.stepped.near.held().map(|h| h.iter().filter(|&&x| x).count())
-    }
+    crate::family::rank_hooks!(World2);
 }
 
 impl FePart2 {

@@ -213,7 +213,8 @@ fn large(dim: usize, nodes: f64) -> bool {
     matrices_bytes(dim, nodes) >= crate::stepped::release_rule().0
 }
 
-/// Whether body `b` is large ([`large`]): a rank drops its factors and matrices
+/// Whether body `b` is large (its [`matrices_bytes`] reach
+/// [`crate::stepped::RELEASE_MIN_BYTES`]): a rank drops its factors and matrices
 /// when it does not step it ([`crate::stepped::Stepped::release`]).
 pub fn is_large(b: &FeBody) -> bool {
     large(b.dim(), b.mesh.n_nodes() as f64)
