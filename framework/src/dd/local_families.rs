@@ -23,11 +23,12 @@ impl<D: Family> super::NscddOf<D> {
     pub(super) fn keep_own(&mut self, w: &mut D::World, fams: &mut [&mut dyn Attached<D>]) {
         self.fam_total = self.fam_points.len();
         let detected = self.fam_points.len() as u64;
-        let again = self.keep_own_points(w, fams);
-        // (every rank's cells of the step's grid, for the families' next detection)
+        // (every rank's cells of the step's grid: a repartition step's new cells, and
+        // the families' next detection's)
         let grid = self.local.new_grid.as_ref().map(|g| &g.0);
         let cells = (0..fams.len()).map(|f| self.family_cells(f, grid)).collect();
         self.fam_cells = cells;
+        let again = self.keep_own_points(w, fams);
         if let Some(rs) = self.ranks.as_mut() {
             rs.totals.family_detected += detected + again;
             rs.totals.family_contacts += self.fam_points.len() as u64;
@@ -52,9 +53,10 @@ impl<D: Family> super::NscddOf<D> {
         D::swap_velocities(w, &mut v);
         for (f, fam) in fams.iter_mut().enumerate() {
             // (what each rank lacks of the family in its new cells sent to it first)
-            if let (Some(index), Some(rs)) = (redetect.then(|| self.family_cells(f, new_grid)).flatten(), self.ranks.as_mut()) {
+            let index = self.fam_cells.get(f).and_then(Option::as_ref).filter(|_| redetect);
+            if let (Some(index), Some(rs)) = (index, self.ranks.as_mut()) {
                 let rank = (rs.cluster.rank(), rs.cluster.size());
-                super::attach::with_cells(&index, rank, |c| super::with_rounds(rs, |r| fam.new_cells(c, r)));
+                super::attach::with_cells(index, rank, |c| super::with_rounds(rs, |r| fam.new_cells(c, r)));
             }
             let Some((boxes, own)) = self.own_cells(f, new_grid) else {
                 continue;
